@@ -1,0 +1,44 @@
+"""latlong: asteroid bodies on the evenly spaced 6M^2+2 latitude/longitude sphere mesh.
+
+Martin et al. 2014: the lat/long mesh, two-phase Poisson faulting and Perlin fBm base
+shapes, mesh export and previews. See ``latlong build --help`` for the command line.
+"""
+
+import logging
+
+from .body import EXPORT_SUFFIXES, Body, load
+from .faulting import (
+    FAULTING_PRESETS,
+    FaultingParams,
+    apply_faults,
+    area_mean,
+    poisson_faulting,
+    random_faults,
+    two_phase_faulting,
+)
+from .grid import LatLongGrid
+from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
+from .smoothing import fwhm_to_sigma, heat_smooth, smooth
+
+__all__ = [
+    "EXPORT_SUFFIXES",
+    "FAULTING_PRESETS",
+    "FBM_PRESETS",
+    "Body",
+    "FaultingParams",
+    "FbmParams",
+    "LatLongGrid",
+    "apply_faults",
+    "area_mean",
+    "fbm3",
+    "fwhm_to_sigma",
+    "heat_smooth",
+    "load",
+    "perlin_fbm",
+    "poisson_faulting",
+    "random_faults",
+    "smooth",
+    "two_phase_faulting",
+]
+
+logging.getLogger(__name__).addHandler(logging.NullHandler())

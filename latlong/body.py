@@ -1,0 +1,223 @@
+"""The body: a lat/long grid with one radius per vertex, saved losslessly as .npz."""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+
+import numpy as np
+
+from craters._infra import atomic_path, check_positive
+
+from .grid import LatLongGrid
+
+__all__ = ["Body", "EXPORT_SUFFIXES", "load"]
+
+FORMAT = "craterform.body/1"
+#: Mesh formats :meth:`Body.export` writes, chosen by suffix (plus ``.npz`` via save).
+EXPORT_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk")
+# a fixed zip timestamp so that the same body always gives the same bytes
+_ZIP_DATE = (1980, 1, 1, 0, 0, 0)
+
+
+class Body:
+    """A lat/long grid plus one radius per vertex (metres) and an optional axis stretch.
+
+    Vertex ``i`` sits at ``stretch * radii_m[i] * u_i`` with ``u_i`` the grid's unit
+    vector. ``radius_m`` is the reference radius (heights are ``radii_m - radius_m``).
+    Bodies are immutable: operations return new bodies.
+
+    Parameters
+    ----------
+    grid : LatLongGrid
+    radii_m : (N,) array_like
+        Radius of every vertex in metres, finite and > 0.
+    radius_m : float, optional
+        Reference radius in metres (default: the area-weighted mean of ``radii_m``).
+    stretch : (3,) array_like, optional
+        Scale factors along x, y, z (default 1, 1, 1).
+    metadata : dict, optional
+        JSON-serialisable description (seed, parameters, version, ...).
+
+    Examples
+    --------
+    >>> b = Body.sphere(LatLongGrid(4), 10.0)
+    >>> b.n_vertices, float(b.radii_m.max())
+    (98, 10.0)
+    """
+
+    __slots__ = ("_grid", "_radii", "_radius_m", "_stretch", "_metadata")
+
+    def __init__(self, grid: LatLongGrid, radii_m, *, radius_m: float | None = None,
+                 stretch=(1.0, 1.0, 1.0), metadata: dict | None = None):
+        if not isinstance(grid, LatLongGrid):
+            raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
+        radii = np.array(radii_m, dtype=np.float64, copy=True)
+        if radii.shape != (grid.n_vertices,):
+            raise ValueError(f"`radii_m` must have shape ({grid.n_vertices},); got {radii.shape}")
+        if not np.isfinite(radii).all():
+            raise ValueError("`radii_m` must be finite")
+        if (radii <= 0).any():
+            bad = int((radii <= 0).sum())
+            raise ValueError(
+                f"`radii_m` must be > 0 everywhere; {bad} vertices have radius <= 0 "
+                f"(min {radii.min():.6g} m): the base shape is too rough for this radius"
+            )
+        radii.setflags(write=False)
+        stretch = np.array(stretch, dtype=np.float64).reshape(-1)
+        if stretch.shape != (3,) or not np.isfinite(stretch).all() or (stretch <= 0).any():
+            raise ValueError(f"`stretch` must be three finite factors > 0; got {stretch.tolist()}")
+        stretch.setflags(write=False)
+        if radius_m is None:
+            w = grid.vertex_areas()
+            radius_m = float(np.dot(w, radii) / w.sum())
+        self._grid = grid
+        self._radii = radii
+        self._radius_m = check_positive("radius_m", radius_m)
+        self._stretch = stretch
+        meta = {} if metadata is None else dict(metadata)
+        try:
+            json.dumps(meta)
+        except TypeError as exc:
+            raise TypeError(f"`metadata` must be JSON-serialisable: {exc}") from None
+        self._metadata = meta
+
+    # ------------------------------------------------------------------ constructors
+    @classmethod
+    def sphere(cls, grid: LatLongGrid, radius_m: float, **kwargs) -> Body:
+        """A sphere of ``radius_m`` metres."""
+        radius_m = check_positive("radius_m", radius_m)
+        return cls(grid, np.full(grid.n_vertices, radius_m), radius_m=radius_m, **kwargs)
+
+    @classmethod
+    def from_heights(cls, grid: LatLongGrid, radius_m: float, heights_m, **kwargs) -> Body:
+        """A body whose radii are ``radius_m + heights_m``."""
+        radius_m = check_positive("radius_m", radius_m)
+        return cls(grid, radius_m + np.asarray(heights_m, dtype=np.float64),
+                   radius_m=radius_m, **kwargs)
+
+    def replace(self, **changes) -> Body:
+        """A new body with some of ``radii_m, radius_m, stretch, metadata`` replaced."""
+        kw = {"radii_m": self._radii, "radius_m": self._radius_m,
+              "stretch": self._stretch, "metadata": self._metadata}
+        unknown = set(changes) - set(kw)
+        if unknown:
+            raise TypeError(f"unknown Body fields: {', '.join(sorted(unknown))}")
+        kw.update(changes)
+        return Body(self._grid, kw.pop("radii_m"), **kw)
+
+    # ------------------------------------------------------------------ data
+    @property
+    def grid(self) -> LatLongGrid:
+        return self._grid
+
+    @property
+    def magnitude(self) -> int:
+        return self._grid.magnitude
+
+    @property
+    def n_vertices(self) -> int:
+        return self._grid.n_vertices
+
+    @property
+    def radii_m(self) -> np.ndarray:
+        """Radius of every vertex in metres (before the stretch), read-only."""
+        return self._radii
+
+    @property
+    def radius_m(self) -> float:
+        """Reference radius in metres."""
+        return self._radius_m
+
+    @property
+    def stretch(self) -> np.ndarray:
+        """Scale factors along x, y, z, read-only."""
+        return self._stretch
+
+    @property
+    def metadata(self) -> dict:
+        """A copy of the metadata dictionary."""
+        return json.loads(json.dumps(self._metadata))
+
+    @property
+    def heights_m(self) -> np.ndarray:
+        """``radii_m - radius_m`` in metres."""
+        return self._radii - self._radius_m
+
+    def vertices(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
+        """Vertex positions in metres, (N, 3) float64 (or the rows ``lo:hi``)."""
+        u = self._grid.unit_vectors()[lo:hi]
+        return u * (self._radii[lo:hi, None] * self._stretch)
+
+    def __repr__(self) -> str:
+        return (f"Body(magnitude={self.magnitude}, n_vertices={self.n_vertices}, "
+                f"radius_m={self._radius_m:g}, stretch={self._stretch.tolist()})")
+
+    # ------------------------------------------------------------------ I/O
+    def save(self, path) -> Path:
+        """Write the body losslessly to ``path`` (.npz, no pickles), atomically.
+
+        The bytes depend only on the body (fixed zip timestamps), so the same seed and
+        parameters give identical files.
+        """
+        path = Path(path)
+        if path.suffix.lower() != ".npz":
+            raise ValueError(f"`path` must end in .npz; got {str(path)!r}")
+        arrays = {
+            "format": np.array(FORMAT),
+            "magnitude": np.array(self.magnitude, dtype=np.int64),
+            "radius_m": np.array(self._radius_m, dtype=np.float64),
+            "stretch": np.asarray(self._stretch, dtype=np.float64),
+            "radii_m": np.asarray(self._radii, dtype=np.float64),
+            "metadata_json": np.array(json.dumps(self._metadata, sort_keys=True)),
+        }
+        with atomic_path(path) as tmp:
+            with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED,
+                                 allowZip64=True) as zf:
+                for name, arr in arrays.items():
+                    info = zipfile.ZipInfo(name + ".npy", date_time=_ZIP_DATE)
+                    info.external_attr = 0o644 << 16
+                    with zf.open(info, "w", force_zip64=True) as fh:
+                        np.lib.format.write_array(fh, np.asarray(arr),
+                                                  allow_pickle=False)
+        return path
+
+    def export(self, path, *, progress: bool = False) -> Path:
+        """Write a mesh file chosen by suffix (.ply .obj .stl .vtp .vtk), atomically.
+
+        PLY (binary, float32 x y z and ``height_m`` per vertex), OBJ and STL (binary)
+        are streamed ring band by ring band; VTP/VTK go through pyvista.
+        """
+        from . import export as _export
+
+        return _export.write_mesh(self, path, progress=progress)
+
+    def to_pyvista(self):
+        """A ``pyvista.PolyData`` with point array ``height_m`` (radius minus reference)."""
+        import pyvista as pv
+
+        faces = np.empty((self._grid.n_triangles, 4), dtype=np.int64)
+        faces[:, 0] = 3
+        faces[:, 1:] = self._grid.triangles()
+        mesh = pv.PolyData(self.vertices(), faces.ravel())
+        mesh.point_data["height_m"] = self.heights_m
+        return mesh
+
+
+def load(path) -> Body:
+    """Read a body written by :meth:`Body.save`."""
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"model file {str(path)!r} does not exist")
+    try:
+        with np.load(path, allow_pickle=False) as z:
+            fields = {k: z[k] for k in z.files}
+    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+        raise ValueError(f"cannot read body {str(path)!r}: {exc}") from None
+    fmt = str(fields["format"]) if "format" in fields else ""
+    if fmt != FORMAT:
+        raise ValueError(f"{str(path)!r} is not a craterform body (format {fmt!r})")
+    return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
+                radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
+                metadata=json.loads(str(fields["metadata_json"])))

@@ -1,0 +1,165 @@
+"""Perlin fBm base shapes (Martin et al. 2014, IV.B)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from craters._infra import check_finite, check_int, check_positive, check_range, normalize_rng
+
+from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
+from .grid import LatLongGrid
+
+__all__ = ["FBM_PRESETS", "FbmParams", "fbm3", "perlin_fbm", "random_rotation"]
+
+_MAX_OCTAVES = 30
+
+
+def _check_noise_params(octaves, persistence, lacunarity, base):
+    octaves = check_int("octaves", octaves, 1, _MAX_OCTAVES)
+    persistence = check_positive("persistence", persistence)
+    lacunarity = check_range("lacunarity", lacunarity, 1.0, None)
+    base = check_int("base", base, 0, 255)
+    if lacunarity ** (octaves - 1) * 1024 >= 2**31:
+        raise ValueError(
+            f"`lacunarity` ** (octaves - 1) * 1024 must stay below 2**31 (the noise "
+            f"tiling period); got lacunarity={lacunarity}, octaves={octaves}"
+        )
+    return octaves, persistence, lacunarity, base
+
+
+def fbm3(x, y, z, octaves: int = 1, persistence: float = 0.5, lacunarity: float = 2.0,
+         base: int = 0) -> np.ndarray:
+    """3-D improved Perlin fBm, identical to ``noise.pnoise3`` (vectorised, numba).
+
+    Same permutation table, gradient table, single-precision arithmetic and octave
+    normalisation (sum of octaves divided by the sum of their amplitudes) as
+    ``noise.pnoise3(x, y, z, octaves, persistence, lacunarity, base=base)``; inputs
+    are rounded to float32 as ``pnoise3`` does. ``noise`` reads outside its 512-entry
+    table for ``base >= 2``; here the table is periodic, which equals ``noise`` for
+    ``base`` 0 and 1 and stays defined up to 255.
+
+    Parameters
+    ----------
+    x, y, z : array_like
+        Coordinates (broadcast together).
+    octaves : int
+        Number of octaves, 1..30.
+    persistence : float
+        Amplitude ratio between successive octaves (> 0).
+    lacunarity : float
+        Frequency ratio between successive octaves (>= 1).
+    base : int
+        Offset into the permutation table, 0..255.
+
+    Returns
+    -------
+    float64 array of the broadcast shape, values in about [-1, 1].
+
+    Examples
+    --------
+    >>> import noise
+    >>> float(fbm3(0.5, 0.25, 0.125, octaves=3)) == noise.pnoise3(0.5, 0.25, 0.125, octaves=3)
+    True
+    """
+    octaves, persistence, lacunarity, base = _check_noise_params(
+        octaves, persistence, lacunarity, base)
+    bx, by, bz = np.broadcast_arrays(np.asarray(x, np.float64), np.asarray(y, np.float64),
+                                     np.asarray(z, np.float64))
+    shape = bx.shape
+    xs = np.ascontiguousarray(bx, dtype=np.float32).ravel()
+    ys = np.ascontiguousarray(by, dtype=np.float32).ravel()
+    zs = np.ascontiguousarray(bz, dtype=np.float32).ravel()
+    if not (np.isfinite(xs).all() and np.isfinite(ys).all() and np.isfinite(zs).all()):
+        raise ValueError("`x`, `y`, `z` must be finite (and within float32 range)")
+    out = np.empty(xs.shape[0], dtype=np.float64)
+    _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, base, out)
+    return out.reshape(shape)
+
+
+def _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, base, out):
+    """Pick the fast kernel when every |coordinate| <= FAST_LIMIT (same results)."""
+    fast = xs.size == 0 or max(np.abs(a).max() for a in (xs, ys, zs)) <= FAST_LIMIT
+    kernel = _fbm3_fast_kernel if fast else _fbm3_kernel
+    kernel(xs, ys, zs, octaves, np.float32(persistence), np.float32(lacunarity), base,
+           PERM, GRAD3, out)
+
+
+def random_rotation(rng=None) -> np.ndarray:
+    """A uniformly random 3x3 rotation matrix (QR of a Gaussian matrix, sign-fixed)."""
+    rng = normalize_rng(rng)
+    q, r = np.linalg.qr(rng.standard_normal((3, 3)))
+    q = q * np.sign(np.diag(r))
+    if np.linalg.det(q) < 0:
+        q[:, 0] = -q[:, 0]
+    return q
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class FbmParams:
+    """Parameters of a Perlin fBm base shape sampled on the unit sphere."""
+
+    frequency: float = 1.5
+    """Frequency of the first octave on the unit sphere (cycles per unit length)."""
+    octaves: int = 10
+    """Number of octaves."""
+    persistence: float = 0.5
+    """Amplitude ratio between successive octaves."""
+    lacunarity: float = 1.75
+    """Frequency ratio between successive octaves."""
+    amplitude: float = 0.4
+    """Height scale as a fraction of the body radius: heights = amplitude * R * fbm."""
+
+    def __post_init__(self):
+        check_positive("frequency", self.frequency)
+        _check_noise_params(self.octaves, self.persistence, self.lacunarity, 0)
+        check_positive("amplitude", self.amplitude, allow_zero=True)
+
+
+#: The three parameter sets of Martin 2014, Fig. 5 (10 octaves each).
+FBM_PRESETS: dict[str, FbmParams] = {
+    "fig5a": FbmParams(1.5, 10, 0.5, 1.75),
+    "fig5b": FbmParams(2.5, 10, 0.5, 1.5),
+    "fig5c": FbmParams(4.0, 10, 0.3, 2.5),
+}
+
+
+def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: float,
+               lacunarity: float, amplitude_m: float, *, rng=None) -> np.ndarray:
+    """Heights (metres) from 3-D Perlin fBm sampled on the unit sphere.
+
+    Each vertex direction ``u`` is rotated by a random rotation, scaled by
+    ``frequency`` and shifted by a random offset in [0, 256)^3 (both from ``rng``), and
+    ``amplitude_m * fbm3(...)`` is its height.
+
+    Examples
+    --------
+    >>> h = perlin_fbm(LatLongGrid(8), 1.5, 4, 0.5, 2.0, 10.0, rng=0)
+    >>> h.shape, bool(np.abs(h).max() <= 10.0)
+    ((386,), True)
+    """
+    if not isinstance(grid, LatLongGrid):
+        raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
+    frequency = check_positive("frequency", frequency)
+    amplitude_m = check_finite("amplitude_m", amplitude_m)
+    octaves, persistence, lacunarity, _ = _check_noise_params(octaves, persistence,
+                                                              lacunarity, 0)
+    rng = normalize_rng(rng)
+    rot = random_rotation(rng)
+    offset = rng.uniform(0.0, 256.0, size=3)
+    u = grid.unit_vectors()
+    out = np.empty(grid.n_vertices, dtype=np.float64)
+    # coordinates in float32 chunks to bound the memory of very large grids
+    chunk = 1 << 22
+    for s in range(0, grid.n_vertices, chunk):
+        # explicit sums, not BLAS, so the rounding never depends on the thread count
+        uc = u[s:s + chunk]
+        xs, ys, zs = (
+            ((uc[:, 0] * rot[a, 0] + uc[:, 1] * rot[a, 1] + uc[:, 2] * rot[a, 2]) * frequency
+             + offset[a]).astype(np.float32)
+            for a in range(3)
+        )
+        _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, 0, out[s:s + chunk])
+    out *= amplitude_m
+    return out

@@ -1,0 +1,178 @@
+"""The latlong command line, through the real entry point."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from latlong import load
+
+SMALL = ["--magnitude", "12"]
+
+
+def assert_one_line_error(proc, *needles):
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("error:")
+    assert "Traceback" not in proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+def test_build_faulting_outputs(run_cli, tmp_path):
+    out = [tmp_path / n for n in ("a.npz", "a.ply", "a.obj")]
+    proc = run_cli("latlong", "build", *SMALL, "--base", "faulting", "--seed", "3",
+                   "--faults-2", "100", *sum((["-o", str(p)] for p in out), []),
+                   "--preview", str(tmp_path / "a.png"))
+    assert proc.returncode == 0, proc.stderr
+    assert all(p.stat().st_size > 0 for p in out)
+    body = load(out[0])
+    assert body.magnitude == 12
+    meta = body.metadata
+    assert meta["seed"] == 3 and meta["base"] == "faulting" and meta["preset"] == "paper"
+    assert meta["parameters"]["n_faults_2"] == 100
+    assert np.array_equal(body.stretch, [2.0, 1.0, 1.0])  # the paper preset
+    assert "wrote" in proc.stdout
+
+
+def test_preview_is_not_blank(run_cli, tmp_path):
+    png = tmp_path / "p.png"
+    proc = run_cli("latlong", "build", "--magnitude", "40", "--seed", "1", "--preview", str(png))
+    assert proc.returncode == 0, proc.stderr
+    import matplotlib.image as mpimg
+
+    img = mpimg.imread(png)[..., :3]
+    lit = img.max(axis=2) > 0.1
+    assert 0.05 < lit.mean() < 0.9  # the body fills part of the frame
+    assert img[lit].std() > 0.02  # shaded, not a flat silhouette
+
+
+def test_same_seed_same_bytes_any_thread_count(run_cli, tmp_path):
+    files = {}
+    for tag, threads in (("one", "1"), ("two", "2")):
+        d = tmp_path / tag
+        d.mkdir()
+        proc = run_cli("latlong", "build", "--magnitude", "30", "--base", "faulting",
+                       "--seed", "5", "--faults-1", "300", "--faults-2", "500",
+                       "-o", str(d / "b.npz"), "-o", str(d / "b.ply"), "-q",
+                       env={"NUMBA_NUM_THREADS": threads})
+        assert proc.returncode == 0, proc.stderr
+        files[tag] = [(d / n).read_bytes() for n in ("b.npz", "b.ply")]
+    assert files["one"] == files["two"]
+    d = tmp_path / "other"
+    d.mkdir()
+    proc = run_cli("latlong", "build", "--magnitude", "30", "--base", "faulting", "--seed", "6",
+                   "--faults-1", "300", "--faults-2", "500", "-o", str(d / "b.npz"), "-q")
+    assert proc.returncode == 0
+    assert (d / "b.npz").read_bytes() != files["one"][0]
+
+
+@pytest.mark.parametrize("args,needles", [
+    (["--magnitude", "0"], ["--magnitude", "[1,"]),
+    (["--magnitude", "-3"], ["--magnitude"]),
+    (["--magnitude", "100000000"], ["--magnitude 100000000", "memory", "GiB"]),
+    (["--magnitude", "abc"], ["--magnitude"]),
+    (["--base", "cube"], ["--base", "sphere, faulting, fbm"]),
+    (["--seed", "1.5"], ["--seed"]),
+    (["--seed", "-1"], ["--seed"]),
+    (["--radius-m", "nan"], ["--radius-m", "finite"]),
+    (["--radius-m", "-5"], ["--radius-m", "> 0"]),
+    (["--base", "fbm", "--octaves", "0"], ["--octaves"]),
+    (["--base", "fbm", "--frequency", "inf"], ["--frequency"]),
+    (["--base", "fbm", "--faults-1", "10"], ["--faults-1", "faulting"]),
+    (["--base", "faulting", "--max-fault-1-m", "nan"], ["--max-fault-1-m"]),
+    (["--base", "faulting", "--preset", "fig5a"], ["--preset", "paper"]),
+    (["--stretch", "1,2"], ["--stretch"]),
+    (["--sun-elevation-deg", "95"], ["--sun-elevation-deg"]),
+    (["--frobnicate"], ["unrecognized"]),
+])
+def test_bad_input_one_line_exit_2(run_cli, tmp_path, args, needles):
+    out = tmp_path / "x.npz"
+    proc = run_cli("latlong", "build", *SMALL, *args, "-o", str(out))
+    assert_one_line_error(proc, *needles)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bad_outputs(run_cli, tmp_path):
+    proc = run_cli("latlong", "build", *SMALL, "-o", str(tmp_path / "nodir" / "x.npz"))
+    assert_one_line_error(proc, "does not exist")
+    proc = run_cli("latlong", "build", *SMALL, "-o", str(tmp_path / "x.xyz"))
+    assert_one_line_error(proc, "unknown format")
+    proc = run_cli("latlong", "build", *SMALL)
+    assert_one_line_error(proc, "nothing to write")
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o500)
+    try:
+        proc = run_cli("latlong", "build", *SMALL, "-o", str(ro / "x.npz"))
+        import os
+
+        if os.access(ro, os.W_OK):  # running as root: permissions do not bind
+            assert proc.returncode == 0
+        else:
+            assert_one_line_error(proc, "not writable")
+    finally:
+        ro.chmod(0o700)
+    # an unwritable target that binds even for root
+    proc = run_cli("latlong", "build", *SMALL, "-o", "/proc/craterform.npz")
+    assert_one_line_error(proc, "/proc")
+
+
+def test_existing_output_needs_force(run_cli, tmp_path):
+    out = tmp_path / "x.npz"
+    out.write_bytes(b"keep me")
+    proc = run_cli("latlong", "build", *SMALL, "-o", str(out))
+    assert_one_line_error(proc, "exists", "--force")
+    assert out.read_bytes() == b"keep me"
+    proc = run_cli("latlong", "build", *SMALL, "-o", str(out), "--force", "-q")
+    assert proc.returncode == 0 and proc.stdout == ""
+    assert load(out).magnitude == 12
+
+
+def test_config_file(run_cli, tmp_path):
+    cfg = tmp_path / "scene.toml"
+    out = tmp_path / "s.npz"
+    cfg.write_text(f'magnitude = 10\nbase = "fbm"\npreset = "fig5c"\nseed = 9\n'
+                   f'radius_m = 500\nstretch = [1, 1, 1.5]\noutput = ["{out}"]\nquiet = true\n')
+    proc = run_cli("latlong", "build", "--config", str(cfg))
+    assert proc.returncode == 0, proc.stderr
+    body = load(out)
+    assert body.magnitude == 10 and body.radius_m == 500
+    assert body.metadata["parameters"]["lacunarity"] == 2.5
+    assert np.array_equal(body.stretch, [1, 1, 1.5])
+    # the command line overrides the file
+    proc = run_cli("latlong", "build", "--config", str(cfg), "--magnitude", "6", "--force")
+    assert proc.returncode == 0, proc.stderr
+    assert load(out).magnitude == 6
+    bad = tmp_path / "bad.toml"
+    bad.write_text("magnitude = 10\ncolour = 'red'\n")
+    assert_one_line_error(run_cli("latlong", "build", "--config", str(bad)), "colour")
+    bad.write_text("magnitude = 'ten'\n")
+    assert_one_line_error(run_cli("latlong", "build", "--config", str(bad)), "magnitude")
+    bad.write_text("magnitude = \n")
+    assert_one_line_error(run_cli("latlong", "build", "--config", str(bad)), "TOML")
+
+
+def test_every_option_has_a_config_key():
+    from latlong.cli import BUILD_OPTIONS, build_parser
+
+    parser = build_parser()
+    build = parser._subparsers._group_actions[0].choices["build"]
+    dests = {a.dest for a in build._actions} - {"help", "config"}
+    assert dests == {o.key for o in BUILD_OPTIONS}
+
+
+def test_info(run_cli, tmp_path):
+    out = tmp_path / "i.npz"
+    assert run_cli("latlong", "build", *SMALL, "--seed", "4", "-o", str(out), "-q").returncode == 0
+    proc = run_cli("latlong", "info", str(out))
+    assert proc.returncode == 0, proc.stderr
+    assert "magnitude  12" in proc.stdout and "seed       4" in proc.stdout
+    assert_one_line_error(run_cli("latlong", "info", str(tmp_path / "none.npz")), "does not exist")
+
+
+def test_other_entry_points(run_cli):
+    for pkg in ("craters", "dem", "latlong"):
+        proc = run_cli(pkg, "--version")
+        assert proc.returncode == 0 and "craterform" in proc.stdout
