@@ -32,11 +32,11 @@ out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
 out.mkdir(parents=True, exist_ok=True)
 grid = LatLongGrid(magnitude)
 radius_m = 100.0
-stretch = (2.0, 1.0, 1.0)
 rng = np.random.default_rng(2014)
 
 # two-phase faulting, Fig. 4: 1000 faults <= 5 m, 3 x 20 m smoothing, 500 faults <= 0.5 m
 p = FAULTING_PRESETS["fig4"]
+stretch = p.stretch
 stage1 = poisson_faulting(grid, p.n_faults_1, p.max_fault_1_m, rng=rng)
 stage2 = smooth(grid, stage1, p.smooth_width_m, radius_m=radius_m, passes=p.smooth_passes)
 stage3 = stage2 + poisson_faulting(grid, p.n_faults_2, p.max_fault_2_m, rng=rng)

@@ -39,11 +39,11 @@ BASES = ("sphere", "faulting", "fbm")
 OUTPUT_SUFFIXES = (".npz", *EXPORT_SUFFIXES)
 # memory per vertex for a build with export (radii, unit vectors, vertices, caches)
 _BYTES_PER_VERTEX = 160
-# the faulting presets also fix the body: the paper's ~100 m asteroid stretched 2x on x.
-# Phase 1 (1000 faults <= 5 m) gives a relief of std ~25 m, so a 100 m radius keeps the
-# deepest pits (faulting is antisymmetric: every bump has an antipodal pit) well above 0.
-_PRESET_BODY = {"paper": {"radius_m": 100.0, "stretch": (2.0, 1.0, 1.0)},
-                "fig4": {"radius_m": 100.0, "stretch": (2.0, 1.0, 1.0)}}
+# the faulting presets are the paper's ~100 m asteroid: phase 1 (1000 faults <= 5 m)
+# gives a relief of std ~25 m, so a 100 m radius keeps the deepest pits (faulting is
+# antisymmetric: every bump has an antipodal pit) well above 0. Their stretch (2 on x)
+# comes with the preset.
+_FAULTING_PRESET_RADIUS_M = 100.0
 
 
 # --------------------------------------------------------------------------- options
@@ -223,10 +223,11 @@ def _resolve(s: dict) -> dict:
     if preset is None and presets:
         preset = "paper" if base == "faulting" else "fig5a"
     s["preset"] = preset
-    body_defaults = _PRESET_BODY.get(preset, {}) if base == "faulting" else {}
-    for key, value in body_defaults.items():
-        if s.get(key) is None:
-            s[key] = value
+    if base == "faulting":
+        if s.get("radius_m") is None:
+            s["radius_m"] = _FAULTING_PRESET_RADIUS_M
+        if s.get("stretch") is None:
+            s["stretch"] = FAULTING_PRESETS[preset].stretch
     for key in ("radius_m", "stretch"):
         if s.get(key) is None:
             s[key] = _BY_KEY[key].default
@@ -294,7 +295,8 @@ def build_body(s: dict, *, progress: bool = False) -> Body:
         params: dict = {}
     elif base == "faulting":
         fp = FaultingParams(s["faults_1"], s["max_fault_1_m"], s["smooth_width_m"],
-                            s["smooth_passes"], s["faults_2"], s["max_fault_2_m"])
+                            s["smooth_passes"], s["faults_2"], s["max_fault_2_m"],
+                            tuple(s["stretch"]))
         heights = two_phase_faulting(grid, s["radius_m"], fp, rng=rng, progress=progress)
         params = dataclasses.asdict(fp)
     else:

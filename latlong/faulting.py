@@ -174,6 +174,8 @@ class FaultingParams:
     """Faults in phase 2 (small faults: surface roughness)."""
     max_fault_2_m: float = 0.03
     """Largest phase-2 fault offset, metres."""
+    stretch: tuple[float, float, float] = (1.0, 1.0, 1.0)
+    """Final stretch of the body along x, y, z (applied by :class:`~latlong.Body`)."""
 
     def __post_init__(self):
         check_int("n_faults_1", self.n_faults_1, 0, 100_000_000)
@@ -182,13 +184,18 @@ class FaultingParams:
         check_positive("max_fault_2_m", self.max_fault_2_m, allow_zero=True)
         check_positive("smooth_width_m", self.smooth_width_m, allow_zero=True)
         check_int("smooth_passes", self.smooth_passes, 0, 1000)
+        if len(self.stretch) != 3:
+            raise ValueError(f"`stretch` must have three factors; got {self.stretch!r}")
+        for v in self.stretch:
+            check_positive("stretch", v)
 
 
-#: Named parameter sets. ``paper``: the asteroid of Martin 2014 IV.A (the CLI preset
-#: adds a 100 m radius and stretch 2 on x); ``fig4``: the three stages of Fig. 4.
+#: Named parameter sets, both stretched 2x along x. ``paper``: the asteroid of Martin
+#: 2014 IV.A (the CLI gives these presets a 100 m radius); ``fig4``: the three stages of
+#: Fig. 4 (500 faults <= 0.5 m in phase 2).
 FAULTING_PRESETS: dict[str, FaultingParams] = {
-    "paper": FaultingParams(1000, 5.0, 20.0, 3, 20000, 0.03),
-    "fig4": FaultingParams(1000, 5.0, 20.0, 3, 500, 0.5),
+    "paper": FaultingParams(1000, 5.0, 20.0, 3, 20000, 0.03, (2.0, 1.0, 1.0)),
+    "fig4": FaultingParams(1000, 5.0, 20.0, 3, 500, 0.5, (2.0, 1.0, 1.0)),
 }
 
 
@@ -199,8 +206,9 @@ def two_phase_faulting(grid: LatLongGrid, radius_m: float, params: FaultingParam
     Phase 1 applies ``params.n_faults_1`` faults of at most ``max_fault_1_m``; the
     result is smoothed ``smooth_passes`` times with a geodesic Gaussian of FWHM
     ``smooth_width_m`` on a sphere of ``radius_m``; phase 2 adds ``n_faults_2`` faults of
-    at most ``max_fault_2_m``. Returns heights in metres with zero area-weighted mean
-    (an axis stretch, if wanted, belongs to the :class:`~latlong.Body`).
+    at most ``max_fault_2_m``. Returns heights in metres with zero area-weighted mean;
+    the final stretch ``params.stretch`` is a property of the body:
+    ``Body.from_heights(grid, radius_m, h, stretch=params.stretch)``.
 
     Examples
     --------

@@ -146,3 +146,6 @@ def test_presets_and_params_validation():
         FaultingParams(smooth_passes=-1)
     with pytest.raises(ValueError, match="max_fault_1_m"):
         FaultingParams(max_fault_1_m=float("inf"))
+    with pytest.raises(ValueError, match="stretch"):
+        FaultingParams(stretch=(1.0, 0.0, 1.0))
+    assert FAULTING_PRESETS["paper"].stretch == (2.0, 1.0, 1.0)

@@ -111,7 +111,7 @@ def test_edge_length_ratio(m):
     assert length.max() / length.min() <= EDGE_RATIO_LIMIT
 
 
-@pytest.mark.parametrize("m", [*range(1, 33), 100])
+@pytest.mark.parametrize("m", MAGNITUDES)
 def test_nesting(m):
     coarse, fine = LatLongGrid(m), LatLongGrid(2 * m)
     idx = fine.nested_indices(coarse)
