@@ -1,11 +1,79 @@
 """craters: crater science shared by the body (latlong) and raster (dem) pipelines.
 
-Pure functions over numpy arrays: crater profiles, degradation, populations and
-catalogs. Imports neither ``latlong`` nor ``dem``.
+Pure functions over numpy arrays: the Martin crater profile with degradation, irregular
+rims and roughness (lunar paper III), stamping into 2-D height grids, power-law crater
+populations and catalogs. Imports neither ``latlong`` nor ``dem``.
 """
 
 import logging
 
-__all__: list[str] = []
+from .catalog import (
+    make_catalog,
+    read_catalog,
+    sort_oldest_first,
+    validate_catalog,
+    write_catalog,
+    write_geojson,
+)
+from .degradation import (
+    DegradationModel,
+    degradation_factors,
+    degradation_from_age,
+    slope_erosion,
+)
+from .morphometry import (
+    MORPHOMETRY_PRESETS,
+    Morphometry,
+    fresh_depth,
+    fresh_rim_height,
+    get_morphometry,
+)
+from .population import (
+    CraterLayer,
+    expected_count,
+    fit_power_law_exponent,
+    parse_layer_spec,
+    population,
+    power_law_population,
+    sample_power_law_diameters,
+    uniform_sphere_directions,
+)
+from .profile import DEFAULT_EJECTA_EDGE, ProfileParams, profile_params, radial_profile
+from .stamp import Crater, Roughness, rim_perturbations, stamp, stamp_many
+
+__all__ = [
+    "DEFAULT_EJECTA_EDGE",
+    "MORPHOMETRY_PRESETS",
+    "Crater",
+    "CraterLayer",
+    "DegradationModel",
+    "Morphometry",
+    "ProfileParams",
+    "Roughness",
+    "degradation_factors",
+    "degradation_from_age",
+    "expected_count",
+    "fit_power_law_exponent",
+    "parse_layer_spec",
+    "fresh_depth",
+    "fresh_rim_height",
+    "get_morphometry",
+    "make_catalog",
+    "population",
+    "power_law_population",
+    "profile_params",
+    "radial_profile",
+    "read_catalog",
+    "rim_perturbations",
+    "sample_power_law_diameters",
+    "slope_erosion",
+    "sort_oldest_first",
+    "stamp",
+    "stamp_many",
+    "uniform_sphere_directions",
+    "validate_catalog",
+    "write_catalog",
+    "write_geojson",
+]
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -34,6 +34,7 @@ __all__ = [
     "load_toml",
     "normalize_rng",
     "package_version",
+    "parse_seed",
     "physical_memory_bytes",
     "progress_bar",
     "run_cli",
@@ -225,6 +226,17 @@ def load_toml(path) -> dict:
 # --------------------------------------------------------------------------- CLI
 class CliError(Exception):
     """An error the CLI reports as one line and exit code 2."""
+
+
+def parse_seed(text) -> int:
+    """argparse type for ``--seed``: a non-negative integer below 2**63."""
+    try:
+        value = int(str(text), 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer; got {text!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2**63); got {text!r}")
+    return value
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -23,6 +23,7 @@ from craters._infra import (
     check_output_path,
     load_toml,
     package_version,
+    parse_seed,
     physical_memory_bytes,
     progress_bar,
     run_cli,
@@ -71,16 +72,6 @@ def _stretch(text: str) -> tuple[float, float, float]:
     return vals
 
 
-def _seed(text) -> int:
-    try:
-        value = int(str(text), 10)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a non-negative integer; got {text!r}") from None
-    if value < 0 or value >= 2**63:
-        raise argparse.ArgumentTypeError(f"must be in [0, 2**63); got {text!r}")
-    return value
-
-
 BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--magnitude",), "magnitude", int, 200,
         "grid magnitude M >= 1 (6M^2+2 vertices)"),
@@ -90,7 +81,7 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--base",), "base", str, "fbm", "base shape: sphere, faulting or fbm"),
     Opt(("--preset",), "preset", str, None,
         "parameter set: faulting: paper (default), fig4; fbm: fig5a (default), fig5b, fig5c"),
-    Opt(("--seed",), "seed", _seed, None,
+    Opt(("--seed",), "seed", parse_seed, None,
         "random seed (non-negative integer); default: a fresh one, recorded in the model"),
     # two-phase faulting
     Opt(("--faults-1",), "faults_1", int, None, "phase-1 fault count", "faulting"),
@@ -150,7 +141,7 @@ def _config_settings(path) -> dict:
             elif opt.parse is _stretch:
                 value = _stretch(",".join(str(v) for v in value)) if isinstance(
                     value, list) else _stretch(value)
-            elif opt.parse is int or opt.parse is _seed:
+            elif opt.parse is int or opt.parse is parse_seed:
                 if isinstance(value, bool) or not isinstance(value, int):
                     raise TypeError
                 value = opt.parse(value)

@@ -1,0 +1,344 @@
+"""Numba kernels for stamping Martin craters into a 2-D height grid.
+
+Scalar versions of the profile (``craters.profile``) and degradation curves
+(``craters.degradation``) - the tests compare them with the numpy versions - plus a
+counter-based 2-D gradient noise for the roughness overlay (a pure function of the
+crater's seed and the position, so results never depend on threads or tiling).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+N_RIM = 64  # samples of the rim perturbation and of the rim offset around a crater
+
+# eight unit gradients for the 2-D noise
+_GRAD = np.array([[1.0, 0.0], [0.70710678118654752, 0.70710678118654752], [0.0, 1.0],
+                  [-0.70710678118654752, 0.70710678118654752], [-1.0, 0.0],
+                  [-0.70710678118654752, -0.70710678118654752], [0.0, -1.0],
+                  [0.70710678118654752, -0.70710678118654752]])
+
+
+# --------------------------------------------------------------------------- profile
+@njit(cache=True)
+def _degradation_factors(d, rim_rate, depth_rate, final_depth):
+    f_r = (np.exp(-rim_rate * d) - np.exp(-rim_rate)) / (1.0 - np.exp(-rim_rate))
+    f_h = 1.0 - (1.0 - final_depth) * (1.0 - np.exp(-depth_rate * d)) / (
+        1.0 - np.exp(-depth_rate))
+    if f_r < 0.0:
+        f_r = 0.0
+    return f_h, f_r
+
+
+@njit(cache=True)
+def _profile_params(diameter_m, d, morph, deg):
+    """(R, H, Hr, alpha, beta, E0) as ``craters.profile.profile_params``.
+
+    ``morph`` = (depth_coef, depth_exp, rim_coef, rim_exp) for D in km;
+    ``deg`` = (rim_rate, depth_rate, final_depth).
+    """
+    d_km = diameter_m / 1000.0
+    h0 = 1000.0 * morph[0] * d_km ** morph[1]
+    hr0 = 1000.0 * morph[2] * d_km ** morph[3]
+    f_h, f_r = _degradation_factors(d, deg[0], deg[1], deg[2])
+    h = f_h * h0
+    hr = f_r * hr0
+    h_ = hr0 - hr + h
+    alpha = 1.0 + (hr - hr0) / h_
+    beta = 1.0 + 1.5 * (hr0 - hr) / h_
+    radius = 0.5 * diameter_m
+    e0 = min(0.14 * radius**0.74, hr0) * f_r
+    return radius, h, hr, alpha, beta, e0
+
+
+@njit(cache=True, inline="always")
+def _inside(x, h, hr, alpha):
+    """Bowl and interior rim, 0 <= x <= 1."""
+    if x <= alpha:
+        return hr - h + (h / alpha) * x * x
+    u = 1.0 - x
+    return hr - h * u * u / (1.0 - alpha)
+
+
+@njit(cache=True, inline="always")
+def _ejecta(x, rim_value, e0, xe):
+    length = xe - 1.0
+    c0 = -e0 * xe**-3.0
+    c1 = -3.0 * e0 * xe**-4.0
+    c2 = (rim_value - e0 - c0 - c1 * length) / (length * length)
+    u = xe - x
+    h = e0 * x**-3.0 + c0 + c1 * u + c2 * u * u
+    dh = -3.0 * e0 * x**-4.0 - c1 - 2.0 * c2 * u
+    return h, dh
+
+
+@njit(cache=True)
+def _outside(x, rim_value, beta, e0, xe):
+    """Exterior rim cubic and ejecta, 1 < x < xe; ``rim_value`` = Hr + delta."""
+    if x >= beta:
+        return _ejecta(x, rim_value, e0, xe)[0]
+    hb, db = _ejecta(beta, rim_value, e0, xe)
+    span = beta - 1.0
+    t = (x - 1.0) / span
+    t2 = t * t
+    t3 = t2 * t
+    return (2 * t3 - 3 * t2 + 1) * rim_value + (-2 * t3 + 3 * t2) * hb + (t3 - t2) * span * db
+
+
+@njit(cache=True)
+def _profile_kernel(x, diameter_m, d, morph, deg, xe, delta, out):
+    """Profile at many x (for testing the scalar functions against numpy)."""
+    radius, h, hr, alpha, beta, e0 = _profile_params(diameter_m, d, morph, deg)
+    for i in range(x.shape[0]):
+        xi = x[i]
+        if xi <= 1.0:
+            out[i] = _inside(xi, h, hr, alpha)
+        elif xi < xe:
+            out[i] = _outside(xi, hr + delta, beta, e0, xe)
+        else:
+            out[i] = 0.0
+
+
+# --------------------------------------------------------------------------- noise
+@njit(cache=True, inline="always")
+def _mix64(z):
+    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
+    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
+    return z ^ (z >> np.uint64(31))
+
+
+@njit(cache=True, inline="always")
+def _hash2(seed, ix, iy):
+    k = np.uint64(ix) * np.uint64(0x9E3779B97F4A7C15) ^ np.uint64(iy) * np.uint64(
+        0xC2B2AE3D27D4EB4F)
+    return _mix64(seed ^ _mix64(k))
+
+
+@njit(cache=True, inline="always")
+def _corner(seed, ix, iy, fx, fy):
+    g = np.int64(_hash2(seed, ix, iy) & np.uint64(7))
+    return _GRAD[g, 0] * fx + _GRAD[g, 1] * fy
+
+
+@njit(cache=True)
+def _noise2(seed, x, y):
+    """2-D gradient noise in about [-0.8, 0.8], zero at integer lattice points."""
+    x0 = np.floor(x)
+    y0 = np.floor(y)
+    ix = np.int64(x0)
+    iy = np.int64(y0)
+    fx = x - x0
+    fy = y - y0
+    u = fx * fx * fx * (fx * (fx * 6.0 - 15.0) + 10.0)
+    v = fy * fy * fy * (fy * (fy * 6.0 - 15.0) + 10.0)
+    n00 = _corner(seed, ix, iy, fx, fy)
+    n10 = _corner(seed, ix + 1, iy, fx - 1.0, fy)
+    n01 = _corner(seed, ix, iy + 1, fx, fy - 1.0)
+    n11 = _corner(seed, ix + 1, iy + 1, fx - 1.0, fy - 1.0)
+    a = n00 + u * (n10 - n00)
+    b = n01 + u * (n11 - n01)
+    return a + v * (b - a)
+
+
+@njit(cache=True)
+def _fbm2(seed, x, y, wavelength, octaves, gain):
+    """fBm of ``octaves`` octaves from ``wavelength`` (metres) halving each octave."""
+    total = 0.0
+    norm = 0.0
+    amp = 1.0
+    inv = 1.0 / wavelength
+    for o in range(octaves):
+        s = seed + np.uint64(o) * np.uint64(0x632BE59BD9B4E019)
+        total += amp * _noise2(s, x * inv, y * inv)
+        norm += amp
+        amp *= gain
+        inv *= 2.0
+    return total / norm
+
+
+# --------------------------------------------------------------------------- helpers
+@njit(cache=True)
+def _bilinear(h, fy, fx):
+    """Bilinear sample at fractional (row, col); NaN outside the grid."""
+    ny, nx = h.shape
+    if fy < 0.0 or fx < 0.0 or fy > ny - 1 or fx > nx - 1:
+        return np.nan
+    i0 = min(int(fy), ny - 2) if ny > 1 else 0
+    j0 = min(int(fx), nx - 2) if nx > 1 else 0
+    ty = fy - i0
+    tx = fx - j0
+    i1 = min(i0 + 1, ny - 1)
+    j1 = min(j0 + 1, nx - 1)
+    a = h[i0, j0] + tx * (h[i0, j1] - h[i0, j0])
+    b = h[i1, j0] + tx * (h[i1, j1] - h[i1, j0])
+    return a + ty * (b - a)
+
+
+@njit(cache=True)
+def _fit_plane(h, cy, cx, r_px, pixel):
+    """Least-squares plane over the pixels within ``r_px`` of (cy, cx).
+
+    Returns (p0, gx, gy, n): height at the centre and gradients in height per metre.
+    Fewer than 3 pixels or a degenerate set: the bilinear height at the centre, flat.
+    """
+    ny, nx = h.shape
+    i_lo = max(0, int(np.ceil(cy - r_px)))
+    i_hi = min(ny - 1, int(np.floor(cy + r_px)))
+    j_lo = max(0, int(np.ceil(cx - r_px)))
+    j_hi = min(nx - 1, int(np.floor(cx + r_px)))
+    s1 = 0.0
+    sx = 0.0
+    sy = 0.0
+    sxx = 0.0
+    syy = 0.0
+    sxy = 0.0
+    sh = 0.0
+    shx = 0.0
+    shy = 0.0
+    r2 = r_px * r_px
+    for i in range(i_lo, i_hi + 1):
+        dy = i - cy
+        for j in range(j_lo, j_hi + 1):
+            dx = j - cx
+            if dx * dx + dy * dy > r2:
+                continue
+            v = h[i, j]
+            s1 += 1.0
+            sx += dx
+            sy += dy
+            sxx += dx * dx
+            syy += dy * dy
+            sxy += dx * dy
+            sh += v
+            shx += v * dx
+            shy += v * dy
+    if s1 >= 3.0:
+        # normal equations [[s1 sx sy][sx sxx sxy][sy sxy syy]] p = [sh shx shy]
+        a00, a01, a02 = s1, sx, sy
+        a11, a12, a22 = sxx, sxy, syy
+        det = (a00 * (a11 * a22 - a12 * a12) - a01 * (a01 * a22 - a12 * a02)
+               + a02 * (a01 * a12 - a11 * a02))
+        scale = s1 * max(sxx, syy, 1.0) * max(sxx, syy, 1.0)
+        if abs(det) > 1e-9 * scale:
+            c00 = a11 * a22 - a12 * a12
+            c01 = -(a01 * a22 - a02 * a12)
+            c02 = a01 * a12 - a02 * a11
+            c11 = a00 * a22 - a02 * a02
+            c12 = -(a00 * a12 - a01 * a02)
+            c22 = a00 * a11 - a01 * a01
+            p0 = (c00 * sh + c01 * shx + c02 * shy) / det
+            px = (c01 * sh + c11 * shx + c12 * shy) / det
+            py = (c02 * sh + c12 * shx + c22 * shy) / det
+            return p0, px / pixel, py / pixel, s1
+    v = _bilinear(h, min(max(cy, 0.0), ny - 1.0), min(max(cx, 0.0), nx - 1.0))
+    return v, 0.0, 0.0, s1
+
+
+@njit(cache=True, inline="always")
+def _table(tab, theta):
+    """Periodic linear interpolation of ``tab`` (N_RIM samples over [-pi, pi))."""
+    n = tab.shape[0]
+    t = (theta + np.pi) * (n / (2.0 * np.pi))
+    k0 = int(np.floor(t))
+    w = t - k0
+    k0 = k0 % n
+    k1 = (k0 + 1) % n
+    return tab[k0] + w * (tab[k1] - tab[k0])
+
+
+@njit(cache=True, inline="always")
+def _roughness_amp(x, xe, a_bowl, a_wall, a_ejecta):
+    """Piecewise-linear overlay amplitude: bowl, wall, ejecta fading to 0 at xe."""
+    if x <= 0.5:
+        return a_bowl
+    if x <= 0.9:
+        return a_bowl + (a_wall - a_bowl) * (x - 0.5) / 0.4
+    if x <= 1.1:
+        return a_wall + (a_ejecta - a_wall) * (x - 0.9) / 0.2
+    if x >= xe:
+        return 0.0
+    return a_ejecta * (xe - x) / (xe - 1.1)
+
+
+# --------------------------------------------------------------------------- stamping
+@njit(cache=True, parallel=True)
+def _write_crater(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab,
+                  delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
+    """Write one crater into ``h`` in place (rows in parallel; pixels independent)."""
+    ny, nx = h.shape
+    rho_max = 0.0
+    for k in range(rim_tab.shape[0]):
+        rho_max = max(rho_max, rim_tab[k])
+    reach = xe * radius * (1.0 + rho_max) / pixel + 1.0
+    i_lo = max(0, int(np.floor(cy - reach)))
+    i_hi = min(ny - 1, int(np.ceil(cy + reach)))
+    j_lo = max(0, int(np.floor(cx - reach)))
+    j_hi = min(nx - 1, int(np.ceil(cx + reach)))
+    for i in prange(i_lo, i_hi + 1):
+        dy = (i - cy) * pixel
+        for j in range(j_lo, j_hi + 1):
+            dx = (j - cx) * pixel
+            r = np.sqrt(dx * dx + dy * dy)
+            theta = np.arctan2(dy, dx)
+            r_theta = radius * (1.0 + _table(rim_tab, theta))
+            x = r / r_theta
+            if x >= xe:
+                continue
+            if x <= 1.0:
+                v = p0 + gx * dx + gy * dy + _inside(x, depth, rim_h, alpha)
+            else:
+                delta = _table(delta_tab, theta)
+                v = h[i, j] + _outside(x, rim_h + delta, beta, e0, xe)
+            if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
+                amp = _roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth
+                v += amp * _fbm2(seed, dx, dy, wavelength, octaves, gain)
+            h[i, j] = v
+
+
+@njit(cache=True)
+def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
+    """delta(theta) = plane - terrain at the rim, sampled at N_RIM azimuths (0 outside)."""
+    n = rim_tab.shape[0]
+    for k in range(n):
+        theta = -np.pi + 2.0 * np.pi * k / n
+        r = radius * (1.0 + rim_tab[k])
+        dx = r * np.cos(theta)
+        dy = r * np.sin(theta)
+        t = _bilinear(h, cy + dy / pixel, cx + dx / pixel)
+        out[k] = 0.0 if np.isnan(t) else (p0 + gx * dx + gy * dy) - t
+
+
+@njit(cache=True)
+def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg, xe,
+                       slope_erosion, onset_deg, full_deg, rough, gain, out_deg, out_depth,
+                       out_rim, out_slope):
+    """Stamp craters in the given order (the caller sorts oldest first), in place.
+
+    For each crater: fit the plane to the obliterated region of the current heights,
+    erode on steep ground, sample the rim offsets, write. Records the degradation,
+    depth, rim height and plane slope actually used.
+    """
+    delta = np.empty(rim_tabs.shape[1])
+    for c in range(cx.shape[0]):
+        r_px = 0.5 * diam[c] / pixel
+        p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
+        slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
+        d = degr[c]
+        if slope_erosion:
+            frac = (slope - onset_deg) / (full_deg - onset_deg)
+            frac = min(max(frac, 0.0), 1.0)
+            d = d + (1.0 - d) * frac
+        radius, depth, rim_h, alpha, beta, e0 = _profile_params(diam[c], d, morph, deg)
+        _rim_offsets(h, cy[c], cx[c], pixel, radius, rim_tabs[c], p0, gx, gy, delta)
+        wavelength = radius
+        octaves = 1
+        while octaves < 10 and wavelength / 2.0**octaves >= 2.0 * pixel:
+            octaves += 1
+        _write_crater(h, cy[c], cx[c], pixel, radius, depth, rim_h, alpha, beta, e0, xe,
+                      rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], wavelength, octaves,
+                      gain)
+        out_deg[c] = d
+        out_depth[c] = depth
+        out_rim[c] = rim_h
+        out_slope[c] = slope

@@ -1,0 +1,225 @@
+"""Stamping craters into a 2-D height grid: the primitive that ``dem`` and ``latlong`` reuse.
+
+Grid frame: pixel (row i, column j) has its centre at ``x = j * pixel_size_m``,
+``y = i * pixel_size_m`` (metres). For each crater (oldest first):
+
+1. the plane fitted (least squares) to the terrain of the obliterated region
+   (r <= R) becomes the crater's base, so craters sit correctly on slopes and on older
+   craters; its slope adds erosion on steep ground (:func:`craters.slope_erosion`);
+2. inside the (irregular) rim the terrain is replaced by plane + bowl; outside, the
+   exterior rim and ejecta are added to the terrain, starting from the plane's height
+   at the rim (the offset ``plane - terrain`` is sampled at 64 azimuths) and ending on
+   the terrain at the ejecta edge; beyond it nothing changes, bit for bit;
+3. with roughness, a fractal overlay (2-D gradient-noise fBm, fractal dimension 2.2 by
+   default) is added with an amplitude that depends on x = r/R: bowl, wall, ejecta,
+   fading linearly to zero at the ejecta edge; the rim radius gets a periodic 1-D
+   fractal perturbation (harmonics 2-16, amplitude ~ k^-1.5) of at most
+   ``irregularity`` x R.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ._infra import (
+    check_finite,
+    check_positive,
+    check_range,
+    normalize_rng,
+    progress_bar,
+)
+from ._stamp_kernels import N_RIM, _stamp_many_kernel
+from .catalog import make_catalog, sort_oldest_first, validate_catalog
+from .degradation import DEFAULT_DEGRADATION, DegradationModel
+from .morphometry import Morphometry, get_morphometry
+from .profile import DEFAULT_EJECTA_EDGE
+
+__all__ = ["Crater", "Roughness", "rim_perturbations", "stamp", "stamp_many"]
+
+_HARMONICS = np.arange(2, 17)
+_BATCH = 512  # craters per kernel call when a progress bar is shown
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class Crater:
+    """One crater on a 2-D grid (grid frame in the module notes)."""
+
+    x_m: float
+    """Centre, metres along the columns."""
+    y_m: float
+    """Centre, metres along the rows."""
+    diameter_m: float
+    """Rim-crest diameter, metres."""
+    degradation: float = 0.0
+    """0 = fresh .. 1 = fully degraded (before slope erosion)."""
+    irregularity: float = 0.02
+    """Largest rim-radius perturbation as a fraction of the radius (with roughness)."""
+
+    def __post_init__(self):
+        check_finite("x_m", self.x_m)
+        check_finite("y_m", self.y_m)
+        check_positive("diameter_m", self.diameter_m)
+        check_range("degradation", self.degradation, 0.0, 1.0)
+        check_range("irregularity", self.irregularity, 0.0, 0.3)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class Roughness:
+    """Fractal overlay amplitudes as fractions of the crater's (degraded) depth."""
+
+    bowl: float = 0.03
+    """Amplitude on the floor (x <= 0.5)."""
+    wall: float = 0.06
+    """Amplitude on the wall (0.9 <= x <= 1)."""
+    ejecta: float = 0.05
+    """Amplitude just outside the rim (x = 1.1), fading linearly to 0 at the edge."""
+    fractal_dimension: float = 2.2
+    """Fractal dimension of the overlay (octave gain 2^(F - 3))."""
+
+    def __post_init__(self):
+        for name in ("bowl", "wall", "ejecta"):
+            check_range(name, getattr(self, name), 0.0, 1.0)
+        check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)
+
+
+_NO_ROUGHNESS = Roughness(0.0, 0.0, 0.0)
+
+
+def rim_perturbations(n: int, irregularity, *, rng=None) -> np.ndarray:
+    """Periodic 1-D fractal rim perturbations, (n, 64) relative radius changes.
+
+    Sample k of row c is the perturbation at azimuth ``-pi + 2 pi k / 64``; each row is
+    a sum of harmonics 2..16 with amplitudes ~ k^-1.5 and random phases, scaled so that
+    its largest magnitude is ``irregularity`` (scalar or per row).
+    """
+    rng = normalize_rng(rng)
+    irr = np.broadcast_to(np.asarray(irregularity, dtype=np.float64), (n,))
+    theta = -np.pi + 2 * np.pi * np.arange(N_RIM) / N_RIM
+    phases = rng.uniform(0.0, 2 * np.pi, size=(n, _HARMONICS.size))
+    amps = _HARMONICS.astype(float) ** -1.5
+    arg = _HARMONICS[None, :, None] * theta[None, None, :] + phases[:, :, None]
+    rho = np.einsum("k,nkt->nt", amps, np.cos(arg))
+    peak = np.abs(rho).max(axis=1, keepdims=True)
+    return np.ascontiguousarray(rho / np.where(peak > 0, peak, 1.0) * irr[:, None])
+
+
+def _check_heights(heights) -> np.ndarray:
+    h = np.asarray(heights)
+    if h.ndim != 2 or h.size == 0:
+        raise ValueError(f"`heights` must be a non-empty 2-D array; got shape {h.shape}")
+    h = np.array(h, dtype=np.float64, order="C", copy=True)
+    if not np.isfinite(h).all():
+        raise ValueError("`heights` must be finite (fill gaps first)")
+    return h
+
+
+def _roughness(roughness) -> Roughness:
+    if roughness is True:
+        return Roughness()
+    if roughness is False or roughness is None:
+        return _NO_ROUGHNESS
+    if isinstance(roughness, Roughness):
+        return roughness
+    raise TypeError(f"`roughness` must be True, False or a Roughness; got {roughness!r}")
+
+
+def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
+               morphometry: str | Morphometry | None = None,
+               model: DegradationModel = DEFAULT_DEGRADATION,
+               ejecta_edge: float = DEFAULT_EJECTA_EDGE, irregularity: float = 0.02,
+               slope_erosion: bool = True, onset_deg: float = 20.0, full_deg: float = 45.0,
+               rng=None, progress: bool = False, return_catalog: bool = False):
+    """Stamp a catalog of craters (oldest first) into a copy of ``heights``.
+
+    Parameters
+    ----------
+    heights : (rows, cols) array_like
+        Terrain heights in metres (finite); not modified.
+    pixel_size_m : float
+        Pixel size in metres.
+    catalog : structured array
+        Columns ``x_m, y_m, diameter_m`` and optionally ``degradation`` (default 0) and
+        ``age_gyr`` (stamping order: oldest first; default 0), see :mod:`craters.catalog`.
+    roughness : bool or Roughness
+        Fractal overlay and irregular rims (True: defaults; False: the ideal crater).
+    morphometry, model, ejecta_edge
+        Fresh depth / rim laws, degradation curves, ejecta edge in radii.
+    irregularity : float
+        Largest rim-radius perturbation as a fraction of the radius (with roughness).
+    slope_erosion, onset_deg, full_deg
+        Extra degradation on steep ground (see :func:`craters.slope_erosion`).
+    rng
+        Seed or Generator for rim shapes and overlay seeds.
+    return_catalog : bool
+        Also return the catalog as stamped (order of stamping) with columns
+        ``degradation`` (after slope erosion), ``rim_radius_m``, ``depth_m``,
+        ``rim_height_m``, ``slope_deg`` and ``seed``.
+
+    Returns
+    -------
+    new heights (float64), and the stamped catalog if ``return_catalog``.
+    """
+    h = _check_heights(heights)
+    pixel = check_positive("pixel_size_m", pixel_size_m)
+    cat = sort_oldest_first(validate_catalog(catalog))
+    if "x_m" not in cat.dtype.names:
+        raise ValueError("`catalog` needs planar positions x_m, y_m for stamping on a grid")
+    rough = _roughness(roughness)
+    morph = get_morphometry(morphometry)
+    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
+    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
+    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
+    full = check_range("full_deg", full_deg, 0.0, 90.0)
+    if slope_erosion and full <= onset:
+        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
+    rng = normalize_rng(rng)
+    n = len(cat)
+    names = cat.dtype.names
+    degr = np.ascontiguousarray(cat["degradation"] if "degradation" in names else np.zeros(n),
+                                dtype=np.float64)
+    irr = irregularity if rough is not _NO_ROUGHNESS else 0.0
+    rim_tabs = rim_perturbations(n, irr, rng=rng)
+    seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
+    cx = np.ascontiguousarray(cat["x_m"] / pixel, dtype=np.float64)
+    cy = np.ascontiguousarray(cat["y_m"] / pixel, dtype=np.float64)
+    diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
+    out = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope")}
+    morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
+    deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
+    rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
+    gain = 2.0 ** (rough.fractal_dimension - 3.0)
+    step = _BATCH if progress else max(n, 1)
+    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+        e = min(s + step, n)
+        _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], degr[s:e], rim_tabs[s:e],
+                           seeds[s:e], morph_arr, deg_arr, ejecta_edge, bool(slope_erosion),
+                           onset, full, rough_arr, gain, out["deg"][s:e], out["depth"][s:e],
+                           out["rim"][s:e], out["slope"][s:e])
+    if not return_catalog:
+        return h
+    cols = {k: cat[k] for k in names}
+    cols.update(degradation=out["deg"], rim_radius_m=diam / 2.0, depth_m=out["depth"],
+                rim_height_m=out["rim"], slope_deg=out["slope"], seed=seeds)
+    return h, make_catalog(**cols)
+
+
+def stamp(heights, pixel_size_m: float, crater: Crater, *, roughness=True, rng=None,
+          **kwargs) -> np.ndarray:
+    """Stamp one :class:`Crater` into a copy of ``heights`` (see :func:`stamp_many`).
+
+    Examples
+    --------
+    >>> h = stamp(np.zeros((101, 101)), 20.0, Crater(1000.0, 1000.0, 1000.0),
+    ...           roughness=False)
+    >>> round(float(h[50, 50]), 1), round(float(h.max()), 1)
+    (-160.0, 36.0)
+    """
+    if not isinstance(crater, Crater):
+        raise TypeError(f"`crater` must be a Crater; got {type(crater).__name__}")
+    cat = make_catalog(x_m=[crater.x_m], y_m=[crater.y_m], diameter_m=[crater.diameter_m],
+                       degradation=[crater.degradation])
+    return stamp_many(heights, pixel_size_m, cat, roughness=roughness, rng=rng,
+                      irregularity=crater.irregularity, **kwargs)
+
