@@ -36,7 +36,8 @@ from .degradation import DEFAULT_DEGRADATION, DegradationModel
 from .morphometry import Morphometry, get_morphometry
 from .profile import DEFAULT_EJECTA_EDGE
 
-__all__ = ["Crater", "Roughness", "rim_perturbations", "stamp", "stamp_many"]
+__all__ = ["Crater", "Roughness", "resolve_roughness", "rim_perturbations", "stamp",
+           "stamp_many"]
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
@@ -96,11 +97,13 @@ def rim_perturbations(n: int, irregularity, *, rng=None) -> np.ndarray:
     """
     rng = normalize_rng(rng)
     irr = np.broadcast_to(np.asarray(irregularity, dtype=np.float64), (n,))
-    theta = -np.pi + 2 * np.pi * np.arange(N_RIM) / N_RIM
     phases = rng.uniform(0.0, 2 * np.pi, size=(n, _HARMONICS.size))
     amps = _HARMONICS.astype(float) ** -1.5
-    arg = _HARMONICS[None, :, None] * theta[None, None, :] + phases[:, :, None]
-    rho = np.einsum("k,nkt->nt", amps, np.cos(arg))
+    # sum_k a_k cos(k theta + phi_k) at theta = -pi + 2 pi j / 64, by an inverse real FFT:
+    # the shift by -pi is the factor (-1)^k
+    spec = np.zeros((n, N_RIM // 2 + 1), dtype=np.complex128)
+    spec[:, _HARMONICS] = (N_RIM / 2) * amps * np.exp(1j * phases) * (-1.0) ** _HARMONICS
+    rho = np.fft.irfft(spec, n=N_RIM, axis=1)
     peak = np.abs(rho).max(axis=1, keepdims=True)
     return np.ascontiguousarray(rho / np.where(peak > 0, peak, 1.0) * irr[:, None])
 
@@ -115,13 +118,15 @@ def _check_heights(heights) -> np.ndarray:
     return h
 
 
-def _roughness(roughness) -> Roughness:
+def resolve_roughness(roughness) -> tuple[Roughness, bool]:
+    """``(overlay amplitudes, irregular rims?)`` for ``roughness`` = True, False/None or a
+    :class:`Roughness` (False: no overlay and circular rims, the ideal crater)."""
     if roughness is True:
-        return Roughness()
+        return Roughness(), True
     if roughness is False or roughness is None:
-        return _NO_ROUGHNESS
+        return _NO_ROUGHNESS, False
     if isinstance(roughness, Roughness):
-        return roughness
+        return roughness, True
     raise TypeError(f"`roughness` must be True, False or a Roughness; got {roughness!r}")
 
 
@@ -166,7 +171,7 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     cat = sort_oldest_first(validate_catalog(catalog))
     if "x_m" not in cat.dtype.names:
         raise ValueError("`catalog` needs planar positions x_m, y_m for stamping on a grid")
-    rough = _roughness(roughness)
+    rough, irregular = resolve_roughness(roughness)
     morph = get_morphometry(morphometry)
     ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
     irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
@@ -179,7 +184,7 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     names = cat.dtype.names
     degr = np.ascontiguousarray(cat["degradation"] if "degradation" in names else np.zeros(n),
                                 dtype=np.float64)
-    irr = irregularity if rough is not _NO_ROUGHNESS else 0.0
+    irr = irregularity if irregular else 0.0
     rim_tabs = rim_perturbations(n, irr, rng=rng)
     seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
     cx = np.ascontiguousarray(cat["x_m"] / pixel, dtype=np.float64)

@@ -7,6 +7,7 @@ shapes, mesh export and previews. See ``latlong build --help`` for the command l
 import logging
 
 from .body import EXPORT_SUFFIXES, Body, load
+from .cratering import crater_extents_deg, stamp_craters
 from .faulting import (
     FAULTING_PRESETS,
     FaultingParams,
@@ -18,18 +19,23 @@ from .faulting import (
 )
 from .grid import LatLongGrid
 from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
+from .scene import PRESETS, body_population, build_body, resolve_settings, surface_positions
 from .smoothing import fwhm_to_sigma, heat_smooth, smooth
 
 __all__ = [
     "EXPORT_SUFFIXES",
     "FAULTING_PRESETS",
     "FBM_PRESETS",
+    "PRESETS",
     "Body",
     "FaultingParams",
     "FbmParams",
     "LatLongGrid",
     "apply_faults",
     "area_mean",
+    "body_population",
+    "build_body",
+    "crater_extents_deg",
     "fbm3",
     "fwhm_to_sigma",
     "heat_smooth",
@@ -37,7 +43,10 @@ __all__ = [
     "perlin_fbm",
     "poisson_faulting",
     "random_faults",
+    "resolve_settings",
     "smooth",
+    "stamp_craters",
+    "surface_positions",
     "two_phase_faulting",
 ]
 

@@ -67,45 +67,49 @@ def _triangles_kernel(m, band_lo, band_hi, ring_offsets, band_offsets, out):
                                _ring_size(rb, m), south, out, t0)
 
 
-@njit(cache=True, parallel=True)
-def _interpolate_kernel(m, ring_offsets, values, colat, lon, out):
-    """Bilinear (ring, longitude) interpolation of a grid-``m`` field at (colat, lon).
+@njit(cache=True)
+def _interpolate_one(m, ring_offsets, values, colat, lon):
+    """Ring-bilinear interpolation of a grid-``m`` field at one (colat, lon).
 
     Rings are equally spaced in colatitude (pi / (2m)); along a ring values are linear in
     longitude with wrap-around; between the two rings the results are blended linearly.
     """
     n_rings = 2 * m + 1
-    step = np.pi / (2 * m)
-    two_pi = 2.0 * np.pi
+    q = colat / (np.pi / (2 * m))
+    r0 = int(np.floor(q))
+    if r0 < 0:
+        r0 = 0
+    if r0 > n_rings - 2:
+        r0 = n_rings - 2
+    t = q - r0
+    if t < 0.0:
+        t = 0.0
+    elif t > 1.0:
+        t = 1.0
+    acc = 0.0
+    for k in range(2):
+        r = r0 + k
+        n = _ring_size(r, m)
+        if n == 1:
+            v = values[ring_offsets[r]]
+        else:
+            s = (lon / (2.0 * np.pi)) * n
+            s = s - np.floor(s / n) * n
+            j0 = int(np.floor(s))
+            w = s - j0
+            if j0 >= n:
+                j0 = n - 1
+                w = 1.0
+            j1 = j0 + 1
+            if j1 == n:
+                j1 = 0
+            v = (1.0 - w) * values[ring_offsets[r] + j0] + w * values[ring_offsets[r] + j1]
+        acc += (1.0 - t) * v if k == 0 else t * v
+    return acc
+
+
+@njit(cache=True, parallel=True)
+def _interpolate_kernel(m, ring_offsets, values, colat, lon, out):
+    """:func:`_interpolate_one` at many points (parallel)."""
     for p in prange(colat.shape[0]):
-        q = colat[p] / step
-        r0 = int(np.floor(q))
-        if r0 < 0:
-            r0 = 0
-        if r0 > n_rings - 2:
-            r0 = n_rings - 2
-        t = q - r0
-        if t < 0.0:
-            t = 0.0
-        elif t > 1.0:
-            t = 1.0
-        acc = 0.0
-        for k in range(2):
-            r = r0 + k
-            n = _ring_size(r, m)
-            if n == 1:
-                v = values[ring_offsets[r]]
-            else:
-                s = (lon[p] / two_pi) * n
-                s = s - np.floor(s / n) * n
-                j0 = int(np.floor(s))
-                w = s - j0
-                if j0 >= n:
-                    j0 = n - 1
-                    w = 1.0
-                j1 = j0 + 1
-                if j1 == n:
-                    j1 = 0
-                v = (1.0 - w) * values[ring_offsets[r] + j0] + w * values[ring_offsets[r] + j1]
-            acc += (1.0 - t) * v if k == 0 else t * v
-        out[p] = acc
+        out[p] = _interpolate_one(m, ring_offsets, values, colat[p], lon[p])

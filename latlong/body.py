@@ -39,6 +39,8 @@ class Body:
         Scale factors along x, y, z (default 1, 1, 1).
     metadata : dict, optional
         JSON-serialisable description (seed, parameters, version, ...).
+    craters : structured array, optional
+        The crater catalog that made the body (see :mod:`craters.catalog`), as stamped.
 
     Examples
     --------
@@ -47,10 +49,10 @@ class Body:
     (98, 10.0)
     """
 
-    __slots__ = ("_grid", "_radii", "_radius_m", "_stretch", "_metadata")
+    __slots__ = ("_grid", "_radii", "_radius_m", "_stretch", "_metadata", "_craters")
 
     def __init__(self, grid: LatLongGrid, radii_m, *, radius_m: float | None = None,
-                 stretch=(1.0, 1.0, 1.0), metadata: dict | None = None):
+                 stretch=(1.0, 1.0, 1.0), metadata: dict | None = None, craters=None):
         if not isinstance(grid, LatLongGrid):
             raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
         radii = np.array(radii_m, dtype=np.float64, copy=True)
@@ -82,6 +84,12 @@ class Body:
         except TypeError as exc:
             raise TypeError(f"`metadata` must be JSON-serialisable: {exc}") from None
         self._metadata = meta
+        if craters is not None:
+            from craters import validate_catalog
+
+            craters = np.array(validate_catalog(craters), copy=True)
+            craters.setflags(write=False)
+        self._craters = craters
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -98,9 +106,11 @@ class Body:
                    radius_m=radius_m, **kwargs)
 
     def replace(self, **changes) -> Body:
-        """A new body with some of ``radii_m, radius_m, stretch, metadata`` replaced."""
+        """A new body with some of ``radii_m, radius_m, stretch, metadata, craters``
+        replaced."""
         kw = {"radii_m": self._radii, "radius_m": self._radius_m,
-              "stretch": self._stretch, "metadata": self._metadata}
+              "stretch": self._stretch, "metadata": self._metadata,
+              "craters": self._craters}
         unknown = set(changes) - set(kw)
         if unknown:
             raise TypeError(f"unknown Body fields: {', '.join(sorted(unknown))}")
@@ -141,6 +151,11 @@ class Body:
         return json.loads(json.dumps(self._metadata))
 
     @property
+    def craters(self) -> np.ndarray | None:
+        """The crater catalog as stamped (read-only structured array) or None."""
+        return self._craters
+
+    @property
     def heights_m(self) -> np.ndarray:
         """``radii_m - radius_m`` in metres."""
         return self._radii - self._radius_m
@@ -172,6 +187,8 @@ class Body:
             "radii_m": np.asarray(self._radii, dtype=np.float64),
             "metadata_json": np.array(json.dumps(self._metadata, sort_keys=True)),
         }
+        if self._craters is not None:
+            arrays["craters"] = np.asarray(self._craters)
         with atomic_path(path) as tmp:
             with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED,
                                  allowZip64=True) as zf:
@@ -220,4 +237,5 @@ def load(path) -> Body:
         raise ValueError(f"{str(path)!r} is not a craterform body (format {fmt!r})")
     return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
                 radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
-                metadata=json.loads(str(fields["metadata_json"])))
+                metadata=json.loads(str(fields["metadata_json"])),
+                craters=fields.get("craters"))

@@ -1,4 +1,12 @@
-"""Off-screen preview images of a body (pyvista/VTK), lit by a directional sun."""
+"""Off-screen pictures of a body (pyvista/VTK): Lambertian shading, one directional sun.
+
+The camera looks at the centre of the body's bounding box from the direction
+(``view_lat_deg``, ``view_lon_deg``) in the body-fixed frame, at ``camera_distance_m``
+(default: far enough to frame the body). The sun is given relative to the camera:
+azimuth 0 = behind the viewer (full phase), 90 = from the right of the picture;
+elevation above the picture's horizontal plane. ``views=6`` writes a contact sheet of
+six views along +x, -x, +y, -y, +z, -z with the same sun geometry.
+"""
 
 from __future__ import annotations
 
@@ -14,11 +22,15 @@ from craters._infra import atomic_path, check_finite, check_int
 from .body import Body
 from .grid import LatLongGrid
 
-__all__ = ["render_preview", "sun_direction"]
+__all__ = ["VIEW_DIRECTIONS", "camera_frame", "render_from_settings", "render_preview",
+           "sun_direction"]
 
-#: Bodies above this magnitude are resampled to it for the preview (a picture of
-#: 1024 x 768 pixels cannot show more).
-PREVIEW_MAX_MAGNITUDE = 600
+#: Bodies above this magnitude are resampled to it for pictures (a picture of a few
+#: thousand pixels cannot show more, and the renderer's memory stays bounded).
+PREVIEW_MAX_MAGNITUDE = 1000
+#: The six views of a contact sheet: (label, view latitude, view longitude) in degrees.
+VIEW_DIRECTIONS = (("+x", 0.0, 0.0), ("-x", 0.0, 180.0), ("+y", 0.0, 90.0),
+                   ("-y", 0.0, -90.0), ("+z", 90.0, 0.0), ("-z", -90.0, 0.0))
 
 
 def _headless_setup() -> None:
@@ -31,11 +43,27 @@ def _headless_setup() -> None:
         os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkOSOpenGLRenderWindow"
 
 
-def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
-    """Unit vector towards the sun for the preview camera, which looks along +y.
+def camera_frame(view_lat_deg: float = 0.0, view_lon_deg: float = -90.0):
+    """(toward_camera, right, up) unit vectors for a camera in direction (lat, lon).
 
-    Azimuth is measured from the camera (0 = sun behind the viewer, full phase; 90 = sun
-    to the right of the picture, +x) and elevation above the body's equator (+z).
+    Examples
+    --------
+    >>> [v.round(12).tolist() for v in camera_frame(0.0, -90.0)]
+    [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    """
+    la = math.radians(check_finite("view_lat_deg", view_lat_deg))
+    lo = math.radians(check_finite("view_lon_deg", view_lon_deg))
+    v = np.array([math.cos(la) * math.cos(lo), math.cos(la) * math.sin(lo), math.sin(la)])
+    ref = np.array([0.0, 0.0, 1.0]) if abs(v[2]) < 0.999 else np.array([0.0, 1.0, 0.0])
+    right = np.cross(ref, v)
+    right /= np.linalg.norm(right)
+    up = np.cross(v, right)
+    return v, right, up
+
+
+def sun_direction(azimuth_deg: float, elevation_deg: float, view_lat_deg: float = 0.0,
+                  view_lon_deg: float = -90.0) -> np.ndarray:
+    """Unit vector towards the sun, given relative to the camera (module notes).
 
     Examples
     --------
@@ -43,16 +71,15 @@ def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:
     [1.0, 0.0, 0.0]
     """
     az = math.radians(check_finite("sun_azimuth_deg", azimuth_deg))
-    el = math.radians(check_finite("sun_elevation_deg", elevation_deg))
-    if not -90.0 <= math.degrees(el) <= 90.0:
+    el_deg = check_finite("sun_elevation_deg", elevation_deg)
+    if not -90.0 <= el_deg <= 90.0:
         raise ValueError(f"`sun_elevation_deg` must be in [-90, 90]; got {elevation_deg!r}")
-    toward_camera = np.array([0.0, -1.0, 0.0])
-    right = np.array([1.0, 0.0, 0.0])
-    up = np.array([0.0, 0.0, 1.0])
-    return math.cos(el) * (math.cos(az) * toward_camera + math.sin(az) * right) + math.sin(el) * up
+    el = math.radians(el_deg)
+    v, right, up = camera_frame(view_lat_deg, view_lon_deg)
+    return math.cos(el) * (math.cos(az) * v + math.sin(az) * right) + math.sin(el) * up
 
 
-def _preview_body(body: Body) -> Body:
+def _picture_body(body: Body) -> Body:
     if body.magnitude <= PREVIEW_MAX_MAGNITUDE:
         return body
     small = LatLongGrid(PREVIEW_MAX_MAGNITUDE)
@@ -61,49 +88,95 @@ def _preview_body(body: Body) -> Body:
     return Body(small, radii, radius_m=body.radius_m, stretch=body.stretch)
 
 
-def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
-                   sun_elevation_deg: float = 20.0, width_px: int = 1024,
-                   height_px: int = 768) -> Path:
-    """Render ``body`` off-screen to a PNG at ``path`` (atomic).
+def _render(mesh, centre, extent, *, sun, view, width_px, height_px, camera_distance_m):
+    import pyvista as pv
 
-    The camera looks along +y at the centre of the body's bounding box, framing it; the body
-    is grey and lit by one directional light (see :func:`sun_direction`) plus a weak
-    ambient term so the night side is not pure black.
-    """
+    v, right, up = view
+    plotter = pv.Plotter(off_screen=True, window_size=(width_px, height_px), lighting="none")
+    try:
+        plotter.set_background("black")
+        plotter.add_mesh(mesh, color=(0.78, 0.76, 0.72), smooth_shading=True, ambient=0.03,
+                         diffuse=1.0, specular=0.0, show_scalar_bar=False)
+        light = pv.Light(position=tuple(centre + sun * 10 * extent), focal_point=tuple(centre),
+                         light_type="scene light", intensity=1.0)
+        light.positional = False
+        plotter.add_light(light)
+        view_angle = 30.0
+        fit = 1.05 * extent / math.tan(math.radians(view_angle / 2))
+        distance = camera_distance_m if camera_distance_m else fit
+        plotter.camera_position = [tuple(centre + v * distance), tuple(centre), tuple(up)]
+        plotter.camera.view_angle = view_angle
+        near = max(distance - 2 * extent, 1e-3 * distance)
+        plotter.camera.clipping_range = (near, distance + 2 * extent)
+        return plotter.screenshot(return_img=True)
+    finally:
+        plotter.close()
+
+
+def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
+                   sun_elevation_deg: float = 20.0, view_lat_deg: float = 0.0,
+                   view_lon_deg: float = -90.0, camera_distance_m: float | None = None,
+                   width_px: int = 1024, height_px: int = 768, views: int = 1) -> Path:
+    """Render ``body`` off-screen to a PNG at ``path`` (atomic); see the module notes."""
     if not isinstance(body, Body):
         raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
     path = Path(path)
     if path.suffix.lower() != ".png":
-        raise ValueError(f"preview path must end in .png; got {str(path)!r}")
+        raise ValueError(f"picture path must end in .png; got {str(path)!r}")
     width_px = check_int("width_px", width_px, 16, 8192)
     height_px = check_int("height_px", height_px, 16, 8192)
-    sun = sun_direction(sun_azimuth_deg, sun_elevation_deg)
+    views = check_int("views", views, 1, 6)
+    if views not in (1, 6):
+        raise ValueError(f"`views` must be 1 or 6; got {views}")
+    if camera_distance_m is not None and not (
+            math.isfinite(camera_distance_m) and camera_distance_m > 0):
+        raise ValueError(f"`camera_distance_m` must be finite and > 0; got {camera_distance_m!r}")
+    sun_direction(sun_azimuth_deg, sun_elevation_deg, view_lat_deg, view_lon_deg)  # validate
     _headless_setup()
-    import pyvista as pv
-
-    mesh = _preview_body(body).to_pyvista()
+    mesh = _picture_body(body).to_pyvista()
     mesh = mesh.compute_normals(cell_normals=False, point_normals=True, split_vertices=False,
                                 consistent_normals=False, auto_orient_normals=False)
     lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
     centre = 0.5 * (lo + hi)
     extent = 0.5 * float(np.linalg.norm(hi - lo))  # radius of the bounding sphere
-    plotter = pv.Plotter(off_screen=True, window_size=(width_px, height_px), lighting="none")
-    try:
-        plotter.set_background("black")
-        plotter.add_mesh(mesh, color=(0.78, 0.76, 0.72), smooth_shading=True, ambient=0.04,
-                         diffuse=1.0, specular=0.0, show_scalar_bar=False)
-        light = pv.Light(position=tuple(centre + sun * 10 * extent),
-                         focal_point=tuple(centre), light_type="scene light", intensity=1.0)
-        light.positional = False
-        plotter.add_light(light)
-        view_angle = 30.0
-        distance = 1.05 * extent / math.tan(math.radians(view_angle / 2))
-        plotter.camera_position = [tuple(centre + np.array([0.0, -distance, 0.0])),
-                                   tuple(centre), (0.0, 0.0, 1.0)]
-        plotter.camera.view_angle = view_angle
-        plotter.camera.clipping_range = (distance - 2 * extent, distance + 2 * extent)
-        with atomic_path(path) as tmp:
-            plotter.screenshot(str(tmp))
-    finally:
-        plotter.close()
+    if views == 1:
+        directions = [("", view_lat_deg, view_lon_deg)]
+    else:
+        directions = list(VIEW_DIRECTIONS)
+    images = []
+    for _, la, lo_deg in directions:
+        frame = camera_frame(la, lo_deg)
+        sun = sun_direction(sun_azimuth_deg, sun_elevation_deg, la, lo_deg)
+        images.append(_render(mesh, centre, extent, sun=sun, view=frame, width_px=width_px,
+                              height_px=height_px, camera_distance_m=camera_distance_m))
+    if views == 1:
+        sheet = images[0]
+    else:
+        sheet = _contact_sheet(images, [d[0] for d in directions])
+    from PIL import Image
+
+    with atomic_path(path) as tmp:
+        Image.fromarray(sheet).save(tmp, format="PNG")
     return path
+
+
+def _contact_sheet(images, labels) -> np.ndarray:
+    """Six equal RGB pictures in 2 rows of 3, each labelled in its corner."""
+    from PIL import Image, ImageDraw
+
+    h, w = images[0].shape[:2]
+    sheet = Image.new("RGB", (3 * w, 2 * h))
+    for k, (img, label) in enumerate(zip(images, labels, strict=True)):
+        tile = Image.fromarray(np.ascontiguousarray(img[..., :3]))
+        ImageDraw.Draw(tile).text((8, 6), f"view from {label}", fill=(230, 230, 230))
+        sheet.paste(tile, ((k % 3) * w, (k // 3) * h))
+    return np.asarray(sheet)
+
+
+def render_from_settings(body: Body, path, s: dict) -> Path:
+    """:func:`render_preview` with the render keys of scene settings ``s``."""
+    return render_preview(body, path, sun_azimuth_deg=s["sun_azimuth_deg"],
+                          sun_elevation_deg=s["sun_elevation_deg"],
+                          view_lat_deg=s["view_lat_deg"], view_lon_deg=s["view_lon_deg"],
+                          camera_distance_m=s.get("camera_distance_m"),
+                          width_px=s["width_px"], height_px=s["height_px"], views=s["views"])

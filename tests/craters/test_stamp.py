@@ -194,3 +194,16 @@ def test_bad_catalogs():
         stamp_many(np.zeros((5, 5)), 1.0, sphere)
     with pytest.raises(TypeError, match="structured"):
         stamp_many(np.zeros((5, 5)), 1.0, np.zeros(3))
+
+
+def test_rim_perturbations_match_the_harmonic_sum():
+    from craters.stamp import _HARMONICS
+
+    got = craters.rim_perturbations(7, 0.03, rng=4)
+    phases = np.random.default_rng(4).uniform(0, 2 * np.pi, (7, _HARMONICS.size))
+    theta = -np.pi + 2 * np.pi * np.arange(64) / 64
+    ref = np.einsum("k,nkt->nt", _HARMONICS.astype(float) ** -1.5,
+                    np.cos(_HARMONICS[None, :, None] * theta[None, None, :] + phases[:, :, None]))
+    ref *= 0.03 / np.abs(ref).max(axis=1, keepdims=True)
+    assert np.allclose(got, ref, rtol=0, atol=1e-15)
+    assert np.allclose(np.abs(got).max(axis=1), 0.03)

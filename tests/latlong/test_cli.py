@@ -82,7 +82,7 @@ def test_same_seed_same_bytes_any_thread_count(run_cli, tmp_path):
     (["--base", "fbm", "--frequency", "inf"], ["--frequency"]),
     (["--base", "fbm", "--faults-1", "10"], ["--faults-1", "faulting"]),
     (["--base", "faulting", "--max-fault-1-m", "nan"], ["--max-fault-1-m"]),
-    (["--base", "faulting", "--preset", "fig5a"], ["--preset", "paper"]),
+    (["--base", "faulting", "--preset", "fig5a"], ["--preset fig5a", "faulting"]),
     (["--stretch", "1,2"], ["--stretch"]),
     (["--sun-elevation-deg", "95"], ["--sun-elevation-deg"]),
     (["--frobnicate"], ["unrecognized"]),
@@ -176,3 +176,98 @@ def test_other_entry_points(run_cli):
     for pkg in ("craters", "dem", "latlong"):
         proc = run_cli(pkg, "--version")
         assert proc.returncode == 0 and "craterform" in proc.stdout
+
+
+def test_cratered_preset_outputs_and_determinism(run_cli, tmp_path):
+    digests = {}
+    for tag, env in (("a", {}), ("b", {}), ("t1", {"NUMBA_NUM_THREADS": "1"})):
+        d = tmp_path / tag
+        d.mkdir()
+        proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "60",
+                       "--seed", "1", "-o", str(d / "a.npz"), "--catalog", str(d / "a.csv"),
+                       "--preview", str(d / "a.png"), "-q", env=env)
+        assert proc.returncode == 0, proc.stderr
+        digests[tag] = [(d / n).read_bytes() for n in ("a.npz", "a.csv", "a.png")]
+    assert digests["a"] == digests["b"] == digests["t1"]
+    import craters
+
+    body = load(tmp_path / "a" / "a.npz")
+    cat = craters.read_catalog(tmp_path / "a" / "a.csv")
+    assert len(cat) == len(body.craters) > 100
+    for name in ("lat_deg", "lon_deg", "diameter_m", "depth_m", "rim_radius_m", "age_gyr"):
+        assert np.array_equal(cat[name], body.craters[name])
+    assert body.metadata["preset"] == "fbm-cratered"
+
+
+def test_crater_layers_from_options_and_config(run_cli, tmp_path):
+    out = tmp_path / "c.npz"
+    proc = run_cli("latlong", "build", "--magnitude", "40", "--base", "sphere", "--radius-m",
+                   "100", "--craters", "c=0.2,k=-2,dmin=3,dmax=20", "--craters",
+                   "c=0.01,k=-3,dmin=20,dmax=30,deg=0.5", "--seed", "2", "-o", str(out), "-q")
+    assert proc.returncode == 0, proc.stderr
+    cat = load(out).craters
+    assert set(np.unique(cat["layer"])) <= {0, 1} and len(cat) > 10
+    cfg = tmp_path / "scene.toml"
+    out2 = tmp_path / "d.npz"
+    cfg.write_text(f'magnitude = 40\nbase = "sphere"\nradius_m = 100\nseed = 2\n'
+                   f'output = ["{out2}"]\nquiet = true\ncrater_roughness = false\n'
+                   '[[craters]]\nc = 0.2\nk = -2.0\nd_min_m = 3\nd_max_m = 20\n'
+                   'age_max_gyr = 1.0\nkind = "young"\n')
+    proc = run_cli("latlong", "build", "--config", str(cfg))
+    assert proc.returncode == 0, proc.stderr
+    cat2 = load(out2).craters
+    assert (cat2["kind"] == "young").all() and (cat2["age_gyr"] <= 1.0).all()
+    cfg.write_text('magnitude = 40\n[[craters]]\nc = 0.2\nk = -2.0\nd_min_m = 3\n'
+                   'd_max_m = 20\nshape = "round"\n')
+    assert_one_line_error(run_cli("latlong", "build", "--config", str(cfg), "-o",
+                                  str(tmp_path / "x.npz")), "shape")
+
+
+@pytest.mark.parametrize("args,needles", [
+    (["--radius-m", "100", "--craters", "c=0.1,k=-2,dmin=5,dmax=150"],
+     ["--craters", "larger than the body"]),
+    (["--craters", "c=0,k=-2,dmin=1,dmax=5"], ["--craters", "`c`"]),
+    (["--craters", "c=-1,k=-2,dmin=1,dmax=5"], ["--craters", "`c`"]),
+    (["--craters", "c=0.1,k=-2,dmin=-1,dmax=5"], ["--craters", "d_min_m"]),
+    (["--craters", "c=0.1,k=-2,dmin=1,dmax=-5"], ["--craters", "d_max_m"]),
+    (["--preset", "vesta-like"], ["--preset", "fbm-cratered"]),
+    (["--catalog", "x.csv"], ["--catalog", "crater layers"]),
+    (["--views", "4", "--preview", "p.png"], ["--views"]),
+])
+def test_bad_crater_input(run_cli, tmp_path, args, needles):
+    proc = run_cli("latlong", "build", "--magnitude", "20", *args, "-o", "out.npz",
+                   cwd=tmp_path)
+    assert_one_line_error(proc, *needles)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_presets_command(run_cli):
+    proc = run_cli("latlong", "presets")
+    assert proc.returncode == 0
+    for name in ("fbm-cratered", "faulted-cratered", "eros-like", "itokawa-like",
+                 "bennu-like", "paper", "fig5c"):
+        assert f"\n{name}\n" in "\n" + proc.stdout
+    assert "craters = ['c=0.5,k=-2,dmin=1,dmax=15']" in proc.stdout
+
+
+def test_render_command(run_cli, tmp_path):
+    model = tmp_path / "m.npz"
+    assert run_cli("latlong", "build", "--magnitude", "30", "--seed", "1", "-o", str(model),
+                   "-q").returncode == 0
+    one, six = tmp_path / "one.png", tmp_path / "six.png"
+    proc = run_cli("latlong", "render", str(model), "-o", str(one), "--width-px", "320",
+                   "--height-px", "240", "--view-lat-deg", "30", "--view-lon-deg", "45",
+                   "--camera-distance-m", "400", "-q")
+    assert proc.returncode == 0, proc.stderr
+    proc = run_cli("latlong", "render", str(model), "-o", str(six), "--views", "6",
+                   "--width-px", "200", "--height-px", "150", "-q")
+    assert proc.returncode == 0, proc.stderr
+    import matplotlib.image as mpimg
+
+    img1, img6 = mpimg.imread(one), mpimg.imread(six)
+    assert img1.shape[:2] == (240, 320) and img6.shape[:2] == (300, 600)
+    for tile in (img6[:150, :200], img6[150:, 400:]):
+        assert (tile[..., :3].max(axis=2) > 0.1).mean() > 0.05  # each view shows the body
+    assert_one_line_error(run_cli("latlong", "render", str(model), "-o", str(one)), "exists")
+    assert_one_line_error(run_cli("latlong", "render", str(model), "-o", str(tmp_path / "x.png"),
+                                  "--sun-elevation-deg", "100"), "--sun-elevation-deg")

@@ -1,0 +1,170 @@
+"""Crater-saturated bodies: stamping craters via local DEM mapping (Martin 2014, V.A)."""
+
+from __future__ import annotations
+
+import logging
+
+import numpy as np
+
+import craters as _craters
+from craters._infra import check_choice, check_range, normalize_rng, progress_bar
+from craters.degradation import DEFAULT_DEGRADATION, DegradationModel
+from craters.morphometry import Morphometry, get_morphometry
+from craters.profile import DEFAULT_EJECTA_EDGE
+from craters.stamp import resolve_roughness
+
+from ._crater_kernels import _stamp_body_kernel
+from .body import Body
+
+__all__ = ["crater_extents_deg", "stamp_craters"]
+
+logger = logging.getLogger(__name__)
+_BATCH = 256  # craters per kernel call when a progress bar is shown
+
+
+def _local_radii(body: Body, lat_deg, lon_deg) -> np.ndarray:
+    """|position| of the body surface in the directions (lat, lon) of the grid."""
+    lat = np.radians(lat_deg)
+    lon = np.radians(lon_deg)
+    r = body.grid.interpolate(body.radii_m, np.pi / 2 - lat, lon)
+    u = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)], axis=-1)
+    return r * np.linalg.norm(u * body.stretch, axis=-1)
+
+
+def crater_extents_deg(body: Body, catalog, *, ejecta_edge: float = DEFAULT_EJECTA_EDGE,
+                       irregularity: float = 0.02) -> np.ndarray:
+    """Angular diameter (degrees of arc) of each crater's affected region on ``body``:
+    ejecta edge to ejecta edge, seen from the body centre at the local radius."""
+    reach = ejecta_edge * 0.5 * catalog["diameter_m"] * (1.0 + irregularity)
+    rloc = _local_radii(body, catalog["lat_deg"], catalog["lon_deg"])
+    return np.degrees(2.0 * np.minimum(reach / rloc, np.pi / 2))
+
+
+def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bool = False,
+                  max_extent_deg: float = 60.0, irregularity: float = 0.02,
+                  slope_erosion: bool = True, onset_deg: float = 20.0, full_deg: float = 45.0,
+                  morphometry: str | Morphometry | None = None,
+                  model: DegradationModel = DEFAULT_DEGRADATION,
+                  ejecta_edge: float = DEFAULT_EJECTA_EDGE, too_large: str = "error") -> Body:
+    """Stamp a crater catalog on a body, oldest first; returns a new :class:`Body`.
+
+    For each crater (Martin 2014 V.A): the vertices of its region are gathered through
+    the ring structure (no scan of the whole body); each gets its true distance from the
+    crater centre (arc length at the local radius, measured between the actual surface
+    directions, so stretched and irregular bodies work) and its azimuth in the east/north
+    frame at the centre, and its height radially relative to the centre's radius. The
+    vertices are binned into a local height grid at the local vertex spacing (holes
+    filled by 8-direction inverse-distance averages), on which the obliterated region's
+    plane, its slope (slope erosion) and the rim offsets are measured; then the crater
+    (:mod:`craters` profile, irregular rim, roughness) is evaluated at every vertex with
+    its true distance and azimuth, and the vertex's radial vector is rescaled by its
+    height change. Works across the 0/360 degree seam and over the poles.
+
+    Parameters
+    ----------
+    body : Body
+    catalog : structured array
+        Columns ``lat_deg, lon_deg`` (the grid's latitude/longitude: planetocentric on
+        an unstretched body), ``diameter_m``, optionally ``degradation``, ``age_gyr``
+        (stamping order, oldest first) and ``kind``.
+    roughness : bool or craters.Roughness
+        Fractal overlay and irregular rims (False: ideal, deterministic craters).
+    rng
+        Seed or Generator for rim shapes and overlay seeds.
+    max_extent_deg : float
+        Largest allowed angular diameter of a crater's affected region (ejecta edge to
+        ejecta edge), measured at the crater's location; larger craters would be
+        distorted by the local mapping.
+    too_large : {"error", "skip"}
+        What to do with craters above ``max_extent_deg``: raise ValueError, or leave
+        them out (logged; the returned catalog lists only stamped craters).
+    irregularity, slope_erosion, onset_deg, full_deg, morphometry, model, ejecta_edge
+        As in :func:`craters.stamp_many`.
+
+    Returns
+    -------
+    Body with the new radii and ``craters`` = the catalog as stamped (stamping order),
+    with the degradation actually used, ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
+    ``slope_deg``, the 3-D centre ``centre_x_m, centre_y_m, centre_z_m``, ``seed``,
+    ``max_change_m`` (largest radial change) and ``n_vertices`` touched.
+    """
+    if not isinstance(body, Body):
+        raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
+    cat = _craters.sort_oldest_first(_craters.validate_catalog(catalog))
+    if "lat_deg" not in cat.dtype.names:
+        raise ValueError("`catalog` needs lat_deg, lon_deg columns to stamp on a body")
+    rough, irregular = resolve_roughness(roughness)
+    max_extent_deg = check_range("max_extent_deg", max_extent_deg, 1.0, 180.0)
+    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
+    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
+    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
+    full = check_range("full_deg", full_deg, 0.0, 90.0)
+    if slope_erosion and full <= onset:
+        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
+    morph = get_morphometry(morphometry)
+    irr = irregularity if irregular else 0.0
+    check_choice("too_large", too_large, ("error", "skip"))
+    if len(cat):
+        ext = crater_extents_deg(body, cat, ejecta_edge=ejecta_edge, irregularity=irr)
+        over = ext > max_extent_deg
+        if over.any() and too_large == "skip":
+            logger.warning("skipped %d of %d craters whose ejecta would span more than %g "
+                           "degrees of arc where they fall", int(over.sum()), len(cat),
+                           max_extent_deg)
+            cat, ext = cat[~over], ext[~over]
+        worst = int(np.argmax(ext)) if len(cat) else 0
+        if len(cat) and ext[worst] > max_extent_deg:
+            raise ValueError(
+                f"crater of diameter {cat['diameter_m'][worst]:.6g} m at lat "
+                f"{cat['lat_deg'][worst]:.3f}, lon {cat['lon_deg'][worst]:.3f} deg spans "
+                f"{ext[worst]:.1f} deg of arc (limit max_extent_deg = {max_extent_deg:g}): "
+                "too large for this body; lower the largest diameter"
+            )
+    n = len(cat)
+    rng = normalize_rng(rng)
+    rim_tabs = _craters.rim_perturbations(n, irr, rng=rng)
+    seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
+    radii = np.array(body.radii_m, dtype=np.float64, copy=True)
+    grid = body.grid
+    names = cat.dtype.names
+    degr = np.ascontiguousarray(cat["degradation"] if "degradation" in names else np.zeros(n),
+                                dtype=np.float64)
+    lat = np.ascontiguousarray(cat["lat_deg"], dtype=np.float64)
+    lon = np.ascontiguousarray(cat["lon_deg"], dtype=np.float64)
+    diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
+    outs = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope", "maxdh", "nvert", "sp")}
+    centre = np.zeros((n, 3))
+    morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
+    deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
+    rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
+    gain = 2.0 ** (rough.fractal_dimension - 3.0)
+    stretch = np.asarray(body.stretch, dtype=np.float64)
+    unit = grid.unit_vectors()
+    offs = grid.ring_offsets()
+    step = _BATCH if progress else max(n, 1)
+    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+        e = min(s + step, n)
+        _stamp_body_kernel(grid.magnitude, offs, unit, radii, stretch, lat[s:e], lon[s:e],
+                           diam[s:e], degr[s:e], rim_tabs[s:e], seeds[s:e], morph_arr,
+                           deg_arr, ejecta_edge, bool(slope_erosion), onset, full, rough_arr,
+                           gain, outs["deg"][s:e], outs["depth"][s:e], outs["rim"][s:e],
+                           outs["slope"][s:e], centre[s:e], outs["maxdh"][s:e],
+                           outs["nvert"][s:e], outs["sp"][s:e])
+    if n and (radii <= 0).any():
+        raise ValueError("craters pushed the surface through the body centre; lower the "
+                         "largest diameter or max_extent_deg")
+    cols = {k: cat[k] for k in names}
+    cols.update(degradation=outs["deg"], rim_radius_m=diam / 2.0, depth_m=outs["depth"],
+                rim_height_m=outs["rim"], slope_deg=outs["slope"], centre_x_m=centre[:, 0],
+                centre_y_m=centre[:, 1], centre_z_m=centre[:, 2], seed=seeds,
+                max_change_m=outs["maxdh"], n_vertices=outs["nvert"].astype(np.int64),
+                spacing_m=outs["sp"])
+    stamped = _craters.make_catalog(**cols)
+    if body.craters is not None and len(body.craters):
+        try:
+            stamped = np.concatenate([body.craters, stamped.astype(body.craters.dtype)])
+        except (TypeError, ValueError):
+            logger.warning("previous crater catalog has other columns; keeping only the new")
+    return body.replace(radii_m=radii, craters=stamped)
+
+

@@ -1,0 +1,234 @@
+"""Craters on the body: local DEM mapping, ground truth, stretched bodies, populations."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+import craters
+from latlong import (
+    Body,
+    LatLongGrid,
+    body_population,
+    load,
+    perlin_fbm,
+    stamp_craters,
+    surface_positions,
+)
+from latlong._crater_kernels import _fill_holes, _fit_plane_points, _gather_kernel
+
+PROFILE_TOL = 0.02  # of the depth
+AZIMUTH_STD_TOL = 0.005  # of the depth
+RIM_TOL = 0.05
+
+
+def unit(lat_deg, lon_deg):
+    la, lo = np.radians(lat_deg), np.radians(lon_deg)
+    return np.array([np.cos(la) * np.cos(lo), np.cos(la) * np.sin(lo), np.sin(la)])
+
+
+@pytest.fixture(scope="module")
+def sphere():
+    return Body.sphere(LatLongGrid(160), 1000.0)
+
+
+@pytest.mark.parametrize("lat,lon", [(0.0, 0.0), (45.0, 100.0), (80.0, 200.0),
+                                     (10.0, 359.9), (-3.0, 0.05), (-89.0, 10.0)])
+def test_single_crater_on_sphere_follows_profile(sphere, lat, lon):
+    g = sphere.grid
+    d = 20 * g.spacing(1000.0)
+    cat = craters.make_catalog(lat_deg=[lat], lon_deg=[lon], diameter_m=[d])
+    out = stamp_craters(sphere, cat, roughness=False)
+    c = unit(lat, lon)
+    u = g.unit_vectors()
+    dist = 1000.0 * np.arctan2(np.linalg.norm(np.cross(u, c), axis=1), u @ c)
+    h = out.radii_m - 1000.0
+    want = craters.radial_profile(dist / (d / 2), d)
+    depth = craters.profile_params(d).depth_m
+    assert np.abs(h - want).max() <= PROFILE_TOL * depth
+    # azimuthal spread of the residual at fixed distance: no radial artifacts
+    resid = h - want
+    bins = np.digitize(dist, np.linspace(0, 1.6 * d, 33))
+    for b in np.unique(bins[dist < 1.6 * d]):
+        sel = bins == b
+        if sel.sum() > 3:
+            assert resid[sel].std() <= AZIMUTH_STD_TOL * depth
+    # outside the ejecta nothing moved
+    assert (h[dist > 1.5 * d * 1.001] == 0).all()
+
+
+def test_rim_radius_matches_catalog_on_rough_body():
+    g = LatLongGrid(200)
+    radius = 1000.0
+    base = Body.from_heights(g, radius, perlin_fbm(g, 1.5, 6, 0.5, 2.0, 20.0, rng=3))
+    sp = g.spacing(radius)
+    rng = np.random.default_rng(7)
+    lats = np.array([-50.0, -20.0, 10.0, 40.0, 70.0, 0.0])
+    lons = np.array([30.0, 150.0, 270.0, 60.0, 200.0, 330.0])
+    diam = rng.uniform(10, 30, len(lats)) * sp
+    cat = craters.make_catalog(lat_deg=lats, lon_deg=lons, diameter_m=diam)
+    out = stamp_craters(base, cat, rng=1)
+    u = g.unit_vectors()
+    for row in out.craters:
+        centre = np.array([row["centre_x_m"], row["centre_y_m"], row["centre_z_m"]])
+        rloc = np.linalg.norm(centre)
+        a = centre / rloc
+        p_new, p_old = out.vertices(), base.vertices()
+        dirs = p_old / np.linalg.norm(p_old, axis=1, keepdims=True)
+        ang = np.arctan2(np.linalg.norm(np.cross(dirs, a), axis=1), dirs @ a)
+        dist = rloc * ang
+        near = dist < 2.0 * row["rim_radius_m"]
+        # heights relative to the plane of the old terrain (radial, local frame)
+        east = np.cross([0, 0, 1.0], a)
+        east /= np.linalg.norm(east)
+        north = np.cross(a, east)
+        az = np.arctan2(dirs[near] @ north, dirs[near] @ east)
+        x, y = dist[near] * np.cos(az), dist[near] * np.sin(az)
+        h_old = np.linalg.norm(p_old[near], axis=1) - rloc
+        h_new = np.linalg.norm(p_new[near], axis=1) - rloc
+        coef = np.linalg.lstsq(np.stack([np.ones_like(x), x, y], 1), h_old, rcond=None)[0]
+        rel = h_new - (coef[0] + coef[1] * x + coef[2] * y)
+        sectors = np.digitize(az, np.linspace(-np.pi, np.pi, 25))
+        crest = [dist[near][sectors == s][np.argmax(rel[sectors == s])]
+                 for s in np.unique(sectors)]
+        assert abs(np.median(crest) / row["rim_radius_m"] - 1) <= RIM_TOL
+        assert u.shape[0] == g.n_vertices
+
+
+def test_stretched_body_no_spikes_or_holes():
+    g = LatLongGrid(150)
+    from latlong import FAULTING_PRESETS, two_phase_faulting
+
+    p = FAULTING_PRESETS["paper"]
+    h = two_phase_faulting(g, 100.0, p, rng=2)
+    body = Body.from_heights(g, 100.0, h, stretch=p.stretch)
+    rng = np.random.default_rng(5)
+    lat, lon, _ = surface_positions(body, 60, rng=rng)
+    diam = np.exp(rng.uniform(np.log(3.0), np.log(20.0), 60))
+    for k in range(60):  # each crater alone: its own change, not its neighbours'
+        cat = craters.make_catalog(lat_deg=lat[k:k + 1], lon_deg=lon[k:k + 1],
+                                   diameter_m=diam[k:k + 1])
+        row = stamp_craters(body, cat, rng=k, slope_erosion=False).craters[0]
+        assert row["max_change_m"] <= 1.5 * (row["rim_height_m"] + row["depth_m"])
+        # with slope erosion, only craters degraded by steep ground (shallow, so that
+        # the relief they smooth away can exceed their depth) may change more
+        row = stamp_craters(body, cat, rng=k).craters[0]
+        if row["max_change_m"] > 1.5 * (row["rim_height_m"] + row["depth_m"]):
+            assert row["slope_deg"] > 35.0 and row["degradation"] > 0.6
+
+
+def test_age_order_and_catalog_columns(sphere):
+    cat = craters.make_catalog(lat_deg=[0.0, 20.0, 40.0], lon_deg=[0.0, 0.0, 0.0],
+                               diameter_m=[100.0, 80.0, 60.0], age_gyr=[1.0, 3.0, 2.0],
+                               degradation=[0.0, 0.5, 0.2])
+    out = stamp_craters(sphere, cat, rng=0)
+    assert out.craters["age_gyr"].tolist() == [3.0, 2.0, 1.0]
+    for name in ("rim_radius_m", "depth_m", "rim_height_m", "slope_deg", "centre_x_m",
+                 "seed", "max_change_m", "n_vertices"):
+        assert name in out.craters.dtype.names
+    assert np.allclose(np.linalg.norm(np.stack([out.craters["centre_x_m"],
+                                                out.craters["centre_y_m"],
+                                                out.craters["centre_z_m"]], 1), axis=1), 1000.0)
+    # same seed, same body; the input body is untouched
+    again = stamp_craters(sphere, cat, rng=0)
+    assert np.array_equal(again.radii_m, out.radii_m)
+    assert (sphere.radii_m == 1000.0).all()
+
+
+def test_catalog_saved_with_the_body(sphere, tmp_path):
+    cat = craters.make_catalog(lat_deg=[10.0], lon_deg=[20.0], diameter_m=[150.0])
+    out = stamp_craters(sphere, cat, rng=0)
+    out.save(tmp_path / "b.npz")
+    back = load(tmp_path / "b.npz")
+    assert np.array_equal(back.craters, out.craters)
+
+
+def test_too_large_craters(sphere):
+    big = craters.make_catalog(lat_deg=[0.0, 5.0], lon_deg=[0.0, 5.0],
+                               diameter_m=[900.0, 50.0])
+    with pytest.raises(ValueError, match="too large"):
+        stamp_craters(sphere, big)
+    out = stamp_craters(sphere, big, too_large="skip")
+    assert len(out.craters) == 1 and out.craters["diameter_m"][0] == 50.0
+    flat = craters.make_catalog(x_m=[0.0], y_m=[0.0], diameter_m=[5.0])
+    with pytest.raises(ValueError, match="lat_deg"):
+        stamp_craters(sphere, flat)
+    with pytest.raises(TypeError, match="Body"):
+        stamp_craters("body", big)
+
+
+def reference_gather(g, colat, lon, ang):
+    u = g.unit_vectors()
+    c = np.array([np.sin(colat) * np.cos(lon), np.sin(colat) * np.sin(lon), np.cos(colat)])
+    return set(np.flatnonzero(u @ c >= np.cos(min(ang, np.pi))).tolist())
+
+
+@pytest.mark.parametrize("colat,lon,ang", [(0.0, 0.0, 0.1), (np.pi, 1.0, 0.3),
+                                           (1.0, 6.27, 0.2), (0.05, 3.0, 0.2),
+                                           (1.5, 0.0, 1.0), (2.0, 2.0, 3.2)])
+def test_gather_is_a_superset_of_the_cap(colat, lon, ang):
+    g = LatLongGrid(40)
+    n = _gather_kernel(40, g.ring_offsets(), colat, lon, ang, np.empty(0, np.int64), True)
+    out = np.empty(n, np.int64)
+    _gather_kernel(40, g.ring_offsets(), colat, lon, ang, out, False)
+    assert len(set(out.tolist())) == n  # no duplicates
+    assert reference_gather(g, colat, lon, ang) <= set(out.tolist())
+    # and it is local: not much more than the cap plus a ring of margin
+    assert n <= min(g.n_vertices, len(reference_gather(g, colat, lon, ang + 4 * np.pi / 80)) + 2)
+
+
+def test_fill_holes_matches_reference(rng):
+    grid = rng.standard_normal((9, 9))
+    known = rng.random((9, 9)) > 0.4
+    got = _fill_holes(np.where(known, grid, 0.0), known)
+    assert np.array_equal(got[known], grid[known])
+    for i, j in zip(*np.nonzero(~known), strict=True):
+        acc = wsum = 0.0
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                if di == dj == 0:
+                    continue
+                s = 1
+                while 0 <= i + s * di < 9 and 0 <= j + s * dj < 9:
+                    if known[i + s * di, j + s * dj]:
+                        w = 1 / (s * np.hypot(di, dj))
+                        acc += w * grid[i + s * di, j + s * dj]
+                        wsum += w
+                        break
+                    s += 1
+        assert got[i, j] == pytest.approx(acc / wsum)
+
+
+def test_fit_plane_points_matches_lstsq(rng):
+    x, y = rng.uniform(-5, 5, 200), rng.uniform(-5, 5, 200)
+    h = 1.5 + 0.3 * x - 0.7 * y + 0.01 * rng.standard_normal(200)
+    dist = np.hypot(x, y)
+    p0, gx, gy = _fit_plane_points(x, y, h, dist, 200, 4.0)
+    sel = dist <= 4.0
+    want = np.linalg.lstsq(np.stack([np.ones(sel.sum()), x[sel], y[sel]], 1), h[sel],
+                           rcond=None)[0]
+    assert np.allclose([p0, gx, gy], want)
+
+
+def test_surface_positions_uniform():
+    body = Body.sphere(LatLongGrid(40), 10.0)
+    lat, lon, area = surface_positions(body, 20000, rng=1)
+    assert stats.kstest(np.sin(np.radians(lat)), "uniform", args=(-1, 2)).pvalue > 0.01
+    assert stats.kstest(lon, "uniform", args=(0, 360)).pvalue > 0.01
+    assert area == pytest.approx(4 * np.pi * 100, rel=0.01)
+    # on a stretched body, points follow the actual area
+    long_body = Body.sphere(LatLongGrid(40), 10.0, stretch=(3.0, 1.0, 1.0))
+    lat, lon, _ = surface_positions(long_body, 20000, rng=2)
+    x = np.cos(np.radians(lat)) * np.cos(np.radians(lon))
+    tip = np.abs(x) > 0.9
+    # the caps |x| > 0.9 of a 3:1:1 spheroid hold ~5.3 % of its area (vs 10 % of a sphere)
+    assert 0.04 < tip.mean() < 0.07
+
+
+def test_body_population_counts_the_actual_area():
+    body = Body.sphere(LatLongGrid(40), 100.0, stretch=(2.0, 1.0, 1.0))
+    cat = body_population(body, [craters.CraterLayer(0.5, -2.0, 5.0, 20.0)], rng=3)
+    area = 4 * np.pi * 100.0**2 * 1.5  # a 2:1:1 prolate spheroid has ~1.48x the area
+    mean = area * 0.5 * (5.0**-2 - 20.0**-2)
+    assert abs(len(cat) - mean) < 0.05 * mean + 4 * np.sqrt(mean)
