@@ -312,12 +312,13 @@ def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
 @njit(cache=True)
 def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg, xe,
                        slope_erosion, onset_deg, full_deg, rough, gain, out_deg, out_depth,
-                       out_rim, out_slope):
+                       out_rim, out_slope, out_erased):
     """Stamp craters in the given order (the caller sorts oldest first), in place.
 
     For each crater: fit the plane to the obliterated region of the current heights,
-    erode on steep ground, sample the rim offsets, write. Records the degradation,
-    depth, rim height and plane slope actually used.
+    erode on steep ground (ground at or above ``full_deg`` erases the crater: it is not
+    written and ``out_erased`` is set), sample the rim offsets, write. Records the
+    degradation, depth, rim height and plane slope actually used.
     """
     delta = np.empty(rim_tabs.shape[1])
     for c in range(cx.shape[0]):
@@ -325,7 +326,11 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg
         p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
         slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
         d = degr[c]
+        out_slope[c] = slope
         if slope_erosion:
+            if slope >= full_deg:
+                out_erased[c] = True
+                continue
             frac = (slope - onset_deg) / (full_deg - onset_deg)
             frac = min(max(frac, 0.0), 1.0)
             d = d + (1.0 - d) * frac
@@ -341,4 +346,3 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg
         out_deg[c] = d
         out_depth[c] = depth
         out_rim[c] = rim_h
-        out_slope[c] = slope

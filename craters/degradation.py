@@ -111,8 +111,10 @@ def slope_erosion(degradation, slope_deg, *, onset_deg: float = 20.0, full_deg: 
     """Extra degradation of craters formed on steep ground (surface creep).
 
     ``d' = d + (1 - d) s`` with ``s`` rising linearly from 0 at ``onset_deg`` to 1 at
-    ``full_deg``: a crater on a 45 degree slope is fully degraded, one on ground flatter
-    than 20 degrees is unchanged.
+    ``full_deg``: a crater on ground flatter than 20 degrees is unchanged, one on a
+    45 degree slope is fully degraded. The stamping functions go one step further: a
+    crater on ground at or above ``full_deg`` (steeper than the angle of repose of
+    regolith, ~35-40 degrees) cannot keep its shape and is erased, not stamped.
 
     Examples
     --------

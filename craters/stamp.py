@@ -20,6 +20,7 @@ Grid frame: pixel (row i, column j) has its centre at ``x = j * pixel_size_m``,
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 
@@ -35,6 +36,8 @@ from .catalog import make_catalog, sort_oldest_first, validate_catalog
 from .degradation import DEFAULT_DEGRADATION, DegradationModel
 from .morphometry import Morphometry, get_morphometry
 from .profile import DEFAULT_EJECTA_EDGE
+
+logger = logging.getLogger(__name__)
 
 __all__ = ["Crater", "Roughness", "resolve_roughness", "rim_perturbations", "stamp",
            "stamp_many"]
@@ -158,7 +161,9 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     rng
         Seed or Generator for rim shapes and overlay seeds.
     return_catalog : bool
-        Also return the catalog as stamped (order of stamping) with columns
+        Also return the catalog of the craters stamped (in stamping order; craters that
+        fell on ground steeper than ``full_deg`` are erased by mass wasting, not stamped,
+        and left out) with columns
         ``degradation`` (after slope erosion), ``rim_radius_m``, ``depth_m``,
         ``rim_height_m``, ``slope_deg`` and ``seed``.
 
@@ -191,6 +196,7 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     cy = np.ascontiguousarray(cat["y_m"] / pixel, dtype=np.float64)
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
     out = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope")}
+    erased = np.zeros(n, dtype=np.bool_)
     morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
     deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
@@ -201,13 +207,16 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
         _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], degr[s:e], rim_tabs[s:e],
                            seeds[s:e], morph_arr, deg_arr, ejecta_edge, bool(slope_erosion),
                            onset, full, rough_arr, gain, out["deg"][s:e], out["depth"][s:e],
-                           out["rim"][s:e], out["slope"][s:e])
+                           out["rim"][s:e], out["slope"][s:e], erased[s:e])
+    if erased.any():
+        logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
+                    int(erased.sum()), n, full)
     if not return_catalog:
         return h
     cols = {k: cat[k] for k in names}
     cols.update(degradation=out["deg"], rim_radius_m=diam / 2.0, depth_m=out["depth"],
                 rim_height_m=out["rim"], slope_deg=out["slope"], seed=seeds)
-    return h, make_catalog(**cols)
+    return h, make_catalog(**cols)[~erased]
 
 
 def stamp(heights, pixel_size_m: float, crater: Crater, *, roughness=True, rng=None,

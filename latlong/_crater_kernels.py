@@ -233,7 +233,7 @@ def _write_kernel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h,
 def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, degr, rim_tabs,
                        seeds, morph, deg, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                        out_deg, out_depth, out_rim, out_slope, out_centre, out_maxdh,
-                       out_nvert, out_spacing, naive=False, stop_after=0):
+                       out_nvert, out_spacing, out_erased, naive=False, stop_after=0):
     """Stamp craters on the body in the given order (oldest first), updating ``radii``.
 
     Per crater: centre on the current surface; gather the region's vertices through the
@@ -366,8 +366,29 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         local = _fill_holes(acc, known)
         if stop_after == 2:
             continue
-        slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
+        # slope: angle between the local surface normal (from the fitted base) and the
+        # normal of the reference body (the stretched sphere, S^-2 P_c; radial when
+        # unstretched), so that an elongated body's shape is not mistaken for steep ground
+        l0 = a0 - gx * e0v - gy * n0
+        l1 = a1 - gx * e1v - gy * n1
+        l2 = a2 - gx * e2v - gy * n2
+        r0 = pc0 / (stretch[0] * stretch[0])
+        r1 = pc1 / (stretch[1] * stretch[1])
+        r2 = pc2 / (stretch[2] * stretch[2])
+        cr0 = l1 * r2 - l2 * r1
+        cr1 = l2 * r0 - l0 * r2
+        cr2 = l0 * r1 - l1 * r0
+        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                      l0 * r0 + l1 * r1 + l2 * r2))
         d = degr[c]
+        out_slope[c] = slope
+        out_centre[c, 0] = pc0
+        out_centre[c, 1] = pc1
+        out_centre[c, 2] = pc2
+        out_spacing[c] = sp
+        if slope_erosion and slope >= full_deg:
+            out_erased[c] = True  # steeper than the angle of repose: erased, not stamped
+            continue
         if slope_erosion:
             frac = min(max((slope - onset_deg) / (full_deg - onset_deg), 0.0), 1.0)
             d = d + (1.0 - d) * frac
@@ -388,10 +409,5 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         out_deg[c] = d
         out_depth[c] = depth
         out_rim[c] = rim_h
-        out_slope[c] = slope
-        out_centre[c, 0] = pc0
-        out_centre[c, 1] = pc1
-        out_centre[c, 2] = pc2
         out_maxdh[c] = big
         out_nvert[c] = keep
-        out_spacing[c] = sp

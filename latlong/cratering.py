@@ -51,13 +51,18 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     For each crater (Martin 2014 V.A): the vertices of its region are gathered through
     the ring structure (no scan of the whole body); each gets its true distance from the
     crater centre (arc length at the local radius, measured between the actual surface
-    directions, so stretched and irregular bodies work) and its azimuth in the east/north
+    directions, so stretched and irregular bodies work), its azimuth in the east/north
     frame at the centre, and its height radially relative to the centre's radius. The
-    vertices are binned into a local height grid at the local vertex spacing (holes
-    filled by 8-direction inverse-distance averages), on which the obliterated region's
-    plane, its slope (slope erosion) and the rim offsets are measured; then the crater
-    (:mod:`craters` profile, irregular rim, roughness) is evaluated at every vertex with
-    its true distance and azimuth, and the vertex's radial vector is rescaled by its
+    base of the obliterated region is a quadric fitted to those vertices (on a stretched
+    or curved body radial heights are curved even where the surface is smooth; on flat
+    ground it is the plane); the terrain relative to it is binned into a local height
+    grid at the local vertex spacing (holes filled by 8-direction inverse-distance
+    averages), from which the rim offsets are sampled. The slope used for slope erosion
+    is the angle between the base's normal and the normal of the reference body (the
+    stretched sphere; the radial direction when unstretched), so an elongated body's
+    shape is not mistaken for steep ground. Then the crater (:mod:`craters` profile,
+    irregular rim, roughness) is evaluated at every vertex with its true distance and
+    azimuth, and the vertex's radial vector is rescaled by its
     height change. Works across the 0/360 degree seam and over the poles.
 
     Parameters
@@ -83,7 +88,9 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
 
     Returns
     -------
-    Body with the new radii and ``craters`` = the catalog as stamped (stamping order),
+    Body with the new radii and ``craters`` = the catalog as stamped (stamping order;
+    craters on ground at or above ``full_deg`` are erased by mass wasting, not stamped,
+    and left out),
     with the degradation actually used, ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
     ``slope_deg``, the 3-D centre ``centre_x_m, centre_y_m, centre_z_m``, ``seed``,
     ``max_change_m`` (largest radial change) and ``n_vertices`` touched.
@@ -134,6 +141,7 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
     outs = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope", "maxdh", "nvert", "sp")}
     centre = np.zeros((n, 3))
+    erased = np.zeros(n, dtype=np.bool_)
     morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
     deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
@@ -149,7 +157,7 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
                            deg_arr, ejecta_edge, bool(slope_erosion), onset, full, rough_arr,
                            gain, outs["deg"][s:e], outs["depth"][s:e], outs["rim"][s:e],
                            outs["slope"][s:e], centre[s:e], outs["maxdh"][s:e],
-                           outs["nvert"][s:e], outs["sp"][s:e])
+                           outs["nvert"][s:e], outs["sp"][s:e], erased[s:e])
     if n and (radii <= 0).any():
         raise ValueError("craters pushed the surface through the body centre; lower the "
                          "largest diameter or max_extent_deg")
@@ -159,7 +167,10 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
                 centre_y_m=centre[:, 1], centre_z_m=centre[:, 2], seed=seeds,
                 max_change_m=outs["maxdh"], n_vertices=outs["nvert"].astype(np.int64),
                 spacing_m=outs["sp"])
-    stamped = _craters.make_catalog(**cols)
+    stamped = _craters.make_catalog(**cols)[~erased]
+    if erased.any():
+        logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
+                    int(erased.sum()), n, full)
     if body.craters is not None and len(body.craters):
         try:
             stamped = np.concatenate([body.craters, stamped.astype(body.craters.dtype)])

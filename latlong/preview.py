@@ -2,10 +2,10 @@
 
 The camera looks at the centre of the body's bounding box from the direction
 (``view_lat_deg``, ``view_lon_deg``) in the body-fixed frame, at ``camera_distance_m``
-(default: far enough to frame the body). The sun is given relative to the camera:
-azimuth 0 = behind the viewer (full phase), 90 = from the right of the picture;
-elevation above the picture's horizontal plane. ``views=6`` writes a contact sheet of
-six views along +x, -x, +y, -y, +z, -z with the same sun geometry.
+(default: the body's silhouette fills the picture with a small margin). The sun is
+given relative to the camera: azimuth 0 = behind the viewer (full phase), 90 = from
+the right of the picture; elevation above the picture's horizontal plane. ``views=6``
+writes a contact sheet of six views along +x, -x, +y, -y, +z, -z with the same sun geometry.
 """
 
 from __future__ import annotations
@@ -101,8 +101,14 @@ def _render(mesh, centre, extent, *, sun, view, width_px, height_px, camera_dist
                          light_type="scene light", intensity=1.0)
         light.positional = False
         plotter.add_light(light)
-        view_angle = 30.0
-        fit = 1.05 * extent / math.tan(math.radians(view_angle / 2))
+        view_angle = 30.0  # vertical field of view, degrees
+        rel = np.asarray(mesh.points) - centre
+        half_w = float(np.abs(rel @ right).max())
+        half_h = float(np.abs(rel @ up).max())
+        depth = float((rel @ v).max())  # nearest point towards the camera
+        tan_v = math.tan(math.radians(view_angle / 2))
+        tan_h = tan_v * width_px / height_px
+        fit = depth + 1.08 * max(half_w / tan_h, half_h / tan_v)
         distance = camera_distance_m if camera_distance_m else fit
         plotter.camera_position = [tuple(centre + v * distance), tuple(centre), tuple(up)]
         plotter.camera.view_angle = view_angle

@@ -187,11 +187,11 @@ PRESETS: dict[str, Preset] = {
     "eros-like": Preset(
         "433 Eros-like: 8 km radius stretched to ~34 x 11 x 11 km, lumpy fBm base, a "
         "saturated crater population near equilibrium (N_cum = 0.1 D^-2, 40 m-1.5 km), "
-        "asteroid d/D = 0.2, 3 Gyr crater lifetime (magnitude >= 800 resolves it)",
+        "asteroid d/D = 0.2 (magnitude >= 700 resolves it)",
         "fbm", None,
         {"radius_m": 8000.0, "stretch": (2.15, 0.7, 0.7), "frequency": 1.2, "octaves": 8,
          "persistence": 0.45, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
-         "crater_lifetime_gyr": 3.0, "craters": ["c=0.1,k=-2,dmin=40,dmax=1500"]},
+         "craters": ["c=0.1,k=-2,dmin=40,dmax=1500"]},
         amplitude=0.12),
     "itokawa-like": Preset(
         "25143 Itokawa-like rubble pile: 165 m radius, elongated (535 x 294 x 209 m), "

@@ -27,6 +27,7 @@ def run_kernel(body, cat, rng, **switches):
     seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
     radii = np.array(body.radii_m)
     outs = [np.zeros(n) for _ in range(4)] + [np.zeros((n, 3))] + [np.zeros(n) for _ in range(3)]
+    outs.append(np.zeros(n, dtype=np.bool_))
     g = body.grid
     t0 = time.perf_counter()
     _stamp_body_kernel(g.magnitude, g.ring_offsets(), g.unit_vectors(), radii,

@@ -154,6 +154,16 @@ def test_roughness_and_irregular_rim():
     assert (rough[r > 450 * 1.05 + 1] == 0).all()
 
 
+def test_craters_on_ground_steeper_than_full_deg_are_erased():
+    yy, xx = np.mgrid[0:201, 0:201]
+    terrain = xx * np.tan(np.radians(50.0))
+    h, cat = stamp(terrain, 1.0, Crater(100.0, 100.0, 30.0), return_catalog=True)
+    assert np.array_equal(h, terrain) and len(cat) == 0
+    h, cat = stamp(terrain, 1.0, Crater(100.0, 100.0, 30.0), return_catalog=True,
+                   slope_erosion=False)
+    assert not np.array_equal(h, terrain) and len(cat) == 1
+
+
 def test_crater_partly_outside_the_grid():
     h = stamp(np.zeros((50, 50)), 1.0, Crater(0.0, 0.0, 40.0))
     assert np.isfinite(h).all() and h.min() < 0

@@ -109,13 +109,10 @@ def test_stretched_body_no_spikes_or_holes():
     for k in range(60):  # each crater alone: its own change, not its neighbours'
         cat = craters.make_catalog(lat_deg=lat[k:k + 1], lon_deg=lon[k:k + 1],
                                    diameter_m=diam[k:k + 1])
-        row = stamp_craters(body, cat, rng=k, slope_erosion=False).craters[0]
-        assert row["max_change_m"] <= 1.5 * (row["rim_height_m"] + row["depth_m"])
-        # with slope erosion, only craters degraded by steep ground (shallow, so that
-        # the relief they smooth away can exceed their depth) may change more
-        row = stamp_craters(body, cat, rng=k).craters[0]
-        if row["max_change_m"] > 1.5 * (row["rim_height_m"] + row["depth_m"]):
-            assert row["slope_deg"] > 35.0 and row["degradation"] > 0.6
+        for erosion in (False, True):
+            stamped = stamp_craters(body, cat, rng=k, slope_erosion=erosion).craters
+            for row in stamped:  # with erosion, craters on >= 45 deg ground are erased
+                assert row["max_change_m"] <= 1.5 * (row["rim_height_m"] + row["depth_m"])
 
 
 def test_age_order_and_catalog_columns(sphere):
