@@ -7,12 +7,26 @@ the georeferencing. See ``dem --help`` for the command line.
 
 import logging
 
+from .analysis import band_power, laplacian, slope_deg
 from .core import Dem
+from .expansion import displacement_scales, expand, expansion_sizes
+from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
 from .io import read, write
 
 __all__ = [
     "Dem",
+    "FractalFit",
+    "band_power",
+    "displacement_scales",
+    "expand",
+    "expansion_sizes",
+    "fractal_dimension",
+    "fractal_fit",
+    "laplacian",
+    "local_roughness",
     "read",
+    "slope_deg",
+    "variogram",
     "write",
 ]
 
