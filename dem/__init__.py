@@ -11,6 +11,7 @@ from .analysis import band_power, laplacian, slope_deg
 from .core import Dem
 from .expansion import displacement_scales, expand, expansion_sizes
 from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
+from .gaps import fill_gaps
 from .io import read, write
 
 __all__ = [
@@ -20,6 +21,7 @@ __all__ = [
     "displacement_scales",
     "expand",
     "expansion_sizes",
+    "fill_gaps",
     "fractal_dimension",
     "fractal_fit",
     "laplacian",
