@@ -23,6 +23,8 @@ __all__ = ["Dem", "HISTORY_TAG", "crs_label"]
 HISTORY_TAG = "CRATERFORM_HISTORY"
 #: Tags holding the layer's place on the global pixel lattice (see :attr:`Dem.level`).
 LEVEL_TAG = "CRATERFORM_LEVEL"
+#: Tag holding the body radius (metres) of a DEM craterform wrote.
+RADIUS_TAG = "CRATERFORM_BODY_RADIUS_M"
 ORIGIN_TAG = "CRATERFORM_ORIGIN"
 
 

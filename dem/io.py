@@ -21,7 +21,7 @@ from rasterio.profiles import DefaultGTiffProfile
 from craters._infra import atomic_path, check_int
 
 from ._pds import Quantity, find_object, parse_label
-from .core import LEVEL_TAG, ORIGIN_TAG, Dem
+from .core import LEVEL_TAG, ORIGIN_TAG, RADIUS_TAG, Dem
 
 __all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "read", "write"]
 
@@ -71,8 +71,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     pixel_size_m : float or (float, float), optional
         Pixel size in metres, required (and only allowed) when the file has no CRS.
     body_radius_m : float, optional
-        Body radius in metres, required for a geographic CRS unless a PDS label gives it
-        (an explicit value wins over the label's).
+        Body radius in metres, required for a geographic CRS unless a PDS label or the
+        ``CRATERFORM_BODY_RADIUS_M`` tag of a file craterform wrote gives it (an explicit
+        value wins).
 
     Returns
     -------
@@ -95,6 +96,11 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
             body_radius_m = label_radius
     else:
         heights, transform, crs, tags = _read_gdal(path, band)
+        if body_radius_m is None and RADIUS_TAG in tags:
+            try:  # written by craterform from a DEM whose radius was known
+                body_radius_m = float(tags[RADIUS_TAG])
+            except ValueError:
+                logger.warning("%s: ignoring malformed %s tag", path, RADIUS_TAG)
     if not np.isfinite(heights).any():
         raise ValueError(f"{str(path)!r}: every pixel is NoData/NaN; there is no terrain to "
                          f"work with")
@@ -358,8 +364,8 @@ def write(dem: Dem, path) -> Path:
     predictor, 256 x 256 tiles when both sides are at least 256 pixels (the
     cloud-optimised layout; smaller rasters are striped), BigTIFF when needed. The CRS,
     transform and tags (including how the layer was made: ``CRATERFORM_GENERATOR``,
-    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``) are written. An existing
-    file is replaced.
+    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``, and the body radius if known,
+    ``CRATERFORM_BODY_RADIUS_M``) are written. An existing file is replaced.
 
     Examples
     --------
@@ -392,7 +398,10 @@ def write(dem: Dem, path) -> Path:
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(tmp, "w", **profile) as ds:
                 ds.write(data, 1)
-                ds.update_tags(**dict(dem.tags))
+                tags = dict(dem.tags)
+                if dem.body_radius_m is not None:
+                    tags[RADIUS_TAG] = repr(dem.body_radius_m)
+                ds.update_tags(**tags)
                 ds.set_band_description(1, "height")
                 ds.units = ("metre",)
     return path

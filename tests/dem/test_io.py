@@ -15,6 +15,8 @@ from dem import Dem
 from dem._pds import Quantity, find_object, parse_label
 
 DATA = os.path.join(os.path.dirname(__file__), "..", "data")
+MOON_WKT = ('GEOGCS["Moon 2015",DATUM["Moon_2015",SPHEROID["Moon",1737400,0]],'
+            'PRIMEM["Reference_Meridian",0],UNIT["degree",0.0174532925199433]]')
 
 
 # --------------------------------------------------------------------------- GeoTIFF
@@ -60,14 +62,28 @@ def test_write_is_deterministic_and_atomic(tmp_path, lola_crop):
     assert (tmp_path / "c.tif").read_bytes() == b"old"
 
 
-def test_geographic_round_trip_needs_radius(tmp_path, lola_crop):
-    p = dem.write(lola_crop, tmp_path / "g.tif")
-    with pytest.raises(ValueError, match="geographic CRS.*--body-radius-m"):
-        dem.read(p)
-    back = dem.read(p, body_radius_m=1737400.0)
+def write_foreign_geographic(path, z):
+    """A geographic (Moon) GeoTIFF written by rasterio directly, without craterform tags."""
+    with rasterio.open(path, "w", driver="GTiff", width=z.shape[1], height=z.shape[0],
+                       count=1, dtype="float32", crs=MOON_WKT,
+                       transform=Affine(0.25, 0, 148.0, 0, -0.25, 32.0)) as ds:
+        ds.write(z.astype(np.float32), 1)
+    return path
+
+
+def test_geographic_needs_radius_unless_craterform_wrote_it(tmp_path, lola_crop):
+    foreign = write_foreign_geographic(tmp_path / "f.tif", lola_crop.heights)
+    with pytest.raises(ValueError, match="geographic CRS.*radius 1737400 m.*--body-radius-m"):
+        dem.read(foreign)
+    assert dem.read(foreign, body_radius_m=1737400.0).pixel_size_m == pytest.approx(
+        lola_crop.pixel_size_m)
+    p = dem.write(lola_crop, tmp_path / "g.tif")  # records the radius it knows
+    back = dem.read(p)
+    assert back.body_radius_m == 1737400.0
     assert back.pixel_size_m == pytest.approx(lola_crop.pixel_size_m)
     assert np.array_equal(back.heights, lola_crop.heights)
     assert back.tags["PDS_PRODUCT_ID"] == "LDEM_4_CROP"
+    assert dem.read(p, body_radius_m=1.0).body_radius_m == 1.0  # explicit value wins
 
 
 def test_read_errors(tmp_path, tiny_geotiff):
