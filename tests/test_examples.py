@@ -14,6 +14,7 @@ EXAMPLES = sorted((Path(__file__).parents[1] / "examples").glob("plot_*.py"))
 @pytest.mark.parametrize("script", EXAMPLES, ids=lambda p: p.stem)
 def test_example_runs(script, tmp_path, monkeypatch, capsys):
     monkeypatch.setenv("CRATERFORM_EXAMPLE_MAGNITUDE", "24")
+    monkeypatch.setenv("CRATERFORM_EXAMPLE_SMALL", "1")
     monkeypatch.setenv("CRATERFORM_EXAMPLE_OUT", str(tmp_path))
     runpy.run_path(str(script), run_name="__main__")
     pngs = list(tmp_path.glob("*.png"))
