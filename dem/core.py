@@ -25,6 +25,8 @@ HISTORY_TAG = "CRATERFORM_HISTORY"
 LEVEL_TAG = "CRATERFORM_LEVEL"
 #: Tag holding the body radius (metres) of a DEM craterform wrote.
 RADIUS_TAG = "CRATERFORM_BODY_RADIUS_M"
+#: Tag holding the pixel size "x,y" (metres) of a DEM without CRS that craterform wrote.
+PIXEL_SIZE_TAG = "CRATERFORM_PIXEL_SIZE_M"
 ORIGIN_TAG = "CRATERFORM_ORIGIN"
 
 

@@ -21,7 +21,7 @@ from rasterio.profiles import DefaultGTiffProfile
 from craters._infra import atomic_path, check_int
 
 from ._pds import Quantity, find_object, parse_label
-from .core import LEVEL_TAG, ORIGIN_TAG, RADIUS_TAG, Dem
+from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
 
 __all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "read", "write"]
 
@@ -69,7 +69,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     band : int
         1-based band number.
     pixel_size_m : float or (float, float), optional
-        Pixel size in metres, required (and only allowed) when the file has no CRS.
+        Pixel size in metres, required (and only allowed) when the file has no CRS,
+        unless craterform wrote the file (tag ``CRATERFORM_PIXEL_SIZE_M``; an explicit
+        value wins).
     body_radius_m : float, optional
         Body radius in metres, required for a geographic CRS unless a PDS label or the
         ``CRATERFORM_BODY_RADIUS_M`` tag of a file craterform wrote gives it (an explicit
@@ -96,11 +98,15 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
             body_radius_m = label_radius
     else:
         heights, transform, crs, tags = _read_gdal(path, band)
-        if body_radius_m is None and RADIUS_TAG in tags:
-            try:  # written by craterform from a DEM whose radius was known
+        # written by craterform: the body radius / the pixel size of a DEM without CRS
+        try:
+            if body_radius_m is None and RADIUS_TAG in tags:
                 body_radius_m = float(tags[RADIUS_TAG])
-            except ValueError:
-                logger.warning("%s: ignoring malformed %s tag", path, RADIUS_TAG)
+            if pixel_size_m is None and crs is None and PIXEL_SIZE_TAG in tags:
+                pixel_size_m = tuple(float(v) for v in tags[PIXEL_SIZE_TAG].split(","))
+        except ValueError:
+            logger.warning("%s: ignoring malformed %s/%s tags", path, RADIUS_TAG,
+                           PIXEL_SIZE_TAG)
     if not np.isfinite(heights).any():
         raise ValueError(f"{str(path)!r}: every pixel is NoData/NaN; there is no terrain to "
                          f"work with")
@@ -364,17 +370,18 @@ def write(dem: Dem, path) -> Path:
     predictor, 256 x 256 tiles when both sides are at least 256 pixels (the
     cloud-optimised layout; smaller rasters are striped), BigTIFF when needed. The CRS,
     transform and tags (including how the layer was made: ``CRATERFORM_GENERATOR``,
-    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``, and the body radius if known,
-    ``CRATERFORM_BODY_RADIUS_M``) are written. An existing file is replaced.
+    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``, the body radius if known,
+    ``CRATERFORM_BODY_RADIUS_M``, and without a CRS the pixel size,
+    ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is replaced.
 
     Examples
     --------
     >>> import tempfile, numpy as np
     >>> d = Dem(np.arange(12.0).reshape(3, 4), pixel_size_m=5.0)
     >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     back = read(write(d, f"{tmp}/d.tif"), pixel_size_m=5.0)
-    >>> bool((back.heights == d.heights).all())
-    True
+    ...     back = read(write(d, f"{tmp}/d.tif"))
+    >>> bool((back.heights == d.heights).all()), back.pixel_size_m
+    (True, (5.0, 5.0))
     """
     if not isinstance(dem, Dem):
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
@@ -401,6 +408,8 @@ def write(dem: Dem, path) -> Path:
                 tags = dict(dem.tags)
                 if dem.body_radius_m is not None:
                     tags[RADIUS_TAG] = repr(dem.body_radius_m)
+                if dem.crs is None:
+                    tags[PIXEL_SIZE_TAG] = ",".join(map(repr, dem.pixel_size_m))
                 ds.update_tags(**tags)
                 ds.set_band_description(1, "height")
                 ds.units = ("metre",)

@@ -208,8 +208,9 @@ def test_separately_cut_tile_with_context(lola_crop):
 def test_level_origin_and_history_survive_a_file(tmp_path):
     d = Dem(np.zeros((5, 5)), pixel_size_m=1.0)
     e = dem.expand(d, 1, fractal_dimension=2.5, roughness=0.0, region=None, rng=0)
-    back = dem.read(dem.write(e, tmp_path / "e.tif"), pixel_size_m=0.5)
+    back = dem.read(dem.write(e, tmp_path / "e.tif"))
     assert (back.level, back.origin) == (1, (0, 0))
+    assert back.pixel_size_m == (0.5, 0.5)  # no CRS: the pixel size travels in a tag
     assert back.history[-1]["op"] == "dem.expand"
 
 

@@ -107,7 +107,7 @@ def test_read_errors(tmp_path, tiny_geotiff):
     allnan = tmp_path / "nan.tif"
     dem.write(Dem(np.full((4, 4), np.nan), pixel_size_m=1.0), allnan)
     with pytest.raises(ValueError, match="every pixel is NoData"):
-        dem.read(allnan, pixel_size_m=1.0)
+        dem.read(allnan)
 
 
 def test_scale_offset_applied(tmp_path):
