@@ -37,9 +37,11 @@ Each half step (square -> diamond -> next square) shrinks the scale by
 starting scale (eq. 15, from a height-range factor and the resolution) and its scale
 after ``n`` RMD iterations (eq. 16) are replaced by ``sigma``, *measured* on the input at
 its own resolution, so the expansion continues the input's roughness across scales. The
-independence of ``D`` is exact for ``H = 1/2`` and an approximation otherwise; the tests
-check numerically that a DEM expanded many levels shows the requested ``F`` (within
-0.1 for F = 2.2 and 2.5) and the predicted variogram.
+independence of ``D`` is an approximation (the neighbours of a new point are not all
+model-distributed pairs: two square-phase points share corners); measured on a 17 x 17
+seed expanded 7 levels (tests, ``bench_dem.py``): F = 2.2 / 2.5 read 2.25 / 2.46 with
+:func:`dem.fractal_dimension` (2.8 reads 2.61), and the variance at the finest lag is
+0.82 / 0.98 of ``gamma``.
 
 Local amplitude. By default ``sigma`` is not one number but the local relief of the
 input, ``sigma(p) = rho(p) R``: the RMS height difference between input pixel ``p`` and
