@@ -282,7 +282,9 @@ def build_parser() -> OneLineParser:
         p = sub.add_parser(command, help=text, description=text[0].upper() + text[1:] + ".")
         p.add_argument("input", nargs="?", default=None, help="input DEM (GeoTIFF, PDS .lbl/.img)")
         if command != "info":
-            p.add_argument("--config", metavar="TOML", help="options file; flags override it")
+            p.add_argument("--config", metavar="TOML",
+                           help="TOML file whose keys are the option names (and input); "
+                                "flags override it")
         for opt in _options(command).values():
             kw: dict = {"dest": opt.key, "help": opt.help, "default": None}
             if opt.flag_only:

@@ -190,7 +190,7 @@ class Dem:
             rad = crs.units_factor[1]  # radians per angular unit
             rows, cols = self._h.shape
             lat_c = t.d * cols / 2.0 + t.e * rows / 2.0 + t.f
-            coslat = math.cos(math.radians(lat_c) if rad != 1.0 else lat_c)
+            coslat = math.cos(lat_c * rad)
             return (self._radius * rad * sx * abs(coslat), self._radius * rad * sy)
         try:
             factor = crs.linear_units_factor[1]
