@@ -1,7 +1,35 @@
-"""dem: GeoTIFF digital elevation models: expansion, gap filling, crater layers, analysis."""
+"""dem: digital elevation models: GeoTIFF/PDS I/O, RMD expansion, gap filling, statistics.
+
+Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement
+expansion of real DEMs and outside-in fractal gap filling, on a :class:`Dem` that keeps
+the georeferencing. See ``dem --help`` for the command line.
+"""
 
 import logging
 
-__all__: list[str] = []
+from .analysis import band_power, laplacian, slope_deg
+from .core import Dem
+from .expansion import displacement_scales, expand, expansion_sizes
+from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
+from .gaps import fill_gaps
+from .io import read, write
+
+__all__ = [
+    "Dem",
+    "FractalFit",
+    "band_power",
+    "displacement_scales",
+    "expand",
+    "expansion_sizes",
+    "fill_gaps",
+    "fractal_dimension",
+    "fractal_fit",
+    "laplacian",
+    "local_roughness",
+    "read",
+    "slope_deg",
+    "variogram",
+    "write",
+]
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -1,21 +1,306 @@
-"""The ``dem`` command line (its subcommands arrive with the dem issues)."""
+"""The ``dem`` command line: ``dem info``, ``dem fill`` and ``dem expand``.
+
+Every option of ``fill`` and ``expand`` has a key of the same name (dashes ->
+underscores) in a TOML file given with ``--config``; options on the command line
+override the file. Errors are one line ``error: ...`` with exit code 2, and nothing is
+written.
+"""
 
 from __future__ import annotations
 
+import argparse
+import math
 import sys
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
 
-from craters._infra import OneLineParser, package_version, run_cli
+import numpy as np
+from rasterio.coords import BoundingBox
+from rasterio.windows import Window
+
+from craters._infra import (
+    CliError,
+    OneLineParser,
+    check_output_path,
+    load_toml,
+    package_version,
+    progress_bar,
+    run_cli,
+)
+
+from .core import crs_label
+from .expansion import expand
+from .fractal import fractal_fit
+from .gaps import fill_gaps
+from .io import GEOTIFF_SUFFIXES, read, write
 
 
+# --------------------------------------------------------------------------- parsing
+def _seed(text) -> int:
+    try:
+        value = int(str(text), 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a non-negative integer; got {text!r}") from None
+    if not 0 <= value < 2**63:
+        raise argparse.ArgumentTypeError(f"must be in [0, 2**63); got {text!r}")
+    return value
+
+
+def _region(text) -> Window | BoundingBox:
+    """``ROW,COL,SIZE`` (pixels) or ``LEFT,BOTTOM,RIGHT,TOP`` (CRS units)."""
+    parts = [p.strip() for p in str(text).split(",")]
+    try:
+        if len(parts) == 3:
+            row, col, size = (int(p) for p in parts)
+            return Window(col, row, size, size)
+        if len(parts) == 4:
+            vals = [float(p) for p in parts]
+            if all(math.isfinite(v) for v in vals):
+                return BoundingBox(*vals)
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(
+        f"expected ROW,COL,SIZE (pixels) or LEFT,BOTTOM,RIGHT,TOP (CRS units); got {text!r}")
+
+
+def _number(text) -> float:
+    try:
+        value = float(text)
+    except (TypeError, ValueError):
+        raise argparse.ArgumentTypeError(f"expected a number; got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be finite; got {text!r}")
+    return value
+
+
+def _count(text) -> int:
+    try:
+        return int(str(text), 10)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer; got {text!r}") from None
+
+
+@dataclass(frozen=True)
+class Opt:
+    """One option: flags, config key, parser, default, help, the commands that take it."""
+
+    flags: tuple[str, ...]
+    key: str
+    parse: Any
+    default: Any
+    help: str
+    commands: tuple[str, ...] = ("fill", "expand")
+    flag_only: bool = False  # a store_true switch
+    metavar: str | None = None
+
+
+OPTIONS: tuple[Opt, ...] = (
+    Opt(("-o", "--output"), "output", str, None, "output GeoTIFF (.tif)", metavar="OUT"),
+    Opt(("--levels",), "levels", _count, 1, "number of 2x expansions (1..16)", ("expand",),
+        metavar="N"),
+    Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
+        "fractal dimension F in [2, 3] (default: estimated from the input)", ("expand",),
+        metavar="F"),
+    Opt(("--roughness",), "roughness", _number, None,
+        "RMS slope between neighbouring pixels, m/m, >= 0 (default: from the input; for "
+        "expand the local relief of each input pixel)", metavar="R"),
+    Opt(("--region",), "region", _region, None,
+        "square to expand, 2^n+1 pixels: ROW,COL,SIZE in pixels or LEFT,BOTTOM,RIGHT,TOP "
+        "in CRS units (default: the whole DEM)", ("expand",), metavar="REGION"),
+    Opt(("--seed",), "seed", _seed, None,
+        "random seed (non-negative integer); default: a fresh one, recorded in the tags",
+        metavar="S"),
+    Opt(("--band",), "band", _count, 1, "band of the input (1-based)",
+        ("info", "fill", "expand"), metavar="B"),
+    Opt(("--pixel-size-m",), "pixel_size_m", _number, None,
+        "pixel size in metres, for inputs without a CRS", ("info", "fill", "expand"),
+        metavar="M"),
+    Opt(("--body-radius-m",), "body_radius_m", _number, None,
+        "body radius in metres, for inputs with a geographic CRS (e.g. 1737400 for the Moon)",
+        ("info", "fill", "expand"), metavar="M"),
+    Opt(("-q", "--quiet"), "quiet", bool, False, "no progress bars or messages",
+        flag_only=True),
+    Opt(("--force",), "force", bool, False, "overwrite an existing output", flag_only=True),
+)
+
+
+def _options(command: str) -> dict[str, Opt]:
+    return {o.key: o for o in OPTIONS if command in o.commands}
+
+
+def _from_config(path, command: str) -> dict:
+    """Settings from a TOML file whose keys are the option names (plus ``input``)."""
+    opts = _options(command)
+    out = {}
+    for key, value in load_toml(path).items():
+        if key == "input":
+            if not isinstance(value, str):
+                raise CliError(f"config {str(path)!r}: key 'input' must be a file name")
+            out[key] = value
+            continue
+        opt = opts.get(key)
+        if opt is None:
+            allowed = ", ".join(["input", *sorted(opts)])
+            raise CliError(f"config {str(path)!r}: unknown key {key!r} for `dem {command}`; "
+                           f"allowed: {allowed}")
+        good = (isinstance(value, bool) if opt.flag_only
+                else isinstance(value, str | int | float) and not isinstance(value, bool))
+        try:
+            if not good:
+                raise TypeError
+            out[key] = value if opt.flag_only or opt.parse is str else opt.parse(value)
+        except (TypeError, ValueError, argparse.ArgumentTypeError):
+            raise CliError(f"config {str(path)!r}: key {key!r} has a bad value {value!r} "
+                           f"({opt.help})") from None
+    return out
+
+
+def _settings(args: argparse.Namespace, command: str) -> dict:
+    """Defaults, then the config file, then the command line."""
+    opts = _options(command)
+    s = {key: opt.default for key, opt in opts.items()}
+    s["input"] = None
+    if getattr(args, "config", None):
+        s.update(_from_config(args.config, command))
+    for key in [*opts, "input"]:
+        value = getattr(args, key, None)
+        if value is not None and value is not False:
+            s[key] = value
+    if s["input"] is None:
+        raise CliError(f"`dem {command}` needs an input DEM (argument or config key 'input')")
+    return s
+
+
+# --------------------------------------------------------------------------- checks
+def _check(s: dict, command: str) -> None:
+    """Validate everything (flags named in the messages) before any work."""
+    flag = {key: opt.flags[-1] for key, opt in _options(command).items()}
+    if s.get("band", 1) < 1:
+        raise CliError(f"--band must be >= 1; got {s['band']}")
+    for key in ("pixel_size_m", "body_radius_m"):
+        if s.get(key) is not None and s[key] <= 0:
+            raise CliError(f"{flag[key]} must be > 0; got {s[key]!r}")
+    if command == "info":
+        return
+    if s.get("roughness") is not None and s["roughness"] < 0:
+        raise CliError(f"--roughness must be >= 0; got {s['roughness']!r}")
+    if command == "expand":
+        if not 1 <= s["levels"] <= 16:
+            raise CliError(f"--levels must be an integer in [1, 16]; got {s['levels']}")
+        fd = s.get("fractal_dimension")
+        if fd is not None and not 2.0 <= fd <= 3.0:
+            raise CliError(f"--fractal-dimension must be in [2, 3]; got {fd!r}")
+    if not s.get("output"):
+        raise CliError("nothing to write: give -o/--output")
+    out = Path(s["output"])
+    if Path(s["input"]).resolve() == out.resolve():
+        raise CliError(f"output {str(out)!r} is the input; inputs are never modified")
+    check_output_path(out, force=s["force"], suffixes=GEOTIFF_SUFFIXES)
+    if s.get("seed") is None:
+        s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
+
+
+def _read(s: dict):
+    return read(s["input"], band=s["band"], pixel_size_m=s.get("pixel_size_m"),
+                body_radius_m=s.get("body_radius_m"))
+
+
+# --------------------------------------------------------------------------- commands
+def _run(args: argparse.Namespace, command: str) -> int:
+    s = _settings(args, command)
+    _check(s, command)
+    show = not s["quiet"]
+    bar = progress_bar(total=3, enabled=show, desc=command)
+    bar.set_description(f"read {s['input']}")
+    dem = _read(s)
+    bar.update()
+    bar.set_description(command)
+    if command == "fill":
+        out = fill_gaps(dem, s["roughness"], rng=s["seed"])
+    else:
+        out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
+                     rng=s["seed"], progress=show)
+    bar.update()
+    bar.set_description(f"write {s['output']}")
+    write(out, s["output"])
+    bar.update()
+    bar.close()
+    if show:
+        params = out.history[-1]["parameters"]
+        detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
+                           else f"{k} {params[k]}" for k in params
+                           if k in ("levels", "fractal_dimension", "roughness",
+                                    "filled_pixels", "waves"))
+        print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {out.shape[0]} x "
+              f"{out.shape[1]} pixels, seed {s['seed']}, {detail}")
+        print(f"wrote {s['output']}")
+    return 0
+
+
+def _cmd_info(args: argparse.Namespace) -> int:
+    s = _settings(args, "info")
+    _check(s, "info")
+    dem = _read(s)
+    z = dem.heights[dem.known]
+    t = dem.transform
+    px = dem.pixel_size_m
+    rows = [
+        ("file", s["input"]),
+        ("size", f"{dem.shape[0]} x {dem.shape[1]} pixels (rows x cols)"),
+        ("crs", crs_label(dem.crs)),
+        ("pixel_m", f"{px[0]:.6g} x {px[1]:.6g} (x, y; resolution {dem.resolution_m:.6g})"),
+        ("transform", ", ".join(f"{v:.10g}" for v in tuple(t)[:6])),
+        ("body_m", "-" if dem.body_radius_m is None else f"{dem.body_radius_m:.10g}"),
+        ("unknown", f"{100 * dem.nan_fraction:.3f} % ({dem.heights.size - z.size} pixels)"),
+        ("height_m", f"min {z.min():.6g}  mean {z.mean():.6g}  max {z.max():.6g}"),
+    ]
+    try:
+        fit = fractal_fit(dem)
+        method = "locally normalised variogram, lags 1-4 px"
+        rows += [("fractal_d", f"{fit.fractal_dimension:.4f} ({method})"),
+                 ("roughness", f"{fit.roughness:.6g} (RMS neighbour slope, m/m)")]
+    except ValueError as exc:
+        rows.append(("fractal_d", f"n/a ({exc})"))
+    for step in dem.history:
+        rows.append(("history", f"{step['op']} seed {step['seed']}"))
+    for key, value in rows:
+        print(f"{key:<10} {value}")
+    return 0
+
+
+# --------------------------------------------------------------------------- parser
 def build_parser() -> OneLineParser:
-    parser = OneLineParser(prog="dem", description=__doc__)
+    parser = OneLineParser(prog="dem", description="DEMs: gap filling, RMD expansion, info.")
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
+    helps = {"info": "describe a DEM (size, CRS, pixel size, heights, fractal dimension)",
+             "fill": "fill the unknown pixels of a DEM with fractal terrain, outside in",
+             "expand": "double the resolution of a DEM (region) by random midpoint "
+                       "displacement"}
+    for command, text in helps.items():
+        p = sub.add_parser(command, help=text, description=text[0].upper() + text[1:] + ".")
+        p.add_argument("input", nargs="?", default=None, help="input DEM (GeoTIFF, PDS .lbl/.img)")
+        if command != "info":
+            p.add_argument("--config", metavar="TOML",
+                           help="TOML file whose keys are the option names (and input); "
+                                "flags override it")
+        for opt in _options(command).values():
+            kw: dict = {"dest": opt.key, "help": opt.help, "default": None}
+            if opt.flag_only:
+                kw.update(action="store_true", default=False)
+            else:
+                kw.update(type=opt.parse, metavar=opt.metavar)
+            p.add_argument(*opt.flags, **kw)
+        p.set_defaults(func=_cmd_info if command == "info" else
+                       (lambda a, c=command: _run(a, c)))
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    build_parser().parse_args(argv)
-    return run_cli(lambda: 0)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    return run_cli(lambda: args.func(args))
 
 
 if __name__ == "__main__":  # pragma: no cover

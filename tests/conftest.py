@@ -34,3 +34,30 @@ def run_entry_point(*args: str, env: dict | None = None, cwd=None) -> subprocess
 @pytest.fixture
 def run_cli():
     return run_entry_point
+
+
+DATA = os.path.join(os.path.dirname(__file__), "data")
+
+
+@pytest.fixture
+def lola_crop():
+    """The 257 x 257 equatorial crop of LOLA LDEM_4 in tests/data (a PDS3 .img + .lbl)."""
+    import dem
+
+    return dem.read(os.path.join(DATA, "ldem4_crop.lbl"))
+
+
+@pytest.fixture
+def tiny_geotiff(tmp_path):
+    """A 33 x 33 projected (metres) GeoTIFF with NoData, made with rasterio directly."""
+    import rasterio
+    from affine import Affine
+
+    path = tmp_path / "tiny.tif"
+    z = np.add.outer(np.arange(33.0), 2 * np.arange(33.0)).astype(np.int16)
+    z[3, 4] = -9999
+    with rasterio.open(path, "w", driver="GTiff", width=33, height=33, count=1,
+                       dtype="int16", nodata=-9999, crs="EPSG:32633",
+                       transform=Affine(10.0, 0, 500000.0, 0, -10.0, 4000000.0)) as ds:
+        ds.write(z, 1)
+    return path

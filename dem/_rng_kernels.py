@@ -1,0 +1,79 @@
+"""Counter-based random numbers for the dem kernels: splitmix64 keyed by pixel.
+
+A Gaussian deviate is a pure function of ``(key, stream, level, row, col)``: the key
+comes from the caller's ``rng`` (drawn once), the stream separates uses (expansion,
+gap filling), ``level`` is the expansion level and ``row, col`` the *global* pixel
+index at that level. Nothing depends on the order in which pixels are visited, on the
+thread count or on how a raster is cut into tiles (DESIGN §3).
+
+Hash: Steele, Lea & Flood's splitmix64 finaliser (the ``java.util.SplittableRandom``
+mix), chained over the five integers; two 53-bit uniforms; Box–Muller (cosine branch).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+STREAM_EXPAND = 1
+STREAM_FILL = 2
+
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_M1 = np.uint64(0xBF58476D1CE4E5B9)
+_M2 = np.uint64(0x94D049BB133111EB)
+_S30 = np.uint64(30)
+_S27 = np.uint64(27)
+_S31 = np.uint64(31)
+_S11 = np.uint64(11)
+_ONE = np.uint64(1)
+_TWO_POW_M53 = 1.0 / 9007199254740992.0  # 2**-53
+_TWO_PI = 2.0 * np.pi
+
+
+@njit(cache=True, inline="always")
+def _splitmix64(x):
+    """The splitmix64 step: add the golden gamma, then the variant-13 finaliser."""
+    z = x + _GOLDEN
+    z = (z ^ (z >> _S30)) * _M1
+    z = (z ^ (z >> _S27)) * _M2
+    return z ^ (z >> _S31)
+
+
+@njit(cache=True, inline="always")
+def _pixel_hash(key, stream, level, row, col):
+    """64-bit hash of (key, stream, level, row, col); all arguments are integers."""
+    h = _splitmix64(np.uint64(key) ^ np.uint64(stream))
+    h = _splitmix64(h ^ np.uint64(level))
+    h = _splitmix64(h ^ np.uint64(row))
+    return _splitmix64(h ^ np.uint64(col))
+
+
+@njit(cache=True, inline="always")
+def _pixel_normal(key, stream, level, row, col):
+    """A standard normal deviate determined by (key, stream, level, row, col)."""
+    a = _pixel_hash(key, stream, level, row, col)
+    b = _splitmix64(a)
+    u1 = ((a >> _S11) + _ONE) * _TWO_POW_M53  # (0, 1]
+    u2 = (b >> _S11) * _TWO_POW_M53  # [0, 1)
+    return np.sqrt(-2.0 * np.log(u1)) * np.cos(_TWO_PI * u2)
+
+
+@njit(cache=True)
+def _normals_kernel(key, stream, level, rows, cols, out):
+    """``out[k] = normal(key, stream, level, rows[k], cols[k])`` (tests, small uses)."""
+    for k in range(rows.shape[0]):
+        out[k] = _pixel_normal(key, stream, level, rows[k], cols[k])
+
+
+def key_from_rng(rng) -> tuple[int, int | None]:
+    """The 63-bit hash key for ``rng`` (int seed, Generator or None) and the seed to record.
+
+    The key is one draw from ``numpy.random.default_rng(rng)`` (SPEC 7), so the same int
+    seed always gives the same key. The recorded seed is the int itself, or None for a
+    Generator / fresh entropy (the key is recorded too, which is enough to reproduce).
+    """
+    from craters._infra import normalize_rng
+
+    gen = normalize_rng(rng)  # validates ``rng``
+    seed = None if rng is None or isinstance(rng, np.random.Generator) else int(rng)
+    return int(gen.integers(0, 2**63, dtype=np.int64)), seed

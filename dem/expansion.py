@@ -1,0 +1,326 @@
+r"""Random midpoint displacement (RMD) expansion of DEMs (Martin et al., lunar paper IV.A).
+
+One level doubles the resolution of a square region of ``W = 2**n + 1`` pixels: the new
+grid has ``2 W - 1`` pixels a side, its even pixels are the old pixels (bit for bit),
+the (odd, odd) pixels come from the *square* phase (mean of the four diagonal old
+pixels) and the remaining pixels from the *diamond* phase (mean of the four axis
+neighbours: two old pixels and two square-phase pixels; three on the border), each plus
+a Gaussian displacement.
+
+Displacement scale (derivation)
+-------------------------------
+The terrain is modelled as fractional Brownian motion with Hurst exponent ``H = 3 - F``
+(``F`` the fractal dimension): its variogram is
+
+    gamma(l) = E[(z(p + l) - z(p))^2] = sigma^2 (l / R)^(2 H),   sigma = roughness * R,
+
+with ``R`` the input resolution (:mod:`dem.fractal` estimates ``F`` and ``roughness``).
+A new point ``c`` has four neighbours ``a_1..a_4`` at distance ``rho`` (a square of side
+``rho sqrt 2``, diagonal ``2 rho``) and gets ``z(c) = mean(z(a_k)) + D`` with ``D`` an
+independent Gaussian of variance ``s^2``. We ask the new increments to follow the
+model, ``E[(z(c) - z(a_1))^2] = gamma(rho)``. Now ``z(c) - z(a_1) = sum_k w_k z(a_k) + D``
+with ``w = (-3/4, 1/4, 1/4, 1/4)``; since ``sum w_k = 0``,
+``E[(sum w_k z_k)^2] = -1/2 sum_kl w_k w_l gamma(|a_k - a_l|)``, which for this square
+is ``gamma(rho sqrt 2) / 4 + gamma(2 rho) / 8 = gamma(rho) (2^(H-2) + 2^(2H-3))``. Hence
+
+    s^2 = gamma(rho) k(H),   k(H) = 1 - 2^(H-2) - 2^(2H-3)
+
+(``k(1) = 0``: a smooth surface needs no displacement; ``k(1/2) = 0.396``;
+``k(0) = 0.625``). At expansion level ``L = 1, 2, ...`` the old spacing is
+``d = 2^(1-L) R``; the square phase has ``rho = d / sqrt 2`` and the diamond phase
+``rho = d / 2``, so
+
+    s_square(L) = sigma sqrt(k(H)) 2^(-(L - 1/2) H),   s_diamond(L) = sigma sqrt(k(H)) 2^(-L H).
+
+Each half step (square -> diamond -> next square) shrinks the scale by
+``2^(-H/2) = 2^(-(3-F)/2)``, Peitgen & Saupe's factor (the paper's eq. 14). The paper's
+starting scale (eq. 15, from a height-range factor and the resolution) and its scale
+after ``n`` RMD iterations (eq. 16) are replaced by ``sigma``, *measured* on the input at
+its own resolution, so the expansion continues the input's roughness across scales. The
+independence of ``D`` is an approximation (the neighbours of a new point are not all
+model-distributed pairs: two square-phase points share corners); measured on a 17 x 17
+seed expanded 7 levels (tests, ``bench_dem.py``): F = 2.2 / 2.5 read 2.25 / 2.46 with
+:func:`dem.fractal_dimension` (2.8 reads 2.61), and the variance at the finest lag is
+0.82 / 0.98 of ``gamma``.
+
+Local amplitude. By default ``sigma`` is not one number but the local relief of the
+input, ``sigma(p) = rho(p) R``: the RMS height difference between input pixel ``p`` and
+its axis neighbours (:func:`dem.local_roughness`), in metres, interpolated bilinearly
+to each new pixel: the terrain model of :mod:`dem.fractal` (one ``H``, amplitude varying in
+space). Smooth mare then gets smooth detail and crater walls rough detail, which is
+what keeps the slope distribution of a real DEM (a single amplitude makes the median
+slope of smooth areas several times too large). An explicit ``roughness`` gives the
+paper's uniform scale.
+
+Randomness and tiles
+--------------------
+The Gaussian of a new pixel is a hash of (seed, level, global pixel index) (see
+:attr:`Dem.level` / :attr:`Dem.origin`), and a region is expanded with up to two pixels
+of context around it at every level (the DEM's own pixels where they exist). So
+expanding a DEM as tiles that share their edge pixels, or expanding a sub-window, gives
+exactly the pixels of the whole expansion, for any thread count (the amplitude map is
+computed from one more pixel of context, so it agrees too). A tile cut out as its own
+:class:`Dem` gives the same pixels when it keeps :data:`CONTEXT_PX` pixels of context
+around the region and is given the whole DEM's ``fractal_dimension`` (the default
+estimate is per DEM); with a uniform ``roughness`` and a geographic CRS the amplitude
+``roughness * resolution_m`` also depends on the crop's centre latitude. A finer layer's even
+pixels equal the coarser layer (the layer-stack consistency ``enhance`` relies on).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+from affine import Affine
+
+from craters._infra import (
+    check_int,
+    check_positive,
+    check_range,
+    physical_memory_bytes,
+    progress_bar,
+)
+
+from ._expand_kernels import _expand_kernel
+from ._rng_kernels import key_from_rng
+from .core import Dem
+from .fractal import _local_msd, fractal_fit
+
+__all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]
+
+logger = logging.getLogger(__name__)
+
+#: Context pixels a separately cut tile needs around its region to expand exactly like
+#: the same region of the whole DEM (level-1 halo plus the amplitude's neighbours).
+CONTEXT_PX = 3
+# context pixels kept around the region at every level: enough for the border diamond
+# pixels of every level to see the same neighbours as in the whole-DEM expansion
+_HALO = 2
+# bytes per output pixel: the output, the previous level, the final crop
+_BYTES_PER_PIXEL = 8 * 2.3
+
+
+def expansion_sizes(n_max: int = 12) -> list[int]:
+    """The region widths expansion accepts: ``2**n + 1`` for n = 1..n_max."""
+    return [2**n + 1 for n in range(1, n_max + 1)]
+
+
+def midpoint_factor(hurst: float) -> float:
+    """k(H) = 1 - 2^(H-2) - 2^(2H-3): displacement variance over gamma(rho) for a midpoint.
+
+    See the module docstring (clipped at 0 for H > 1).
+    """
+    return max(0.0, 1.0 - 2.0 ** (hurst - 2.0) - 2.0 ** (2.0 * hurst - 3.0))
+
+
+def displacement_scales(level: int, fractal_dimension: float, sigma_m: float):
+    """Standard deviations (square, diamond) of the displacements at expansion ``level``.
+
+    ``sigma_m`` is the RMS height difference (metres) of neighbouring pixels of the input
+    (``roughness * resolution_m``); level 1 is the first doubling. See the module
+    docstring for the derivation.
+
+    Examples
+    --------
+    >>> sq, dia = displacement_scales(1, 2.5, 1.0)
+    >>> round(sq / dia, 6) == round(2 ** 0.25, 6)   # one half step: 2^((3 - F) / 2)
+    True
+    """
+    level = check_int("level", level, 1)
+    hurst = 3.0 - check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
+    base = check_positive("sigma_m", sigma_m, allow_zero=True) * math.sqrt(midpoint_factor(hurst))
+    return base * 2.0 ** (-(level - 0.5) * hurst), base * 2.0 ** (-level * hurst)
+
+
+def _check_dem(dem) -> Dem:
+    if not isinstance(dem, Dem):
+        raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
+    if not dem.known.any():
+        raise ValueError("`dem` has no known pixel (all NaN)")
+    return dem
+
+
+def _human_bytes(n: float) -> str:
+    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
+        if n < 1024 or unit == "TiB":
+            return f"{n:.1f} {unit}"
+        n /= 1024
+    return f"{n:.1f} TiB"  # pragma: no cover
+
+
+def _region(dem: Dem, region) -> tuple[int, int, int]:
+    """(row_off, col_off, width) of a valid square 2^n + 1 region."""
+    allowed = ", ".join(map(str, expansion_sizes(12))) + ", ..."
+    if region is None:
+        rows, cols = dem.shape
+        if rows != cols or rows < 3 or (rows - 1) & (rows - 2):
+            raise ValueError(
+                f"`dem` is {rows} x {cols} pixels; expansion needs a square region of "
+                f"W = 2^n + 1 pixels ({allowed}): give `region` (--region) or crop the DEM")
+        return 0, 0, rows
+    win = dem.window(region)
+    h, w = int(win.height), int(win.width)
+    if h != w or h < 3 or (h - 1) & (h - 2):
+        raise ValueError(f"`region` is {h} x {w} pixels; expansion needs a square of "
+                         f"W = 2^n + 1 pixels ({allowed})")
+    return int(win.row_off), int(win.col_off), h
+
+
+def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
+           roughness: float | None = None, region=None, rng=None, *,
+           progress: bool = False) -> Dem:
+    """Double the resolution of a square region ``levels`` times by RMD (diamond-square).
+
+    A region of ``W = 2^n + 1`` pixels becomes ``(W - 1) 2^levels + 1`` pixels; its
+    pixels are kept exactly (``out.heights[::2**levels, ::2**levels]`` equals the region),
+    new pixel centres fall on the old ones, and the new pixel size is the old one over
+    ``2^levels``. Displacements follow fBm with fractal dimension ``fractal_dimension``;
+    their amplitude is the input's relief at its finest scale (see the module
+    docstring). Defaults come from the input DEM itself, so the expansion continues its
+    statistics: F from :func:`dem.fractal_dimension` of the *whole* DEM (clipped to
+    [2, 3]) and, without ``roughness``, the local roughness of each input pixel
+    (:func:`dem.local_roughness`, interpolated bilinearly), so rough areas get rough
+    detail and smooth areas smooth detail. A ``roughness`` value makes it uniform (the
+    paper's single scale).
+
+    Parameters
+    ----------
+    dem : Dem
+    levels : int
+        Number of doublings, 1..16.
+    fractal_dimension : float, optional
+        F in [2, 3] (H = 3 - F).
+    roughness : float, optional
+        Uniform RMS slope between neighbouring input pixels (m/m, >= 0; 0 = smooth
+        diamond-square interpolation). Default: local, from the input.
+    region : rasterio.windows.Window or rasterio.coords.BoundingBox, optional
+        The square to expand (pixels, or world bounds in CRS units selecting the pixels
+        whose centres lie inside). Default: the whole DEM, which must then be a
+        2^n + 1 square. Pixels around it are used as context for its border.
+    rng : int, numpy.random.Generator or None
+        Seed of the counter-based randomness. Give the same *int* to get the same pixels
+        from separate calls (tiles).
+    progress : bool
+        Show a progress bar over the levels.
+
+    Returns
+    -------
+    Dem
+        The expanded region, with its transform, level, origin and history tags.
+
+    Examples
+    --------
+    >>> d = Dem(np.arange(25.0).reshape(5, 5), pixel_size_m=8.0)
+    >>> e = expand(d, 2, fractal_dimension=2.3, roughness=0.1, rng=1)
+    >>> e.shape, e.pixel_size_m, bool((e.heights[::4, ::4] == d.heights).all())
+    ((17, 17), (2.0, 2.0), True)
+    """
+    dem = _check_dem(dem)
+    levels = check_int("levels", levels, 1, 16)
+    r0, c0, width = _region(dem, region)
+    block = dem.heights[r0:r0 + width, c0:c0 + width]
+    unknown = int(np.isnan(block).sum())
+    if unknown:
+        raise ValueError(f"the region has {unknown} unknown (NaN) pixels; fill them first "
+                         f"(dem.fill_gaps, `dem fill`)")
+    side = (width - 1) * 2**levels + 1
+    need = (side + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
+    have = physical_memory_bytes()
+    if need > 0.85 * have:
+        raise ValueError(f"expanding {width} x {width} pixels {levels} levels gives {side} x "
+                         f"{side} pixels and needs about {_human_bytes(need)} of memory; this "
+                         f"machine has {_human_bytes(have)}")
+    if fractal_dimension is not None:
+        fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
+    if roughness is not None:
+        roughness = check_positive("roughness", roughness, allow_zero=True)
+    params: dict = {"levels": levels, "region": [r0, c0, width],
+                    "input_resolution_m": dem.resolution_m}
+    fit = None
+    if fractal_dimension is None or roughness is None:
+        fit = fractal_fit(dem)
+    if fractal_dimension is None:
+        fractal_dimension = min(3.0, max(2.0, fit.fractal_dimension))
+        params["fractal_dimension_estimated"] = fit.fractal_dimension
+    params["fractal_dimension"] = fractal_dimension
+    resolution = dem.resolution_m
+    if roughness is None:
+        amp, amp_r0, amp_c0 = _local_amplitude(dem, r0, c0, width,
+                                               fit.roughness * resolution)
+        params["roughness"] = "local"
+        params["roughness_rms"] = fit.roughness
+    else:
+        amp = np.full((1, 1), roughness * resolution)
+        amp_r0, amp_c0 = dem.origin[0] + r0, dem.origin[1] + c0
+        params["roughness"] = roughness
+    key, seed = key_from_rng(rng)
+    params["key"] = key
+    heights = _expand_region(dem.heights, (r0, c0, width), dem.origin, dem.level, levels,
+                             key, fractal_dimension, amp, (amp_r0, amp_c0), progress=progress)
+    scale = 0.5**levels
+    shift = 0.5 - scale / 2.0  # keeps pixel centres: new (0, 0) on old (r0, c0)
+    transform = (dem.transform @ Affine.translation(c0 + shift, r0 + shift)
+                 @ Affine.scale(scale))
+    px = None if dem.crs is not None else tuple(v * scale for v in dem.pixel_size_m)
+    origin = ((dem.origin[0] + r0) * 2**levels, (dem.origin[1] + c0) * 2**levels)
+    return dem.with_step(heights, "dem.expand", seed, params, transform=transform,
+                         pixel_size_m=px, level=dem.level + levels, origin=origin)
+
+
+def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
+    """Local relief sqrt(m(p)) (metres) around the region and its lattice origin.
+
+    NaN (no known neighbour) becomes ``fallback`` metres.
+
+    Covers the region plus the context any level can reach, computed from one more
+    pixel of the DEM so that every value equals the whole-DEM value (tiles agree).
+    """
+    rows, cols = dem.shape
+    m = _HALO + 1
+    a_r, a_c = max(r0 - m, 0), max(c0 - m, 0)
+    b_r, b_c = min(r0 + width + m, rows), min(c0 + width + m, cols)
+    e_r, e_c = max(a_r - 1, 0), max(a_c - 1, 0)
+    z = dem.heights[e_r:min(b_r + 1, rows), e_c:min(b_c + 1, cols)]
+    msd = _local_msd(z)[a_r - e_r:a_r - e_r + b_r - a_r, a_c - e_c:a_c - e_c + b_c - a_c]
+    amp = np.sqrt(msd)
+    amp[~np.isfinite(amp)] = fallback
+    return (np.ascontiguousarray(amp), dem.origin[0] + a_r, dem.origin[1] + a_c)
+
+
+def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key: int,
+                   fractal_dimension: float, amp: np.ndarray, amp_origin, *,
+                   progress: bool = False) -> np.ndarray:
+    """Expand ``z[region]`` ``levels`` times with ``_HALO`` context pixels per level.
+
+    ``region`` is (row_off, col_off, width) in ``z``; ``origin`` the lattice index of
+    ``z[0, 0]`` at ``level0``; ``amp`` the displacement amplitude in metres on the
+    ``level0`` grid, its pixel (0, 0) at lattice index ``amp_origin``. Returns the
+    expanded region only.
+    """
+    r0, c0, width = region
+    rows, cols = z.shape
+    a_r, a_c = max(r0 - _HALO, 0), max(c0 - _HALO, 0)
+    b_r, b_c = min(r0 + width + _HALO, rows), min(c0 + width + _HALO, cols)
+    arr = np.ascontiguousarray(z[a_r:b_r, a_c:b_c], dtype=np.float64)
+    org = (origin[0] + a_r, origin[1] + a_c)
+    reg = (r0 - a_r, c0 - a_c, width)
+    for lev in progress_bar(range(1, levels + 1), enabled=progress, desc="expand"):
+        sd_sq, sd_dia = displacement_scales(lev, fractal_dimension, 1.0)
+        out = np.empty((2 * arr.shape[0] - 1, 2 * arr.shape[1] - 1), dtype=np.float64)
+        org = (2 * org[0], 2 * org[1])
+        _expand_kernel(arr, key, level0 + lev, org[0], org[1], sd_sq, sd_dia, amp,
+                       float(amp_origin[0]), float(amp_origin[1]), 0.5**lev, out)
+        reg = (2 * reg[0], 2 * reg[1], 2 * reg[2] - 1)
+        if lev == levels:
+            return np.ascontiguousarray(out[reg[0]:reg[0] + reg[2], reg[1]:reg[1] + reg[2]])
+        a_r, a_c = max(reg[0] - _HALO, 0), max(reg[1] - _HALO, 0)
+        b_r = min(reg[0] + reg[2] + _HALO, out.shape[0])
+        b_c = min(reg[1] + reg[2] + _HALO, out.shape[1])
+        arr = out[a_r:b_r, a_c:b_c]
+        if a_r or a_c or b_r < out.shape[0] or b_c < out.shape[1]:
+            arr = np.ascontiguousarray(arr)
+        org = (org[0] + a_r, org[1] + a_c)
+        reg = (reg[0] - a_r, reg[1] - a_c, reg[2])
+    raise AssertionError("unreachable")  # pragma: no cover

@@ -1,0 +1,236 @@
+"""The dem command line, through the real entry point (python -m dem)."""
+
+from __future__ import annotations
+
+import subprocess
+
+import numpy as np
+import pytest
+import rasterio
+import rasterio.transform
+from affine import Affine
+
+import dem
+
+MOON_WKT = ('GEOGCS["Moon 2015",DATUM["Moon_2015",SPHEROID["Moon",1737400,0]],'
+            'PRIMEM["Reference_Meridian",0],UNIT["degree",0.0174532925199433]]')
+
+
+def assert_one_line_error(proc, *needles):
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].startswith("error:") and "Traceback" not in proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+class InProcess:
+    """``dem.cli.main`` in this process (quick) with the entry point's exit code and output."""
+
+    def __init__(self, capsys):
+        self.capsys = capsys
+
+    def __call__(self, *argv):
+        from dem.cli import main
+
+        try:
+            code = main(list(argv[1:]))
+        except SystemExit as exc:  # argparse errors
+            code = exc.code
+        out, err = self.capsys.readouterr()
+        return subprocess.CompletedProcess(argv, code, out, err)
+
+
+@pytest.fixture
+def lola_tif(tmp_path, lola_crop):
+    """The LOLA crop as a 257 x 257 geographic GeoTIFF without craterform tags."""
+    path = tmp_path / "in.tif"
+    with rasterio.open(path, "w", driver="GTiff", width=257, height=257, count=1,
+                       dtype="float32", crs=MOON_WKT, transform=lola_crop.transform) as ds:
+        ds.write(lola_crop.heights.astype(np.float32), 1)
+    return path
+
+
+MOON = ["--body-radius-m", "1737400"]
+
+
+def test_expand_acceptance_257(run_cli, capsys, tmp_path, lola_tif):
+    out = tmp_path / "out.tif"
+    proc = run_cli("dem", "expand", str(lola_tif), "-o", str(out), "--levels", "1",
+                   "--seed", "7", *MOON)
+    assert proc.returncode == 0, proc.stderr
+    assert "wrote" in proc.stdout
+    with rasterio.open(lola_tif) as a, rasterio.open(out) as b:
+        zin, zout = a.read(1), b.read(1)
+        assert zout.shape == (513, 513) and np.array_equal(zout[::2, ::2], zin)
+        assert b.crs == a.crs
+        rows, cols = np.mgrid[0:257, 0:257]
+        x0, y0 = rasterio.transform.xy(a.transform, rows.ravel(), cols.ravel())
+        x1, y1 = rasterio.transform.xy(b.transform, 2 * rows.ravel(), 2 * cols.ravel())
+        assert np.abs(np.subtract(x0, x1)).max() < 1e-9
+        assert np.abs(np.subtract(y0, y1)).max() < 1e-9
+        tags = b.tags()
+        assert tags["CRATERFORM_GENERATOR"] == "craterform dem.expand"
+        assert tags["CRATERFORM_SEED"] == "7"
+        assert "fractal_dimension" in tags["CRATERFORM_PARAMETERS"]
+    # the same DEM expanded as 4 tiles (sharing their edge pixels) gives the same pixels
+    mosaic = np.full((513, 513), np.nan, np.float32)
+    fd = str(dem.read(out).history[-1]["parameters"]["fractal_dimension"])
+    for r0 in (0, 128):
+        for c0 in (0, 128):
+            tile = tmp_path / f"t{r0}_{c0}.tif"
+            proc = InProcess(capsys)("dem", "expand", str(lola_tif), "-o", str(tile),
+                                     "--seed", "7", "--region", f"{r0},{c0},129", "-q", *MOON)
+            assert proc.returncode == 0, proc.stderr
+            with rasterio.open(tile) as t:
+                mosaic[2 * r0:2 * r0 + 257, 2 * c0:2 * c0 + 257] = t.read(1)
+                assert t.transform == b.transform @ Affine.translation(2 * c0, 2 * r0)
+            assert dem.read(tile).history[-1]["parameters"]["fractal_dimension"] == float(fd)
+    assert np.array_equal(mosaic, zout)
+
+
+@pytest.mark.parametrize("command,extra", [("expand", ["--levels", "2"]), ("fill", [])])
+def test_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path, lola_crop, command,
+                                               extra):
+    z = lola_crop.heights.copy()
+    z[100:130, 40:90] = np.nan
+    src = tmp_path / "src.tif"
+    dem.write(lola_crop.replace(heights=z) if command == "fill" else lola_crop, src)
+    files = {}
+    for threads in ("1", "2"):
+        out = tmp_path / f"{command}_{threads}.tif"
+        proc = run_cli("dem", command, str(src), "-o", str(out), "--seed", "5", "-q", *extra,
+                       env={"NUMBA_NUM_THREADS": threads})
+        assert proc.returncode == 0 and proc.stdout == "", proc.stderr
+        files[threads] = out.read_bytes()
+    assert files["1"] == files["2"]
+    other = tmp_path / "other.tif"
+    assert InProcess(capsys)("dem", command, str(src), "-o", str(other), "--seed", "6", "-q",
+                             *extra).returncode == 0
+    assert other.read_bytes() != files["2"]
+
+
+def test_fill(run_cli, tmp_path, tiny_geotiff):
+    out = tmp_path / "filled.tif"
+    proc = run_cli("dem", "fill", str(tiny_geotiff), "-o", str(out), "--seed", "1",
+                   "--roughness", "0.01")
+    assert proc.returncode == 0, proc.stderr
+    a, b = dem.read(tiny_geotiff), dem.read(out)
+    assert np.isfinite(b.heights).all() and b.crs == a.crs and b.transform == a.transform
+    known = a.known
+    assert np.array_equal(b.heights[known], a.heights[known])
+    assert b.history[-1]["parameters"]["roughness"] == 0.01
+
+
+def test_info(run_cli, capsys, lola_tif, tiny_geotiff):
+    proc = run_cli("dem", "info", str(lola_tif), *MOON)
+    assert proc.returncode == 0, proc.stderr
+    out = proc.stdout
+    for needle in ("257 x 257 pixels", "Moon 2015", "7580.8", "0.25, 0, 148, 0, -0.25, 32",
+                   "unknown    0.000 %", "fractal_d  2.2", "height_m   min -6059.5"):
+        assert needle in out, out
+    proc = InProcess(capsys)("dem", "info", str(tiny_geotiff))
+    assert "EPSG:32633" in proc.stdout and "(1 pixels)" in proc.stdout
+
+
+def write_no_crs(path):
+    with rasterio.open(path, "w", driver="GTiff", width=9, height=9, count=1, dtype="float32",
+                       transform=Affine(2, 0, 0, 0, -2, 18)) as ds:
+        ds.write(np.random.default_rng(0).random((9, 9), dtype=np.float32), 1)
+
+
+# the acceptance cases run through the real entry point, the others in-process (quicker)
+ENTRY_POINT = {"nocrs", "geographic", "allnan", "outside", "not-raster", "no-command"}
+
+
+@pytest.mark.parametrize("case,args,needles", [
+    ("nocrs", ["expand", "{nocrs}", "-o", "{out}"], ["no CRS", "--pixel-size-m"]),
+    ("nocrs-info", ["info", "{nocrs}"], ["no CRS", "--pixel-size-m"]),
+    ("geographic", ["expand", "{geo}", "-o", "{out}"], ["geographic CRS", "--body-radius-m"]),
+    ("allnan", ["fill", "{nan}", "-o", "{out}", "--pixel-size-m", "1"], ["NoData/NaN"]),
+    ("outside", ["expand", "{geo}", "-o", "{out}", "--region", "200,200,129", *MOON],
+     ["not inside the DEM"]),
+    ("outside-bounds", ["expand", "{geo}", "-o", "{out}", "--region", "0,0,1,1", *MOON],
+     ["not inside the DEM"]),
+    ("not-raster", ["expand", "{text}", "-o", "{out}"], ["not a raster file"]),
+    ("missing", ["info", "{missing}"], ["does not exist"]),
+    ("size", ["expand", "{geo}", "-o", "{out}", "--region", "0,0,100", *MOON], ["2^n + 1"]),
+    ("levels", ["expand", "{geo}", "-o", "{out}", "--levels", "0", *MOON], ["--levels"]),
+    ("levels-syntax", ["expand", "{geo}", "-o", "{out}", "--levels", "two"], ["--levels"]),
+    ("fd", ["expand", "{geo}", "-o", "{out}", "--fractal-dimension", "3.5", *MOON],
+     ["--fractal-dimension", "[2, 3]"]),
+    ("fd-nan", ["expand", "{geo}", "-o", "{out}", "--fractal-dimension", "nan"],
+     ["--fractal-dimension", "finite"]),
+    ("roughness", ["fill", "{geo}", "-o", "{out}", "--roughness", "-1", *MOON], ["--roughness"]),
+    ("region-syntax", ["expand", "{geo}", "-o", "{out}", "--region", "1,2"], ["--region"]),
+    ("seed", ["fill", "{geo}", "-o", "{out}", "--seed", "-4"], ["--seed"]),
+    ("radius", ["fill", "{geo}", "-o", "{out}", "--body-radius-m", "0"], ["--body-radius-m"]),
+    ("band", ["fill", "{geo}", "-o", "{out}", "--band", "2", *MOON], ["band", "[1, 1]"]),
+    ("suffix", ["fill", "{geo}", "-o", "{png}", *MOON], ["unknown format"]),
+    ("no-output", ["fill", "{geo}", *MOON], ["-o/--output"]),
+    ("no-input", ["fill", "-o", "{out}"], ["needs an input"]),
+    ("in-is-out", ["fill", "{geo}", "-o", "{geo}", "--force", *MOON], ["is the input"]),
+    ("unknown-flag", ["fill", "{geo}", "--frobnicate"], ["unrecognized"]),
+    ("no-command", [], ["required"]),
+])
+def test_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_path, lola_tif, case,
+                                                   args, needles):
+    write_no_crs(tmp_path / "nocrs.tif")
+    dem.write(dem.Dem(np.full((5, 5), np.nan), pixel_size_m=1.0), tmp_path / "nan.tif")
+    (tmp_path / "notes.txt").write_text("not a raster\n")
+    names = {"nocrs": tmp_path / "nocrs.tif", "geo": lola_tif, "nan": tmp_path / "nan.tif",
+             "text": tmp_path / "notes.txt", "missing": tmp_path / "none.tif",
+             "out": tmp_path / "out.tif", "png": tmp_path / "out.png"}
+    before = sorted(p.name for p in tmp_path.iterdir())
+    runner = run_cli if case in ENTRY_POINT else InProcess(capsys)
+    proc = runner("dem", *[a.format(**names) for a in args])
+    assert_one_line_error(proc, *needles)
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_existing_output_needs_force(run_cli, capsys, tmp_path, tiny_geotiff):
+    out = tmp_path / "x.tif"
+    out.write_bytes(b"keep me")
+    proc = InProcess(capsys)("dem", "fill", str(tiny_geotiff), "-o", str(out))
+    assert_one_line_error(proc, "exists", "--force")
+    assert out.read_bytes() == b"keep me"
+    proc = run_cli("dem", "fill", str(tiny_geotiff), "-o", str(out), "--force", "-q")
+    assert proc.returncode == 0 and proc.stdout == ""
+    assert dem.read(out).shape == (33, 33)
+
+
+def test_config_file(run_cli, capsys, tmp_path, tiny_geotiff):
+    cfg = tmp_path / "x.toml"
+    out = tmp_path / "e.tif"
+    cfg.write_text(f'input = "{tiny_geotiff}"\noutput = "{out}"\nlevels = 2\nseed = 3\n'
+                   f'fractal_dimension = 2.3\nroughness = 0.02\nregion = "0,0,17"\n'
+                   f'quiet = true\n')
+    # the tiny GeoTIFF has a NoData pixel at (3, 4): fill first, then expand
+    filled = tmp_path / "f.tif"
+    assert InProcess(capsys)("dem", "fill", str(tiny_geotiff), "-o", str(filled),
+                             "-q").returncode == 0
+    proc = run_cli("dem", "expand", "--config", str(cfg), str(filled))
+    assert proc.returncode == 0, proc.stderr
+    e = dem.read(out)
+    params = e.history[-1]["parameters"]
+    assert e.shape == (65, 65) and params["roughness"] == 0.02 and params["levels"] == 2
+    assert proc.stdout == ""  # quiet from the file
+    run = InProcess(capsys)
+    cfg.write_text('levels = 2\ncolour = "red"\n')
+    assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)),
+                          "colour", "allowed")
+    cfg.write_text("levels = 'two'\n")
+    assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)), "levels")
+    cfg.write_text("levels = \n")
+    assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)), "TOML")
+
+
+def test_every_option_has_a_config_key():
+    from dem.cli import _options, build_parser
+
+    parser = build_parser()
+    for command in ("fill", "expand"):
+        sub = parser._subparsers._group_actions[0].choices[command]
+        dests = {a.dest for a in sub._actions} - {"help", "config", "input"}
+        assert dests == set(_options(command))
