@@ -10,6 +10,7 @@ to evaluate the same profile, plane fit, rim offsets and roughness as
 * ``rim_offsets(h, cy, cx, pixel, R, rim_tab, p0, gx, gy, out)``: plane - terrain at the rim
 * ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)`` and ``fbm2(seed, x, y, ...)``
+* ``mix64(z)``: the splitmix64 finaliser (uint64 -> uint64), for counter-based noise
 * ``N_RIM``: samples per azimuth table
 """
 
@@ -17,11 +18,12 @@ from ._stamp_kernels import N_RIM
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
 from ._stamp_kernels import _inside as inside
+from ._stamp_kernels import _mix64 as mix64
 from ._stamp_kernels import _outside as outside
 from ._stamp_kernels import _profile_params as profile_params
 from ._stamp_kernels import _rim_offsets as rim_offsets
 from ._stamp_kernels import _roughness_amp as roughness_amp
 from ._stamp_kernels import _table as table
 
-__all__ = ["N_RIM", "fbm2", "fit_plane", "inside", "outside", "profile_params",
+__all__ = ["N_RIM", "fbm2", "fit_plane", "inside", "mix64", "outside", "profile_params",
            "rim_offsets", "roughness_amp", "table"]

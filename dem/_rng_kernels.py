@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from craters.kernels import mix64
+
 STREAM_EXPAND = 1
 STREAM_FILL = 2
 
@@ -33,10 +35,7 @@ _TWO_PI = 2.0 * np.pi
 @njit(cache=True, inline="always")
 def _splitmix64(x):
     """The splitmix64 step: add the golden gamma, then the variant-13 finaliser."""
-    z = x + _GOLDEN
-    z = (z ^ (z >> _S30)) * _M1
-    z = (z ^ (z >> _S27)) * _M2
-    return z ^ (z >> _S31)
+    return mix64(x + _GOLDEN)
 
 
 @njit(cache=True, inline="always")

@@ -25,6 +25,7 @@ from craters._infra import (
     check_output_path,
     load_toml,
     package_version,
+    parse_seed,
     progress_bar,
     run_cli,
 )
@@ -37,16 +38,6 @@ from .io import GEOTIFF_SUFFIXES, read, write
 
 
 # --------------------------------------------------------------------------- parsing
-def _seed(text) -> int:
-    try:
-        value = int(str(text), 10)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a non-negative integer; got {text!r}") from None
-    if not 0 <= value < 2**63:
-        raise argparse.ArgumentTypeError(f"must be in [0, 2**63); got {text!r}")
-    return value
-
-
 def _region(text) -> Window | BoundingBox:
     """``ROW,COL,SIZE`` (pixels) or ``LEFT,BOTTOM,RIGHT,TOP`` (CRS units)."""
     parts = [p.strip() for p in str(text).split(",")]
@@ -108,7 +99,7 @@ OPTIONS: tuple[Opt, ...] = (
     Opt(("--region",), "region", _region, None,
         "square to expand, 2^n+1 pixels: ROW,COL,SIZE in pixels or LEFT,BOTTOM,RIGHT,TOP "
         "in CRS units (default: the whole DEM)", ("expand",), metavar="REGION"),
-    Opt(("--seed",), "seed", _seed, None,
+    Opt(("--seed",), "seed", parse_seed, None,
         "random seed (non-negative integer); default: a fresh one, recorded in the tags",
         metavar="S"),
     Opt(("--band",), "band", _count, 1, "band of the input (1-based)",
