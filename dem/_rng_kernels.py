@@ -21,11 +21,6 @@ STREAM_EXPAND = 1
 STREAM_FILL = 2
 
 _GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_M1 = np.uint64(0xBF58476D1CE4E5B9)
-_M2 = np.uint64(0x94D049BB133111EB)
-_S30 = np.uint64(30)
-_S27 = np.uint64(27)
-_S31 = np.uint64(31)
 _S11 = np.uint64(11)
 _ONE = np.uint64(1)
 _TWO_POW_M53 = 1.0 / 9007199254740992.0  # 2**-53
