@@ -20,6 +20,7 @@ from .faulting import (
 from .grid import LatLongGrid
 from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
 from .scene import PRESETS, body_population, build_body, resolve_settings, surface_positions
+from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
 from .smoothing import fwhm_to_sigma, heat_smooth, smooth
 
 __all__ = [
@@ -31,18 +32,22 @@ __all__ = [
     "FaultingParams",
     "FbmParams",
     "LatLongGrid",
+    "ShapeModel",
     "apply_faults",
     "area_mean",
     "body_population",
     "build_body",
+    "cast_radii",
     "crater_extents_deg",
     "fbm3",
+    "from_shape_model",
     "fwhm_to_sigma",
     "heat_smooth",
     "load",
     "perlin_fbm",
     "poisson_faulting",
     "random_faults",
+    "read_shape_model",
     "resolve_settings",
     "smooth",
     "stamp_craters",

@@ -141,7 +141,8 @@ def build_parser() -> argparse.ArgumentParser:
     b.add_argument("--config", metavar="TOML", help="scene file; options override its keys")
     groups = {"body": b.add_argument_group("body"),
               "faulting": b.add_argument_group("two-phase faulting (--base faulting)"),
-              "fbm": b.add_argument_group("Perlin fBm (--base fbm)"),
+              "fbm": b.add_argument_group("Perlin fBm (--base fbm; detail on --base shape)"),
+              "shape": b.add_argument_group("shape models (--base shape:PATH)"),
               "craters": b.add_argument_group("craters"),
               "output": b.add_argument_group("output"),
               "render": b.add_argument_group("preview picture")}

@@ -94,7 +94,9 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--stretch",), "stretch", _stretch, None,
         "scale factors X,Y,Z applied to the body (e.g. 2,1,1; default 1,1,1 or the "
         "preset's)"),
-    Opt(("--base",), "base", str, None, "base shape: sphere, faulting or fbm (default fbm)"),
+    Opt(("--base",), "base", str, None,
+        "base shape: sphere, faulting, fbm (default) or shape:PATH (a real shape model: "
+        "OBJ, PDS plate .tab/.plt, PLY, STL)"),
     Opt(("--seed",), "seed", parse_seed, None,
         "random seed (non-negative integer); default: a fresh one, recorded in the model"),
     # two-phase faulting
@@ -107,9 +109,22 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--faults-2",), "faults_2", int, None, "phase-2 fault count", "faulting"),
     Opt(("--max-fault-2-m",), "max_fault_2_m", float, None,
         "largest phase-2 fault offset, metres", "faulting"),
+    # shape models
+    Opt(("--shape-units",), "shape_units", str, None,
+        "units of the shape model file: km or m (required with --base shape:PATH)", "shape"),
+    Opt(("--shape-center",), "shape_center", str, None,
+        "ray origin: volume-centroid (default), area-centroid, origin or X,Y,Z in metres",
+        "shape"),
+    Opt(("--shape-crossings",), "shape_crossings", str, None,
+        "where a ray crosses the surface more than once: error (default), outermost, "
+        "innermost", "shape"),
+    Opt(("--shape-smooth",), "shape_smooth", str, None,
+        "subdivision before casting: butterfly (default, interpolating), linear (keep "
+        "the facets), loop, none", "shape"),
     # fBm
-    Opt(("--frequency",), "frequency", float, None, "first-octave frequency on the unit sphere",
-        "fbm"),
+    Opt(("--frequency",), "frequency", float, None,
+        "first-octave frequency on the unit sphere (with a shape base: fBm detail, "
+        "default wavelength = the model's resolution)", "fbm"),
     Opt(("--octaves",), "octaves", int, None, "number of octaves", "fbm"),
     Opt(("--persistence",), "persistence", float, None, "amplitude ratio per octave", "fbm"),
     Opt(("--lacunarity",), "lacunarity", float, None, "frequency ratio per octave (>= 1)",
@@ -343,13 +358,21 @@ def resolve_settings(given: dict) -> dict:
     if preset is not None and preset not in PRESETS:
         raise CliError(f"--preset must be one of {', '.join(PRESETS)}; got {preset!r}")
     base = given.get("base")
-    if base is not None and base not in BASES:
-        raise CliError(f"--base must be one of {', '.join(BASES)}; got {base!r}")
+    shape_path = None
+    if isinstance(base, str) and base.startswith("shape:"):
+        shape_path, base = base[len("shape:"):], "shape"
+        if preset is not None:
+            raise CliError("--preset and --base shape:PATH cannot be combined")
+        if not shape_path:
+            raise CliError("--base shape:PATH needs a path after 'shape:'")
+    elif base is not None and base not in BASES:
+        raise CliError(f"--base must be one of {', '.join(BASES)} or shape:PATH; "
+                       f"got {base!r}")
     if preset is not None and base is not None and PRESETS[preset].base != base:
         raise CliError(f"--preset {preset} has --base {PRESETS[preset].base}, not {base}")
     if preset is None:
         base = base or "fbm"
-        preset = _DEFAULT_PRESET[base]
+        preset = _DEFAULT_PRESET.get(base)
     p = PRESETS[preset] if preset else None
     base = p.base if p else base
     s = {o.key: o.default for o in BUILD_OPTIONS}
@@ -359,9 +382,15 @@ def resolve_settings(given: dict) -> dict:
     s["preset"], s["base"] = preset, base
     _count("magnitude", s["magnitude"], 1, 10**9)
     _check_memory(s["magnitude"])
+    allowed = {"faulting": ("faulting",), "fbm": ("fbm",), "sphere": (),
+               "shape": ("fbm", "shape")}[base]
     for key, opt in _BY_KEY.items():
-        if opt.group in _BASE_GROUPS and opt.group != base and given.get(key) is not None:
-            raise CliError(f"{opt.flags[-1]} applies to --base {opt.group}, not --base {base}")
+        if (opt.group in _BASE_GROUPS or opt.group == "shape") and opt.group not in allowed \
+                and given.get(key) is not None:
+            wanted = "shape:PATH" if opt.group == "shape" else opt.group
+            raise CliError(f"{opt.flags[-1]} applies to --base {wanted}, not --base {base}")
+    if base == "shape":
+        return _resolve_shape(s, given, shape_path)
     _finite("radius_m", s["radius_m"], positive=True)
     if s["stretch"] is None:
         s["stretch"] = FAULTING_PRESETS[p.base_params].stretch if base == "faulting" else (
@@ -369,6 +398,14 @@ def resolve_settings(given: dict) -> dict:
     s["stretch"] = tuple(float(v) for v in s["stretch"])
     if any(not math.isfinite(v) or v <= 0 for v in s["stretch"]):
         raise CliError(f"--stretch factors must be finite and > 0; got {s['stretch']}")
+    _resolve_base_params(s, p)
+    _resolve_craters_and_outputs(s)
+    return s
+
+
+def _resolve_base_params(s: dict, p) -> None:
+    """Fill and check the faulting / fBm parameters of resolved settings."""
+    base = s["base"]
     if base == "faulting":
         fp = FAULTING_PRESETS[p.base_params]
         fields = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
@@ -390,13 +427,75 @@ def resolve_settings(given: dict) -> dict:
         if s.get("amplitude_m") is None:
             frac = p.amplitude if p.amplitude is not None else fp.amplitude
             s["amplitude_m"] = frac * s["radius_m"]
-        _finite("frequency", s["frequency"], positive=True)
-        _count("octaves", s["octaves"], 1, 30)
-        _finite("persistence", s["persistence"], positive=True)
-        _finite("lacunarity", s["lacunarity"])
-        if s["lacunarity"] < 1:
-            raise CliError(f"--lacunarity must be >= 1; got {s['lacunarity']!r}")
-        _finite("amplitude_m", s["amplitude_m"], nonneg=True)
+        _check_fbm(s)
+
+
+def _check_fbm(s: dict) -> None:
+    _finite("frequency", s["frequency"], positive=True)
+    _count("octaves", s["octaves"], 1, 30)
+    _finite("persistence", s["persistence"], positive=True)
+    _finite("lacunarity", s["lacunarity"])
+    if s["lacunarity"] < 1:
+        raise CliError(f"--lacunarity must be >= 1; got {s['lacunarity']!r}")
+    _finite("amplitude_m", s["amplitude_m"], nonneg=True)
+
+
+def _resolve_shape(s: dict, given: dict, path: str) -> dict:
+    """Settings for --base shape:PATH: read and check the model up front."""
+    from .shapes import read_shape_model
+
+    for key in ("radius_m", "stretch"):
+        if given.get(key) is not None:
+            raise CliError(f"{flag(key)} does not apply to --base shape:PATH (the model "
+                           "sets the size and shape)")
+    units = s.get("shape_units")
+    if units not in ("km", "m"):
+        raise CliError(f"--shape-units must be km or m with --base shape:PATH; got {units!r}")
+    crossings = s.get("shape_crossings") or "error"
+    if crossings not in ("error", "outermost", "innermost"):
+        raise CliError(f"--shape-crossings must be error, outermost or innermost; "
+                       f"got {crossings!r}")
+    smooth = s.get("shape_smooth") or "butterfly"
+    if smooth not in ("butterfly", "linear", "loop", "none"):
+        raise CliError(f"--shape-smooth must be butterfly, linear, loop or none; "
+                       f"got {smooth!r}")
+    center = s.get("shape_center") or "volume-centroid"
+    if center not in ("volume-centroid", "area-centroid", "origin"):
+        try:
+            center = tuple(float(v) for v in center.split(","))
+        except ValueError:
+            center = ()
+        if len(center) != 3 or not all(math.isfinite(v) for v in center):
+            raise CliError("--shape-center must be volume-centroid, area-centroid, origin or "
+                           f"X,Y,Z in metres; got {s.get('shape_center')!r}")
+    try:
+        model = read_shape_model(path, units=units)
+    except ValueError as exc:
+        raise CliError(f"--base shape:{path}: {exc}") from None
+    volume = model.volume_m3
+    s.update(shape_path=path, shape_units=units, shape_crossings=crossings,
+             shape_smooth=smooth, shape_center=center, stretch=(1.0, 1.0, 1.0),
+             radius_m=(3.0 * volume / (4.0 * math.pi)) ** (1.0 / 3.0),
+             shape_resolution_m=model.mean_edge_m)
+    # fBm detail below the model's resolution: off unless an amplitude is given
+    detail = {"frequency": s["radius_m"] / model.mean_edge_m, "octaves": 6,
+              "persistence": 0.5, "lacunarity": 2.0, "amplitude_m": 0.0}
+    for key, value in detail.items():
+        if s.get(key) is None:
+            s[key] = value
+    _check_fbm(s)
+    _resolve_craters_and_outputs(s)
+    for la in s["craters"]:
+        if la.d_max_m > 2.0 * model.mean_edge_m:
+            raise CliError(
+                f"--craters dmax={la.d_max_m:g} m is above the shape model's resolution "
+                f"(mean edge {model.mean_edge_m:.3g} m): the model already holds craters "
+                f"that large; keep crater layers below {2 * model.mean_edge_m:.3g} m")
+    return s
+
+
+def _resolve_craters_and_outputs(s: dict) -> None:
+    """Crater layers, render and output checks shared by every base."""
     # craters
     layers = []
     for item in s.get("craters") or []:
@@ -449,7 +548,6 @@ def resolve_settings(given: dict) -> dict:
         check_output_path(s["catalog"], force=s["force"], suffixes=(".csv",))
     if s.get("seed") is None:
         s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
-    return s
 
 
 # --------------------------------------------------------------------------- populations
@@ -522,7 +620,22 @@ def build_body(s: dict, *, progress: bool = False) -> Body:
     grid = LatLongGrid(s["magnitude"])
     rng = np.random.default_rng(s["seed"])
     base = s["base"]
-    if base == "sphere":
+    shape_meta = None
+    if base == "shape":
+        from .shapes import from_shape_model, read_shape_model
+
+        model = read_shape_model(s["shape_path"], units=s["shape_units"])
+        shaped = from_shape_model(model, s["magnitude"], center=s["shape_center"],
+                                  crossings=s["shape_crossings"], smooth=s["shape_smooth"])
+        shape_meta = shaped.metadata
+        s["radius_m"] = shaped.radius_m
+        detail = perlin_fbm(grid, s["frequency"], s["octaves"], s["persistence"],
+                            s["lacunarity"], s["amplitude_m"], rng=rng) if s["amplitude_m"] else 0.0
+        heights = shaped.radii_m - shaped.radius_m + detail
+        params = {k: s[k] for k in ("frequency", "octaves", "persistence", "lacunarity",
+                                    "amplitude_m")}
+        params["shape"] = shape_meta
+    elif base == "sphere":
         heights = np.zeros(grid.n_vertices)
         params: dict = {}
     elif base == "faulting":

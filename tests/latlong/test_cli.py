@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -271,3 +273,30 @@ def test_render_command(run_cli, tmp_path):
     assert_one_line_error(run_cli("latlong", "render", str(model), "-o", str(one)), "exists")
     assert_one_line_error(run_cli("latlong", "render", str(model), "-o", str(tmp_path / "x.png"),
                                   "--sun-elevation-deg", "100"), "--sun-elevation-deg")
+
+
+def test_shape_model_base(run_cli, tmp_path):
+    data = Path(__file__).parents[1] / "data"
+    out, png = tmp_path / "b.npz", tmp_path / "b.png"
+    proc = run_cli("latlong", "build", "--base", f"shape:{data / 'bennu_radar_sbgat.obj'}",
+                   "--shape-units", "km", "--magnitude", "60", "--craters",
+                   "c=0.9,k=-3,dmin=10,dmax=40", "--amplitude-m", "0.5", "--seed", "2",
+                   "-o", str(out), "--preview", str(png), "-q")
+    assert proc.returncode == 0, proc.stderr
+    body = load(out)
+    assert body.metadata["base"] == "shape" and len(body.craters) > 0
+    assert 200 < body.radius_m < 290  # Bennu's volume-equivalent radius is ~246 m
+    itokawa = data / "itokawa_32.obj"
+    for args, needles in (
+            ([f"shape:{itokawa}"], ["--shape-units"]),
+            ([f"shape:{itokawa}", "--shape-units", "km"], ["not star-shaped", "%"]),
+            ([f"shape:{itokawa}", "--shape-units", "km", "--shape-crossings", "outermost",
+              "--craters", "c=0.1,k=-2,dmin=5,dmax=40"], ["--craters", "resolution"]),
+            ([f"shape:{itokawa}", "--shape-units", "km", "--radius-m", "5"],
+             ["--radius-m", "shape"]),
+            ([f"shape:{tmp_path / 'none.obj'}", "--shape-units", "km"], ["does not exist"]),
+            (["shape:"], ["needs a path"])):
+        proc = run_cli("latlong", "build", "--magnitude", "20", "--base", *args, "-o",
+                       str(tmp_path / "x.npz"))
+        assert_one_line_error(proc, *needles)
+    assert not (tmp_path / "x.npz").exists()
