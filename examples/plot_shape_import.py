@@ -16,10 +16,10 @@ matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-import pyvista as pv  # noqa: E402
 
-from latlong import Body, build_body, from_shape_model, read_shape_model, resolve_settings  # noqa: E402
+from latlong import Body, build_body, from_shape_model, read_shape_model, resolve_settings  # noqa: E402, I001
 from latlong.preview import render_preview  # noqa: E402
+from latlong.shapes import mean_surface_distance  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
@@ -30,23 +30,8 @@ png = out / "_shape_panel.png"
 rng = np.random.default_rng(0)
 
 
-def sample(mesh, n=20000):
-    mesh = mesh.triangulate()
-    p = np.asarray(mesh.points)
-    f = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
-    a, b, c = p[f[:, 0]], p[f[:, 1]], p[f[:, 2]]
-    w = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    k = rng.choice(len(f), n, p=w / w.sum())
-    u, v = rng.random(n), rng.random(n)
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    return pv.PolyData(a[k] + u[:, None] * (b[k] - a[k]) + v[:, None] * (c[k] - a[k]))
-
-
 def distance(a, b):
-    da = np.abs(sample(a).compute_implicit_distance(b)["implicit_distance"]).mean()
-    db = np.abs(sample(b).compute_implicit_distance(a)["implicit_distance"]).mean()
-    return 0.5 * (da + db)
+    return mean_surface_distance(a, b, rng=rng)
 
 
 q8 = read_shape_model(data / "itokawa_8.obj", units="km")

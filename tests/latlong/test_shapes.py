@@ -10,31 +10,15 @@ import pyvista as pv
 
 from latlong import LatLongGrid
 from latlong.shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
+from latlong.shapes import mean_surface_distance as _msd
 
 DATA = Path(__file__).parents[1] / "data"
 DIST_TOL = 0.005  # mean surface distance, fraction of the mean radius
 VOLUME_TOL = 0.01
 
 
-def sample_surface(mesh, n, rng):
-    mesh = mesh.triangulate()
-    pts = np.asarray(mesh.points)
-    f = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
-    a, b, c = pts[f[:, 0]], pts[f[:, 1]], pts[f[:, 2]]
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-    k = rng.choice(len(f), n, p=area / area.sum())
-    u, v = rng.random(n), rng.random(n)
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    return a[k] + u[:, None] * (b[k] - a[k]) + v[:, None] * (c[k] - a[k])
-
-
 def mean_surface_distance(a, b, rng, n=20000):
-    """Symmetric mean distance between two closed surfaces (points sampled on each)."""
-    pa, pb = pv.PolyData(sample_surface(a, n, rng)), pv.PolyData(sample_surface(b, n, rng))
-    da = np.abs(pa.compute_implicit_distance(b)["implicit_distance"])
-    db = np.abs(pb.compute_implicit_distance(a)["implicit_distance"])
-    return 0.5 * (da.mean() + db.mean())
+    return _msd(a, b, n_points=n, rng=rng)
 
 
 # --------------------------------------------------------------------------- readers
