@@ -21,6 +21,15 @@ from .grid import LatLongGrid
 from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
 from .scene import PRESETS, body_population, build_body, resolve_settings, surface_positions
 from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
+from .slopes import (
+    facet_slopes,
+    mesh_slopes,
+    radius_spectrum,
+    slope_summary,
+    slopes,
+    slopes_and_areas,
+    vertex_normals,
+)
 from .smoothing import fwhm_to_sigma, heat_smooth, smooth
 
 __all__ = [
@@ -39,19 +48,26 @@ __all__ = [
     "build_body",
     "cast_radii",
     "crater_extents_deg",
+    "facet_slopes",
     "fbm3",
     "from_shape_model",
     "fwhm_to_sigma",
     "heat_smooth",
     "load",
+    "mesh_slopes",
     "perlin_fbm",
     "poisson_faulting",
+    "radius_spectrum",
     "random_faults",
     "read_shape_model",
     "resolve_settings",
+    "slope_summary",
+    "slopes",
+    "slopes_and_areas",
     "smooth",
     "stamp_craters",
     "surface_positions",
+    "vertex_normals",
     "two_phase_faulting",
 ]
 

@@ -20,6 +20,7 @@ from craters._infra import (
     run_cli,
 )
 
+from .analysis_cli import add_parsers as add_analysis_parsers
 from .body import load
 from .scene import (
     BUILD_OPTIONS,
@@ -160,6 +161,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="no messages")
     _add_options(r, RENDER_OPTIONS, {"render": r})
     r.set_defaults(func=_cmd_render)
+    add_analysis_parsers(sub)
     return parser
 
 

@@ -91,6 +91,17 @@ def bench_smooth(quick):
           f"{cold:.2f} s first call (builds the Laplacians), {warm:.2f} s after")
 
 
+def bench_slopes(quick):
+    from latlong import Body, LatLongGrid, perlin_fbm, slopes
+
+    m = 300 if quick else 1000
+    g = LatLongGrid(m)
+    body = Body.from_heights(g, 1000.0, perlin_fbm(g, 1.5, 10, 0.5, 1.75, 300.0, rng=1))
+    slopes(Body.sphere(LatLongGrid(8), 1.0))  # compile
+    t, _ = best_of(lambda: slopes(body, 3.0), repeat=1)
+    print(f"slopes M={m} ({g.n_vertices:,} vertices), 3 deg area-weighted caps: {t:.1f} s")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
@@ -102,6 +113,7 @@ def main():
     bench_faults(args.quick)
     bench_fbm(args.quick)
     bench_smooth(args.quick)
+    bench_slopes(args.quick)
 
 
 if __name__ == "__main__":

@@ -300,3 +300,37 @@ def test_shape_model_base(run_cli, tmp_path):
                        str(tmp_path / "x.npz"))
         assert_one_line_error(proc, *needles)
     assert not (tmp_path / "x.npz").exists()
+
+
+def test_slopes_and_spectrum_commands(run_cli, tmp_path):
+    data = Path(__file__).parents[1] / "data"
+    model = tmp_path / "m.npz"
+    assert run_cli("latlong", "build", "--preset", "eros-like", "--magnitude", "40",
+                   "--seed", "3", "-o", str(model), "-q").returncode == 0
+    csv, png = tmp_path / "s.csv", tmp_path / "s.png"
+    proc = run_cli("latlong", "slopes", str(model), "--compare", str(data / "eros001708.tab"),
+                   "--shape-units", "km", "--label", "synthetic", "Eros", "--csv", str(csv),
+                   "--plot", str(png))
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert lines[0].split()[:2] == ["input", "median_deg"]
+    assert lines[1].startswith("synthetic") and lines[2].startswith("Eros")
+    text = csv.read_text().splitlines()
+    assert text[0].startswith("# latlong slopes") and "deg" in text[1]
+    table = np.loadtxt(csv, delimiter=",", skiprows=2)
+    assert table[:, 2].sum() == pytest.approx(1.0) and table[:, 4].sum() == pytest.approx(1.0)
+    assert png.stat().st_size > 20_000
+    csv2, png2 = tmp_path / "p.csv", tmp_path / "p.png"
+    proc = run_cli("latlong", "spectrum", str(model), "--compare",
+                   str(data / "eros001708.tab"), "--shape-units", "km", "--magnitude", "40",
+                   "--csv", str(csv2), "--plot", str(png2), "-q")
+    assert proc.returncode == 0, proc.stderr
+    assert "power_m2" in csv2.read_text().splitlines()[1]
+    assert_one_line_error(run_cli("latlong", "slopes", str(data / "eros001708.tab"),
+                                  "--csv", str(tmp_path / "x.csv")), "--shape-units")
+    assert_one_line_error(run_cli("latlong", "slopes", str(model), "--radius-deg", "-1",
+                                  "--csv", str(tmp_path / "x.csv")), "--radius-deg")
+    assert_one_line_error(run_cli("latlong", "slopes", str(model), "--compare", str(model),
+                                  "--label", "one", "--csv", str(tmp_path / "x.csv")),
+                          "--label")
+    assert not (tmp_path / "x.csv").exists()

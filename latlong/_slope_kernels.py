@@ -1,0 +1,134 @@
+"""Numba kernels for slopes on the lat/long body: vertex normals and cap averages."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ._grid_kernels import _ring_size
+
+
+@njit(cache=True)
+def _vertex_normals_kernel(verts, tris, out, area):
+    """Add each triangle's area vector (cross product / 2) to its vertices' normals and
+    a third of its area to their areas."""
+    for t in range(tris.shape[0]):
+        a = tris[t, 0]
+        b = tris[t, 1]
+        c = tris[t, 2]
+        e1x = verts[b, 0] - verts[a, 0]
+        e1y = verts[b, 1] - verts[a, 1]
+        e1z = verts[b, 2] - verts[a, 2]
+        e2x = verts[c, 0] - verts[a, 0]
+        e2y = verts[c, 1] - verts[a, 1]
+        e2z = verts[c, 2] - verts[a, 2]
+        nx = 0.5 * (e1y * e2z - e1z * e2y)
+        ny = 0.5 * (e1z * e2x - e1x * e2z)
+        nz = 0.5 * (e1x * e2y - e1y * e2x)
+        third = np.sqrt(nx * nx + ny * ny + nz * nz) / 3.0
+        for v in (a, b, c):
+            out[v, 0] += nx
+            out[v, 1] += ny
+            out[v, 2] += nz
+            area[v] += third
+
+
+@njit(cache=True, parallel=True)
+def _ring_prefix_kernel(ring_offsets, values, out):
+    """Per-ring prefix sums of ``values`` (N, k) into ``out`` (N + rings, k).
+
+    Ring r's prefix occupies rows ring_offsets[r] + r .. ring_offsets[r+1] + r, the first
+    being zero, so the sum of positions [j0, j1) is out[o + r + j1] - out[o + r + j0].
+    """
+    n_rings = ring_offsets.shape[0] - 1
+    k = values.shape[1]
+    for r in prange(n_rings):
+        o = ring_offsets[r]
+        n = ring_offsets[r + 1] - o
+        base = o + r
+        for c in range(k):
+            out[base, c] = 0.0
+        for j in range(n):
+            for c in range(k):
+                out[base + j + 1, c] = out[base + j, c] + values[o + j, c]
+
+
+@njit(cache=True, inline="always")
+def _arc_sum(prefix, base, n, jlo, jhi, c):
+    """Sum of ring positions jlo..jhi (inclusive, may wrap; jhi - jlo + 1 <= n)."""
+    lo = jlo % n
+    count = jhi - jlo + 1
+    hi = lo + count
+    if hi <= n:
+        return prefix[base + hi, c] - prefix[base + lo, c]
+    return (prefix[base + n, c] - prefix[base + lo, c]) + (prefix[base + hi - n, c]
+                                                          - prefix[base, c])
+
+
+@njit(cache=True, parallel=True)
+def _cap_average_kernel(m, ring_offsets, prefix, ang, out):
+    """Sum over every vertex's cap of angular radius ``ang`` (parameter directions).
+
+    For a vertex, the rings the cap crosses are visited and on each the arc of
+    longitudes inside it is summed from the ring's prefix sums: O(rings in the cap) per
+    vertex, whatever the number of vertices in the cap. The arc's half-width depends
+    only on the two rings (closed form: cos(dlon) >= (cos a - cos t cos t') / (sin t
+    sin t')), so it is computed once per ring pair, not per vertex.
+    """
+    step = np.pi / (2 * m)
+    cos_a = np.cos(ang)
+    k = prefix.shape[1]
+    n_rings = 2 * m + 1
+    span = int(np.ceil(ang / step - 1e-9)) + 1
+    for rv in prange(n_rings):
+        nv = _ring_size(rv, m)
+        ov = ring_offsets[rv]
+        th = rv * step
+        ct = np.cos(th)
+        st = np.sin(th)
+        r_lo = max(0, rv - span)
+        r_hi = min(2 * m, rv + span)
+        # per target ring: -1 = not crossed, 2 = whole ring, else half-width of the arc
+        half = np.empty(r_hi - r_lo + 1)
+        for r in range(r_lo, r_hi + 1):
+            theta = r * step
+            if abs(theta - th) > ang + 1e-12:
+                half[r - r_lo] = -1.0
+                continue
+            n = _ring_size(r, m)
+            den = np.sin(theta) * st
+            if n == 1 or den < 1e-15:
+                half[r - r_lo] = 2.0 * np.pi
+                continue
+            cc = (cos_a - np.cos(theta) * ct) / den
+            if cc > 1.0:
+                half[r - r_lo] = -1.0
+            elif cc <= -1.0:
+                half[r - r_lo] = 2.0 * np.pi
+            else:
+                half[r - r_lo] = np.arccos(cc)
+        for j in range(nv):
+            i = ov + j
+            lon = 2.0 * np.pi * j / nv
+            for c in range(k):
+                out[i, c] = 0.0
+            for r in range(r_lo, r_hi + 1):
+                dl = half[r - r_lo]
+                if dl < 0.0:
+                    continue
+                n = _ring_size(r, m)
+                base = ring_offsets[r] + r
+                if dl >= np.pi or n == 1:
+                    for c in range(k):
+                        out[i, c] += prefix[base + n, c] - prefix[base, c]
+                    continue
+                scale = n / (2.0 * np.pi)
+                jlo = int(np.ceil((lon - dl) * scale - 1e-9))
+                jhi = int(np.floor((lon + dl) * scale + 1e-9))
+                if jhi < jlo:
+                    continue
+                if jhi - jlo + 1 > n:
+                    jlo = 0
+                    jhi = n - 1
+                for c in range(k):
+                    out[i, c] += _arc_sum(prefix, base, n, jlo, jhi, c)
