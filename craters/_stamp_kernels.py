@@ -262,20 +262,55 @@ def _roughness_amp(x, xe, a_bowl, a_wall, a_ejecta):
 
 
 # --------------------------------------------------------------------------- stamping
-@njit(cache=True, parallel=True)
-def _write_crater(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab,
-                  delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
-    """Write one crater into ``h`` in place (rows in parallel; pixels independent)."""
+# pixels above which a crater is written in parallel: a parallel region costs tens of
+# microseconds, far more when the other core is busy, so small craters stay serial
+PARALLEL_MIN = 40_000
+
+
+@njit(cache=True)
+def _crater_box(h, cy, cx, pixel, radius, xe, rim_tab):
+    """Row and column bounds of a crater's reach in the grid."""
     ny, nx = h.shape
     rho_max = 0.0
     for k in range(rim_tab.shape[0]):
         rho_max = max(rho_max, rim_tab[k])
     reach = xe * radius * (1.0 + rho_max) / pixel + 1.0
-    i_lo = max(0, int(np.floor(cy - reach)))
-    i_hi = min(ny - 1, int(np.ceil(cy + reach)))
-    j_lo = max(0, int(np.floor(cx - reach)))
-    j_hi = min(nx - 1, int(np.ceil(cx + reach)))
+    return (max(0, int(np.floor(cy - reach))), min(ny - 1, int(np.ceil(cy + reach))),
+            max(0, int(np.floor(cx - reach))), min(nx - 1, int(np.ceil(cx + reach))))
+
+
+@njit(cache=True, parallel=True)
+def _write_crater_parallel(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe,
+                           rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves,
+                           gain):
+    """:func:`_write_rows` row by row in parallel (pixels are independent)."""
+    i_lo, i_hi, j_lo, j_hi = _crater_box(h, cy, cx, pixel, radius, xe, rim_tab)
     for i in prange(i_lo, i_hi + 1):
+        _write_rows(i, i + 1, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha, beta,
+                    e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves,
+                    gain)
+
+
+@njit(cache=True)
+def _write_crater(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab,
+                  delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
+    """Write one crater into ``h`` in place (in parallel when it is large)."""
+    i_lo, i_hi, j_lo, j_hi = _crater_box(h, cy, cx, pixel, radius, xe, rim_tab)
+    if (i_hi - i_lo + 1) * (j_hi - j_lo + 1) >= PARALLEL_MIN:
+        _write_crater_parallel(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe,
+                               rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength,
+                               octaves, gain)
+    else:
+        _write_rows(i_lo, i_hi + 1, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha,
+                    beta, e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength,
+                    octaves, gain)
+
+
+@njit(cache=True)
+def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha, beta,
+                e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
+    """Write rows r_lo..r_hi-1 (columns j_lo..j_hi) of a crater into ``h`` in place."""
+    for i in range(r_lo, r_hi):
         dy = (i - cy) * pixel
         for j in range(j_lo, j_hi + 1):
             dx = (j - cx) * pixel

@@ -206,12 +206,17 @@ def _fill_holes(grid, known):
     return out
 
 
-@njit(cache=True, parallel=True)
-def _write_kernel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h, alpha, beta,
-                  e0, xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength,
-                  octaves, gain, dh_out):
-    """New radii for the gathered vertices (each vertex written once: parallel-safe)."""
-    for q in prange(idx.shape[0]):
+# vertices above which a crater is written in parallel: a parallel region costs tens of
+# microseconds, far more when the other core is busy, so small craters stay serial
+PARALLEL_MIN = 20_000
+
+
+@njit(cache=True)
+def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h, alpha,
+                 beta, e0, xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength,
+                 octaves, gain, dh_out):
+    """New radii for gathered vertices lo..hi-1 (each vertex written once)."""
+    for q in range(lo, hi):
         x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
         dh = 0.0
         if x < xe:
@@ -227,6 +232,19 @@ def _write_kernel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h,
             i = idx[q]
             radii[i] = radii[i] * (pmag[q] + dh) / pmag[q]
         dh_out[q] = dh
+
+
+@njit(cache=True, parallel=True)
+def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h, alpha, beta,
+                    e0, xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength,
+                    octaves, gain, dh_out):
+    """:func:`_write_range` over blocks of vertices in parallel (blocks are disjoint)."""
+    n = idx.shape[0]
+    block = 4096
+    for b in prange((n + block - 1) // block):
+        _write_range(b * block, min(n, (b + 1) * block), radii, idx, pmag, dist, az, xl, yl,
+                     hgt, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab, delta, p0, gx,
+                     gy, qa, qb, qc, rough, seed, wavelength, octaves, gain, dh_out)
 
 
 @njit(cache=True)
@@ -399,10 +417,15 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         while octaves < 10 and radius / 2.0**octaves >= 2.0 * sp:
             octaves += 1
         dh = np.empty(keep)
-        _write_kernel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
-                      yl[:keep], hgt[:keep], radius, depth, rim_h, alpha, beta, e0, xe,
-                      rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c], radius,
-                      octaves, gain, dh)
+        if keep >= PARALLEL_MIN:
+            _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
+                            yl[:keep], hgt[:keep], radius, depth, rim_h, alpha, beta, e0, xe,
+                            rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
+                            radius, octaves, gain, dh)
+        else:
+            _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth,
+                         rim_h, alpha, beta, e0, xe, rim_tabs[c], delta, p0, gx, gy, qa, qb,
+                         qc, rough, seeds[c], radius, octaves, gain, dh)
         big = 0.0
         for q in range(keep):
             big = max(big, abs(dh[q]))

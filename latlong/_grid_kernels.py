@@ -113,3 +113,119 @@ def _interpolate_kernel(m, ring_offsets, values, colat, lon, out):
     """:func:`_interpolate_one` at many points (parallel)."""
     for p in prange(colat.shape[0]):
         out[p] = _interpolate_one(m, ring_offsets, values, colat[p], lon[p])
+
+
+@njit(cache=True)
+def _band_strip_kernel(oa, na, ob, nb, south, step_lo, step_hi, out):
+    """Triangle strip of zipper steps ``step_lo .. step_hi - 1`` of a band into ``out``.
+
+    Every zipper triangle is (current a, current b, new vertex) in the north and
+    (current b, current a, new vertex) in the south. A strip appends one vertex per
+    triangle; the tail is the current pair, and the step is free when the parity (GL
+    winding alternation) matches the kind of advance: an a-advance at even parity with
+    the tail (a, b), a b-advance at odd parity with (b, a) (mirrored in the south).
+    Otherwise one repeated vertex (a degenerate triangle) flips the parity and the tail
+    order together. Alternating advances - most of a band - cost nothing. Returns the
+    number of vertices written (``out`` needs 2 + 2 * steps entries).
+    """
+    i = 0
+    j = 0
+    steps = na + nb if na > 1 else nb
+    for _ in range(step_lo):  # replay the zipper to the first step
+        if na > 1 and i < na and (j >= nb or (i + 1) * nb <= (j + 1) * na):
+            i += 1
+        else:
+            j += 1
+    a = oa + (i % na)
+    b = ob + (j % nb)
+    # start in a canonical state: even parity with (a, b) north / (b, a) south
+    if south:
+        out[0] = b
+        out[1] = a
+    else:
+        out[0] = a
+        out[1] = b
+    k = 2
+    for _ in range(step_lo, min(step_hi, steps)):
+        advance_a = na > 1 and i < na and (j >= nb or (i + 1) * nb <= (j + 1) * na)
+        parity_even = (k - 2) % 2 == 0
+        # north: even parity expects an a-advance; south: even parity expects a b-advance
+        expects_a = parity_even != south
+        if advance_a != expects_a:
+            out[k] = out[k - 2]  # degenerate: flips parity and the tail order
+            k += 1
+        if advance_a:
+            i += 1
+            out[k] = oa + (i % na)
+        else:
+            j += 1
+            out[k] = ob + (j % nb)
+        k += 1
+    return k
+
+
+@njit(cache=True, inline="always")
+def _ring_positions(m, r, o, radii, stretch, out):
+    """Positions of ring r's vertices (radii times unit vectors, stretched) into out."""
+    n = _ring_size(r, m)
+    colat = r * (np.pi / (2 * m))
+    if n == 1:
+        z = 1.0 if r == 0 else -1.0
+        out[0, 0] = 0.0
+        out[0, 1] = 0.0
+        out[0, 2] = stretch[2] * radii[o] * z
+        return
+    s = np.sin(colat)
+    c = np.cos(colat)
+    for j in range(n):
+        lon = 2.0 * np.pi * j / n
+        out[j, 0] = stretch[0] * radii[o + j] * s * np.cos(lon)
+        out[j, 1] = stretch[1] * radii[o + j] * s * np.sin(lon)
+        out[j, 2] = stretch[2] * radii[o + j] * c
+
+
+@njit(cache=True, parallel=True)
+def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, acc):
+    """Area-weighted vertex normals of the body, streamed band by band (no triangle or
+    vertex array of the whole body). Even bands first, then odd bands: the bands of one
+    pass share no ring, so they run in parallel and every vertex receives its two bands'
+    contributions in a fixed order (deterministic)."""
+    n_bands = 2 * m
+    for parity in range(2):
+        for hb in prange((n_bands - parity + 1) // 2):
+            band = 2 * hb + parity
+            if band >= n_bands:
+                continue
+            if band < m:
+                ra, rb, south = band, band + 1, False
+            else:
+                ra, rb, south = band + 1, band, True
+            na = _ring_size(ra, m)
+            nb = _ring_size(rb, m)
+            oa = ring_offsets[ra]
+            ob = ring_offsets[rb]
+            pa = np.empty((na, 3))
+            pb = np.empty((nb, 3))
+            _ring_positions(m, ra, oa, radii, stretch, pa)
+            _ring_positions(m, rb, ob, radii, stretch, pb)
+            nt = band_offsets[band + 1] - band_offsets[band]
+            tris = np.empty((nt, 3), dtype=np.int64)
+            _band_triangles_kernel(oa, na, ob, nb, south, tris, 0)
+            for t in range(nt):
+                p = np.empty((3, 3))
+                for c in range(3):
+                    v = tris[t, c]
+                    if oa <= v < oa + na:
+                        p[c] = pa[v - oa]
+                    else:
+                        p[c] = pb[v - ob]
+                e1 = p[1] - p[0]
+                e2 = p[2] - p[0]
+                nx = 0.5 * (e1[1] * e2[2] - e1[2] * e2[1])
+                ny = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2])
+                nz = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0])
+                for c in range(3):
+                    v = tris[t, c]
+                    acc[v, 0] += nx
+                    acc[v, 1] += ny
+                    acc[v, 2] += nz

@@ -160,6 +160,24 @@ class Body:
         """``radii_m - radius_m`` in metres."""
         return self._radii - self._radius_m
 
+    def lod(self, level: int) -> Body:
+        """The nested coarser body of magnitude M / 2^level: exactly this body's vertices
+        on the even rings / even positions, ``level`` times (no resampling)."""
+        from craters._infra import check_int
+
+        level = check_int("level", level, 0, 30)
+        factor = 2**level
+        if self.magnitude % factor:
+            raise ValueError(f"`level` {level} needs a magnitude divisible by {factor}; "
+                             f"this body has M = {self.magnitude}")
+        if level == 0:
+            return self
+        coarse = LatLongGrid(self.magnitude // factor)
+        idx = self._grid.nested_indices(coarse)
+        meta = {**self._metadata, "lod_level": level, "lod_of_magnitude": self.magnitude}
+        return Body(coarse, self._radii[idx], radius_m=self._radius_m, stretch=self._stretch,
+                    metadata=meta)
+
     def vertices(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
         """Vertex positions in metres, (N, 3) float64 (or the rows ``lo:hi``)."""
         u = self._grid.unit_vectors()[lo:hi]

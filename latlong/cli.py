@@ -13,6 +13,7 @@ import sys
 from pathlib import Path
 
 from craters._infra import (
+    CliError,
     OneLineParser,
     check_output_path,
     package_version,
@@ -119,6 +120,37 @@ def _cmd_render(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_export(args: argparse.Namespace) -> int:
+    from .gltf import export_glb, export_vtp_strips
+
+    out = Path(args.output)
+    suffix = out.suffix.lower()
+    if suffix not in (".glb", ".vtp"):
+        raise CliError(f"-o/--output must end in .glb or .vtp; got {str(out)!r}")
+    if not 2 <= args.patch_k <= 1_000_000:
+        raise CliError(f"--patch-k must be in [2, 1000000]; got {args.patch_k}")
+    if not 0 <= args.lod <= 20:
+        raise CliError(f"--lod must be in [0, 20]; got {args.lod}")
+    check_output_path(out, force=args.force, suffixes=(".glb", ".vtp"))
+    if suffix == ".glb":
+        check_output_path(out.with_suffix(".json"), force=args.force, suffixes=(".json",))
+    body = load(args.model)
+    if body.magnitude % (2**args.lod):
+        raise CliError(f"--lod {args.lod} needs a magnitude divisible by {2**args.lod}; "
+                       f"{args.model} has M = {body.magnitude}")
+    if suffix == ".glb":
+        man = export_glb(body, out, patch_k=args.patch_k, lod=args.lod,
+                         progress=not args.quiet)
+        summary = ", ".join(f"LOD {lv['level']}: M={lv['magnitude']} "
+                            f"{len(lv['patches'])} patches" for lv in man["levels"])
+    else:
+        export_vtp_strips(body, out)
+        summary = f"{2 * body.magnitude} strips"
+    if not args.quiet:
+        print(f"wrote {out} ({human_bytes(out.stat().st_size)}): {summary}")
+    return 0
+
+
 def _add_options(parser, options, groups) -> None:
     for opt in options:
         kw: dict = {"dest": opt.key, "help": opt.help, "default": None}
@@ -161,6 +193,16 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-q", "--quiet", action="store_true", help="no messages")
     _add_options(r, RENDER_OPTIONS, {"render": r})
     r.set_defaults(func=_cmd_render)
+    e = sub.add_parser("export", help="renderer export: patched triangle strips (.glb, with "
+                       "a JSON manifest, nested LODs) or a VTP with native strips")
+    e.add_argument("model", help="a .npz written by latlong build")
+    e.add_argument("-o", "--output", required=True, help="out.glb or out.vtp")
+    e.add_argument("--patch-k", type=int, default=64, help="patch tree parameter K")
+    e.add_argument("--lod", type=int, default=0,
+                   help="coarsest level of detail (M / 2^lod), 0 = the body only")
+    e.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    e.add_argument("-q", "--quiet", action="store_true", help="no progress or messages")
+    e.set_defaults(func=_cmd_export)
     add_analysis_parsers(sub)
     return parser
 

@@ -1,0 +1,214 @@
+"""Renderer export: patched triangle strips as glTF 2.0 binary, VTP strips, a manifest.
+
+``export_glb`` writes one glTF scene per level of detail (scene 0 = the full body,
+scene l = the nested magnitude M / 2^l body); every leaf of the patch tree
+(:func:`latlong.strips.patch_tree`) is one node with one mesh whose single primitive is
+a ``TRIANGLE_STRIP`` (mode 5) over the patch's own vertices: float32 ``POSITION`` (with
+min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band strips cut
+to the patch and joined with degenerate triangles. Node extras and the JSON manifest
+give each patch's bounding sphere, bands, triangle count and the byte ranges of its
+data in the binary chunk, so a renderer can cull and stream patches. Nothing holds the
+whole body's triangles: patches are generated and written one by one, normals come
+from a band-streaming kernel, and the binary chunk goes to a temporary file first
+(its length is only known at the end).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import struct
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from craters._infra import atomic_path, check_int, package_version, progress_bar
+
+from ._grid_kernels import _normals_from_radii_kernel
+from .body import Body
+from .grid import LatLongGrid
+from .strips import join_strips, patch_tree, strip_triangles
+
+__all__ = ["body_normals", "export_glb", "export_vtp_strips", "unit_vectors_of"]
+
+_ARRAY_BUFFER = 34962
+_ELEMENT_ARRAY_BUFFER = 34963
+_FLOAT = 5126
+_UINT = 5125
+_TRIANGLE_STRIP = 5
+
+
+def unit_vectors_of(grid: LatLongGrid, idx) -> np.ndarray:
+    """Unit vectors of the vertices ``idx`` (same values as ``grid.unit_vectors()``,
+    computed without the whole-grid cache)."""
+    idx = np.asarray(idx, dtype=np.int64)
+    offs = grid.ring_offsets()
+    ring = np.searchsorted(offs, idx, side="right") - 1
+    pos = idx - offs[ring]
+    colat = grid.ring_colatitudes()[ring]
+    lat = np.pi / 2 - colat
+    lon = (2 * np.pi) * pos / grid.ring_sizes()[ring]
+    c = np.cos(lat)
+    out = np.stack([c * np.cos(lon), c * np.sin(lon), np.sin(lat)], axis=1)
+    out[ring == 0] = (0.0, 0.0, 1.0)
+    out[ring == grid.n_rings - 1] = (0.0, 0.0, -1.0)
+    return out
+
+
+def body_normals(body: Body) -> np.ndarray:
+    """Unit vertex normals (area-weighted), float32 (N, 3), streamed band by band."""
+    grid = body.grid
+    acc = np.zeros((grid.n_vertices, 3), dtype=np.float64)
+    _normals_from_radii_kernel(grid.magnitude, grid.ring_offsets(), grid.band_offsets(),
+                               np.asarray(body.radii_m, dtype=np.float64),
+                               np.asarray(body.stretch, dtype=np.float64), acc)
+    norm = np.linalg.norm(acc, axis=1, keepdims=True)
+    return (acc / np.where(norm > 0, norm, 1.0)).astype(np.float32)
+
+
+def _pad4(n: int) -> int:
+    return (4 - n % 4) % 4
+
+
+def export_glb(body: Body, path, *, patch_k: int = 64, lod: int = 0,
+               progress: bool = False) -> dict:
+    """Write ``body`` as a patched, multi-LOD glTF binary and a JSON manifest.
+
+    Parameters
+    ----------
+    body : Body
+    path : str or Path
+        The ``.glb`` to write; the manifest goes next to it as ``<stem>.json``.
+    patch_k : int
+        The patch tree parameter K (>= 2).
+    lod : int
+        Coarsest level of detail: levels 0..lod are written (M must be divisible by
+        2^lod); level l is ``body.lod(l)``.
+
+    Returns
+    -------
+    The manifest (also written): per level the magnitude, triangle count and patches
+    with their bounds and byte ranges.
+    """
+    if not isinstance(body, Body):
+        raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
+    path = Path(path)
+    if path.suffix.lower() != ".glb":
+        raise ValueError(f"`path` must end in .glb; got {str(path)!r}")
+    patch_k = check_int("patch_k", patch_k, 2, 1_000_000)
+    lod = check_int("lod", lod, 0, 20)
+    if body.magnitude % (2**lod):
+        raise ValueError(f"`lod` {lod} needs a magnitude divisible by {2**lod}; "
+                         f"the body has M = {body.magnitude}")
+    gl = {"asset": {"version": "2.0", "generator": f"craterform {package_version()}"},
+          "scene": 0, "scenes": [], "nodes": [], "meshes": [], "accessors": [],
+          "bufferViews": [], "buffers": []}
+    manifest = {"format": "craterform.patches/1", "glb": path.name, "patch_k": patch_k,
+                "levels": []}
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, bin_tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".bin", dir=folder)
+    os.close(fd)
+    try:
+        offset = 0
+        with open(bin_tmp, "wb") as binf:
+            for level in range(lod + 1):
+                offset = _write_level(body.lod(level), level, patch_k, gl, manifest, binf,
+                                      offset, progress)
+        gl["buffers"].append({"byteLength": offset})
+        js = json.dumps(gl, separators=(",", ":"), sort_keys=True).encode("utf-8")
+        js += b" " * _pad4(len(js))
+        total = 12 + 8 + len(js) + 8 + offset
+        with atomic_path(path) as tmp:
+            with open(tmp, "wb") as out, open(bin_tmp, "rb") as src:
+                out.write(struct.pack("<4sII", b"glTF", 2, total))
+                out.write(struct.pack("<I4s", len(js), b"JSON"))
+                out.write(js)
+                out.write(struct.pack("<I4s", offset, b"BIN\x00"))
+                shutil.copyfileobj(src, out, length=16 << 20)
+    finally:
+        os.unlink(bin_tmp)
+    base = 12 + 8 + len(js) + 8
+    manifest["bin_chunk_offset"] = base
+    with atomic_path(path.with_suffix(".json")) as tmp:
+        tmp.write_text(json.dumps(manifest, indent=1, sort_keys=True), encoding="utf-8")
+    return manifest
+
+
+def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
+                 offset: int, progress: bool) -> int:
+    grid = body.grid
+    normals = body_normals(body)
+    radii = np.asarray(body.radii_m)
+    stretch = np.asarray(body.stretch)
+    root = patch_tree(grid, patch_k)
+    leaves = list(root.leaves())
+    scene_nodes = []
+    level_info = {"level": level, "magnitude": grid.magnitude, "n_vertices": grid.n_vertices,
+                  "n_triangles": grid.n_triangles, "scene": level, "patches": []}
+    for leaf in progress_bar(leaves, enabled=progress, desc=f"LOD {level}"):
+        strip = join_strips(leaf.strips(grid))
+        if len(strip) < 3:
+            continue
+        idx, local = np.unique(strip, return_inverse=True)
+        pos = (unit_vectors_of(grid, idx) * radii[idx, None] * stretch).astype(np.float32)
+        nrm = normals[idx]
+        ind = local.astype(np.uint32)
+        lo, hi = pos.min(axis=0), pos.max(axis=0)
+        centre = 0.5 * (lo.astype(np.float64) + hi)
+        radius = float(np.sqrt(((pos - centre) ** 2).sum(axis=1).max()))
+        n_tri = len(strip_triangles(strip))
+        ranges = {}
+        for name, data, target in (("positions", pos, _ARRAY_BUFFER),
+                                   ("normals", nrm, _ARRAY_BUFFER),
+                                   ("indices", ind, _ELEMENT_ARRAY_BUFFER)):
+            raw = np.ascontiguousarray(data).tobytes()
+            binf.write(raw)
+            gl["bufferViews"].append({"buffer": 0, "byteOffset": offset,
+                                      "byteLength": len(raw), "target": target})
+            ranges[name] = [offset, len(raw)]
+            offset += len(raw)
+        v0 = len(gl["bufferViews"]) - 3
+        a0 = len(gl["accessors"])
+        gl["accessors"] += [
+            {"bufferView": v0, "componentType": _FLOAT, "count": len(pos), "type": "VEC3",
+             "min": [float(x) for x in lo], "max": [float(x) for x in hi]},
+            {"bufferView": v0 + 1, "componentType": _FLOAT, "count": len(pos), "type": "VEC3"},
+            {"bufferView": v0 + 2, "componentType": _UINT, "count": len(ind),
+             "type": "SCALAR"}]
+        gl["meshes"].append({"primitives": [{"attributes": {"POSITION": a0, "NORMAL": a0 + 1},
+                                             "indices": a0 + 2, "mode": _TRIANGLE_STRIP}]})
+        pid = len(level_info["patches"])
+        info = {"id": pid, "bands": [leaf.band_lo, leaf.band_hi],
+                "fraction": [leaf.frac_lo, leaf.frac_hi], "depth": leaf.depth,
+                "centre_m": [float(x) for x in centre], "radius_m": radius,
+                "n_vertices": len(pos), "n_triangles": n_tri, "strip_length": len(ind),
+                "bytes": ranges}
+        gl["nodes"].append({"name": f"lod{level}/patch{pid}", "mesh": len(gl["meshes"]) - 1,
+                            "extras": {"centre_m": info["centre_m"], "radius_m": radius,
+                                       "n_triangles": n_tri}})
+        scene_nodes.append(len(gl["nodes"]) - 1)
+        level_info["patches"].append(info)
+    gl["nodes"].append({"name": f"lod{level}", "children": scene_nodes,
+                        "extras": {"magnitude": grid.magnitude, "level": level}})
+    gl["scenes"].append({"name": f"lod{level}", "nodes": [len(gl["nodes"]) - 1]})
+    manifest["levels"].append(level_info)
+    return offset
+
+
+def export_vtp_strips(body: Body, path) -> Path:
+    """VTP with native triangle strips (one per band) and point normals/heights."""
+    import pyvista as pv
+
+    from .strips import triangle_strips
+
+    path = Path(path)
+    strips = triangle_strips(body.grid)
+    cells = np.concatenate([np.concatenate([[len(s)], s]) for s in strips])
+    mesh = pv.PolyData(body.vertices(), strips=cells)
+    mesh.point_data["Normals"] = body_normals(body)
+    mesh.point_data["height_m"] = body.heights_m
+    with atomic_path(path) as tmp:
+        mesh.save(str(tmp), binary=True)
+    return path

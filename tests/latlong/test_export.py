@@ -1,0 +1,173 @@
+"""Renderer export: strips, patch trees, LODs, glTF binary, VTP strips."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+import pyvista as pv
+
+from latlong import Body, LatLongGrid, perlin_fbm
+from latlong.gltf import body_normals, export_glb, export_vtp_strips, unit_vectors_of
+from latlong.slopes import vertex_normals
+from latlong.strips import (
+    band_strip,
+    join_strips,
+    patch_tree,
+    strip_triangles,
+    triangle_strips,
+)
+
+
+def canonical(tri):
+    """Rotate each triangle so its smallest index comes first (orientation kept)."""
+    tri = np.asarray(tri)
+    i = np.argmin(tri, axis=1)
+    r = np.arange(len(tri))
+    out = np.stack([tri[r, i], tri[r, (i + 1) % 3], tri[r, (i + 2) % 3]], axis=1)
+    return out[np.lexsort(out.T[::-1])]
+
+
+@pytest.mark.parametrize("m", [*range(1, 65), 500])
+def test_strips_are_the_triangulation(m):
+    g = LatLongGrid(m)
+    strips = triangle_strips(g)
+    assert len(strips) == 2 * m
+    got = np.concatenate([strip_triangles(s) for s in strips])
+    assert np.array_equal(canonical(got), canonical(g.triangles()))  # same set, same winding
+
+
+def test_strip_sub_ranges_and_joins():
+    g = LatLongGrid(20)
+    band = g.band_triangles(7, 8)
+    n = len(band)
+    for lo, hi in ((0, n), (3, 17), (n - 5, n), (10, 11)):
+        got = strip_triangles(band_strip(g, 7, lo, hi))
+        assert np.array_equal(canonical(got), canonical(band[lo:hi]))
+    joined = join_strips([band_strip(g, b) for b in range(4)])
+    want = np.concatenate([g.band_triangles(b, b + 1) for b in range(4)])
+    assert np.array_equal(canonical(strip_triangles(joined)), canonical(want))
+    # the strips are efficient: about one vertex per triangle
+    total = sum(len(s) for s in triangle_strips(LatLongGrid(200)))
+    assert total < 1.01 * LatLongGrid(200).n_triangles
+
+
+@pytest.mark.parametrize("m,k", [(1, 2), (16, 4), (64, 8), (64, 64), (500, 64)])
+def test_patch_tree_leaves(m, k):
+    g = LatLongGrid(m)
+    leaves = list(patch_tree(g, k).leaves())
+    all_tri, bo = g.triangles(), g.band_offsets()
+    tri = []
+    for leaf in leaves:
+        assert leaf.n_strips() < k or leaf.longest(g) < k
+        for b in range(leaf.band_lo, leaf.band_hi):
+            lo, hi = leaf.triangle_range(g, b)
+            tri.append(all_tri[bo[b] + lo:bo[b] + hi])
+    # the leaves partition the triangulation
+    assert np.array_equal(canonical(np.concatenate(tri)), canonical(g.triangles()))
+
+
+@pytest.fixture(scope="module")
+def body():
+    g = LatLongGrid(64)
+    return Body.from_heights(g, 100.0, perlin_fbm(g, 1.5, 6, 0.5, 2.0, 10.0, rng=1),
+                             stretch=(1.5, 1.0, 1.0))
+
+
+def test_lod_is_the_nested_body(body):
+    for level in (1, 2, 3):
+        coarse = body.lod(level)
+        assert coarse.magnitude == 64 // 2**level
+        idx = body.grid.nested_indices(coarse.grid)
+        assert np.array_equal(coarse.vertices(), body.vertices()[idx])  # exactly
+    with pytest.raises(ValueError, match="divisible"):
+        Body.sphere(LatLongGrid(6), 1.0).lod(2)
+
+
+def test_normals_and_unit_vectors(body):
+    assert np.abs(body_normals(body) - vertex_normals(body)[0]).max() < 1e-6
+    g = body.grid
+    idx = np.array([0, 1, 7, 500, g.n_vertices - 2, g.n_vertices - 1])
+    assert np.array_equal(unit_vectors_of(g, idx), g.unit_vectors()[idx])
+
+
+def non_degenerate(faces):
+    f = np.asarray(faces)
+    return int(((f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])).sum())
+
+
+def test_glb_loads_in_three_readers(body, tmp_path):
+    path = tmp_path / "b.glb"
+    man = export_glb(body, path, patch_k=16, lod=2)
+    expected = [2 * body.lod(level).n_vertices - 4 for level in range(3)]
+    assert [lv["n_triangles"] for lv in man["levels"]] == expected
+    import pygltflib
+
+    gl = pygltflib.GLTF2().load(str(path))
+    assert len(gl.scenes) == 3 and all(p.mode == 5 for m in gl.meshes for p in m.primitives)
+    import trimesh
+
+    scene = trimesh.load(path, process=False)
+    faces = [scene.geometry[scene.graph[n][1]].faces for n in scene.graph.nodes_geometry]
+    assert sum(non_degenerate(f) for f in faces) == expected[0]
+    import vtk
+
+    for level in range(3):
+        reader = vtk.vtkGLTFReader()
+        reader.SetFileName(str(path))
+        reader.UpdateInformation()
+        reader.SetCurrentScene(level)
+        reader.Update()
+        it = reader.GetOutput().NewIterator()
+        it.InitTraversal()
+        count = 0
+        while not it.IsDoneWithTraversal():
+            tri = pv.wrap(it.GetCurrentDataObject()).triangulate()
+            count += non_degenerate(tri.faces.reshape(-1, 4)[:, 1:])
+            it.GoToNextItem()
+        assert count == expected[level]
+    # manifest: bounding spheres hold their patches' vertices; byte ranges point at them
+    doc = json.loads(path.with_suffix(".json").read_text())
+    raw = path.read_bytes()
+    base = doc["bin_chunk_offset"]
+    for patch in doc["levels"][0]["patches"][::7]:
+        off, n = patch["bytes"]["positions"]
+        pos = np.frombuffer(raw[base + off: base + off + n], dtype="<f4").reshape(-1, 3)
+        d = np.linalg.norm(pos - np.asarray(patch["centre_m"]), axis=1)
+        assert d.max() <= patch["radius_m"] * (1 + 1e-6) + 1e-6
+
+
+def test_export_is_deterministic(body, tmp_path):
+    a, b = tmp_path / "a.glb", tmp_path / "b.glb"
+    export_glb(body, a, patch_k=32, lod=1)
+    export_glb(body, b, patch_k=32, lod=1)
+    assert a.read_bytes() == b.read_bytes()
+    ma = json.loads(a.with_suffix(".json").read_text())
+    mb = json.loads(b.with_suffix(".json").read_text())
+    assert ma.pop("glb") == "a.glb" and mb.pop("glb") == "b.glb" and ma == mb
+
+
+def test_vtp_strips(body, tmp_path):
+    path = tmp_path / "s.vtp"
+    export_vtp_strips(body, path)
+    mesh = pv.read(path)
+    assert mesh.n_strips == 2 * body.magnitude
+    tri = mesh.triangulate().faces.reshape(-1, 4)[:, 1:]
+    assert non_degenerate(tri) == body.grid.n_triangles
+    assert "Normals" in mesh.point_data and "height_m" in mesh.point_data
+
+
+def test_export_cli(run_cli, tmp_path, body):
+    model = tmp_path / "m.npz"
+    body.save(model)
+    out = tmp_path / "m.glb"
+    proc = run_cli("latlong", "export", str(model), "-o", str(out), "--patch-k", "16",
+                   "--lod", "3", "-q")
+    assert proc.returncode == 0, proc.stderr
+    assert out.exists() and out.with_suffix(".json").exists()
+    for args, needle in ((["--lod", "7"], "--lod"), (["--patch-k", "1"], "--patch-k")):
+        proc = run_cli("latlong", "export", str(model), "-o", str(tmp_path / "x.glb"), *args)
+        assert proc.returncode == 2 and needle in proc.stderr
+        assert len(proc.stderr.strip().splitlines()) == 1
+    assert not (tmp_path / "x.glb").exists()
