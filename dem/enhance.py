@@ -193,8 +193,12 @@ class EnhanceConfig:
         return cls(**config)
 
     def to_dict(self) -> dict:
-        """JSON-ready values (for the manifest)."""
+        """JSON-ready values that define the stack (for the manifest): all keys but
+        ``output``, ``force`` and ``quiet``, so a stack's bytes do not depend on where and
+        how it was written."""
         d = dataclasses.asdict(self)
+        for key in ("output", "force", "quiet"):
+            del d[key]
         d["craters"] = list(self.craters)
         d["target"] = None if self.target is None else list(self.target)
         return d

@@ -148,14 +148,15 @@ def pixel_affine(dem: Dem, frame: LocalFrame) -> Affine:
     return frame.affine @ dem.transform @ Affine.translation(0.5, 0.5)
 
 
-def grid_pixel_size(a: Affine, what: str = "the DEM") -> float:
+def grid_pixel_size(a: Affine, what: str = "the DEM", *, square: bool = True) -> float:
     """Side ``p`` (metres) of the square pixels of a pixel affine ``a``.
 
-    Raises ValueError if the pixels are not square within :data:`SQUARE_TOLERANCE`.
+    Raises ValueError if the pixels are not square within :data:`SQUARE_TOLERANCE`
+    (with ``square=False``: the side of a square of the same area, unchecked).
     """
     lx, ly = math.hypot(a.a, a.d), math.hypot(a.b, a.e)
     cosang = abs(a.a * a.b + a.d * a.e) / (lx * ly)
-    if abs(lx / ly - 1.0) > SQUARE_TOLERANCE or cosang > SQUARE_TOLERANCE:
+    if square and (abs(lx / ly - 1.0) > SQUARE_TOLERANCE or cosang > SQUARE_TOLERANCE):
         raise ValueError(
             f"craters need square pixels: {what} has pixels of {lx:.6g} x {ly:.6g} m in its "
             f"local frame (tolerance {100 * SQUARE_TOLERANCE:g} %); reproject it to a CRS "

@@ -167,9 +167,10 @@ class Stack:
         return f"Stack({len(self)} layers of {self._layers[0].shape}, pixel sizes m: {sizes})"
 
     def pixel_sizes_m(self) -> list[float]:
-        """Side of each layer's pixels in the local frame, metres."""
-        return [grid_pixel_size(pixel_affine(d, self._frame), f"layer {k}")
-                for k, d in enumerate(self._layers)]
+        """Side of each layer's pixels in the local frame, metres (the square root of the
+        pixel area if the pixels are not square)."""
+        return [grid_pixel_size(pixel_affine(d, self._frame), square=False)
+                for d in self._layers]
 
     def replace(self, *, layers=None, catalogs=None, info=None) -> Stack:
         """A new stack with some parts replaced (same footprints and frame)."""
