@@ -1,33 +1,49 @@
-"""dem: digital elevation models: GeoTIFF/PDS I/O, RMD expansion, gap filling, statistics.
+"""dem: digital elevation models: I/O, RMD expansion, gap filling, layer stacks, meshes.
 
 Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement
-expansion of real DEMs and outside-in fractal gap filling, on a :class:`Dem` that keeps
-the georeferencing. See ``dem --help`` for the command line.
+expansion of real DEMs, outside-in fractal gap filling, crater gap filling and crater
+replacement, multi-resolution layer stacks with craters per layer (:func:`enhance`) and
+their stitched meshes (:func:`to_mesh`), on a :class:`Dem` that keeps the
+georeferencing. See ``dem --help`` for the command line.
 """
 
 import logging
 
 from .analysis import band_power, laplacian, slope_deg
 from .core import Dem
+from .craterfill import fill_crater_gaps, replace_crater
+from .enhance import EnhanceConfig, enhance
 from .expansion import displacement_scales, expand, expansion_sizes
 from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
+from .frame import LocalFrame, local_frame
 from .gaps import fill_gaps
 from .io import read, write
+from .mesh import to_mesh
+from .stack import Stack, read_stack
 
 __all__ = [
     "Dem",
+    "EnhanceConfig",
     "FractalFit",
+    "LocalFrame",
+    "Stack",
     "band_power",
     "displacement_scales",
+    "enhance",
     "expand",
     "expansion_sizes",
+    "fill_crater_gaps",
     "fill_gaps",
     "fractal_dimension",
     "fractal_fit",
     "laplacian",
+    "local_frame",
     "local_roughness",
     "read",
+    "read_stack",
+    "replace_crater",
     "slope_deg",
+    "to_mesh",
     "variogram",
     "write",
 ]

@@ -1,9 +1,11 @@
-"""The ``dem`` command line: ``dem info``, ``dem fill`` and ``dem expand``.
+"""The ``dem`` command line: ``dem info``, ``fill``, ``expand``, ``enhance`` and ``mesh``.
 
-Every option of ``fill`` and ``expand`` has a key of the same name (dashes ->
-underscores) in a TOML file given with ``--config``; options on the command line
-override the file. Errors are one line ``error: ...`` with exit code 2, and nothing is
-written.
+Every option of ``fill``, ``expand`` and ``mesh`` has a key of the same name (dashes ->
+underscores) in a TOML file given with ``--config``; ``dem enhance SCENE.toml`` takes the
+scene file as its argument, whose keys are the options of ``enhance`` (and of
+:class:`dem.EnhanceConfig`). Options on the command line override the file; file names
+are relative to the working folder. Errors are one line ``error: ...`` with exit code 2,
+and nothing is written.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import numpy as np
 from rasterio.coords import BoundingBox
 from rasterio.windows import Window
 
+import craters
 from craters._infra import (
     CliError,
     OneLineParser,
@@ -31,10 +34,13 @@ from craters._infra import (
 )
 
 from .core import crs_label
+from .enhance import EnhanceConfig, enhance
 from .expansion import expand
 from .fractal import fractal_fit
 from .gaps import fill_gaps
 from .io import GEOTIFF_SUFFIXES, read, write
+from .mesh import MESH_SUFFIXES, to_mesh
+from .stack import read_stack
 
 
 # --------------------------------------------------------------------------- parsing
@@ -65,6 +71,27 @@ def _number(text) -> float:
     return value
 
 
+def _target(text) -> tuple[float, float]:
+    """``X,Y`` in world coordinates (CRS units)."""
+    parts = str(text).split(",")
+    try:
+        if len(parts) == 2:
+            x, y = (float(p) for p in parts)
+            if math.isfinite(x) and math.isfinite(y):
+                return x, y
+    except ValueError:
+        pass
+    raise argparse.ArgumentTypeError(f"expected X,Y in world coordinates; got {text!r}")
+
+
+def _crater_spec(text) -> str:
+    try:
+        craters.parse_layer_spec(text)
+    except (TypeError, ValueError) as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+    return text
+
+
 def _count(text) -> int:
     try:
         return int(str(text), 10)
@@ -84,35 +111,62 @@ class Opt:
     commands: tuple[str, ...] = ("fill", "expand")
     flag_only: bool = False  # a store_true switch
     metavar: str | None = None
+    many: bool = False  # repeatable; the values form a list
 
+
+_READ = ("info", "fill", "expand", "enhance", "mesh")
+_WRITE = ("fill", "expand", "enhance", "mesh")
 
 OPTIONS: tuple[Opt, ...] = (
     Opt(("-o", "--output"), "output", str, None, "output GeoTIFF (.tif)", metavar="OUT"),
+    Opt(("-o", "--output"), "output", str, None,
+        "output folder of the stack (layer GeoTIFFs, crater catalogs, manifest.json)",
+        ("enhance",), metavar="DIR"),
+    Opt(("-o", "--output"), "output", str, None, "output mesh (.ply or .vtp)", ("mesh",),
+        metavar="OUT"),
+    Opt(("--input",), "input", str, None, "base DEM (GeoTIFF, PDS .lbl/.img)", ("enhance",),
+        metavar="DEM"),
+    Opt(("--target",), "target", _target, None,
+        "site in world coordinates (CRS units), X,Y (default: the base DEM's centre)",
+        ("enhance",), metavar="X,Y"),
+    Opt(("--layers",), "layers", _count, 11, "number of layers, each 2x finer (1..24)",
+        ("enhance",), metavar="N"),
+    Opt(("--size",), "size", _count, 1025, "pixels per side of every layer, 2^n + 1",
+        ("enhance",), metavar="W"),
+    Opt(("--craters",), "craters", _crater_spec, (),
+        "crater layer c=..,k=..,dmin=..,dmax=..[,amin=..,amax=..,deg=..,kind=..] (N_cum = "
+        "c D^k per m^2, D in metres, ages in Gyr); repeat for several", ("enhance",),
+        metavar="SPEC", many=True),
+    Opt(("--min-crater-px",), "min_crater_px", _number, 2.0,
+        "smallest crater diameter a layer takes, in its pixels (>= 1)", ("enhance",),
+        metavar="PX"),
+    Opt(("--smooth-craters",), "smooth_craters", bool, False,
+        "ideal craters: no fractal overlay, circular rims", ("enhance",), flag_only=True),
     Opt(("--levels",), "levels", _count, 1, "number of 2x expansions (1..16)", ("expand",),
         metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
-        "fractal dimension F in [2, 3] (default: estimated from the input)", ("expand",),
-        metavar="F"),
+        "fractal dimension F in [2, 3] (default: estimated from the input)",
+        ("expand", "enhance"), metavar="F"),
     Opt(("--roughness",), "roughness", _number, None,
         "RMS slope between neighbouring pixels, m/m, >= 0 (default: from the input; for "
-        "expand the local relief of each input pixel)", metavar="R"),
+        "expand and enhance the local relief of each input pixel)",
+        ("fill", "expand", "enhance"), metavar="R"),
     Opt(("--region",), "region", _region, None,
         "square to expand, 2^n+1 pixels: ROW,COL,SIZE in pixels or LEFT,BOTTOM,RIGHT,TOP "
         "in CRS units (default: the whole DEM)", ("expand",), metavar="REGION"),
     Opt(("--seed",), "seed", parse_seed, None,
         "random seed (non-negative integer); default: a fresh one, recorded in the tags",
-        metavar="S"),
-    Opt(("--band",), "band", _count, 1, "band of the input (1-based)",
-        ("info", "fill", "expand"), metavar="B"),
+        ("fill", "expand", "enhance"), metavar="S"),
+    Opt(("--band",), "band", _count, 1, "band of the input (1-based)", _READ, metavar="B"),
     Opt(("--pixel-size-m",), "pixel_size_m", _number, None,
-        "pixel size in metres, for inputs without a CRS", ("info", "fill", "expand"),
-        metavar="M"),
+        "pixel size in metres, for inputs without a CRS", _READ, metavar="M"),
     Opt(("--body-radius-m",), "body_radius_m", _number, None,
         "body radius in metres, for inputs with a geographic CRS (e.g. 1737400 for the Moon)",
-        ("info", "fill", "expand"), metavar="M"),
-    Opt(("-q", "--quiet"), "quiet", bool, False, "no progress bars or messages",
+        _READ, metavar="M"),
+    Opt(("-q", "--quiet"), "quiet", bool, False, "no progress bars or messages", _WRITE,
         flag_only=True),
-    Opt(("--force",), "force", bool, False, "overwrite an existing output", flag_only=True),
+    Opt(("--force",), "force", bool, False, "overwrite an existing output", _WRITE,
+        flag_only=True),
 )
 
 
@@ -187,7 +241,8 @@ def _check(s: dict, command: str) -> None:
     out = Path(s["output"])
     if Path(s["input"]).resolve() == out.resolve():
         raise CliError(f"output {str(out)!r} is the input; inputs are never modified")
-    check_output_path(out, force=s["force"], suffixes=GEOTIFF_SUFFIXES)
+    check_output_path(out, force=s["force"],
+                      suffixes=MESH_SUFFIXES if command == "mesh" else GEOTIFF_SUFFIXES)
     if s.get("seed") is None:
         s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
 
@@ -260,19 +315,77 @@ def _cmd_info(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_enhance(args: argparse.Namespace) -> int:
+    s: dict = {}
+    if args.config:
+        s.update(load_toml(args.config))
+    for key, opt in _options("enhance").items():
+        value = getattr(args, key, None)
+        if value is not None and value is not False:
+            s[key] = list(value) if opt.many else value
+    if not s.get("output"):
+        raise CliError("nothing to write: give -o/--output (or the scene key 'output')")
+    unknown = sorted(set(s) - set(EnhanceConfig.keys()))
+    if unknown:
+        raise CliError(f"scene {args.config!r}: unknown key(s) {', '.join(map(repr, unknown))}; "
+                       f"allowed: {', '.join(EnhanceConfig.keys())}")
+    cfg = EnhanceConfig.from_mapping(s)
+    if cfg.input is None:
+        raise CliError("`dem enhance` needs a base DEM (--input or the scene key 'input')")
+    stack = enhance(cfg, progress=not cfg.quiet)
+    if not cfg.quiet:
+        info = stack.info
+        c = info["craters"]
+        sizes = stack.pixel_sizes_m()
+        print(f"dem enhance: {len(stack)} layers of {cfg.size} x {cfg.size} pixels, "
+              f"{sizes[0]:.4g} m -> {sizes[-1]:.4g} m per pixel, seed {info['seed']}; craters "
+              f"stamped {sum(c['stamped'])}, erased on steep ground "
+              f"{sum(c['erased_on_steep_ground'])}, rejected {c['rejected']} of {c['drawn']}")
+        print(f"wrote {Path(cfg.output) / 'manifest.json'}")
+    return 0
+
+
+def _cmd_mesh(args: argparse.Namespace) -> int:
+    s = _settings(args, "mesh")
+    _check(s, "mesh")
+    show = not s["quiet"]
+    if Path(s["input"]).suffix.lower() == ".json":
+        src = read_stack(s["input"], progress=show)
+    else:
+        src = _read(s)
+    path = to_mesh(src, s["output"], progress=show)
+    if show:
+        n = len(src) if hasattr(src, "layers") else 1
+        print(f"dem mesh: {n} layer(s), {path.stat().st_size / 2**20:.1f} MiB")
+        print(f"wrote {path}")
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 def build_parser() -> OneLineParser:
-    parser = OneLineParser(prog="dem", description="DEMs: gap filling, RMD expansion, info.")
+    parser = OneLineParser(prog="dem", description="DEMs: gap filling, RMD expansion, "
+                                                   "layer stacks with craters, meshes, info.")
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     helps = {"info": "describe a DEM (size, CRS, pixel size, heights, fractal dimension)",
              "fill": "fill the unknown pixels of a DEM with fractal terrain, outside in",
              "expand": "double the resolution of a DEM (region) by random midpoint "
-                       "displacement"}
+                       "displacement",
+             "enhance": "build a stack of layers around a site, each 2x finer, with craters "
+                        "per layer",
+             "mesh": "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY "
+                     "or VTP"}
     for command, text in helps.items():
         p = sub.add_parser(command, help=text, description=text[0].upper() + text[1:] + ".")
-        p.add_argument("input", nargs="?", default=None, help="input DEM (GeoTIFF, PDS .lbl/.img)")
-        if command != "info":
+        if command == "enhance":
+            p.add_argument("config", nargs="?", default=None, metavar="SCENE.toml",
+                           help="TOML scene whose keys are the option names; flags override "
+                                "it")
+        else:
+            p.add_argument("input", nargs="?", default=None,
+                           help="input stack manifest (.json) or DEM" if command == "mesh"
+                           else "input DEM (GeoTIFF, PDS .lbl/.img)")
+        if command in ("fill", "expand", "mesh"):
             p.add_argument("--config", metavar="TOML",
                            help="TOML file whose keys are the option names (and input); "
                                 "flags override it")
@@ -282,9 +395,11 @@ def build_parser() -> OneLineParser:
                 kw.update(action="store_true", default=False)
             else:
                 kw.update(type=opt.parse, metavar=opt.metavar)
+                if opt.many:
+                    kw.update(action="append")
             p.add_argument(*opt.flags, **kw)
-        p.set_defaults(func=_cmd_info if command == "info" else
-                       (lambda a, c=command: _run(a, c)))
+        funcs = {"info": _cmd_info, "enhance": _cmd_enhance, "mesh": _cmd_mesh}
+        p.set_defaults(func=funcs.get(command, lambda a, c=command: _run(a, c)))
     return parser
 
 

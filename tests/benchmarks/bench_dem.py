@@ -3,16 +3,24 @@
 Speeds are reported as absolute times on this machine plus a ratio against a reference
 measured in the same run (a plain-numpy version of the same diamond-square doubling;
 GDAL's inverse-distance ``fillnodata`` for gap filling). Usage:
-``python tests/benchmarks/bench_dem.py [--quick]``. Uses ``../shared/data`` (LOLA
-LDEM_4, 720 x 1440 = 1.04 Mpx) when present, else the 257 x 257 crop in tests/data.
+``python tests/benchmarks/bench_dem.py [--quick] [--only enhance]``. Uses
+``../shared/data`` (LOLA LDEM_4, 720 x 1440 = 1.04 Mpx) when present, else the
+257 x 257 crop in tests/data. The ``dem enhance`` / ``dem mesh`` figures run the real
+command line in a child process and report its wall time and peak RSS (``wait4``), the
+machine's load average, the exact consistency of every pair of layers, the crater
+accounting and the byte identity of a rerun with ``NUMBA_NUM_THREADS=1``.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import platform
+import subprocess
 import sys
+import tempfile
+import time
 from pathlib import Path
 
 import numpy as np
@@ -155,15 +163,85 @@ def figures(quick):
         print(f"  {passed} of {len(cols)} equatorial crops inside all three bounds")
 
 
+def timed_child(args, env=None):
+    """Wall time and peak RSS (MiB) of one child process, through wait4."""
+    full = dict(os.environ)
+    full.update(env or {})
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([sys.executable, "-m", *args], env=full, stdout=subprocess.DEVNULL,
+                            stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(proc.pid, 0)
+    wall = time.perf_counter() - t0
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    if status:
+        raise RuntimeError(f"{' '.join(args)} failed: {err}")
+    return wall, usage.ru_maxrss / 1024
+
+
+def bench_enhance(quick):
+    """`dem enhance`: an 11-level stack of 1025^2 layers from a 1025^2 base, with craters."""
+    size, levels = (513, 6) if quick else (1025, 11)
+    crop = dem.read(CROP)
+    base = dem.expand(crop, 1 if quick else 2, rng=5)  # LOLA at 3.8 / 1.9 km per pixel
+    with tempfile.TemporaryDirectory(dir=ROOT.parent) as tmp:
+        tmp = Path(tmp)
+        dem.write(base, tmp / "base.tif")
+        scene = tmp / "scene.toml"
+        scene.write_text(
+            f'input = "{tmp / "base.tif"}"\nlayers = {levels}\nsize = {size}\n'
+            'craters = ["c=0.05,k=-2,dmin=0.5,dmax=60000", '
+            '"c=0.01,k=-1.8,dmin=5000,dmax=200000,amin=3,amax=3.9,kind=old"]\n')
+        load = os.getloadavg()[0]
+        wall, rss = timed_child(["dem", "enhance", str(scene), "-o", str(tmp / "a"), "--seed",
+                                 "2014", "-q"])
+        stack = dem.read_stack(tmp / "a")
+        pairs = [np.array_equal(stack.layers[k].heights[::2, ::2],
+                                stack.layers[k - 1].heights[r0:r0 + w, c0:c0 + w])
+                 for k, (r0, c0, w) in enumerate(stack.windows, start=1)]
+        c = stack.info["craters"]
+        adds_up = c["drawn"] == (sum(c["stamped"]) + sum(c["erased_on_steep_ground"])
+                                 + c["rejected"])
+        ids = np.concatenate([cat["index"] for cat in stack.catalogs])
+        sizes = stack.pixel_sizes_m()
+        print(f"dem enhance {levels} layers of {size}^2 from a {size}^2 LOLA-based base "
+              f"({sizes[0]:.4g} -> {sizes[-1]:.4g} m/px), 2 crater layers: {wall:.1f} s wall, "
+              f"peak RSS {rss:.0f} MiB (load average before: {load:.2f})")
+        print(f"  consistency, every pair of layers exact: {all(pairs)} ({len(pairs)} pairs); "
+              f"craters stamped {sum(c['stamped'])} (per layer {c['stamped']}), erased on "
+              f"steep ground {sum(c['erased_on_steep_ground'])}, rejected {c['rejected']}, "
+              f"drawn {c['drawn']}: adds up {adds_up}; catalog rows {len(ids)}, distinct ids "
+              f"{len(np.unique(ids))}")
+        wall1, _ = timed_child(["dem", "enhance", str(scene), "-o", str(tmp / "b"), "--seed",
+                                "2014", "-q"], env={"NUMBA_NUM_THREADS": "1"})
+        same = all((tmp / "a" / f.name).read_bytes() == f.read_bytes()
+                   for f in (tmp / "b").iterdir())
+        print(f"  rerun with NUMBA_NUM_THREADS=1: {wall1:.1f} s, same bytes in all "
+              f"{len(list((tmp / 'b').iterdir()))} files: {same}")
+        for suffix in (".ply", ".vtp"):
+            mesh = tmp / f"stack{suffix}"
+            wall, rss = timed_child(["dem", "mesh", str(tmp / "a" / "manifest.json"), "-o",
+                                     str(mesh), "-q"])
+            print(f"dem mesh -> {suffix}: {wall:.1f} s, peak RSS {rss:.0f} MiB, "
+                  f"{mesh.stat().st_size / 2**20:.0f} MiB")
+        doc = json.loads((tmp / "a" / "manifest.json").read_text())
+        assert doc["info"]["seed"] == 2014
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
-    quick = parser.parse_args().quick
+    parser.add_argument("--only", choices=["expand", "fill", "figures", "enhance"],
+                        help="run one part")
+    args = parser.parse_args()
+    quick = args.quick
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numba threads {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
-    bench_expand(quick)
-    bench_fill(quick)
-    figures(quick)
+    parts = {"expand": bench_expand, "fill": bench_fill, "figures": figures,
+             "enhance": bench_enhance}
+    for name, func in parts.items():
+        if args.only in (None, name):
+            func(quick)
 
 
 if __name__ == "__main__":

@@ -234,3 +234,166 @@ def test_every_option_has_a_config_key():
         sub = parser._subparsers._group_actions[0].choices[command]
         dests = {a.dest for a in sub._actions} - {"help", "config", "input"}
         assert dests == set(_options(command))
+
+
+# --------------------------------------------------------------------------- enhance, mesh
+def write_scene(path, **keys):
+    """A TOML scene (strings, numbers, lists of those)."""
+    def fmt(v):
+        if isinstance(v, bool):
+            return "true" if v else "false"
+        if isinstance(v, list | tuple):
+            return "[" + ", ".join(fmt(x) for x in v) + "]"
+        return f'"{v}"' if isinstance(v, str) else repr(v)
+
+    path.write_text("".join(f"{k} = {fmt(v)}\n" for k, v in keys.items()))
+    return path
+
+
+def scene_keys(tmp_path, lola_tif, **extra):
+    keys = dict(input=str(lola_tif), output=str(tmp_path / "stack"), layers=4, size=65,
+                target=[180.0, -0.5], body_radius_m=1737400.0,
+                craters=["c=0.05,k=-2,dmin=200,dmax=100000",
+                         "c=0.005,k=-1.8,dmin=20000,dmax=200000,amin=3,amax=3.8,kind=old"])
+    keys.update(extra)
+    return keys
+
+
+def test_enhance_and_mesh_through_the_entry_point(run_cli, tmp_path, lola_tif):
+    scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif))
+    proc = run_cli("dem", "enhance", str(scene), "--seed", "9")
+    assert proc.returncode == 0, proc.stderr
+    assert "wrote" in proc.stdout and "seed 9" in proc.stdout
+    stack = dem.read_stack(tmp_path / "stack" / "manifest.json")
+    assert len(stack) == 4 and stack.is_consistent()
+    for k in range(1, 4):  # every pair, from the files
+        r0, c0, w = stack.windows[k - 1]
+        with rasterio.open(tmp_path / "stack" / f"layer_{k:02d}.tif") as fine, \
+                rasterio.open(tmp_path / "stack" / f"layer_{k - 1:02d}.tif") as coarse:
+            assert np.array_equal(fine.read(1)[::2, ::2],
+                                  coarse.read(1)[r0:r0 + w, c0:c0 + w])
+            assert fine.crs == coarse.crs
+            assert fine.transform.a == pytest.approx(coarse.transform.a / 2, rel=1e-12)
+    info = stack.info
+    c = info["craters"]
+    assert info["seed"] == 9 and sum(c["stamped"]) > 20
+    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    ids = np.concatenate([cat["index"] for cat in stack.catalogs])
+    assert len(ids) == len(set(ids.tolist()))
+    # the target pixel is the centre of every layer
+    for d in stack.layers:
+        x, y = d.xy(32, 32)
+        assert abs(x - 180.0) < 0.25 and abs(y + 0.5) < 0.25
+    for suffix in (".ply", ".vtp"):
+        out = tmp_path / f"mesh{suffix}"
+        proc = run_cli("dem", "mesh", str(tmp_path / "stack" / "manifest.json"), "-o", str(out))
+        assert proc.returncode == 0 and "wrote" in proc.stdout, proc.stderr
+        m = __import__("pyvista").read(out)
+        assert m.n_points == 3 * (65**2 - 33**2) + 65**2
+    proc = run_cli("dem", "mesh", str(lola_tif), "-o", str(tmp_path / "one.ply"), "-q", *MOON)
+    assert proc.returncode == 0 and proc.stdout == ""
+
+
+def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path, lola_tif):
+    scene = write_scene(tmp_path / "scene.toml",
+                        **scene_keys(tmp_path, lola_tif, layers=3, output="unused"))
+    trees = {}
+    for threads in ("1", "2"):
+        out = tmp_path / f"stack{threads}"
+        proc = run_cli("dem", "enhance", str(scene), "-o", str(out), "--seed", "4", "-q",
+                       env={"NUMBA_NUM_THREADS": threads})
+        assert proc.returncode == 0 and proc.stdout == "", proc.stderr
+        trees[threads] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
+    assert len(trees["1"]) == 3 + 2 * 3 + 1 and trees["1"] == trees["2"]
+    other = tmp_path / "other"
+    assert InProcess(capsys)("dem", "enhance", str(scene), "-o", str(other), "--seed", "5",
+                             "-q").returncode == 0
+    assert (other / "layer_02.tif").read_bytes() != trees["2"]["layer_02.tif"]
+
+
+@pytest.mark.parametrize("case,extra,argv,needles", [
+    ("unknown-key", {"colour": "red"}, [], ["unknown key", "colour", "allowed"]),
+    ("target-outside", {"target": [10.0, 10.0]}, [], ["outside the base DEM"]),
+    ("target-flag-outside", {}, ["--target", "100,80"], ["outside the base DEM"]),
+    ("size-zero", {"size": 0}, [], ["size", "2^n + 1"]),
+    ("size-negative", {}, ["--size", "-65"], ["size", "2^n + 1"]),
+    ("size-not-2n1", {"size": 64}, [], ["size", "2^n + 1"]),
+    ("size-too-big", {"size": 513}, [], ["at least 513 x 513"]),
+    ("layers-zero", {"layers": 0}, [], ["layers"]),
+    ("layers-text", {"layers": "many"}, [], ["layers"]),
+    ("crater-spec", {"craters": ["c=0.5,k=2,dmin=1,dmax=5"]}, [], ["k", "< 0"]),
+    ("crater-spec-key", {"craters": ["c=0.5,k=-2,dmin=1,dmax=5,colour=1"]}, [],
+     ["unknown item"]),
+    ("crater-flag", {}, ["--craters", "c=0.5,k=-2,dmin=9,dmax=5"], ["--craters", "d_min_m"]),
+    ("craters-not-list", {"craters": "c=0.5,k=-2,dmin=1,dmax=5"}, [], ["list"]),
+    ("too-many-craters", {"craters": ["c=1e6,k=-3,dmin=0.001,dmax=5"]}, [],
+     ["craters", "dmin"]),
+    ("no-output", {"output": None}, [], ["-o/--output"]),
+    ("no-input", {"input": None}, [], ["base DEM"]),
+    ("no-radius", {"body_radius_m": None}, [], ["geographic CRS", "--body-radius-m"]),
+    ("bad-toml", None, [], ["TOML"]),
+    ("missing-scene", "missing", [], ["does not exist"]),
+])
+def test_enhance_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_path, lola_tif,
+                                                          case, extra, argv, needles):
+    scene = tmp_path / "scene.toml"
+    if extra is None:
+        scene.write_text("layers = \n")
+    elif extra != "missing":
+        keys = {k: v for k, v in {**scene_keys(tmp_path, lola_tif), **extra}.items()
+                if v is not None}
+        write_scene(scene, **keys)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    runner = run_cli if case in ("unknown-key", "target-outside", "size-zero") else \
+        InProcess(capsys)
+    proc = runner("dem", "enhance", str(scene), *argv)
+    assert_one_line_error(proc, *needles)
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+
+
+def test_enhance_existing_output(run_cli, capsys, tmp_path, lola_tif):
+    scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
+    run = InProcess(capsys)
+    assert run("dem", "enhance", str(scene), "-q", "--seed", "1").returncode == 0
+    first = (tmp_path / "stack" / "layer_01.tif").read_bytes()
+    assert_one_line_error(run("dem", "enhance", str(scene), "--seed", "2"), "exists", "--force")
+    assert (tmp_path / "stack" / "layer_01.tif").read_bytes() == first
+    assert run("dem", "enhance", str(scene), "-q", "--seed", "2", "--force").returncode == 0
+    assert (tmp_path / "stack" / "layer_01.tif").read_bytes() != first
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.tif", "scene.toml", "stack"]
+
+
+@pytest.mark.parametrize("case,args,needles", [
+    ("suffix", ["{manifest}", "-o", "{tmp}/m.obj"], ["unknown format", ".ply"]),
+    ("no-output", ["{manifest}"], ["-o/--output"]),
+    ("not-a-manifest", ["{json}", "-o", "{tmp}/m.ply"], ["not a craterform stack manifest"]),
+    ("nan-dem", ["{nan}", "-o", "{tmp}/m.ply"], ["NaN"]),
+    ("exists", ["{manifest}", "-o", "{tmp}/keep.ply"], ["exists", "--force"]),
+])
+def test_mesh_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, lola_crop, case,
+                                                        args, needles):
+    layer = lola_crop.crop(rasterio.windows.Window(0, 0, 9, 9))
+    dem.Stack([layer], [], dem.local_frame(layer)).write(tmp_path / "st")
+    (tmp_path / "other.json").write_text('{"format": "something else"}')
+    (tmp_path / "keep.ply").write_text("keep me")
+    z = np.array(layer.heights)
+    z[3, 3] = np.nan
+    dem.write(layer.replace(heights=z), tmp_path / "nan.tif")
+    names = {"manifest": tmp_path / "st" / "manifest.json", "json": tmp_path / "other.json",
+             "nan": tmp_path / "nan.tif", "tmp": tmp_path}
+    before = sorted(p.name for p in tmp_path.iterdir())
+    proc = InProcess(capsys)("dem", "mesh", *[a.format(**names) for a in args])
+    assert_one_line_error(proc, *needles)
+    assert sorted(p.name for p in tmp_path.iterdir()) == before
+    assert (tmp_path / "keep.ply").read_text() == "keep me"
+
+
+def test_every_enhance_and_mesh_option_has_a_config_key():
+    from dem.cli import _options, build_parser
+
+    parser = build_parser()
+    subs = parser._subparsers._group_actions[0].choices
+    dests = {a.dest for a in subs["enhance"]._actions} - {"help", "config"}
+    assert dests == set(_options("enhance")) == set(dem.EnhanceConfig.keys())
+    dests = {a.dest for a in subs["mesh"]._actions} - {"help", "config", "input"}
+    assert dests == set(_options("mesh"))

@@ -1,0 +1,333 @@
+"""Nested multi-resolution layer stacks: data object, consistency, manifest and files.
+
+A :class:`Stack` holds layers ``0..n-1`` of a DEM around a site, each 2x finer than the
+last: layer ``k`` (k >= 1) is the RMD expansion of the square *footprint*
+``windows[k-1] = (row_off, col_off, width)`` of layer ``k - 1``, so it has
+``2 width - 1`` pixels a side and its even pixels lie on the footprint's pixels.
+**Consistency**: inside its footprint, a finer layer's even pixels equal the coarser
+layer, ``layers[k].heights[::2, ::2] == layers[k-1].heights[footprint]`` exactly
+(:meth:`Stack.mismatch_m`, :meth:`Stack.is_consistent`).
+
+On disk a stack is a folder: ``layer_00.tif ...`` (GeoTIFF, :func:`dem.write`),
+``craters_00.csv`` / ``craters_00.geojson ...`` (the craters stamped in each layer, local
+frame metres + world coordinates) and ``manifest.json`` (format, frame, layers, files,
+bounds, pixel sizes, seeds, parameters, crater counts). The folder is written as a whole
+(:meth:`Stack.write`: a temporary folder renamed into place), so it is complete or absent.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from craters import make_catalog, read_catalog, validate_catalog, write_catalog, write_geojson
+from craters._infra import check_int, package_version, progress_bar
+
+from .core import Dem, crs_label
+from .frame import LocalFrame, grid_pixel_size, pixel_affine
+from .io import read, write
+
+__all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "read_stack"]
+
+STACK_FORMAT = "craterform layer stack v1"
+#: File name of the manifest inside a stack folder.
+MANIFEST = "manifest.json"
+
+
+def _layer_file(k: int) -> str:
+    return f"layer_{k:02d}.tif"
+
+
+def _catalog_files(k: int) -> tuple[str, str]:
+    return f"craters_{k:02d}.csv", f"craters_{k:02d}.geojson"
+
+
+def _window(value, k: int) -> tuple[int, int, int]:
+    try:
+        r0, c0, w = value
+    except (TypeError, ValueError):
+        raise TypeError(f"`windows[{k}]` must be (row_off, col_off, width); "
+                        f"got {value!r}") from None
+    return (check_int(f"windows[{k}] row_off", r0, 0), check_int(f"windows[{k}] col_off", c0, 0),
+            check_int(f"windows[{k}] width", w, 2))
+
+
+class Stack:
+    """Layers of a DEM, each the 2x expansion of a footprint of the previous one.
+
+    Parameters
+    ----------
+    layers : sequence of Dem
+        Coarsest first; all with the same CRS.
+    windows : sequence of (row_off, col_off, width)
+        ``windows[k - 1]`` is the footprint of layer ``k`` in layer ``k - 1`` (pixels);
+        layer ``k`` must have ``2 width - 1`` pixels a side.
+    frame : LocalFrame
+        The local metric frame of the stack (:mod:`dem.frame`), origin at the site.
+    catalogs : sequence of structured arrays, optional
+        Per layer, the craters stamped in it (``x_m, y_m`` in ``frame``); None = none.
+    info : dict, optional
+        JSON-ready metadata (seed, parameters, crater counts) kept in the manifest.
+
+    Examples
+    --------
+    >>> import dem
+    >>> from rasterio.windows import Window
+    >>> base = Dem(np.zeros((5, 5)), pixel_size_m=4.0)
+    >>> fine = dem.expand(base, 1, fractal_dimension=2.2, roughness=0.1,
+    ...                   region=Window(1, 1, 3, 3), rng=1)   # rows/cols 1..3
+    >>> s = Stack([base, fine], [(1, 1, 3)], dem.local_frame(base))
+    >>> s.shapes, s.is_consistent()
+    ([(5, 5), (5, 5)], True)
+    """
+
+    __slots__ = ("_layers", "_windows", "_frame", "_catalogs", "_info")
+
+    def __init__(self, layers, windows, frame: LocalFrame, catalogs=None, info=None):
+        layers = tuple(layers)
+        if not layers or not all(isinstance(d, Dem) for d in layers):
+            raise TypeError("`layers` must be a non-empty sequence of Dem")
+        windows = tuple(_window(w, k) for k, w in enumerate(windows))
+        if len(windows) != len(layers) - 1:
+            raise ValueError(f"`windows` must have one footprint per finer layer "
+                             f"({len(layers) - 1}); got {len(windows)}")
+        if not isinstance(frame, LocalFrame):
+            raise TypeError(f"`frame` must be a LocalFrame; got {type(frame).__name__}")
+        for k, (r0, c0, w) in enumerate(windows, start=1):
+            rows, cols = layers[k - 1].shape
+            if r0 + w > rows or c0 + w > cols:
+                raise ValueError(f"footprint of layer {k} (rows {r0}..{r0 + w - 1}, cols "
+                                 f"{c0}..{c0 + w - 1}) is not inside layer {k - 1} "
+                                 f"({rows} x {cols})")
+            if layers[k].shape != (2 * w - 1, 2 * w - 1):
+                raise ValueError(f"layer {k} must be {2 * w - 1} x {2 * w - 1} pixels (its "
+                                 f"footprint is {w} pixels wide); got {layers[k].shape}")
+            if layers[k].crs != layers[0].crs:
+                raise ValueError(f"layer {k} has CRS {crs_label(layers[k].crs)}, layer 0 "
+                                 f"{crs_label(layers[0].crs)}")
+        if catalogs is None:
+            catalogs = (None,) * len(layers)
+        catalogs = tuple(catalogs)
+        if len(catalogs) != len(layers):
+            raise ValueError(f"`catalogs` must have one entry per layer ({len(layers)}); "
+                             f"got {len(catalogs)}")
+        for cat in catalogs:
+            if cat is not None:
+                validate_catalog(cat)
+                if "x_m" not in cat.dtype.names:
+                    raise ValueError("stack catalogs need local-frame positions x_m, y_m")
+        self._layers = layers
+        self._windows = windows
+        self._frame = frame
+        self._catalogs = catalogs
+        self._info = dict(info or {})
+
+    # ------------------------------------------------------------------ data
+    @property
+    def layers(self) -> tuple[Dem, ...]:
+        """The layers, coarsest first."""
+        return self._layers
+
+    @property
+    def windows(self) -> tuple[tuple[int, int, int], ...]:
+        """Footprint (row_off, col_off, width) of layer k + 1 in layer k, for each k."""
+        return self._windows
+
+    @property
+    def frame(self) -> LocalFrame:
+        """The local metric frame (origin at the site)."""
+        return self._frame
+
+    @property
+    def catalogs(self) -> tuple:
+        """Per layer, the craters stamped in it (structured arrays or None)."""
+        return self._catalogs
+
+    @property
+    def info(self) -> dict:
+        """Metadata (a copy): seed, parameters, crater counts."""
+        return json.loads(json.dumps(self._info))
+
+    @property
+    def shapes(self) -> list[tuple[int, int]]:
+        """(rows, cols) of every layer."""
+        return [d.shape for d in self._layers]
+
+    def __len__(self) -> int:
+        return len(self._layers)
+
+    def __repr__(self) -> str:
+        sizes = ", ".join(f"{p:.4g}" for p in self.pixel_sizes_m())
+        return f"Stack({len(self)} layers of {self._layers[0].shape}, pixel sizes m: {sizes})"
+
+    def pixel_sizes_m(self) -> list[float]:
+        """Side of each layer's pixels in the local frame, metres (the square root of the
+        pixel area if the pixels are not square)."""
+        return [grid_pixel_size(pixel_affine(d, self._frame), square=False)
+                for d in self._layers]
+
+    def replace(self, *, layers=None, catalogs=None, info=None) -> Stack:
+        """A new stack with some parts replaced (same footprints and frame)."""
+        return Stack(self._layers if layers is None else layers, self._windows, self._frame,
+                     self._catalogs if catalogs is None else catalogs,
+                     self._info if info is None else info)
+
+    # ------------------------------------------------------------------ consistency
+    def mismatch_m(self) -> list[float]:
+        """For k = 1..n-1: max |layer k even pixels - layer k-1 footprint| in metres.
+
+        0.0 everywhere means the stack is consistent; NaN pixels count as equal when both
+        are NaN, as infinitely different otherwise.
+        """
+        out = []
+        for k, (r0, c0, w) in enumerate(self._windows, start=1):
+            coarse = self._layers[k - 1].heights[r0:r0 + w, c0:c0 + w]
+            fine = self._layers[k].heights[::2, ::2]
+            both = np.isnan(coarse) & np.isnan(fine)
+            d = np.where(both, 0.0, np.abs(fine - coarse))
+            out.append(float(np.where(np.isnan(d), np.inf, d).max()))
+        return out
+
+    def is_consistent(self) -> bool:
+        """True if every finer layer's even pixels equal the coarser layer exactly."""
+        return all(m == 0.0 for m in self.mismatch_m())
+
+    # ------------------------------------------------------------------ files
+    def manifest(self) -> dict:
+        """The JSON manifest describing this stack (file names relative to the folder)."""
+        sizes = self.pixel_sizes_m()
+        layers = []
+        for k, d in enumerate(self._layers):
+            b = d.bounds
+            entry = {
+                "index": k, "file": _layer_file(k), "shape": list(d.shape),
+                "pixel_size_m": sizes[k], "dem_pixel_size_m": list(d.pixel_size_m),
+                "bounds": [b.left, b.bottom, b.right, b.top],
+                "transform": list(tuple(d.transform)[:6]), "level": d.level,
+                "origin": list(d.origin),
+                "footprint_in_parent": list(self._windows[k - 1]) if k else None,
+            }
+            cat = self._catalogs[k]
+            if cat is not None:
+                csv_name, geojson_name = _catalog_files(k)
+                entry["craters"] = {"csv": csv_name, "geojson": geojson_name,
+                                    "stamped": int(len(cat))}
+            layers.append(entry)
+        return {
+            "format": STACK_FORMAT, "generator": f"craterform {package_version()}",
+            "crs": crs_label(self._layers[0].crs),
+            "crs_wkt": None if self._layers[0].crs is None else self._layers[0].crs.to_wkt(),
+            "frame": self._frame.to_dict(), "layers": layers, "info": self._info,
+            "consistency": "inside its footprint, layer k's even pixels equal layer k-1 "
+                           "exactly (layer[k][::2, ::2] == layer[k-1][footprint])",
+        }
+
+    def write(self, folder, *, force: bool = False, progress: bool = False) -> Path:
+        """Write the stack into ``folder`` as a whole; return the manifest's path.
+
+        The files go to a temporary folder next to ``folder`` that is renamed into place
+        at the end, so an error leaves nothing behind. An existing ``folder`` is replaced
+        only with ``force`` and only if it is empty or a stack folder (has a manifest).
+        """
+        folder = check_stack_folder(folder, force=force)
+        with _atomic_folder(folder) as tmp:
+            steps = [("layer", k) for k in range(len(self))]
+            steps += [("craters", k) for k in range(len(self)) if self._catalogs[k] is not None]
+            for what, k in progress_bar(steps, enabled=progress, desc="write"):
+                if what == "layer":
+                    write(self._layers[k], tmp / _layer_file(k))
+                else:
+                    self._write_catalog(k, tmp)
+            text = json.dumps(self.manifest(), indent=1, sort_keys=True, allow_nan=False)
+            (tmp / MANIFEST).write_text(text + "\n", encoding="utf-8")
+        return folder / MANIFEST
+
+    def world_catalog(self, k: int) -> np.ndarray:
+        """Layer ``k``'s catalog with ``world_x, world_y`` columns (CRS units) added."""
+        cat = self._catalogs[k]
+        wx, wy = self._frame.to_world(cat["x_m"], cat["y_m"])
+        cols = {n: cat[n] for n in cat.dtype.names if n not in ("world_x", "world_y")}
+        return make_catalog(**cols, world_x=wx, world_y=wy)
+
+    def _write_catalog(self, k: int, folder: Path) -> None:
+        csv_name, geojson_name = _catalog_files(k)
+        cat = self.world_catalog(k)
+        write_catalog(cat, folder / csv_name)
+        crs = self._layers[0].crs
+        write_geojson(cat, folder / geojson_name, to_world=self._frame.to_world,
+                      crs=None if crs is None else crs_label(crs))
+
+
+def check_stack_folder(folder, *, force: bool) -> Path:
+    """Validate an output stack folder before any work (see :meth:`Stack.write`)."""
+    folder = Path(folder)
+    parent = folder.parent if str(folder.parent) else Path(".")
+    if not parent.is_dir():
+        raise ValueError(f"output {str(folder)!r}: folder {str(parent)!r} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"output {str(folder)!r}: folder {str(parent)!r} is not writable")
+    if folder.exists():
+        if not folder.is_dir():
+            raise ValueError(f"output {str(folder)!r} exists and is not a folder")
+        if any(folder.iterdir()):
+            if not force:
+                raise ValueError(f"output {str(folder)!r} exists; use --force to overwrite")
+            if not (folder / MANIFEST).is_file():
+                raise ValueError(f"output {str(folder)!r} is not a stack folder (no {MANIFEST}); "
+                                 f"refusing to replace it")
+    return folder
+
+
+@contextlib.contextmanager
+def _atomic_folder(folder: Path):
+    """Yield a temporary folder next to ``folder``; swap it into place on success."""
+    parent = folder.parent if str(folder.parent) else Path(".")
+    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".tmp", dir=parent))
+    try:
+        yield tmp
+        os.chmod(tmp, 0o755)
+        if folder.exists():
+            old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".old", dir=parent))
+            os.replace(folder, old / "stack")
+            os.replace(tmp, folder)
+            shutil.rmtree(old, ignore_errors=True)
+        else:
+            os.replace(tmp, folder)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+
+
+def read_stack(path, *, progress: bool = False) -> Stack:
+    """Read a stack written by :meth:`Stack.write` (its manifest, or the folder)."""
+    path = Path(path)
+    manifest = path / MANIFEST if path.is_dir() else path
+    if not manifest.is_file():
+        raise ValueError(f"stack manifest {str(manifest)!r} does not exist")
+    try:
+        doc = json.loads(manifest.read_text(encoding="utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise ValueError(f"{str(manifest)!r} is not a JSON manifest: {exc}") from None
+    if not isinstance(doc, dict) or doc.get("format") != STACK_FORMAT:
+        raise ValueError(f"{str(manifest)!r} is not a craterform stack manifest (format "
+                         f"{STACK_FORMAT!r})")
+    folder = manifest.parent
+    try:
+        frame = LocalFrame.from_dict(doc["frame"])
+        entries = doc["layers"]
+        layers, windows, catalogs = [], [], []
+        for e in progress_bar(entries, enabled=progress, desc="read"):
+            layers.append(read(folder / e["file"]))
+            if e["index"] > 0:
+                windows.append(tuple(e["footprint_in_parent"]))
+            cat = e.get("craters")
+            catalogs.append(read_catalog(folder / cat["csv"]) if cat else None)
+        return Stack(layers, windows, frame, catalogs, doc.get("info"))
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f"stack manifest {str(manifest)!r} is incomplete: {exc!r}") from None

@@ -1,0 +1,273 @@
+"""dem.enhance: layer stacks with craters per layer, exact consistency, catalogs, files."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from affine import Affine
+
+import craters
+import dem
+from dem.enhance import _geometry, _windows, plan_craters
+
+REACH = craters.DEFAULT_EJECTA_EDGE * 1.02  # ejecta edge with the default rim irregularity
+
+
+@pytest.fixture(scope="module")
+def base():
+    """A 129 x 129 rough projected base DEM (50 m pixels)."""
+    seed = dem.Dem(np.random.default_rng(3).normal(0, 40, (17, 17)), pixel_size_m=400.0)
+    e = dem.expand(seed, 3, fractal_dimension=2.3, roughness=0.05, rng=1)
+    return dem.Dem(e.heights, Affine(50.0, 0, 400000.0, 0, -50.0, 3000000.0), "EPSG:32633")
+
+
+SPECS = ["c=0.05,k=-2,dmin=0.5,dmax=3000",
+         "c=0.002,k=-1.8,dmin=100,dmax=3000,amin=3,amax=3.8,kind=old"]
+
+
+@pytest.fixture(scope="module")
+def stack(base):
+    return dem.enhance({"layers": 6, "size": 65, "seed": 11, "craters": SPECS}, dem=base)
+
+
+def test_every_pair_of_layers_is_exactly_consistent(stack):
+    assert len(stack) == 6 and stack.shapes == [(65, 65)] * 6
+    for k, (r0, c0, w) in enumerate(stack.windows, start=1):
+        assert w == 33
+        assert np.array_equal(stack.layers[k].heights[::2, ::2],
+                              stack.layers[k - 1].heights[r0:r0 + w, c0:c0 + w])
+    assert stack.mismatch_m() == [0.0] * 5 and stack.is_consistent()
+    # craters really went into the finer layers (else the test above would be trivial)
+    assert all(n > 10 for n in stack.info["craters"]["stamped"])
+
+
+def test_layers_are_nested_and_2x_finer(stack, base):
+    sizes = stack.pixel_sizes_m()
+    assert sizes == [50.0 / 2**k for k in range(6)]
+    # the target (default: the base's centre pixel) is the centre pixel of every layer
+    centre = base.xy(64, 64)
+    for d in stack.layers:
+        assert d.xy(32, 32) == pytest.approx(centre, abs=1e-6)
+        assert d.crs == base.crs
+    for k, (r0, c0, w) in enumerate(stack.windows, start=1):
+        coarse, fine = stack.layers[k - 1], stack.layers[k]
+        rows, cols = np.mgrid[0:w, 0:w]
+        assert np.allclose(np.stack(coarse.xy(rows + r0, cols + c0)),
+                           np.stack(fine.xy(2 * rows, 2 * cols)), rtol=0, atol=1e-6)
+        assert fine.level == coarse.level + 1
+
+
+def test_crater_accounting_adds_up_and_nothing_is_listed_twice(stack):
+    c = stack.info["craters"]
+    n = len(stack)
+    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    assert c["assigned"] == [s + e for s, e in zip(c["stamped"], c["erased_on_steep_ground"],
+                                                   strict=True)]
+    assert c["drawn"] == sum(b["drawn"] for b in c["bands"]) + c["rejected_below_finest"]
+    for b in c["bands"]:
+        assert b["drawn"] == b["assigned"] + b["rejected"]
+    assert c["rejected_below_finest"] > 0  # dmin = 0.5 m < 2 pixels of the finest layer
+    ids = np.concatenate([cat["index"] for cat in stack.catalogs])
+    assert len(ids) == len(np.unique(ids)) == sum(c["stamped"])
+    assert [len(cat) for cat in stack.catalogs] == c["stamped"]
+    assert stack.manifest()["layers"][n - 1]["craters"]["stamped"] == c["stamped"][-1]
+
+
+def test_each_crater_is_in_the_finest_layer_containing_and_resolving_it(stack):
+    sizes = stack.pixel_sizes_m()
+    frame = stack.frame
+
+    def contained(cat, k):
+        d = stack.layers[k]
+        x, y = frame.to_world(cat["x_m"], cat["y_m"])
+        col, row = (~(d.transform @ Affine.translation(0.5, 0.5))) @ (x, y)
+        reach = REACH * cat["diameter_m"] / 2 / sizes[k] + 1  # pixels
+        n = d.shape[0] - 1
+        return (col - reach >= 0) & (col + reach <= n) & (row - reach >= 0) & (row + reach <= n)
+
+    for k, cat in enumerate(stack.catalogs):
+        assert contained(cat, k).all()
+        assert (cat["diameter_m"] >= 2 * sizes[k] * (1 - 1e-12)).all()
+        if k + 1 < len(stack):
+            assert not contained(cat, k + 1).any()  # a finer layer would have taken it
+        assert set(cat["kind"]) <= {"simple", "old"}
+        assert (np.diff(cat["age_gyr"]) <= 0).all()  # stamped oldest first
+
+
+def test_catalog_positions_are_where_the_craters_are():
+    """Ideal craters on flat ground: every pixel within the reach of an isolated crater, in
+    its layer and in every coarser one (propagated), is the Martin profile at that pixel's
+    distance from the catalog position -- catalog frame, pixel sizes and propagation agree."""
+    flat = dem.Dem(np.zeros((65, 65)), Affine(20.0, 0, 0, 0, -20.0, 0), "EPSG:32633")
+    s = dem.enhance({"layers": 3, "size": 65, "seed": 2, "smooth_craters": True,
+                     "craters": ["c=0.01,k=-2,dmin=10,dmax=200"]}, dem=flat)
+    sizes = s.pixel_sizes_m()
+    every = np.concatenate([np.stack([c["x_m"], c["y_m"], c["diameter_m"]], 1)
+                            for c in s.catalogs])
+    reach = craters.DEFAULT_EJECTA_EDGE * every[:, 2] / 2  # smooth: circular rims
+    checked = []
+    for k, cat in enumerate(s.catalogs):
+        for row in cat:
+            dist = np.hypot(every[:, 0] - row["x_m"], every[:, 1] - row["y_m"])
+            r_me = craters.DEFAULT_EJECTA_EDGE * row["diameter_m"] / 2
+            if ((dist < reach + r_me + 4 * sizes[0]) & (dist > 0)).any():
+                continue  # overlaps another crater
+            for j in range(k + 1):
+                d = s.layers[j]
+                a = dem.frame.pixel_affine(d, s.frame)
+                rr, cc = np.mgrid[0:d.shape[0], 0:d.shape[1]]
+                x = a.a * cc + a.b * rr + a.c
+                y = a.d * cc + a.e * rr + a.f
+                r = np.hypot(x - row["x_m"], y - row["y_m"])
+                inside = r < r_me
+                want = craters.radial_profile(r[inside] / (row["diameter_m"] / 2),
+                                              row["diameter_m"], row["degradation"])
+                assert np.abs(d.heights[inside] - want).max() < 1e-9 * row["depth_m"] + 1e-12
+                if inside.any():
+                    checked.append((k, j))
+    assert len({k for k, _ in checked}) >= 2 and any(j < k for k, j in checked), checked
+
+
+def test_band_split_has_the_law_of_one_catalog_split_afterwards():
+    """Per-layer counts and mean diameters of the banded draw equal those of one catalog
+    for layer 0's area, split crater by crater (independent reimplementation)."""
+    size, n_layers, p0, min_px = 33, 3, 10.0, 2.0
+    _, windows, _, _ = _windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None, size,
+                                n_layers)
+    geom = _geometry(size, windows, p0)
+    spec = craters.parse_layer_spec("c=0.2,k=-2,dmin=5,dmax=300")
+    half = (size - 1) / 2
+    runs = 300
+    banded = np.zeros((runs, n_layers))
+    direct = np.zeros((runs, n_layers))
+    d_banded = [[] for _ in range(n_layers)]
+    d_direct = [[] for _ in range(n_layers)]
+    for run in range(runs):
+        cats, acc = plan_craters([spec], geom, min_px=min_px, reach_radii=REACH, seed=run)
+        banded[run] = [len(c) for c in cats]
+        for k, c in enumerate(cats):
+            d_banded[k] += c["diameter_m"].tolist()
+        # one catalog for layer 0 (centred frame: layer 0 spans +-(size/2) p0), split
+        cat = craters.population([spec], x_range_m=(-size / 2 * p0, size / 2 * p0),
+                                 y_range_m=(-size / 2 * p0, size / 2 * p0), rng=10_000 + run)
+        x, y, dia = cat["x_m"], cat["y_m"], cat["diameter_m"]
+        home = np.full(len(cat), -1)
+        for k in range(n_layers):
+            p = p0 / 2**k
+            lim = half * p - REACH * dia / 2 - p  # centred layers: |x| <= (W-1)/2 p
+            home[(np.abs(x) <= lim) & (np.abs(y) <= lim)] = k
+        ok = (home >= 0) & (dia >= min_px * p0 / 2.0**np.maximum(home, 0))
+        for k in range(n_layers):
+            direct[run, k] = np.sum(ok & (home == k))
+            d_direct[k] += dia[ok & (home == k)].tolist()
+    for k in range(n_layers):
+        diff = banded[:, k].mean() - direct[:, k].mean()
+        se = math.sqrt((banded[:, k].var() + direct[:, k].var()) / runs)
+        assert abs(diff) < 4 * se + 1e-9, (k, banded[:, k].mean(), direct[:, k].mean())
+        assert direct[:, k].mean() > 3
+        assert np.mean(d_banded[k]) == pytest.approx(np.mean(d_direct[k]), rel=0.1)
+
+
+def test_target_near_the_edge_shifts_footprints_inside(base):
+    x, y = base.xy(3, 125)  # near the top-right corner
+    s = dem.enhance({"layers": 5, "size": 33, "seed": 1, "target": [float(x), float(y)]},
+                    dem=base)
+    for r0, c0, w in s.windows:
+        assert 1 <= r0 and r0 + w <= 33 - 1 and 1 <= c0 and c0 + w <= 33 - 1
+    assert s.is_consistent()
+    # the target pixel stays the frame origin and lies inside every layer
+    assert s.frame.to_local(*base.xy(3, 125)) == pytest.approx((0.0, 0.0), abs=1e-6)
+    for d in s.layers:
+        b = d.bounds
+        assert b.left <= x <= b.right and b.bottom <= y <= b.top
+    assert s.info["target"]["pixel_in_base"] == [3, 125]
+
+
+def test_same_seed_same_stack_different_seed_different(base):
+    cfg = {"layers": 3, "size": 33, "seed": 4, "craters": SPECS[:1]}
+    a, b = dem.enhance(cfg, dem=base), dem.enhance(cfg, dem=base)
+    c = dem.enhance({**cfg, "seed": 5}, dem=base)
+    for x, y, z in zip(a.layers, b.layers, c.layers, strict=True):
+        assert np.array_equal(x.heights, y.heights)
+        assert not np.array_equal(x.heights, z.heights)
+    for x, y in zip(a.catalogs, b.catalogs, strict=True):
+        assert np.array_equal(x, y)
+
+
+def test_write_read_roundtrip_and_files(tmp_path, stack):
+    out = tmp_path / "st"
+    manifest = stack.write(out)
+    doc = json.loads(manifest.read_text())
+    assert doc["format"] == dem.stack.STACK_FORMAT and len(doc["layers"]) == 6
+    assert doc["info"]["seed"] == 11 and doc["info"]["craters"]["drawn"] > 0
+    back = dem.read_stack(manifest)
+    assert back.is_consistent()  # the float32 files too
+    for k, (x, y) in enumerate(zip(stack.layers, back.layers, strict=True)):
+        assert np.array_equal(x.heights.astype(np.float32), y.heights)
+        assert x.transform == y.transform and x.crs == y.crs
+        entry = doc["layers"][k]
+        assert entry["bounds"] == list(y.bounds) and entry["pixel_size_m"] == 50.0 / 2**k
+        cat = back.catalogs[k]
+        assert np.array_equal(cat["index"], stack.catalogs[k]["index"])
+        assert np.allclose(cat["x_m"], stack.catalogs[k]["x_m"], rtol=0, atol=1e-9)
+        wx, wy = stack.frame.to_world(cat["x_m"], cat["y_m"])
+        assert np.allclose(cat["world_x"], wx) and np.allclose(cat["world_y"], wy)
+        gj = json.loads((out / entry["craters"]["geojson"]).read_text())
+        assert len(gj["features"]) == len(cat)
+        if len(cat):
+            assert gj["features"][0]["geometry"]["coordinates"] == pytest.approx(
+                [float(wx[0]), float(wy[0])])
+            assert gj["crs"]["properties"]["name"] == "EPSG:32633"
+    # an existing stack is replaced only with force; a foreign folder never
+    with pytest.raises(ValueError, match="exists; use --force"):
+        stack.write(out)
+    stack.write(out, force=True)
+    other = tmp_path / "photos"
+    other.mkdir()
+    (other / "a.jpg").write_bytes(b"x")
+    with pytest.raises(ValueError, match="not a stack folder"):
+        stack.write(other, force=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["photos", "st"]
+
+
+def test_geographic_base_from_lola(lola_crop):
+    s = dem.enhance({"layers": 3, "size": 65, "seed": 1,
+                     "craters": ["c=0.05,k=-2,dmin=1000,dmax=100000"]}, dem=lola_crop)
+    assert s.frame.kind == "equirectangular" and s.is_consistent()
+    assert s.pixel_sizes_m()[0] == pytest.approx(7580.8, rel=1e-4)
+    assert sum(s.info["craters"]["stamped"]) > 0
+    est = s.info["parameters"]["fractal_dimension_estimated"]
+    assert s.info["parameters"]["fractal_dimension"] == min(3.0, max(2.0, est))
+
+
+@pytest.mark.parametrize("config,error,match", [
+    ({"sizes": 65}, ValueError, "unknown config key"),
+    ({"size": 100}, ValueError, "2\\^n \\+ 1"),
+    ({"size": 0}, ValueError, "2\\^n \\+ 1"),
+    ({"size": -65}, ValueError, "2\\^n \\+ 1"),
+    ({"size": 257}, ValueError, "at least 257 x 257"),
+    ({"layers": 0}, ValueError, "layers"),
+    ({"layers": 2.5}, TypeError, "layers"),
+    ({"target": [1.0, 2.0]}, ValueError, "outside the base DEM"),
+    ({"target": "centre"}, TypeError, "target"),
+    ({"craters": ["c=0.5,k=-2,dmin=50,dmax=10"]}, ValueError, "d_min_m"),
+    ({"craters": ["c=0.5,k=-2"]}, ValueError, "missing dmin"),
+    ({"craters": "c=0.5,k=-2,dmin=1,dmax=10"}, TypeError, "list of crater layer specs"),
+    ({"craters": ["c=1e9,k=-3,dmin=1e-6,dmax=10"]}, ValueError, "absurd|limit"),
+    ({"min_crater_px": 0.5}, ValueError, "min_crater_px"),
+    ({"fractal_dimension": 3.5}, ValueError, "fractal_dimension"),
+    ({"smooth_craters": "yes"}, TypeError, "smooth_craters"),
+])
+def test_bad_config(base, config, error, match):
+    with pytest.raises(error, match=match):
+        dem.enhance({"layers": 2, "size": 65, "seed": 1, **config}, dem=base)
+
+
+def test_unknown_pixels_in_layer0_are_refused(base):
+    z = np.array(base.heights)
+    z[60, 60] = np.nan
+    with pytest.raises(ValueError, match="unknown \\(NaN\\) pixels"):
+        dem.enhance({"layers": 2, "size": 65}, dem=base.replace(heights=z))
