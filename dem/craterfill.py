@@ -57,7 +57,7 @@ import craters
 from craters._infra import check_range, normalize_rng
 
 from .core import Dem
-from .enhance import _propagate_up, serial_numba
+from .enhance import _propagate_up
 from .frame import LocalFrame, grid_affine, grid_pixel_size, local_frame, pixel_affine
 from .gaps import fill_gaps
 from .stack import Stack
@@ -255,10 +255,9 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
     base = fill_gaps(crop, roughness, rng=gen)
     local = {name: cat[name] for name in cat.dtype.names}
     local.update(x_m=gx - c0 * p, y_m=gy - r0 * p)
-    with serial_numba():
-        synth, stamped = craters.stamp_many(base.heights, p, craters.make_catalog(**local),
-                                            roughness=not smooth_craters, slope_erosion=False,
-                                            rng=gen, return_catalog=True)
+    synth, stamped = craters.stamp_many(base.heights, p, craters.make_catalog(**local),
+                                        roughness=not smooth_craters, slope_erosion=False,
+                                        rng=gen, return_catalog=True)
     region = fill[r0:r1, c0:c1]
     warp = harmonic_warp(crop.heights, synth, region)
     z = np.array(dem.heights)

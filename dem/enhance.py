@@ -48,13 +48,11 @@ the same bytes whatever the thread count.
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import logging
 import math
 import numbers
 
-import numba
 import numpy as np
 from rasterio.windows import Window
 
@@ -393,25 +391,6 @@ def plan_craters(specs, geometry: _Geometry, *, min_px: float, reach_radii: floa
 
 
 # --------------------------------------------------------------------------- build
-@contextlib.contextmanager
-def serial_numba():
-    """Run numba kernels on one thread inside the block (restored afterwards).
-
-    ``craters.stamp_many`` opens one parallel region per crater; with thousands of
-    craters of a few pixels the thread hand-offs cost more than the work, and when
-    another process holds a core they stall: an 11-layer stack of 1025^2 (116 000
-    craters) stamped in 4.3 s on one thread and 431 s on two while another process kept
-    one of this machine's two cores busy (about 3 s on two idle cores). Results do not
-    depend on the thread count.
-    """
-    n = numba.get_num_threads()
-    numba.set_num_threads(1)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(n)
-
-
 def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: _Geometry, k: int, *,
                  roughness: bool, seed: int, progress: bool):
     """Stamp layer k's craters (layer-0 grid frame positions) into a copy of ``z``."""
@@ -423,10 +402,9 @@ def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: _Geometry, k: int, *,
     cols["x_m"] = cat["x_m"] - c * p0
     cols["y_m"] = cat["y_m"] - r * p0
     grid = craters.make_catalog(**cols)
-    with serial_numba():
-        h, stamped = craters.stamp_many(z, geometry.pixel_m(k), grid, roughness=roughness,
-                                        rng=_stream(seed, _STREAM_STAMP, k),
-                                        progress=progress, return_catalog=True)
+    h, stamped = craters.stamp_many(z, geometry.pixel_m(k), grid, roughness=roughness,
+                                    rng=_stream(seed, _STREAM_STAMP, k),
+                                    progress=progress, return_catalog=True)
     # back to layer-0 grid positions, exactly as planned
     order = np.argsort(cat["index"])
     pos = order[np.searchsorted(cat["index"], stamped["index"], sorter=order)]

@@ -15,7 +15,7 @@ from craters.kernels import (
     table,
 )
 
-from ._grid_kernels import _interpolate_one, _ring_size
+from ._grid_kernels import _interpolate_one, _ring_size, _unit_of
 
 
 @njit(cache=True)
@@ -261,9 +261,11 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
     the rim offsets; the crater evaluated at every vertex with its true distance and
     azimuth; radii rescaled by the height change.
 
-    Benchmark switches: ``naive`` gathers by scanning every vertex (the O(N)-per-crater
-    reference); ``stop_after`` = 1 stops after the gather and local coordinates, 2 after
-    the local grid and plane fit (to time the stages).
+    Vertex directions are computed from the ring structure (no whole-grid unit-vector
+    array). Benchmark switches: ``naive`` gathers by scanning every vertex of ``unit``
+    (the O(N)-per-crater reference; otherwise ``unit`` is unused and may be empty);
+    ``stop_after`` = 1 stops after the gather and local coordinates, 2 after the local
+    grid and base fit (to time the stages).
     """
     smax = max(stretch[0], max(stretch[1], stretch[2]))
     smin = min(stretch[0], min(stretch[1], stretch[2]))
@@ -325,9 +327,12 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         for q in range(cnt):
             i = cand[q]
             r = radii[i]
-            p0v = stretch[0] * r * unit[i, 0]
-            p1v = stretch[1] * r * unit[i, 1]
-            p2v = stretch[2] * r * unit[i, 2]
+            ring = np.searchsorted(ring_offsets, i, side="right") - 1
+            o = ring_offsets[ring]
+            ux, uy, uz = _unit_of(m, ring, i - o, ring_offsets[ring + 1] - o)
+            p0v = stretch[0] * r * ux
+            p1v = stretch[1] * r * uy
+            p2v = stretch[2] * r * uz
             pm = np.sqrt(p0v * p0v + p1v * p1v + p2v * p2v)
             b0 = p0v / pm
             b1 = p1v / pm

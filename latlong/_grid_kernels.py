@@ -229,3 +229,46 @@ def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, ac
                     acc[v, 0] += nx
                     acc[v, 1] += ny
                     acc[v, 2] += nz
+
+
+@njit(cache=True, inline="always")
+def _unit_of(m, r, j, n):
+    """Unit vector of vertex j of ring r (n vertices): the one definition used everywhere."""
+    if r == 0:
+        return 0.0, 0.0, 1.0
+    if r == 2 * m:
+        return 0.0, 0.0, -1.0
+    lat = 0.5 * np.pi - r * (np.pi / (2 * m))
+    lon = (2.0 * np.pi * j) / n
+    c = np.cos(lat)
+    return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
+
+
+@njit(cache=True, parallel=True)
+def _unit_range_kernel(m, ring_offsets, lo, hi, out):
+    """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3), ring by ring."""
+    r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
+    r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
+    for r in prange(r_first, r_last + 1):
+        o = ring_offsets[r]
+        n = ring_offsets[r + 1] - o
+        j0 = max(lo - o, 0)
+        j1 = min(hi - o, n)
+        for j in range(j0, j1):
+            x, y, z = _unit_of(m, r, j, n)
+            out[o + j - lo, 0] = x
+            out[o + j - lo, 1] = y
+            out[o + j - lo, 2] = z
+
+
+@njit(cache=True, parallel=True)
+def _unit_index_kernel(m, ring_offsets, idx, out):
+    """Unit vectors of the vertices ``idx`` (any order) into out (len(idx), 3)."""
+    for k in prange(idx.shape[0]):
+        i = idx[k]
+        r = np.searchsorted(ring_offsets, i, side="right") - 1
+        o = ring_offsets[r]
+        x, y, z = _unit_of(m, r, i - o, ring_offsets[r + 1] - o)
+        out[k, 0] = x
+        out[k, 1] = y
+        out[k, 2] = z

@@ -180,7 +180,7 @@ class Body:
 
     def vertices(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
         """Vertex positions in metres, (N, 3) float64 (or the rows ``lo:hi``)."""
-        u = self._grid.unit_vectors()[lo:hi]
+        u = self._grid.unit_vectors_range(lo, hi)
         return u * (self._radii[lo:hi, None] * self._stretch)
 
     def __repr__(self) -> str:

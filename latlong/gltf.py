@@ -41,20 +41,8 @@ _TRIANGLE_STRIP = 5
 
 
 def unit_vectors_of(grid: LatLongGrid, idx) -> np.ndarray:
-    """Unit vectors of the vertices ``idx`` (same values as ``grid.unit_vectors()``,
-    computed without the whole-grid cache)."""
-    idx = np.asarray(idx, dtype=np.int64)
-    offs = grid.ring_offsets()
-    ring = np.searchsorted(offs, idx, side="right") - 1
-    pos = idx - offs[ring]
-    colat = grid.ring_colatitudes()[ring]
-    lat = np.pi / 2 - colat
-    lon = (2 * np.pi) * pos / grid.ring_sizes()[ring]
-    c = np.cos(lat)
-    out = np.stack([c * np.cos(lon), c * np.sin(lon), np.sin(lat)], axis=1)
-    out[ring == 0] = (0.0, 0.0, 1.0)
-    out[ring == grid.n_rings - 1] = (0.0, 0.0, -1.0)
-    return out
+    """Unit vectors of the vertices ``idx`` without the whole-grid cache."""
+    return grid.unit_vectors_of(idx)
 
 
 def body_normals(body: Body) -> np.ndarray:

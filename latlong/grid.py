@@ -8,7 +8,12 @@ import numpy as np
 
 from craters._infra import check_int
 
-from ._grid_kernels import _interpolate_kernel, _triangles_kernel
+from ._grid_kernels import (
+    _interpolate_kernel,
+    _triangles_kernel,
+    _unit_index_kernel,
+    _unit_range_kernel,
+)
 
 __all__ = ["LatLongGrid", "MAX_MAGNITUDE"]
 
@@ -178,20 +183,35 @@ class LatLongGrid:
         return self._cached("lon", make)
 
     def unit_vectors(self) -> np.ndarray:
-        """Unit direction of every vertex, shape (N, 3), float64 (poles exactly +-z)."""
+        """Unit direction of every vertex, shape (N, 3), float64 (poles exactly +-z).
 
-        def make():
-            lat, lon = self.latitudes(), self.longitudes()
-            out = np.empty((self.n_vertices, 3), dtype=np.float64)
-            c = np.cos(lat)
-            out[:, 0] = c * np.cos(lon)
-            out[:, 1] = c * np.sin(lon)
-            out[:, 2] = np.sin(lat)
-            out[0] = (0.0, 0.0, 1.0)
-            out[-1] = (0.0, 0.0, -1.0)
-            return out
+        Cached; for very large grids prefer :meth:`unit_vectors_range` /
+        :meth:`unit_vectors_of`, which compute the same values without keeping them.
+        """
+        return self._cached("unit", lambda: self.unit_vectors_range(0, self.n_vertices))
 
-        return self._cached("unit", make)
+    def unit_vectors_range(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
+        """Unit vectors of vertices ``lo .. hi - 1`` (from the cache if it exists)."""
+        hi = self.n_vertices if hi is None else min(int(hi), self.n_vertices)
+        lo = max(0, int(lo))
+        cached = self._cache.get("unit")
+        if cached is not None:
+            return cached[lo:hi]
+        out = np.empty((max(hi - lo, 0), 3), dtype=np.float64)
+        if hi > lo:
+            _unit_range_kernel(self._m, self.ring_offsets(), lo, hi, out)
+        return out
+
+    def unit_vectors_of(self, idx) -> np.ndarray:
+        """Unit vectors of the vertices ``idx`` (any shape of indices), shape (..., 3)."""
+        idx = np.asarray(idx, dtype=np.int64)
+        flat = np.ascontiguousarray(idx.ravel())
+        if flat.size and (flat.min() < 0 or flat.max() >= self.n_vertices):
+            raise ValueError(f"`idx` must be in [0, {self.n_vertices - 1}]")
+        out = np.empty((flat.size, 3), dtype=np.float64)
+        if flat.size:
+            _unit_index_kernel(self._m, self.ring_offsets(), flat, out)
+        return out.reshape(idx.shape + (3,))
 
     def vertex_areas(self) -> np.ndarray:
         """Area represented by each vertex on the unit sphere (sum 4 pi), shape (N,).

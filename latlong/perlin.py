@@ -148,13 +148,12 @@ def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: f
     rng = normalize_rng(rng)
     rot = random_rotation(rng)
     offset = rng.uniform(0.0, 256.0, size=3)
-    u = grid.unit_vectors()
     out = np.empty(grid.n_vertices, dtype=np.float64)
     # coordinates in float32 chunks to bound the memory of very large grids
     chunk = 1 << 22
     for s in range(0, grid.n_vertices, chunk):
         # explicit sums, not BLAS, so the rounding never depends on the thread count
-        uc = u[s:s + chunk]
+        uc = grid.unit_vectors_range(s, s + chunk)
         xs, ys, zs = (
             ((uc[:, 0] * rot[a, 0] + uc[:, 1] * rot[a, 1] + uc[:, 2] * rot[a, 2]) * frequency
              + offset[a]).astype(np.float32)

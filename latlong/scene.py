@@ -551,48 +551,58 @@ def _resolve_craters_and_outputs(s: dict) -> None:
 
 
 # --------------------------------------------------------------------------- populations
-def _band_areas(body: Body) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles (by index) and their actual areas, streamed band by band."""
-    grid = body.grid
-    areas = []
-    tris = []
-    bo = grid.band_offsets()
-    chunk = 1 << 20
-    lo = 0
-    while lo < len(bo) - 1:
-        hi = int(np.searchsorted(bo, bo[lo] + chunk, side="right")) - 1
-        hi = min(max(hi, lo + 1), len(bo) - 1)
-        t = grid.band_triangles(lo, hi)
-        v0, v1 = int(t.min()), int(t.max()) + 1
-        p = body.vertices(v0, v1)[t - v0]
-        areas.append(0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]),
-                                          axis=1))
-        tris.append(t)
-        lo = hi
-    return np.concatenate(tris), np.concatenate(areas)
+def _triangle_areas(body: Body, band_lo: int, band_hi: int):
+    """Triangles of bands band_lo..band_hi-1 and their actual areas (m^2)."""
+    t = body.grid.band_triangles(band_lo, band_hi)
+    v0, v1 = int(t.min()), int(t.max()) + 1
+    p = body.vertices(v0, v1)[t - v0]
+    return t, 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+
+
+def _band_totals(body: Body) -> np.ndarray:
+    """Actual surface area of every band (m^2), streamed a few bands at a time."""
+    n_bands = 2 * body.grid.magnitude
+    totals = np.empty(n_bands)
+    step = max(1, n_bands // 64)
+    for lo in range(0, n_bands, step):
+        hi = min(lo + step, n_bands)
+        t, a = _triangle_areas(body, lo, hi)
+        bo = body.grid.band_offsets()
+        totals[lo:hi] = np.add.reduceat(a, bo[lo:hi] - bo[lo])
+    return totals
 
 
 def surface_positions(body: Body, n: int, *, rng=None) -> tuple[np.ndarray, np.ndarray, float]:
     """``n`` points uniform on the body's actual surface, as grid (lat_deg, lon_deg).
 
-    Triangles are chosen with probability proportional to their area and a uniform
-    point is taken inside; the point's direction in the unstretched frame gives the grid
+    Triangles are chosen with probability proportional to their area (a band first, then
+    a triangle of it: nothing holds the whole triangulation) and a uniform point is taken
+    inside; the point's direction in the unstretched frame gives the grid
     latitude/longitude. Returns (lat_deg, lon_deg, total area in m^2).
     """
-    return _sample_surface(body, *_band_areas(body), n, normalize_rng(rng))
+    return _sample_surface(body, _band_totals(body), n, normalize_rng(rng))
 
 
-def _sample_surface(body, tris, areas, n, rng):
-    cum = np.cumsum(areas)
+def _sample_surface(body, totals, n, rng):
+    cum = np.cumsum(totals)
     total = float(cum[-1])
-    pick = np.minimum(np.searchsorted(cum, rng.random(n) * total, side="right"), len(cum) - 1)
+    u = rng.random(n) * total
     a, b = rng.random(n), rng.random(n)
     flip = a + b > 1
     a[flip], b[flip] = 1 - a[flip], 1 - b[flip]
-    t = tris[pick]
-    v = body.vertices()
-    p = v[t[:, 0]] + a[:, None] * (v[t[:, 1]] - v[t[:, 0]]) + b[:, None] * (
-        v[t[:, 2]] - v[t[:, 0]])
+    band = np.minimum(np.searchsorted(cum, u, side="right"), len(cum) - 1)
+    resid = u - np.concatenate([[0.0], cum[:-1]])[band]
+    p = np.empty((n, 3))
+    order = np.argsort(band, kind="stable")
+    starts = np.searchsorted(band[order], np.arange(len(totals) + 1))
+    for bnd in np.flatnonzero(np.diff(starts)):
+        sel = order[starts[bnd]:starts[bnd + 1]]
+        t, area = _triangle_areas(body, int(bnd), int(bnd) + 1)
+        k = np.minimum(np.searchsorted(np.cumsum(area), resid[sel], side="right"), len(t) - 1)
+        tri = t[k]
+        v = body.vertices(int(tri.min()), int(tri.max()) + 1)
+        v0, v1, v2 = (v[tri[:, c] - tri.min()] for c in range(3))
+        p[sel] = v0 + a[sel, None] * (v1 - v0) + b[sel, None] * (v2 - v0)
     q = p / np.asarray(body.stretch)
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     lat = np.degrees(np.arcsin(np.clip(q[:, 2], -1, 1)))
@@ -604,10 +614,10 @@ def body_population(body: Body, layers, *, rng=None, degradation_kwargs=None) ->
     """A crater catalog for ``body``: counts from its actual surface area, positions
     uniform on its actual surface (:func:`surface_positions`), oldest first."""
     rng = normalize_rng(rng)
-    tris, areas = _band_areas(body)
-    cat = _craters.population(layers, area_m2=float(areas.sum()), rng=rng,
+    totals = _band_totals(body)
+    cat = _craters.population(layers, area_m2=float(totals.sum()), rng=rng,
                               degradation_kwargs=degradation_kwargs)
-    lat, lon, _ = _sample_surface(body, tris, areas, len(cat), rng)
+    lat, lon, _ = _sample_surface(body, totals, len(cat), rng)
     cat["lat_deg"], cat["lon_deg"] = lat, lon
     return cat
 
