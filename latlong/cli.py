@@ -134,6 +134,8 @@ def _cmd_export(args: argparse.Namespace) -> int:
     check_output_path(out, force=args.force, suffixes=(".glb", ".vtp"))
     if suffix == ".glb":
         check_output_path(out.with_suffix(".json"), force=args.force, suffixes=(".json",))
+        for level in range(args.lod + 1):  # external buffers of exports past 4 GiB
+            check_output_path(out.with_name(f"{out.stem}.lod{level}.bin"), force=args.force)
     body = load(args.model)
     if body.magnitude % (2**args.lod):
         raise CliError(f"--lod {args.lod} needs a magnitude divisible by {2**args.lod}; "

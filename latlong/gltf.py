@@ -7,10 +7,12 @@ a ``TRIANGLE_STRIP`` (mode 5) over the patch's own vertices: float32 ``POSITION`
 min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band strips cut
 to the patch and joined with degenerate triangles. Node extras and the JSON manifest
 give each patch's bounding sphere, bands, triangle count and the byte ranges of its
-data in the binary chunk, so a renderer can cull and stream patches. Nothing holds the
-whole body's triangles: patches are generated and written one by one, normals come
-from a band-streaming kernel, and the binary chunk goes to a temporary file first
-(its length is only known at the end).
+data, so a renderer can cull and stream patches. Nothing holds the whole body's
+triangles: patches are generated and written one by one, normals come from a
+band-streaming kernel, and each level's binary data goes to a temporary file first.
+A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
+``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
+glTF 2.0 allows.
 """
 
 from __future__ import annotations
@@ -96,36 +98,78 @@ def export_glb(body: Body, path, *, patch_k: int = 64, lod: int = 0,
     manifest = {"format": "craterform.patches/1", "glb": path.name, "patch_k": patch_k,
                 "levels": []}
     folder = path.parent if str(path.parent) else Path(".")
-    fd, bin_tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".bin", dir=folder)
-    os.close(fd)
+    temps = []
     try:
-        offset = 0
-        with open(bin_tmp, "wb") as binf:
-            for level in range(lod + 1):
-                offset = _write_level(body.lod(level), level, patch_k, gl, manifest, binf,
-                                      offset, progress)
-        gl["buffers"].append({"byteLength": offset})
-        js = json.dumps(gl, separators=(",", ":"), sort_keys=True).encode("utf-8")
-        js += b" " * _pad4(len(js))
-        total = 12 + 8 + len(js) + 8 + offset
-        with atomic_path(path) as tmp:
-            with open(tmp, "wb") as out, open(bin_tmp, "rb") as src:
-                out.write(struct.pack("<4sII", b"glTF", 2, total))
-                out.write(struct.pack("<I4s", len(js), b"JSON"))
-                out.write(js)
-                out.write(struct.pack("<I4s", offset, b"BIN\x00"))
-                shutil.copyfileobj(src, out, length=16 << 20)
+        sizes = []
+        for level in range(lod + 1):
+            fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".lod{level}.bin",
+                                           dir=folder)
+            os.close(fd)
+            temps.append(tmp_bin)
+            with open(tmp_bin, "wb") as binf:
+                sizes.append(_write_level(body.lod(level), level, patch_k, gl, manifest,
+                                          binf, progress))
+        _finish(path, gl, manifest, temps, sizes)
     finally:
-        os.unlink(bin_tmp)
-    base = 12 + 8 + len(js) + 8
-    manifest["bin_chunk_offset"] = base
+        for t in temps:
+            if os.path.exists(t):
+                os.unlink(t)
     with atomic_path(path.with_suffix(".json")) as tmp:
         tmp.write_text(json.dumps(manifest, indent=1, sort_keys=True), encoding="utf-8")
     return manifest
 
 
+#: A GLB's length and chunk lengths are 32-bit: past this the levels go to .bin files.
+GLB_LIMIT = 2**32 - 1
+
+
+def _finish(path: Path, gl: dict, manifest: dict, temps: list, sizes: list) -> None:
+    """Embed the levels' binary data in the GLB, or - past 4 GiB, the format's limit -
+    reference one external ``<stem>.lod<k>.bin`` per level (glTF external buffers)."""
+    starts = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
+    embedded = dict(gl, buffers=[{"byteLength": int(starts[-1])}],
+                    bufferViews=[dict(v, buffer=0, byteOffset=v["byteOffset"]
+                                      + int(starts[v["buffer"]])) for v in gl["bufferViews"]])
+    js = _json_chunk(embedded)
+    if 12 + 8 + len(js) + 8 + int(starts[-1]) <= GLB_LIMIT:
+        for level, info in enumerate(manifest["levels"]):
+            for patch in info["patches"]:
+                for rng in patch["bytes"].values():
+                    rng[0] += int(starts[level])
+        manifest["bin_chunk_offset"] = 12 + 8 + len(js) + 8
+        manifest["buffers"] = [path.name]
+        with atomic_path(path) as tmp, open(tmp, "wb") as out:
+            out.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js) + 8 + int(starts[-1])))
+            out.write(struct.pack("<I4s", len(js), b"JSON"))
+            out.write(js)
+            out.write(struct.pack("<I4s", int(starts[-1]), b"BIN\x00"))
+            for t in temps:
+                with open(t, "rb") as src:
+                    shutil.copyfileobj(src, out, length=16 << 20)
+        return
+    names = [f"{path.stem}.lod{k}.bin" for k in range(len(temps))]
+    gl["buffers"] = [{"uri": n, "byteLength": int(sz)} for n, sz in zip(names, sizes,
+                                                                       strict=True)]
+    js = _json_chunk(gl)
+    manifest["bin_chunk_offset"] = None
+    manifest["buffers"] = names
+    for t, n in zip(temps, names, strict=True):
+        os.replace(t, path.parent / n)
+    with atomic_path(path) as tmp, open(tmp, "wb") as out:
+        out.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js)))
+        out.write(struct.pack("<I4s", len(js), b"JSON"))
+        out.write(js)
+
+
+def _json_chunk(gl: dict) -> bytes:
+    js = json.dumps(gl, separators=(",", ":"), sort_keys=True).encode("utf-8")
+    return js + b" " * _pad4(len(js))
+
+
 def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
-                 offset: int, progress: bool) -> int:
+                 progress: bool) -> int:
+    """Write one level's patches to ``binf`` (buffer = the level); returns its size."""
+    offset = 0
     grid = body.grid
     normals = body_normals(body)
     radii = np.asarray(body.radii_m)
@@ -153,7 +197,7 @@ def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict,
                                    ("indices", ind, _ELEMENT_ARRAY_BUFFER)):
             raw = np.ascontiguousarray(data).tobytes()
             binf.write(raw)
-            gl["bufferViews"].append({"buffer": 0, "byteOffset": offset,
+            gl["bufferViews"].append({"buffer": level, "byteOffset": offset,
                                       "byteLength": len(raw), "target": target})
             ranges[name] = [offset, len(raw)]
             offset += len(raw)

@@ -145,7 +145,33 @@ def test_export_is_deterministic(body, tmp_path):
     assert a.read_bytes() == b.read_bytes()
     ma = json.loads(a.with_suffix(".json").read_text())
     mb = json.loads(b.with_suffix(".json").read_text())
-    assert ma.pop("glb") == "a.glb" and mb.pop("glb") == "b.glb" and ma == mb
+    assert ma.pop("glb") == "a.glb" and mb.pop("glb") == "b.glb"
+    assert ma.pop("buffers") == ["a.glb"] and mb.pop("buffers") == ["b.glb"] and ma == mb
+
+
+def test_past_4_gib_levels_go_to_external_buffers(body, tmp_path, monkeypatch):
+    import latlong.gltf as gltf
+
+    monkeypatch.setattr(gltf, "GLB_LIMIT", 100_000)  # pretend the data is too large
+    path = tmp_path / "big.glb"
+    man = export_glb(body, path, patch_k=16, lod=1)
+    assert man["buffers"] == ["big.lod0.bin", "big.lod1.bin"]
+    raw_glb = path.read_bytes()
+    json_len = int(np.frombuffer(raw_glb[12:16], dtype="<u4")[0])
+    assert len(raw_glb) == 12 + 8 + json_len  # a JSON chunk only, no embedded binary
+    doc = json.loads(raw_glb[20:20 + json_len])
+    assert [b["uri"] for b in doc["buffers"]] == man["buffers"]
+    for b in doc["buffers"]:
+        assert (tmp_path / b["uri"]).stat().st_size == b["byteLength"]
+    import trimesh
+
+    scene = trimesh.load(path, process=False)
+    faces = [scene.geometry[scene.graph[n][1]].faces for n in scene.graph.nodes_geometry]
+    assert sum(non_degenerate(f) for f in faces) == body.grid.n_triangles
+    patch = man["levels"][1]["patches"][0]
+    raw = (tmp_path / "big.lod1.bin").read_bytes()
+    off, n = patch["bytes"]["indices"]
+    assert len(np.frombuffer(raw[off:off + n], dtype="<u4")) == patch["strip_length"]
 
 
 def test_vtp_strips(body, tmp_path):
