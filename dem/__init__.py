@@ -9,7 +9,7 @@ georeferencing. See ``dem --help`` for the command line.
 
 import logging
 
-from .analysis import band_power, laplacian, slope_deg
+from .analysis import band_power, laplacian
 from .core import Dem
 from .craterfill import fill_crater_gaps, replace_crater
 from .enhance import EnhanceConfig, enhance
@@ -20,6 +20,14 @@ from .gaps import fill_gaps
 from .io import read, write
 from .mesh import to_mesh
 from .stack import Stack, read_stack
+from .terrain import (
+    pixel_sizes_by_row,
+    power_spectrum,
+    roughness,
+    slope,
+    slope_distribution,
+    spectral_exponent,
+)
 
 __all__ = [
     "Dem",
@@ -42,7 +50,12 @@ __all__ = [
     "read",
     "read_stack",
     "replace_crater",
-    "slope_deg",
+    "pixel_sizes_by_row",
+    "power_spectrum",
+    "roughness",
+    "slope",
+    "slope_distribution",
+    "spectral_exponent",
     "to_mesh",
     "variogram",
     "write",

@@ -1,4 +1,5 @@
-"""Terrain statistics used to compare DEMs: Horn slope, Laplacian, band power."""
+"""Terrain statistics used to compare DEMs: Laplacian and band power (slopes and spectra
+are in :mod:`dem.terrain`)."""
 
 from __future__ import annotations
 
@@ -8,7 +9,7 @@ from craters._infra import check_range
 
 from .core import Dem
 
-__all__ = ["band_power", "laplacian", "slope_deg"]
+__all__ = ["band_power", "laplacian"]
 
 
 def _check(dem) -> Dem:
@@ -21,31 +22,6 @@ def _stencil_input(dem) -> tuple[np.ndarray, float, float, np.ndarray]:
     """Heights, pixel sizes and an all-NaN output for a 3 x 3 stencil statistic."""
     dem = _check(dem)
     return dem.heights, *dem.pixel_size_m, np.full(dem.shape, np.nan)
-
-
-def slope_deg(dem: Dem) -> np.ndarray:
-    """Slope in degrees by Horn's (1981) 3 x 3 finite differences.
-
-    ``dz/dx = ((c + 2f + i) - (a + 2d + g)) / (8 dx)`` with the 3 x 3 window
-    ``a b c / d e f / g h i`` (rows top to bottom) and the pixel size in metres; NaN on
-    the one-pixel border and where the window has an unknown pixel.
-
-    Examples
-    --------
-    >>> d = Dem(np.add.outer(np.zeros(4), np.arange(4.0)), pixel_size_m=1.0)  # 1 m/m
-    >>> slope_deg(d)[1:-1, 1:-1].round(6).tolist()
-    [[45.0, 45.0], [45.0, 45.0]]
-    """
-    z, dx, dy, out = _stencil_input(dem)
-    if min(z.shape) < 3:
-        return out
-    a, b, c = z[:-2, :-2], z[:-2, 1:-1], z[:-2, 2:]
-    d, f = z[1:-1, :-2], z[1:-1, 2:]
-    g, h, i = z[2:, :-2], z[2:, 1:-1], z[2:, 2:]
-    gx = ((c + 2 * f + i) - (a + 2 * d + g)) / (8 * dx)
-    gy = ((g + 2 * h + i) - (a + 2 * b + c)) / (8 * dy)
-    out[1:-1, 1:-1] = np.degrees(np.arctan(np.hypot(gx, gy)))
-    return out
 
 
 def laplacian(dem: Dem) -> np.ndarray:

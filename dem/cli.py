@@ -33,6 +33,7 @@ from craters._infra import (
     run_cli,
 )
 
+from .analysis_cli import add_parsers as add_analysis_parsers
 from .core import crs_label
 from .enhance import EnhanceConfig, enhance
 from .expansion import expand
@@ -400,6 +401,7 @@ def build_parser() -> OneLineParser:
             p.add_argument(*opt.flags, **kw)
         funcs = {"info": _cmd_info, "enhance": _cmd_enhance, "mesh": _cmd_mesh}
         p.set_defaults(func=funcs.get(command, lambda a, c=command: _run(a, c)))
+    add_analysis_parsers(sub)
     return parser
 
 

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from craters._infra import check_int, check_range
+from craters._infra import area_slope_summary, check_int, check_range
 
 from ._slope_kernels import _cap_average_kernel, _ring_prefix_kernel, _vertex_normals_kernel
 from .body import Body
@@ -169,26 +169,10 @@ def slope_summary(slopes_deg, areas, *, bin_deg: float = SLOPE_BIN_DEG) -> dict:
 
     Returns a dict with ``edges_deg`` (bin edges), ``area_fraction`` (per bin, sums to
     1), ``above_percent`` (share of the area steeper than each edge), ``median_deg``,
-    ``mean_deg`` and ``percent_above`` for 10, 20 and 30 degrees.
+    ``mean_deg`` and ``percent_above`` for 10, 20 and 30 degrees (the same summary as
+    ``dem.slope_distribution``).
     """
-    s = np.asarray(slopes_deg, dtype=np.float64).ravel()
-    w = np.asarray(areas, dtype=np.float64).ravel()
-    if s.shape != w.shape or s.size == 0:
-        raise ValueError("`slopes_deg` and `areas` must be non-empty and the same length")
-    ok = np.isfinite(s) & np.isfinite(w)
-    s, w = s[ok], w[ok]
-    bin_deg = check_range("bin_deg", bin_deg, 0.01, 90.0)
-    edges = np.arange(0.0, 180.0 + bin_deg, bin_deg)
-    edges = edges[edges <= max(90.0, float(s.max()) + bin_deg)]
-    hist, _ = np.histogram(s, bins=edges, weights=w)
-    frac = hist / w.sum()
-    order = np.argsort(s)
-    cw = np.cumsum(w[order]) / w.sum()
-    median = float(s[order][np.searchsorted(cw, 0.5)])
-    above = 100.0 * (1.0 - np.concatenate([[0.0], np.cumsum(frac)]))[:len(edges)]
-    return {"edges_deg": edges, "area_fraction": frac, "above_percent": above,
-            "median_deg": median, "mean_deg": float(np.average(s, weights=w)),
-            "percent_above": {a: float(100.0 * w[s > a].sum() / w.sum()) for a in (10, 20, 30)}}
+    return area_slope_summary(slopes_deg, areas, bin_deg=bin_deg)
 
 
 def radius_spectrum(body: Body, l_max: int | None = None) -> tuple[np.ndarray, np.ndarray]:

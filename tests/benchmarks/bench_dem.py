@@ -127,7 +127,7 @@ def figures(quick):
                      crop.crs, body_radius_m=crop.body_radius_m)
 
     def ratios(d):
-        return (np.nanmedian(dem.slope_deg(d)) / np.nanmedian(dem.slope_deg(crop)),
+        return (np.nanmedian(dem.slope(d)) / np.nanmedian(dem.slope(crop)),
                 dem.band_power(d) / dem.band_power(crop),
                 np.nanstd(dem.laplacian(d)) / np.nanstd(dem.laplacian(crop)))
 
@@ -152,7 +152,7 @@ def figures(quick):
                          @ Affine.translation(-(k - 1) / 2, -(k - 1) / 2) @ Affine.scale(k),
                          c.crs, body_radius_m=c.body_radius_m)
             e = dem.expand(cc, 2, rng=1)
-            q = (np.nanmedian(dem.slope_deg(e)) / np.nanmedian(dem.slope_deg(c)),
+            q = (np.nanmedian(dem.slope(e)) / np.nanmedian(dem.slope(c)),
                  dem.band_power(e) / dem.band_power(c),
                  np.nanstd(dem.laplacian(e)) / np.nanstd(dem.laplacian(c)))
             ok = 0.75 <= q[0] <= 1.33 and 1 / 3 <= q[1] <= 3 and 0.5 <= q[2] <= 2

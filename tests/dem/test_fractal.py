@@ -62,7 +62,7 @@ def test_slope_laplacian_band_power(rng):
     x = np.arange(20.0)
     z = np.add.outer(0.5 * x, np.zeros(20))  # rises 0.5 m per 2 m row step
     d = Dem(z, pixel_size_m=2.0)
-    s = dem.slope_deg(d)
+    s = dem.slope(d)
     assert np.isnan(s[0]).all() and np.allclose(s[1:-1, 1:-1], np.degrees(np.arctan(0.25)))
     assert np.allclose(dem.laplacian(d)[1:-1, 1:-1], 0.0)
     assert dem.band_power(d) < 1e-20  # a plane has no power once detrended

@@ -33,7 +33,7 @@ def bicubic(coarse: Dem, like: Dem, k: int) -> Dem:
 
 def ratios(test: Dem, ref: Dem) -> tuple[float, float, float]:
     """(median Horn slope, top-octave power, Laplacian std) of ``test`` over ``ref``."""
-    return (np.nanmedian(dem.slope_deg(test)) / np.nanmedian(dem.slope_deg(ref)),
+    return (np.nanmedian(dem.slope(test)) / np.nanmedian(dem.slope(ref)),
             dem.band_power(test) / dem.band_power(ref),
             np.nanstd(dem.laplacian(test)) / np.nanstd(dem.laplacian(ref)))
 
