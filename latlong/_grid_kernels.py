@@ -53,18 +53,33 @@ def _band_triangles_kernel(oa, na, ob, nb, south, out, t0):
         t += 1
 
 
+@njit(cache=True, inline="always")
+def _one_band(m, band, base, ring_offsets, band_offsets, out):
+    t0 = band_offsets[band] - base
+    if band < m:  # northern band: inner ring = band, outer = band + 1
+        ra, rb, south = band, band + 1, False
+    else:  # southern band: inner ring = band + 1 (nearer the south pole)
+        ra, rb, south = band + 1, band, True
+    _band_triangles_kernel(ring_offsets[ra], _ring_size(ra, m), ring_offsets[rb],
+                           _ring_size(rb, m), south, out, t0)
+
+
 @njit(cache=True, parallel=True)
 def _triangles_kernel(m, band_lo, band_hi, ring_offsets, band_offsets, out):
-    """Triangles of bands ``band_lo .. band_hi - 1`` into ``out`` (rows from band_lo's)."""
+    """Triangles of bands ``band_lo .. band_hi - 1`` into ``out`` (rows from band_lo's),
+    bands in parallel (for many triangles: a parallel region costs more than a few
+    bands' work)."""
     base = band_offsets[band_lo]
     for band in prange(band_lo, band_hi):
-        t0 = band_offsets[band] - base
-        if band < m:  # northern band: inner ring = band, outer = band + 1
-            ra, rb, south = band, band + 1, False
-        else:  # southern band: inner ring = band + 1 (nearer the south pole)
-            ra, rb, south = band + 1, band, True
-        _band_triangles_kernel(ring_offsets[ra], _ring_size(ra, m), ring_offsets[rb],
-                               _ring_size(rb, m), south, out, t0)
+        _one_band(m, band, base, ring_offsets, band_offsets, out)
+
+
+@njit(cache=True)
+def _triangles_serial(m, band_lo, band_hi, ring_offsets, band_offsets, out):
+    """:func:`_triangles_kernel` on one thread."""
+    base = band_offsets[band_lo]
+    for band in range(band_lo, band_hi):
+        _one_band(m, band, base, ring_offsets, band_offsets, out)
 
 
 @njit(cache=True)
@@ -244,9 +259,25 @@ def _unit_of(m, r, j, n):
     return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
 
 
+@njit(cache=True)
+def _unit_range_serial(m, ring_offsets, lo, hi, out):
+    """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3) (one thread)."""
+    r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
+    r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
+    for r in range(r_first, r_last + 1):
+        o = ring_offsets[r]
+        n = ring_offsets[r + 1] - o
+        for j in range(max(lo - o, 0), min(hi - o, n)):
+            x, y, z = _unit_of(m, r, j, n)
+            out[o + j - lo, 0] = x
+            out[o + j - lo, 1] = y
+            out[o + j - lo, 2] = z
+
+
 @njit(cache=True, parallel=True)
 def _unit_range_kernel(m, ring_offsets, lo, hi, out):
-    """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3), ring by ring."""
+    """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3), rings in parallel (for
+    large ranges: a parallel region costs far more than a small range's work)."""
     r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
     r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
     for r in prange(r_first, r_last + 1):
@@ -261,10 +292,10 @@ def _unit_range_kernel(m, ring_offsets, lo, hi, out):
             out[o + j - lo, 2] = z
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True)
 def _unit_index_kernel(m, ring_offsets, idx, out):
     """Unit vectors of the vertices ``idx`` (any order) into out (len(idx), 3)."""
-    for k in prange(idx.shape[0]):
+    for k in range(idx.shape[0]):
         i = idx[k]
         r = np.searchsorted(ring_offsets, i, side="right") - 1
         o = ring_offsets[r]

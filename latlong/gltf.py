@@ -50,12 +50,16 @@ def unit_vectors_of(grid: LatLongGrid, idx) -> np.ndarray:
 def body_normals(body: Body) -> np.ndarray:
     """Unit vertex normals (area-weighted), float32 (N, 3), streamed band by band."""
     grid = body.grid
-    acc = np.zeros((grid.n_vertices, 3), dtype=np.float64)
+    acc = np.zeros((grid.n_vertices, 3), dtype=np.float32)  # 12 B per vertex, no copies
     _normals_from_radii_kernel(grid.magnitude, grid.ring_offsets(), grid.band_offsets(),
                                np.asarray(body.radii_m, dtype=np.float64),
                                np.asarray(body.stretch, dtype=np.float64), acc)
-    norm = np.linalg.norm(acc, axis=1, keepdims=True)
-    return (acc / np.where(norm > 0, norm, 1.0)).astype(np.float32)
+    step = 1 << 22
+    for s in range(0, grid.n_vertices, step):  # normalise in place, in chunks
+        block = acc[s:s + step]
+        norm = np.sqrt((block.astype(np.float64) ** 2).sum(axis=1))
+        block /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
+    return acc
 
 
 def _pad4(n: int) -> int:

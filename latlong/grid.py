@@ -11,8 +11,10 @@ from craters._infra import check_int
 from ._grid_kernels import (
     _interpolate_kernel,
     _triangles_kernel,
+    _triangles_serial,
     _unit_index_kernel,
     _unit_range_kernel,
+    _unit_range_serial,
 )
 
 __all__ = ["LatLongGrid", "MAX_MAGNITUDE"]
@@ -198,8 +200,10 @@ class LatLongGrid:
         if cached is not None:
             return cached[lo:hi]
         out = np.empty((max(hi - lo, 0), 3), dtype=np.float64)
-        if hi > lo:
+        if hi - lo > 1_000_000:
             _unit_range_kernel(self._m, self.ring_offsets(), lo, hi, out)
+        elif hi > lo:
+            _unit_range_serial(self._m, self.ring_offsets(), lo, hi, out)
         return out
 
     def unit_vectors_of(self, idx) -> np.ndarray:
@@ -260,8 +264,10 @@ class LatLongGrid:
                              f"got {band_lo}, {band_hi}")
         bo = self.band_offsets()
         out = np.empty((bo[band_hi] - bo[band_lo], 3), dtype=np.int64)
-        if band_hi > band_lo:
+        if len(out) > 500_000:
             _triangles_kernel(self._m, band_lo, band_hi, self.ring_offsets(), bo, out)
+        elif band_hi > band_lo:
+            _triangles_serial(self._m, band_lo, band_hi, self.ring_offsets(), bo, out)
         return out
 
     def triangles(self) -> np.ndarray:

@@ -41,7 +41,8 @@ def main():
     t0 = time.perf_counter()
     man = export_glb(body, glb, patch_k=args.patch_k, lod=args.lod)
     t_export = time.perf_counter() - t0
-    size = glb.stat().st_size
+    files = [glb] + [glb.with_name(b) for b in man["buffers"] if b != glb.name]
+    size = sum(f.stat().st_size for f in files)
     n_strips = sum(sum(p["bands"][1] - p["bands"][0] for p in lv["patches"])
                    for lv in man["levels"])
     n_patches = sum(len(lv["patches"]) for lv in man["levels"])
@@ -50,9 +51,10 @@ def main():
           f"patches, {n_strips:,} strips ({n_strips / t_export:,.0f} strips/s), "
           f"{n_tri:,} triangles, {size / 2**20:,.0f} MiB ({size / 2**20 / t_export:.0f} MiB/s)")
     print(json.dumps({"build_s": round(t_build, 1), "export_s": round(t_export, 1),
-                      "glb_bytes": size, "patches": n_patches}))
-    glb.unlink()
-    glb.with_suffix(".json").unlink()
+                      "bytes": size, "files": [f.name for f in files],
+                      "patches": n_patches}))
+    for f in files + [glb.with_suffix(".json")]:
+        f.unlink()
 
 
 if __name__ == "__main__":
