@@ -7,6 +7,15 @@ populations and catalogs. Imports neither ``latlong`` nor ``dem``.
 
 import logging
 
+from .boulders import (
+    BoulderLayer,
+    BoulderNode,
+    BoulderShape,
+    boulder,
+    boulder_meshes,
+    boulder_normals,
+    parse_boulder_spec,
+)
 from .catalog import (
     make_catalog,
     read_catalog,
@@ -42,6 +51,9 @@ from .profile import DEFAULT_EJECTA_EDGE, ProfileParams, profile_params, radial_
 from .stamp import Crater, Roughness, rim_perturbations, stamp, stamp_many
 
 __all__ = [
+    "BoulderLayer",
+    "BoulderNode",
+    "BoulderShape",
     "DEFAULT_EJECTA_EDGE",
     "MORPHOMETRY_PRESETS",
     "Crater",
@@ -50,10 +62,14 @@ __all__ = [
     "Morphometry",
     "ProfileParams",
     "Roughness",
+    "boulder",
+    "boulder_meshes",
+    "boulder_normals",
     "degradation_factors",
     "degradation_from_age",
     "expected_count",
     "fit_power_law_exponent",
+    "parse_boulder_spec",
     "parse_layer_spec",
     "fresh_depth",
     "fresh_rim_height",

@@ -2,7 +2,8 @@
 
 Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement
 expansion of real DEMs, outside-in fractal gap filling, crater gap filling and crater
-replacement, multi-resolution layer stacks with craters per layer (:func:`enhance`) and
+replacement, boulders (:func:`stamp_boulders`), multi-resolution layer stacks with
+craters and boulders per layer (:func:`enhance`) and
 their stitched meshes (:func:`to_mesh`), on a :class:`Dem` that keeps the
 georeferencing. See ``dem --help`` for the command line.
 """
@@ -10,6 +11,7 @@ georeferencing. See ``dem --help`` for the command line.
 import logging
 
 from .analysis import band_power, laplacian
+from .boulders import boulder_population, stamp_boulders
 from .core import Dem
 from .craterfill import fill_crater_gaps, replace_crater
 from .enhance import EnhanceConfig, enhance
@@ -36,6 +38,7 @@ __all__ = [
     "LocalFrame",
     "Stack",
     "band_power",
+    "boulder_population",
     "displacement_scales",
     "enhance",
     "expand",
@@ -56,6 +59,7 @@ __all__ = [
     "slope",
     "slope_distribution",
     "spectral_exponent",
+    "stamp_boulders",
     "to_mesh",
     "variogram",
     "write",

@@ -85,12 +85,19 @@ def _target(text) -> tuple[float, float]:
     raise argparse.ArgumentTypeError(f"expected X,Y in world coordinates; got {text!r}")
 
 
-def _crater_spec(text) -> str:
-    try:
-        craters.parse_layer_spec(text)
-    except (TypeError, ValueError) as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
-    return text
+def _spec_checker(parse):
+    """An argparse type that validates a layer spec with ``parse`` and keeps the text."""
+    def check(text) -> str:
+        try:
+            parse(text)
+        except (TypeError, ValueError) as exc:
+            raise argparse.ArgumentTypeError(str(exc)) from None
+        return text
+    return check
+
+
+_crater_spec = _spec_checker(craters.parse_layer_spec)
+_boulder_spec = _spec_checker(craters.parse_boulder_spec)
 
 
 def _count(text) -> int:
@@ -143,6 +150,15 @@ OPTIONS: tuple[Opt, ...] = (
         metavar="PX"),
     Opt(("--smooth-craters",), "smooth_craters", bool, False,
         "ideal craters: no fractal overlay, circular rims", ("enhance",), flag_only=True),
+    Opt(("--boulders",), "boulders", _boulder_spec, (),
+        "boulder layer c=..,k=..,dmin=..,dmax=..[,burial=..] (N_cum = c D^k per m^2, D in "
+        "metres; burial = largest buried fraction of the height); stamped as a heightfield "
+        "maximum in the finest layer holding each; repeat for several", ("enhance",),
+        metavar="SPEC", many=True),
+    Opt(("--min-boulder-px",), "min_boulder_px", _number, 2.0,
+        "smallest boulder a layer takes, in its pixels (>= 1)", ("enhance",), metavar="PX"),
+    Opt(("--no-boulders",), "no_boulders", bool, False,
+        "leave the stack's boulders out of the mesh", ("mesh",), flag_only=True),
     Opt(("--levels",), "levels", _count, 1, "number of 2x expansions (1..16)", ("expand",),
         metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
@@ -342,6 +358,11 @@ def _cmd_enhance(args: argparse.Namespace) -> int:
               f"{sizes[0]:.4g} m -> {sizes[-1]:.4g} m per pixel, seed {info['seed']}; craters "
               f"stamped {sum(c['stamped'])}, erased on steep ground "
               f"{sum(c['erased_on_steep_ground'])}, rejected {c['rejected']} of {c['drawn']}")
+        b = info.get("boulders")
+        if b:
+            print(f"boulders stamped {sum(b['stamped'])}, rejected {b['rejected']} of "
+                  f"{b['drawn']} (below {cfg.min_boulder_px:g} px of the finest layer or "
+                  f"crossing a layer's border)")
         print(f"wrote {Path(cfg.output) / 'manifest.json'}")
     return 0
 
@@ -354,7 +375,7 @@ def _cmd_mesh(args: argparse.Namespace) -> int:
         src = read_stack(s["input"], progress=show)
     else:
         src = _read(s)
-    path = to_mesh(src, s["output"], progress=show)
+    path = to_mesh(src, s["output"], progress=show, boulders=not s.get("no_boulders"))
     if show:
         n = len(src) if hasattr(src, "layers") else 1
         print(f"dem mesh: {n} layer(s), {path.stat().st_size / 2**20:.1f} MiB")

@@ -73,7 +73,7 @@ from .frame import grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .stack import Stack, check_stack_folder
 
-__all__ = ["EnhanceConfig", "enhance", "plan_craters"]
+__all__ = ["EnhanceConfig", "enhance", "plan_boulders", "plan_craters"]
 
 logger = logging.getLogger(__name__)
 
@@ -83,6 +83,7 @@ MAX_STAMPED = 20_000_000
 _MAX_COUNT_MEAN = 1e15
 # stream tags of the SeedSequence spawn keys
 _STREAM_BAND, _STREAM_OUTSIDE, _STREAM_SMALL, _STREAM_STAMP = 1, 2, 3, 4
+_STREAM_BOULDER_BAND, _STREAM_BOULDER_OUTSIDE, _STREAM_BOULDER_SMALL = 5, 6, 7
 
 
 def _stream(seed: int, *key: int) -> np.random.Generator:
@@ -107,6 +108,11 @@ class EnhanceConfig:
     """Crater layers ``c=..,k=..,dmin=..,dmax=..[,amin,amax,deg,kind]`` (metres, Gyr)."""
     min_crater_px: float = 2.0
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
+    boulders: tuple[str, ...] = ()
+    """Boulder layers ``c=..,k=..,dmin=..,dmax=..[,burial,near]`` (metres; ``near`` is
+    ignored on DEMs)."""
+    min_boulder_px: float = 2.0
+    """Smallest boulder a layer takes, in its pixels (>= 1)."""
     smooth_craters: bool = False
     """Ideal craters: no fractal overlay, circular rims."""
     fractal_dimension: float | None = None
@@ -150,13 +156,20 @@ class EnhanceConfig:
             raise ValueError(f"`size` must be 2^n + 1 pixels, 5..16385 (5, 9, 17, ..., 1025, "
                              f"2049, ...); got {size}")
         object.__setattr__(self, "size", size)
-        specs = self.craters
-        if isinstance(specs, str) or not isinstance(specs, list | tuple):
-            raise TypeError(f"`craters` must be a list of crater layer specs like "
-                            f"'c=0.05,k=-2,dmin=1,dmax=500'; got {specs!r}")
-        for s in specs:
-            craters.parse_layer_spec(s)  # raises naming the spec
-        object.__setattr__(self, "craters", tuple(specs))
+        for name, parse, example in (("craters", craters.parse_layer_spec,
+                                      "c=0.05,k=-2,dmin=1,dmax=500"),
+                                     ("boulders", craters.parse_boulder_spec,
+                                      "c=0.01,k=-3,dmin=0.5,dmax=5")):
+            kind = name[:-1]
+            specs = getattr(self, name)
+            if isinstance(specs, str) or not isinstance(specs, list | tuple):
+                raise TypeError(f"`{name}` must be a list of {kind} layer specs like "
+                                f"'{example}'; got {specs!r}")
+            for spec in specs:
+                parse(spec)  # raises naming the spec
+            object.__setattr__(self, name, tuple(specs))
+        object.__setattr__(self, "min_boulder_px",
+                           check_range("min_boulder_px", self.min_boulder_px, 1.0, 1e6))
         object.__setattr__(self, "min_crater_px",
                            check_range("min_crater_px", self.min_crater_px, 1.0, 1e6))
         for name in ("smooth_craters", "force", "quiet"):
@@ -200,6 +213,7 @@ class EnhanceConfig:
         for key in ("output", "force", "quiet"):
             del d[key]
         d["craters"] = list(self.craters)
+        d["boulders"] = list(self.boulders)
         d["target"] = None if self.target is None else list(self.target)
         return d
 
@@ -286,6 +300,33 @@ def _poisson(rng: np.random.Generator, mean: float, what: str) -> int:
     return int(rng.poisson(mean)) if mean > 0 else 0
 
 
+def _size_bands(geometry: _Geometry, min_px: float):
+    """Per layer the size band it takes (``[lo[b], hi[b])`` metres: at least ``min_px``
+    of its pixels, too small for the coarser layer) and the whole area's size in m^2."""
+    lo = [min_px * geometry.pixel_m(b) for b in range(geometry.n_layers)]
+    return lo, [math.inf] + lo[:-1], geometry.area_m2(0)
+
+
+def _assign(cat, reach, geometry: _Geometry, b: int, per_layer: list, next_index: int):
+    """Put each item of band ``b`` into the finest layer L >= b holding its ``reach``
+    (metres) plus one pixel clear of the layer's border pixels; give the kept ones stack
+    indices from ``next_index``. Returns (kept mask, next free index)."""
+    best = np.full(len(cat), -1, dtype=np.int64)
+    for L in range(b, geometry.n_layers):
+        x0, x1, y0, y1 = geometry.centres(L)
+        m = reach + geometry.pixel_m(L)
+        inside = ((cat["x_m"] - m >= x0) & (cat["x_m"] + m <= x1)
+                  & (cat["y_m"] - m >= y0) & (cat["y_m"] + m <= y1))
+        best[inside] = L
+    keep = best >= 0
+    kept = cat[keep]
+    ids = np.arange(next_index, next_index + len(kept), dtype=np.int64)
+    kept = craters.make_catalog(**{name: kept[name] for name in kept.dtype.names}, index=ids)
+    for L in np.unique(best[keep]):
+        per_layer[L].append(kept[best[keep] == L])
+    return keep, next_index + len(kept)
+
+
 def plan_craters(specs, geometry: _Geometry, *, min_px: float, reach_radii: float, seed: int,
                  degradation_kwargs: dict | None = None):
     """Split one crater population of layer 0's area into per-layer catalogs.
@@ -312,10 +353,7 @@ def plan_craters(specs, geometry: _Geometry, *, min_px: float, reach_radii: floa
     """
     specs = list(specs)
     n = geometry.n_layers
-    p = [geometry.pixel_m(k) for k in range(n)]
-    lo = [min_px * p[b] for b in range(n)]
-    hi = [math.inf] + lo[:-1]
-    area0 = geometry.area_m2(0)
+    lo, hi, area0 = _size_bands(geometry, min_px)
 
     def truncated(b):
         out = []
@@ -351,22 +389,8 @@ def plan_craters(specs, geometry: _Geometry, *, min_px: float, reach_radii: floa
         n_out = _poisson(_stream(seed, _STREAM_OUTSIDE, b),
                          sum(craters.expected_count(outside, s.c, s.k, s.d_min_m, s.d_max_m)
                              for _, s in bands[b]), f"diameter band {b}")
-        reach = reach_radii * cat["diameter_m"] / 2.0
-        best = np.full(len(cat), -1, dtype=np.int64)
-        for L in range(b, n):
-            x0, x1, y0, y1 = geometry.centres(L)
-            m = reach + p[L]
-            inside = ((cat["x_m"] - m >= x0) & (cat["x_m"] + m <= x1)
-                      & (cat["y_m"] - m >= y0) & (cat["y_m"] + m <= y1))
-            best[inside] = L
-        keep = best >= 0
-        kept = cat[keep]
-        ids = np.arange(next_index, next_index + len(kept), dtype=np.int64)
-        next_index += len(kept)
-        cols = {name: kept[name] for name in kept.dtype.names}
-        kept = craters.make_catalog(**cols, index=ids)
-        for L in np.unique(best[keep]):
-            per_layer[L].append(kept[best[keep] == L])
+        keep, next_index = _assign(cat, reach_radii * cat["diameter_m"] / 2.0, geometry, b,
+                                   per_layer, next_index)
         entry.update(drawn=len(cat) + n_out, assigned=int(keep.sum()),
                      rejected=int((~keep).sum()) + n_out)
         drawn += entry["drawn"]
@@ -388,6 +412,92 @@ def plan_craters(specs, geometry: _Geometry, *, min_px: float, reach_radii: floa
                   "rejected_below_finest": n_small, "bands": band_rows,
                   "min_crater_px": min_px, "reach_radii": reach_radii}
     return catalogs, accounting
+
+
+def plan_boulders(specs, geometry: _Geometry, *, min_px: float, seed: int):
+    """Split one boulder population of layer 0's area into per-layer catalogs.
+
+    The same banded draw as :func:`plan_craters`: band b (diameters [m p_b, m p_(b-1)))
+    is drawn over layer b's area and each boulder goes into the finest layer that holds
+    its whole footprint (``0.87 D`` from its centre, plus one pixel) clear of the
+    border; the band's boulders outside layer b's area and those below the finest
+    layer's ``m`` pixels are only counted. Positions are in the layer-0 grid frame.
+    """
+    from .boulders import _REACH, draw_boulders
+
+    specs = list(specs)
+    n = geometry.n_layers
+    lo, hi, area0 = _size_bands(geometry, min_px)
+
+    def count(area, s, d0, d1):
+        return area * s.c * (d0**s.k - d1**s.k)
+
+    per_layer: list[list[np.ndarray]] = [[] for _ in range(n)]
+    bands = []
+    next_index = 0
+    expected = 0.0
+    for b in range(n):
+        for s in specs:
+            d0, d1 = max(s.d_min_m, lo[b]), min(s.d_max_m, hi[b])
+            if d0 < d1:
+                expected += count(geometry.area_m2(b), s, d0, d1)
+    if expected > MAX_STAMPED:
+        raise ValueError(f"the boulder layers put about {expected:.3g} boulders into the stack "
+                         f"(limit {MAX_STAMPED:.0e}); raise dmin or lower c")
+    for b in range(n):
+        entry = {"layer": b, "d_min_m": lo[b], "d_max_m": hi[b] if b else None,
+                 "drawn": 0, "assigned": 0, "rejected": 0}
+        bands.append(entry)
+        trunc = []
+        for i, s in enumerate(specs):
+            d0, d1 = max(s.d_min_m, lo[b]), min(s.d_max_m, hi[b])
+            if d0 < d1:
+                trunc.append((i, dataclasses.replace(s, d_min_m=d0, d_max_m=d1)))
+        if not trunc:
+            continue
+        idx = np.array([i for i, _ in trunc], dtype=np.int64)
+        xr, yr = geometry.area_ranges(b)
+        cat = draw_boulders([s for _, s in trunc], xr, yr,
+                            rng=_stream(seed, _STREAM_BOULDER_BAND, b))
+        cat["layer"] = idx[cat["layer"]]
+        outside = area0 - geometry.area_m2(b)
+        n_out = _poisson(_stream(seed, _STREAM_BOULDER_OUTSIDE, b),
+                         sum(count(outside, s, s.d_min_m, s.d_max_m) for _, s in trunc),
+                         f"boulder diameter band {b}")
+        keep, next_index = _assign(cat, _REACH * cat["diameter_m"], geometry, b, per_layer,
+                                   next_index)
+        entry.update(drawn=len(cat) + n_out, assigned=int(keep.sum()),
+                     rejected=int((~keep).sum()) + n_out)
+    small = sum(count(area0, s, s.d_min_m, min(s.d_max_m, lo[-1])) for s in specs
+                if s.d_min_m < min(s.d_max_m, lo[-1]))
+    n_small = _poisson(_stream(seed, _STREAM_BOULDER_SMALL), small,
+                       "boulders below the finest layer")
+    catalogs = [np.concatenate(parts) if parts else None for parts in per_layer]
+    assigned = [0 if c is None else len(c) for c in catalogs]
+    accounting = {"drawn": sum(e["drawn"] for e in bands) + n_small, "assigned": assigned,
+                  "rejected": sum(e["rejected"] for e in bands) + n_small,
+                  "rejected_below_finest": n_small, "bands": bands, "min_boulder_px": min_px}
+    return catalogs, accounting
+
+
+def _stamp_boulders_layer(z, cat, geometry: _Geometry, k: int, a0, shape):
+    """Place and stamp layer k's boulders (layer-0 grid positions); returns the heights
+    and the placed catalog in the local frame."""
+    from .boulders import _place, _placed_catalog
+
+    if cat is None:
+        cat = craters.make_catalog(x_m=[], y_m=[], diameter_m=[], burial_frac=[],
+                                   azimuth_deg=[], seed=np.zeros(0, np.uint64),
+                                   layer=np.zeros(0, np.int64), index=np.zeros(0, np.int64),
+                                   kind=np.zeros(0, "U7"))
+    p0 = geometry.pixel0_m
+    local = _to_local(cat, a0, p0)
+    r, c = geometry.offsets[k]
+    m = np.array([[a0.a, a0.b], [a0.d, a0.e]]) / p0
+    t = np.array([a0.a * c + a0.b * r + a0.c, a0.d * c + a0.e * r + a0.f])
+    h, keep, centre, nrm, rot, height, burial, achieved = _place(
+        z, geometry.pixel_m(k), m, t, local, shape=shape)
+    return h, _placed_catalog(local[keep], centre, nrm, rot, height, burial, achieved, shape)
 
 
 # --------------------------------------------------------------------------- build
@@ -499,6 +609,11 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     reach_radii = craters.DEFAULT_EJECTA_EDGE * (1.0 + irregularity)
     plans, accounting = plan_craters(specs, geometry, min_px=cfg.min_crater_px,
                                      reach_radii=reach_radii, seed=seed)
+    rock_specs = [craters.parse_boulder_spec(s) for s in cfg.boulders]
+    rock_plans, rock_accounting = (plan_boulders(rock_specs, geometry,
+                                                 min_px=cfg.min_boulder_px, seed=seed)
+                                   if rock_specs else ([None] * cfg.layers, None))
+    rock_shape = craters.BoulderShape()
     fd = cfg.fractal_dimension
     fd_estimated = None
     if fd is None:
@@ -508,6 +623,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     arrays: list[np.ndarray] = []
     metas: list[Dem] = []
     stamped: list[np.ndarray] = []
+    rocks: list = []
     bar = progress_bar(range(cfg.layers), enabled=show, desc="enhance")
     for k in bar:
         if k == 0:
@@ -518,14 +634,23 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
             meta = expand(parent, 1, fd, cfg.roughness, Window(cc, rr, w, w), rng=seed)
         z, cat = _stamp_layer(np.array(meta.heights), plans[k], geometry, k,
                               roughness=roughness, seed=seed, progress=False)
+        rock = None
+        if rock_specs:
+            z, rock = _stamp_boulders_layer(z, rock_plans[k], geometry, k, a0, rock_shape)
         arrays.append(np.array(z, dtype=np.float64))
         metas.append(meta)
         stamped.append(cat)
+        rocks.append(rock)
         _propagate_up(arrays, windows, k)
     n_stamped = [len(c) for c in stamped]
     accounting["stamped"] = n_stamped
     accounting["erased_on_steep_ground"] = [a - s for a, s in
                                             zip(accounting["assigned"], n_stamped, strict=True)]
+    if rock_accounting is not None:
+        n_rocks = [0 if r is None else len(r) for r in rocks]
+        rock_accounting["stamped"] = n_rocks
+        rock_accounting["off_grid"] = [a - s for a, s in
+                                       zip(rock_accounting["assigned"], n_rocks, strict=True)]
     params = cfg.to_dict()
     params.update(seed=seed, fractal_dimension=fd, fractal_dimension_estimated=fd_estimated)
     info = {
@@ -536,6 +661,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
                    "world_pixel_centre": [float(v) for v in layer0.xy(*t0)]},
         "layer0_window_in_base": [int(win0.row_off), int(win0.col_off), cfg.size],
         "craters": accounting,
+        "boulders": rock_accounting,
         "randomness": "numpy SeedSequence(seed, spawn_key=(1, band)) for the population of "
                       "each diameter band, (2, band) and (3,) for the rejected counts, "
                       "(4, layer) for stamping; the RMD key is default_rng(seed)'s first "
@@ -545,9 +671,11 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     for k in range(cfg.layers):
         step = {"layer": k, "craters_stamped": n_stamped[k],
                 "synchronised_with_finer_layers": k < cfg.layers - 1}
+        if rock_specs:
+            step["boulders_stamped"] = len(rocks[k])
         layers.append(metas[k].with_step(arrays[k], "dem.enhance", seed, step))
     catalogs = [_to_local(c, a0, p0) for c in stamped]
-    stack = Stack(layers, windows, frame, catalogs, info)
+    stack = Stack(layers, windows, frame, catalogs, info, rocks if rock_specs else None)
     if cfg.output is not None:
         stack.write(cfg.output, force=cfg.force, progress=show)
     return stack

@@ -25,6 +25,14 @@ Formats
 
 Both are written layer by layer (memory ~ a few arrays of one layer) to a temporary
 file renamed into place at the end.
+
+Boulders
+--------
+A stack's boulders (:attr:`dem.Stack.boulders`, stamped by :func:`dem.enhance`) are
+appended as their own closed meshes (finest level of the boulder shape, same frame),
+after the terrain: their vertices carry the ``layer`` they were stamped in and a
+``boulder_id`` (int32: the boulder's ``index`` in the stack catalogs; -1 on the
+terrain), which the files then have as an extra vertex property / point array.
 """
 
 from __future__ import annotations
@@ -172,6 +180,53 @@ class _Layout:
                                for f in fans for q in (1, 2, 3)])
 
 
+class _Rocks:
+    """The boulders of a stack, meshed a chunk at a time after the terrain."""
+
+    def __init__(self, stack: Stack):
+        from craters.boulders import catalog_shape
+
+        parts, layers = [], []
+        for k, cat in enumerate(stack.boulders):
+            if cat is not None and len(cat):
+                parts.append(cat)
+                layers.append(np.full(len(cat), k, dtype=np.uint8))
+        self.cat = np.concatenate(parts) if parts else None
+        self.layer = np.concatenate(layers) if layers else np.zeros(0, np.uint8)
+        n = 0 if self.cat is None else len(self.cat)
+        if n:
+            self.level = catalog_shape(self.cat).levels[-1]
+            self.ids = (self.cat["index"].astype(np.int32) if "index" in self.cat.dtype.names
+                        else np.arange(n, dtype=np.int32))
+        else:
+            self.level = 0
+        self.nv = 10 * 4**self.level + 2
+        self.n_vertices = n * self.nv
+        self.n_faces = n * 20 * 4**self.level
+
+    def __bool__(self) -> bool:
+        return self.n_vertices > 0
+
+    def vertex_chunks(self):
+        """(xyz (m, 3), layer (m,), boulder_id (m,)) per chunk."""
+        from craters.boulders import iter_boulder_meshes
+
+        for s0, world, _ in iter_boulder_meshes(self.cat, self.level, chunk=1024):
+            k = len(world)
+            yield (world.reshape(-1, 3), np.repeat(self.layer[s0:s0 + k], self.nv),
+                   np.repeat(self.ids[s0:s0 + k], self.nv))
+
+    def face_chunks(self, base: int):
+        from craters.boulders import _topology
+
+        faces = _topology(self.level)[0][self.level]
+        n = len(self.cat)
+        for s0 in range(0, n, 1024):
+            k = min(1024, n - s0)
+            offsets = base + (s0 + np.arange(k))[:, None, None] * self.nv
+            yield (faces[None] + offsets).reshape(-1, 3)
+
+
 def _as_stack(source) -> Stack:
     if isinstance(source, Stack):
         return source
@@ -192,7 +247,7 @@ def mesh_arrays(source) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return verts, faces, layer
 
 
-def to_mesh(source, path, *, progress: bool = False) -> Path:
+def to_mesh(source, path, *, progress: bool = False, boulders: bool = True) -> Path:
     """Write the multi-resolution mesh of a stack (or one DEM) as PLY or VTP.
 
     See the module notes for the geometry, the frame and the formats.
@@ -205,6 +260,8 @@ def to_mesh(source, path, *, progress: bool = False) -> Path:
         ``.ply`` or ``.vtp``; written atomically.
     progress : bool
         Show a progress bar over the layers.
+    boulders : bool
+        Append the stack's boulders (if it has any) as their own meshes.
 
     Returns
     -------
@@ -224,8 +281,11 @@ def to_mesh(source, path, *, progress: bool = False) -> Path:
     if suffix not in MESH_SUFFIXES:
         raise ValueError(f"output {str(path)!r}: unknown mesh format {suffix or '(none)'!r}; "
                          f"allowed: {' '.join(MESH_SUFFIXES)}")
-    lay = _Layout(_as_stack(source))
-    if lay.n_vertices >= 2**31 - 1:
+    stack = _as_stack(source)
+    lay = _Layout(stack)
+    lay.rocks = _Rocks(stack) if boulders else _Rocks(stack.replace(
+        boulders=[None] * len(stack)))
+    if lay.n_vertices + lay.rocks.n_vertices >= 2**31 - 1:
         raise ValueError(f"the mesh would have {lay.n_vertices} vertices; PLY/VTP indices are "
                          f"limited to 2^31 - 1 here")
     with atomic_path(path) as tmp, open(tmp, "wb") as fh:
@@ -240,37 +300,64 @@ _PLY_VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer", "u1"
 _PLY_FACE = np.dtype([("n", "u1"), ("v", "<i4", (3,))])
 
 
+_PLY_VERTEX_ROCKS = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer", "u1"),
+                              ("boulder_id", "<i4")])
+
+
 def _write_ply(lay: _Layout, fh, progress: bool) -> None:
     frame = lay.stack.frame
+    rocks = lay.rocks
     header = ("ply\nformat binary_little_endian 1.0\n"
               "comment craterform multi-resolution mesh; metres in a local frame: x = "
               f"(X - {frame.origin_x!r}) * {frame.scale_x!r}, y = (Y - {frame.origin_y!r}) * "
               f"{frame.scale_y!r} ({frame.kind}), z = height\n"
-              f"element vertex {lay.n_vertices}\nproperty float x\nproperty float y\n"
-              f"property float z\nproperty uchar layer\nelement face {lay.n_faces}\n"
+              + ("comment boulders after the terrain; boulder_id -1 = terrain\n"
+                 if rocks else "")
+              + f"element vertex {lay.n_vertices + rocks.n_vertices}\nproperty float x\n"
+              "property float y\nproperty float z\nproperty uchar layer\n"
+              + ("property int boulder_id\n" if rocks else "")
+              + f"element face {lay.n_faces + rocks.n_faces}\n"
               "property list uchar int vertex_indices\nend_header\n")
     fh.write(header.encode("ascii"))
+    vdt = _PLY_VERTEX_ROCKS if rocks else _PLY_VERTEX
     n = len(lay.counts)
     for k in progress_bar(range(n), enabled=progress, desc="mesh vertices"):
         x, y, z = lay.vertices(k)
-        rec = np.empty(x.size, dtype=_PLY_VERTEX)
+        rec = np.empty(x.size, dtype=vdt)
         rec["x"], rec["y"], rec["z"], rec["layer"] = x, y, z, k
+        if rocks:
+            rec["boulder_id"] = -1
         fh.write(rec.tobytes())
+    if rocks:
+        for xyz, layer, ids in rocks.vertex_chunks():
+            rec = np.empty(len(xyz), dtype=vdt)
+            rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+            rec["layer"], rec["boulder_id"] = layer, ids
+            fh.write(rec.tobytes())
     for k in progress_bar(range(n), enabled=progress, desc="mesh faces"):
         tri = lay.faces(k)
         rec = np.empty(len(tri), dtype=_PLY_FACE)
         rec["n"] = 3
         rec["v"] = tri
         fh.write(rec.tobytes())
+    if rocks:
+        for tri in rocks.face_chunks(lay.n_vertices):
+            rec = np.empty(len(tri), dtype=_PLY_FACE)
+            rec["n"] = 3
+            rec["v"] = tri
+            fh.write(rec.tobytes())
 
 
 def _write_vtp(lay: _Layout, fh, progress: bool) -> None:
-    n_v, n_f = lay.n_vertices, lay.n_faces
+    rocks = lay.rocks
+    n_v, n_f = lay.n_vertices + rocks.n_vertices, lay.n_faces + rocks.n_faces
     itype, idt = ("Int32", "<i4") if 3 * n_f < 2**31 - 1 else ("Int64", "<i8")
     isize = np.dtype(idt).itemsize
-    sizes = [12 * n_v, n_v, 3 * n_f * isize, n_f * isize]
+    sizes = [12 * n_v, n_v, 3 * n_f * isize, n_f * isize] + ([4 * n_v] if rocks else [])
     offs = np.concatenate([[0], np.cumsum([8 + s for s in sizes])])
     frame = lay.stack.frame
+    rock_array = (f'<DataArray type="Int32" Name="boulder_id" format="appended" '
+                  f'offset="{offs[4]}"/>\n' if rocks else "")
     xml = (
         '<?xml version="1.0"?>\n'
         '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
@@ -283,6 +370,7 @@ def _write_vtp(lay: _Layout, fh, progress: bool) -> None:
         f'NumberOfStrips="0" NumberOfPolys="{n_f}">\n'
         '<PointData Scalars="layer">\n'
         f'<DataArray type="UInt8" Name="layer" format="appended" offset="{offs[1]}"/>\n'
+        + rock_array +
         "</PointData>\n<Points>\n"
         f'<DataArray type="Float32" Name="Points" NumberOfComponents="3" format="appended" '
         f'offset="{offs[0]}"/>\n'
@@ -299,13 +387,21 @@ def _write_vtp(lay: _Layout, fh, progress: bool) -> None:
     for k in range(n):
         fh.write(np.stack(lay.vertices(k), 1).astype("<f4").tobytes())
         bar.update()
+    if rocks:
+        for xyz, _, _ in rocks.vertex_chunks():
+            fh.write(xyz.astype("<f4").tobytes())
     fh.write(np.uint64(sizes[1]).tobytes())
     for k in range(n):
         fh.write(np.full(lay.counts[k], k, dtype="u1").tobytes())
+    if rocks:
+        fh.write(np.repeat(rocks.layer, rocks.nv).tobytes())
     fh.write(np.uint64(sizes[2]).tobytes())
     for k in range(n):
         fh.write(lay.faces(k).astype(idt).tobytes())
         bar.update()
+    if rocks:
+        for tri in rocks.face_chunks(lay.n_vertices):
+            fh.write(tri.astype(idt).tobytes())
     fh.write(np.uint64(sizes[3]).tobytes())
     done = 0
     for k in range(n):
@@ -313,5 +409,12 @@ def _write_vtp(lay: _Layout, fh, progress: bool) -> None:
         fh.write((3 * np.arange(done + 1, done + m + 1, dtype=np.int64)).astype(idt).tobytes())
         done += m
         bar.update()
+    if rocks:
+        fh.write((3 * np.arange(done + 1, done + rocks.n_faces + 1, dtype=np.int64))
+                 .astype(idt).tobytes())
+    if rocks:
+        fh.write(np.uint64(sizes[4]).tobytes())
+        fh.write(np.full(lay.n_vertices, -1, dtype="<i4").tobytes())
+        fh.write(np.repeat(rocks.ids, rocks.nv).astype("<i4").tobytes())
     bar.close()
     fh.write(b"\n</AppendedData>\n</VTKFile>\n")

@@ -10,7 +10,8 @@ layer, ``layers[k].heights[::2, ::2] == layers[k-1].heights[footprint]`` exactly
 
 On disk a stack is a folder: ``layer_00.tif ...`` (GeoTIFF, :func:`dem.write`),
 ``craters_00.csv`` / ``craters_00.geojson ...`` (the craters stamped in each layer, local
-frame metres + world coordinates) and ``manifest.json`` (format, frame, layers, files,
+frame metres + world coordinates), ``boulders_00.csv`` / ``.geojson`` (the boulders
+stamped in each layer, if any) and ``manifest.json`` (format, frame, layers, files,
 bounds, pixel sizes, seeds, parameters, crater counts). The folder is written as a whole
 (:meth:`Stack.write`: a temporary folder renamed into place), so it is complete or absent.
 """
@@ -48,6 +49,18 @@ def _catalog_files(k: int) -> tuple[str, str]:
     return f"craters_{k:02d}.csv", f"craters_{k:02d}.geojson"
 
 
+def _boulder_files(k: int) -> tuple[str, str]:
+    return f"boulders_{k:02d}.csv", f"boulders_{k:02d}.geojson"
+
+
+def _check_catalogs(catalogs, column: str, message: str) -> None:
+    for cat in catalogs:
+        if cat is not None:
+            validate_catalog(cat)
+            if column not in cat.dtype.names:
+                raise ValueError(message)
+
+
 def _window(value, k: int) -> tuple[int, int, int]:
     try:
         r0, c0, w = value
@@ -74,6 +87,9 @@ class Stack:
         Per layer, the craters stamped in it (``x_m, y_m`` in ``frame``); None = none.
     info : dict, optional
         JSON-ready metadata (seed, parameters, crater counts) kept in the manifest.
+    boulders : sequence of structured arrays, optional
+        Per layer, the boulders stamped in it (placement in ``frame``, see
+        :mod:`dem.boulders`); None = none.
 
     Examples
     --------
@@ -87,9 +103,10 @@ class Stack:
     ([(5, 5), (5, 5)], True)
     """
 
-    __slots__ = ("_layers", "_windows", "_frame", "_catalogs", "_info")
+    __slots__ = ("_layers", "_windows", "_frame", "_catalogs", "_info", "_boulders")
 
-    def __init__(self, layers, windows, frame: LocalFrame, catalogs=None, info=None):
+    def __init__(self, layers, windows, frame: LocalFrame, catalogs=None, info=None,
+                 boulders=None):
         layers = tuple(layers)
         if not layers or not all(isinstance(d, Dem) for d in layers):
             raise TypeError("`layers` must be a non-empty sequence of Dem")
@@ -117,11 +134,14 @@ class Stack:
         if len(catalogs) != len(layers):
             raise ValueError(f"`catalogs` must have one entry per layer ({len(layers)}); "
                              f"got {len(catalogs)}")
-        for cat in catalogs:
-            if cat is not None:
-                validate_catalog(cat)
-                if "x_m" not in cat.dtype.names:
-                    raise ValueError("stack catalogs need local-frame positions x_m, y_m")
+        _check_catalogs(catalogs, "x_m", "stack catalogs need local-frame positions x_m, y_m")
+        boulders = (None,) * len(layers) if boulders is None else tuple(boulders)
+        if len(boulders) != len(layers):
+            raise ValueError(f"`boulders` must have one entry per layer ({len(layers)}); "
+                             f"got {len(boulders)}")
+        _check_catalogs(boulders, "centre_x_m", "stack boulder catalogs need placed "
+                        "boulders (centre_x_m, ... from dem.stamp_boulders)")
+        self._boulders = boulders
         self._layers = layers
         self._windows = windows
         self._frame = frame
@@ -150,6 +170,11 @@ class Stack:
         return self._catalogs
 
     @property
+    def boulders(self) -> tuple:
+        """Per layer, the boulders stamped in it (structured array) or None."""
+        return self._boulders
+
+    @property
     def info(self) -> dict:
         """Metadata (a copy): seed, parameters, crater counts."""
         return json.loads(json.dumps(self._info))
@@ -172,11 +197,12 @@ class Stack:
         return [grid_pixel_size(pixel_affine(d, self._frame), square=False)
                 for d in self._layers]
 
-    def replace(self, *, layers=None, catalogs=None, info=None) -> Stack:
+    def replace(self, *, layers=None, catalogs=None, info=None, boulders=None) -> Stack:
         """A new stack with some parts replaced (same footprints and frame)."""
         return Stack(self._layers if layers is None else layers, self._windows, self._frame,
                      self._catalogs if catalogs is None else catalogs,
-                     self._info if info is None else info)
+                     self._info if info is None else info,
+                     self._boulders if boulders is None else boulders)
 
     # ------------------------------------------------------------------ consistency
     def mismatch_m(self) -> list[float]:
@@ -218,6 +244,11 @@ class Stack:
                 csv_name, geojson_name = _catalog_files(k)
                 entry["craters"] = {"csv": csv_name, "geojson": geojson_name,
                                     "stamped": int(len(cat))}
+            rocks = self._boulders[k]
+            if rocks is not None:
+                csv_name, geojson_name = _boulder_files(k)
+                entry["boulders"] = {"csv": csv_name, "geojson": geojson_name,
+                                     "stamped": int(len(rocks))}
             layers.append(entry)
         return {
             "format": STACK_FORMAT, "generator": f"craterform {package_version()}",
@@ -239,25 +270,30 @@ class Stack:
         with _atomic_folder(folder) as tmp:
             steps = [("layer", k) for k in range(len(self))]
             steps += [("craters", k) for k in range(len(self)) if self._catalogs[k] is not None]
+            steps += [("boulders", k) for k in range(len(self))
+                      if self._boulders[k] is not None]
             for what, k in progress_bar(steps, enabled=progress, desc="write"):
                 if what == "layer":
                     write(self._layers[k], tmp / _layer_file(k))
-                else:
+                elif what == "craters":
                     self._write_catalog(k, tmp)
+                else:
+                    self._write_catalog(k, tmp, boulders=True)
             text = json.dumps(self.manifest(), indent=1, sort_keys=True, allow_nan=False)
             (tmp / MANIFEST).write_text(text + "\n", encoding="utf-8")
         return folder / MANIFEST
 
-    def world_catalog(self, k: int) -> np.ndarray:
-        """Layer ``k``'s catalog with ``world_x, world_y`` columns (CRS units) added."""
-        cat = self._catalogs[k]
+    def world_catalog(self, k: int, *, boulders: bool = False) -> np.ndarray:
+        """Layer ``k``'s crater (or boulder) catalog with ``world_x, world_y`` columns (CRS
+        units) added."""
+        cat = self._boulders[k] if boulders else self._catalogs[k]
         wx, wy = self._frame.to_world(cat["x_m"], cat["y_m"])
         cols = {n: cat[n] for n in cat.dtype.names if n not in ("world_x", "world_y")}
         return make_catalog(**cols, world_x=wx, world_y=wy)
 
-    def _write_catalog(self, k: int, folder: Path) -> None:
-        csv_name, geojson_name = _catalog_files(k)
-        cat = self.world_catalog(k)
+    def _write_catalog(self, k: int, folder: Path, *, boulders: bool = False) -> None:
+        csv_name, geojson_name = (_boulder_files if boulders else _catalog_files)(k)
+        cat = self.world_catalog(k, boulders=boulders)
         write_catalog(cat, folder / csv_name)
         crs = self._layers[0].crs
         write_geojson(cat, folder / geojson_name, to_world=self._frame.to_world,
@@ -321,13 +357,15 @@ def read_stack(path, *, progress: bool = False) -> Stack:
     try:
         frame = LocalFrame.from_dict(doc["frame"])
         entries = doc["layers"]
-        layers, windows, catalogs = [], [], []
+        layers, windows, catalogs, rocks = [], [], [], []
         for e in progress_bar(entries, enabled=progress, desc="read"):
             layers.append(read(folder / e["file"]))
             if e["index"] > 0:
                 windows.append(tuple(e["footprint_in_parent"]))
             cat = e.get("craters")
             catalogs.append(read_catalog(folder / cat["csv"]) if cat else None)
-        return Stack(layers, windows, frame, catalogs, doc.get("info"))
+            b = e.get("boulders")
+            rocks.append(read_catalog(folder / b["csv"]) if b else None)
+        return Stack(layers, windows, frame, catalogs, doc.get("info"), rocks)
     except (KeyError, TypeError) as exc:
         raise ValueError(f"stack manifest {str(manifest)!r} is incomplete: {exc!r}") from None

@@ -7,6 +7,16 @@ shapes, mesh export and previews. See ``latlong build --help`` for the command l
 import logging
 
 from .body import EXPORT_SUFFIXES, Body, load
+from .boulders import (
+    BoulderLayer,
+    BoulderNode,
+    BoulderShape,
+    boulder,
+    boulder_meshes,
+    boulder_population,
+    boulder_world_meshes,
+    place_boulders,
+)
 from .cratering import crater_extents_deg, stamp_craters
 from .faulting import (
     FAULTING_PRESETS,
@@ -38,6 +48,9 @@ __all__ = [
     "FBM_PRESETS",
     "PRESETS",
     "Body",
+    "BoulderLayer",
+    "BoulderNode",
+    "BoulderShape",
     "FaultingParams",
     "FbmParams",
     "LatLongGrid",
@@ -45,6 +58,10 @@ __all__ = [
     "apply_faults",
     "area_mean",
     "body_population",
+    "boulder",
+    "boulder_meshes",
+    "boulder_population",
+    "boulder_world_meshes",
     "build_body",
     "cast_radii",
     "crater_extents_deg",
@@ -56,6 +73,7 @@ __all__ = [
     "load",
     "mesh_slopes",
     "perlin_fbm",
+    "place_boulders",
     "poisson_faulting",
     "radius_spectrum",
     "random_faults",

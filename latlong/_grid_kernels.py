@@ -303,3 +303,122 @@ def _unit_index_kernel(m, ring_offsets, idx, out):
         out[k, 0] = x
         out[k, 1] = y
         out[k, 2] = z
+
+
+@njit(cache=True, inline="always")
+def _vertex_point(m, r, j, ring_offsets, radii, out):
+    """Position (radius x unit vector) of vertex j (taken modulo the ring size) of ring r."""
+    n = _ring_size(r, m)
+    jj = j % n
+    colat = r * (np.pi / (2 * m))
+    lon = 2.0 * np.pi * jj / n
+    rad = radii[ring_offsets[r] + jj]
+    s = np.sin(colat)
+    out[0] = rad * s * np.cos(lon)
+    out[1] = rad * s * np.sin(lon)
+    out[2] = rad * np.cos(colat)
+
+
+@njit(cache=True, inline="always")
+def _ray_triangle(d, p0, p1, p2, best):
+    """Ray from the origin along d against triangle (p0, p1, p2), two-sided.
+
+    best = (outside-ness, distance): replaced when this triangle contains the ray
+    better (outside-ness = how far the barycentric coordinates leave [0, 1]; <= 0
+    inside).
+    """
+    e1x, e1y, e1z = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
+    e2x, e2y, e2z = p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]
+    hx = d[1] * e2z - d[2] * e2y
+    hy = d[2] * e2x - d[0] * e2z
+    hz = d[0] * e2y - d[1] * e2x
+    det = e1x * hx + e1y * hy + e1z * hz
+    if det == 0.0:
+        return
+    inv = 1.0 / det
+    sx, sy, sz = -p0[0], -p0[1], -p0[2]
+    u = (sx * hx + sy * hy + sz * hz) * inv
+    qx = sy * e1z - sz * e1y
+    qy = sz * e1x - sx * e1z
+    qz = sx * e1y - sy * e1x
+    v = (d[0] * qx + d[1] * qy + d[2] * qz) * inv
+    t = (e2x * qx + e2y * qy + e2z * qz) * inv
+    if t <= 0.0:
+        return
+    out = max(-u, -v, u + v - 1.0)
+    if out < best[0]:
+        best[0] = out
+        best[1] = t
+
+
+@njit(cache=True)
+def _surface_radius_one(m, ring_offsets, radii, colat, lon, p0, p1, p2, d, best):
+    """Distance from the centre to the flat-triangle mesh along direction (colat, lon).
+
+    The hit triangle lies in one of the three bands around the colatitude (ring edges
+    are chords, which bow towards the poles) and near the longitude: each band's zipper
+    is replayed from the state entering the b-column before the longitude (the zipper
+    enters column j at i = floor(j na / nb)) for three columns.
+    """
+    d[0] = np.sin(colat) * np.cos(lon)
+    d[1] = np.sin(colat) * np.sin(lon)
+    d[2] = np.cos(colat)
+    s = lon / (2.0 * np.pi)
+    s -= np.floor(s)
+    best[0] = np.inf
+    best[1] = np.nan
+    r0 = int(np.floor(colat / (np.pi / (2 * m))))
+    for step in range(3):  # the band of the colatitude first, then its neighbours
+        band = r0 if step == 0 else (r0 - 1 if step == 1 else r0 + 1)
+        if band < 0 or band > 2 * m - 1:
+            continue
+        if band < m:
+            ra, rb = band, band + 1
+        else:
+            ra, rb = band + 1, band
+        na = _ring_size(ra, m)
+        nb = _ring_size(rb, m)
+        j = int(np.floor(s * nb)) - 1
+        if na == 1:
+            _vertex_point(m, ra, 0, ring_offsets, radii, p0)
+            for k in range(3):
+                _vertex_point(m, rb, j + k, ring_offsets, radii, p1)
+                _vertex_point(m, rb, j + k + 1, ring_offsets, radii, p2)
+                _ray_triangle(d, p0, p1, p2, best)
+                if best[0] <= 0.0:
+                    return best[1]
+            continue
+        i = (j * na) // nb  # floor division, also for j = -1
+        j_end = j + 3
+        _vertex_point(m, ra, i, ring_offsets, radii, p0)
+        _vertex_point(m, rb, j, ring_offsets, radii, p1)
+        while j < j_end:
+            if (i + 1) * nb <= (j + 1) * na:
+                _vertex_point(m, ra, i + 1, ring_offsets, radii, p2)
+                _ray_triangle(d, p0, p1, p2, best)
+                i += 1
+                p0[0], p0[1], p0[2] = p2[0], p2[1], p2[2]
+            else:
+                _vertex_point(m, rb, j + 1, ring_offsets, radii, p2)
+                _ray_triangle(d, p0, p1, p2, best)
+                j += 1
+                p1[0], p1[1], p1[2] = p2[0], p2[1], p2[2]
+            if best[0] <= 0.0:  # inside (a hit on a shared edge is the same point)
+                return best[1]
+    return best[1]
+
+
+@njit(cache=True, parallel=True)
+def _surface_radius_kernel(m, ring_offsets, radii, colat, lon, out):
+    """:func:`_surface_radius_one` at many directions (parallel over chunks)."""
+    n = colat.shape[0]
+    chunk = 4096
+    for c in prange((n + chunk - 1) // chunk):
+        p0 = np.empty(3)
+        p1 = np.empty(3)
+        p2 = np.empty(3)
+        d = np.empty(3)
+        best = np.empty(2)
+        for p in range(c * chunk, min(n, (c + 1) * chunk)):
+            out[p] = _surface_radius_one(m, ring_offsets, radii, colat[p], lon[p], p0, p1, p2,
+                                         d, best)

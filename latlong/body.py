@@ -41,6 +41,8 @@ class Body:
         JSON-serialisable description (seed, parameters, version, ...).
     craters : structured array, optional
         The crater catalog that made the body (see :mod:`craters.catalog`), as stamped.
+    boulders : structured array, optional
+        The boulders placed on the body (see :mod:`latlong.boulders`).
 
     Examples
     --------
@@ -49,10 +51,12 @@ class Body:
     (98, 10.0)
     """
 
-    __slots__ = ("_grid", "_radii", "_radius_m", "_stretch", "_metadata", "_craters")
+    __slots__ = ("_grid", "_radii", "_radius_m", "_stretch", "_metadata", "_craters",
+                 "_boulders")
 
     def __init__(self, grid: LatLongGrid, radii_m, *, radius_m: float | None = None,
-                 stretch=(1.0, 1.0, 1.0), metadata: dict | None = None, craters=None):
+                 stretch=(1.0, 1.0, 1.0), metadata: dict | None = None, craters=None,
+                 boulders=None):
         if not isinstance(grid, LatLongGrid):
             raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
         radii = np.array(radii_m, dtype=np.float64, copy=True)
@@ -90,6 +94,12 @@ class Body:
             craters = np.array(validate_catalog(craters), copy=True)
             craters.setflags(write=False)
         self._craters = craters
+        if boulders is not None:
+            from craters import validate_catalog
+
+            boulders = np.array(validate_catalog(boulders), copy=True)
+            boulders.setflags(write=False)
+        self._boulders = boulders
 
     # ------------------------------------------------------------------ constructors
     @classmethod
@@ -106,11 +116,11 @@ class Body:
                    radius_m=radius_m, **kwargs)
 
     def replace(self, **changes) -> Body:
-        """A new body with some of ``radii_m, radius_m, stretch, metadata, craters``
-        replaced."""
+        """A new body with some of ``radii_m, radius_m, stretch, metadata, craters,
+        boulders`` replaced."""
         kw = {"radii_m": self._radii, "radius_m": self._radius_m,
               "stretch": self._stretch, "metadata": self._metadata,
-              "craters": self._craters}
+              "craters": self._craters, "boulders": self._boulders}
         unknown = set(changes) - set(kw)
         if unknown:
             raise TypeError(f"unknown Body fields: {', '.join(sorted(unknown))}")
@@ -154,6 +164,11 @@ class Body:
     def craters(self) -> np.ndarray | None:
         """The crater catalog as stamped (read-only structured array) or None."""
         return self._craters
+
+    @property
+    def boulders(self) -> np.ndarray | None:
+        """The boulders placed on the body (read-only structured array) or None."""
+        return self._boulders
 
     @property
     def heights_m(self) -> np.ndarray:
@@ -207,6 +222,8 @@ class Body:
         }
         if self._craters is not None:
             arrays["craters"] = np.asarray(self._craters)
+        if self._boulders is not None:
+            arrays["boulders"] = np.asarray(self._boulders)
         with atomic_path(path) as tmp:
             with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_STORED,
                                  allowZip64=True) as zf:
@@ -256,4 +273,4 @@ def load(path) -> Body:
     return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
                 radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
                 metadata=json.loads(str(fields["metadata_json"])),
-                craters=fields.get("craters"))
+                craters=fields.get("craters"), boulders=fields.get("boulders"))

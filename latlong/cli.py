@@ -56,7 +56,7 @@ def _cmd_build(args: argparse.Namespace) -> int:
     given.update(_given(args, _KEYS))
     s = resolve_settings(given)
     show = not s["quiet"]
-    outs = [*s["output"], *[s[k] for k in ("catalog", "preview") if s.get(k)]]
+    outs = [*s["output"], *[s[k] for k in ("catalog", "boulder_catalog", "preview") if s.get(k)]]
     bar = progress_bar(total=1 + len(outs), enabled=show, desc="build")
     bar.set_description("body")
     body = build_body(s, progress=show)
@@ -179,6 +179,7 @@ def build_parser() -> argparse.ArgumentParser:
               "fbm": b.add_argument_group("Perlin fBm (--base fbm; detail on --base shape)"),
               "shape": b.add_argument_group("shape models (--base shape:PATH)"),
               "craters": b.add_argument_group("craters"),
+              "boulders": b.add_argument_group("boulders"),
               "output": b.add_argument_group("output"),
               "render": b.add_argument_group("preview picture")}
     _add_options(b, BUILD_OPTIONS, groups)

@@ -13,6 +13,14 @@ band-streaming kernel, and each level's binary data goes to a temporary file fir
 A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
 ``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
 glTF 2.0 allows.
+
+Placed boulders (``body.boulders``) are one node each (translation = centre, rotation =
+the placement quaternion, uniform scale = diameter) under a root node
+``lod<l>/boulders`` of each scene; their meshes (``TRIANGLES``, unit size, every level
+of the boulder shape, uint16 indices shared by all boulders of a level) go with level
+0's data. Scene l uses boulder level max(finest - l, coarsest); every boulder node's
+extras list its mesh of each level (coarse to fine), the paper's bi-resolution levels,
+so a renderer can switch by distance.
 """
 
 from __future__ import annotations
@@ -39,6 +47,8 @@ _ARRAY_BUFFER = 34962
 _ELEMENT_ARRAY_BUFFER = 34963
 _FLOAT = 5126
 _UINT = 5125
+_USHORT = 5123
+_TRIANGLES = 4
 _TRIANGLE_STRIP = 5
 
 
@@ -111,8 +121,14 @@ def export_glb(body: Body, path, *, patch_k: int = 64, lod: int = 0,
             os.close(fd)
             temps.append(tmp_bin)
             with open(tmp_bin, "wb") as binf:
-                sizes.append(_write_level(body.lod(level), level, patch_k, gl, manifest,
-                                          binf, progress))
+                size = _write_level(body.lod(level), level, patch_k, gl, manifest, binf,
+                                    progress)
+                if body.boulders is not None and len(body.boulders):
+                    if level == 0:
+                        size, boulder_first = _write_boulder_meshes(body.boulders, gl,
+                                                                     manifest, binf, size)
+                    _boulder_nodes(body.boulders, level, boulder_first, gl, manifest)
+                sizes.append(size)
         _finish(path, gl, manifest, temps, sizes)
     finally:
         for t in temps:
@@ -231,6 +247,79 @@ def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict,
     gl["scenes"].append({"name": f"lod{level}", "nodes": [len(gl["nodes"]) - 1]})
     manifest["levels"].append(level_info)
     return offset
+
+
+def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
+    """Every level's unit boulder meshes into ``binf`` (buffer 0); returns the new offset
+    and {level: first mesh index} (boulder i's mesh at level l = first[l] + i)."""
+    from craters.boulders import boulder_meshes, boulder_normals
+
+    from .boulders import _CHUNK, catalog_shape
+
+    shape = catalog_shape(cat)
+    first = {}
+
+    def view(raw: bytes, target: int) -> int:
+        nonlocal offset
+        binf.write(raw)
+        gl["bufferViews"].append({"buffer": 0, "byteOffset": offset, "byteLength": len(raw),
+                                  "target": target})
+        offset += len(raw)
+        pad = _pad4(len(raw))
+        binf.write(b"\0" * pad)
+        offset += pad
+        return len(gl["bufferViews"]) - 1
+
+    _, faces = boulder_meshes(cat["seed"][:1], shape)
+    index_acc = {}
+    for lv in shape.levels:
+        ind = faces[lv].astype(np.uint16).ravel()
+        gl["accessors"].append({"bufferView": view(ind.tobytes(), _ELEMENT_ARRAY_BUFFER),
+                                "componentType": _USHORT, "count": len(ind),
+                                "type": "SCALAR"})
+        index_acc[lv] = len(gl["accessors"]) - 1
+    for lv in shape.levels:
+        first[lv] = len(gl["meshes"])
+        nv = 10 * 4**lv + 2
+        for s0 in range(0, len(cat), _CHUNK):
+            verts, _ = boulder_meshes(cat["seed"][s0:s0 + _CHUNK], shape)
+            v = verts[:, :nv]
+            nrm = boulder_normals(v, faces[lv]).astype(np.float32)
+            v = v.astype(np.float32)
+            for k in range(len(v)):
+                pos = view(v[k].tobytes(), _ARRAY_BUFFER)
+                nv_ = view(nrm[k].tobytes(), _ARRAY_BUFFER)
+                a0 = len(gl["accessors"])
+                gl["accessors"] += [
+                    {"bufferView": pos, "componentType": _FLOAT, "count": nv, "type": "VEC3",
+                     "min": [float(x) for x in v[k].min(axis=0)],
+                     "max": [float(x) for x in v[k].max(axis=0)]},
+                    {"bufferView": nv_, "componentType": _FLOAT, "count": nv, "type": "VEC3"}]
+                gl["meshes"].append({"primitives": [{
+                    "attributes": {"POSITION": a0, "NORMAL": a0 + 1},
+                    "indices": index_acc[lv], "mode": _TRIANGLES}]})
+    manifest["boulders"] = {"count": int(len(cat)), "levels": list(shape.levels),
+                            "first_mesh": {str(lv): m for lv, m in first.items()}}
+    return offset, first
+
+
+def _boulder_nodes(cat, level: int, first: dict, gl: dict, manifest: dict) -> None:
+    """One node per boulder in scene ``level`` (its boulder level), under a root node."""
+    levels = sorted(first)
+    blevel = max(levels[-1] - level, levels[0])
+    children = []
+    for i in range(len(cat)):
+        gl["nodes"].append({
+            "name": f"boulder{i}", "mesh": first[blevel] + i,
+            "translation": [float(cat[f"centre_{a}_m"][i]) for a in "xyz"],
+            "rotation": [float(cat[f"quat_{a}"][i]) for a in "xyzw"],
+            "scale": [float(cat["diameter_m"][i])] * 3,
+            "extras": {"id": i, "lod_meshes": [first[lv] + i for lv in levels]}})
+        children.append(len(gl["nodes"]) - 1)
+    gl["nodes"].append({"name": f"lod{level}/boulders", "children": children,
+                        "extras": {"boulder_level": blevel}})
+    gl["scenes"][level]["nodes"].append(len(gl["nodes"]) - 1)
+    manifest["levels"][level]["boulder_level"] = blevel
 
 
 def export_vtp_strips(body: Body, path) -> Path:

@@ -10,6 +10,7 @@ from craters._infra import check_int
 
 from ._grid_kernels import (
     _interpolate_kernel,
+    _surface_radius_kernel,
     _triangles_kernel,
     _triangles_serial,
     _unit_index_kernel,
@@ -329,13 +330,30 @@ class LatLongGrid:
         Linear along each ring (with wrap-around) and linear between the two rings that
         bracket the colatitude; exact at the grid's own vertices.
         """
+        return self._sample(_interpolate_kernel, "values", values, colatitudes, longitudes)
+
+    def surface_radii(self, radii, colatitudes, longitudes) -> np.ndarray:
+        """Distance from the centre to the triangle mesh along arbitrary directions.
+
+        ``radii`` are the per-vertex radii of a body on this grid; the answer is where
+        the ray from the centre towards (colatitude, longitude) (radians) crosses the flat
+        triangles a renderer draws, not an interpolation (``interpolate`` blends ring
+        values; it differs from the flat triangles by a fraction of the relief between
+        neighbouring vertices). For a stretched body pass the direction of ``p / stretch``:
+        stretching maps the rays from the centre and the triangles onto themselves.
+        """
+        return self._sample(_surface_radius_kernel, "radii", radii, colatitudes, longitudes)
+
+    def _sample(self, kernel, name: str, values, colatitudes, longitudes) -> np.ndarray:
+        """Run a per-point kernel(m, ring_offsets, values, colat, lon, out) after checks."""
         values = np.ascontiguousarray(values, dtype=np.float64)
         if values.shape != (self.n_vertices,):
-            raise ValueError(f"`values` must have shape ({self.n_vertices},); got {values.shape}")
+            raise ValueError(f"`{name}` must have shape ({self.n_vertices},); got "
+                             f"{values.shape}")
         colat = np.ascontiguousarray(colatitudes, dtype=np.float64).ravel()
         lon = np.ascontiguousarray(longitudes, dtype=np.float64).ravel()
         if colat.shape != lon.shape:
             raise ValueError("`colatitudes` and `longitudes` must have the same shape")
         out = np.empty(colat.shape[0], dtype=np.float64)
-        _interpolate_kernel(self._m, self.ring_offsets(), values, colat, lon, out)
+        kernel(self._m, self.ring_offsets(), values, colat, lon, out)
         return out.reshape(np.shape(colatitudes))

@@ -140,6 +140,14 @@ def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
     sun_direction(sun_azimuth_deg, sun_elevation_deg, view_lat_deg, view_lon_deg)  # validate
     _headless_setup()
     mesh = _picture_body(body).to_pyvista()
+    if body.boulders is not None and len(body.boulders):
+        import pyvista as pv
+
+        from .boulders import boulder_world_meshes
+
+        bv, bf = boulder_world_meshes(body.boulders)
+        rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())
+        mesh = mesh.merge(rocks)
     mesh = mesh.compute_normals(cell_normals=False, point_normals=True, split_vertices=False,
                                 consistent_normals=False, auto_orient_normals=False)
     lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)

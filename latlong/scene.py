@@ -37,7 +37,7 @@ __all__ = ["BUILD_OPTIONS", "PRESETS", "Opt", "body_population", "build_body",
            "config_settings", "resolve_settings", "surface_positions", "write_outputs"]
 
 BASES = ("sphere", "faulting", "fbm")
-OUTPUT_SUFFIXES = (".npz", *EXPORT_SUFFIXES)
+OUTPUT_SUFFIXES = (".npz", *EXPORT_SUFFIXES, ".glb")
 # memory per vertex for a build with export (radii, unit vectors, vertices, caches)
 BYTES_PER_VERTEX = 160
 
@@ -145,12 +145,27 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "ideal craters: no fractal overlay, circular rims", "craters", "store_false"),
     Opt(("--max-crater-extent-deg",), "max_crater_extent_deg", float, 60.0,
         "largest angular size of a crater's ejecta blanket, degrees of arc", "craters"),
+    # boulders
+    Opt(("--boulders",), "boulders", str, None,
+        "boulder layer c=0.05,k=-3,dmin=0.5,dmax=10[,burial=0.5,near=0.3]: N_cum = c D^k "
+        "per m^2, D in metres; burial = largest buried fraction of the height (<= 0.9); "
+        "near = share around crater rims (repeatable)", "boulders", "append"),
+    Opt(("--boulder-flatten",), "boulder_flatten", float, 0.6,
+        "boulder up-axis scale relative to its width", "boulders"),
+    Opt(("--boulder-elongation",), "boulder_elongation", float, 1.4,
+        "boulder length relative to its width", "boulders"),
+    Opt(("--boulder-roughness",), "boulder_roughness", float, 0.22,
+        "boulder midpoint-displacement amplitude (fraction of the edge length)", "boulders"),
     # outputs
     Opt(("-o", "--output"), "output", str, None,
-        "output file, format by suffix: " + " ".join(OUTPUT_SUFFIXES) + " (repeatable)",
+        "output file, format by suffix: " + " ".join(OUTPUT_SUFFIXES) + " (repeatable; .glb "
+        "is the patched strip export with its .json manifest, full resolution only - "
+        "`latlong export` adds levels of detail)",
         "output", "append"),
     Opt(("--catalog",), "catalog", str, None,
         "write the ground-truth crater catalog as stamped (CSV)", "output"),
+    Opt(("--boulder-catalog",), "boulder_catalog", str, None,
+        "write the boulder catalog as placed (CSV)", "output"),
     Opt(("--preview",), "preview", str, None, "write a preview picture (PNG)", "output"),
     *RENDER_OPTIONS,
     Opt(("-q", "--quiet"), "quiet", bool, False, "no progress bars or messages", "output",
@@ -256,6 +271,20 @@ def _layer_from_table(table: dict, where: str) -> _craters.CraterLayer:
         raise ValueError(f"{where}: {exc}") from None
 
 
+def _boulder_from_table(table: dict, where: str):
+    from .boulders import BoulderLayer
+
+    allowed = {f.name for f in dataclasses.fields(BoulderLayer)}
+    unknown = set(table) - allowed
+    if unknown:
+        raise ValueError(f"{where}: unknown boulder key(s) {', '.join(sorted(unknown))}; "
+                         f"allowed: {', '.join(sorted(allowed))}")
+    try:
+        return BoulderLayer(**table)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{where}: {exc}") from None
+
+
 def config_settings(path) -> dict:
     """Read a TOML scene file: keys are the option names with underscores."""
     raw = load_toml(path)
@@ -270,6 +299,10 @@ def config_settings(path) -> dict:
             if key == "craters":
                 items = value if isinstance(value, list) else [value]
                 value = [_layer_from_table(v, where) if isinstance(v, dict) else str(v)
+                         for v in items]
+            elif key == "boulders":
+                items = value if isinstance(value, list) else [value]
+                value = [_boulder_from_table(v, where) if isinstance(v, dict) else str(v)
                          for v in items]
             elif opt.action == "append":
                 value = [value] if isinstance(value, str) else [str(v) for v in value]
@@ -494,6 +527,32 @@ def _resolve_shape(s: dict, given: dict, path: str) -> dict:
     return s
 
 
+def _resolve_boulders(s: dict) -> None:
+    """Boulder layers and shape."""
+    from .boulders import BoulderLayer, BoulderShape, parse_boulder_spec
+
+    layers = []
+    for item in s.get("boulders") or []:
+        if isinstance(item, BoulderLayer):
+            layers.append(item)
+            continue
+        try:
+            layers.append(parse_boulder_spec(item))
+        except ValueError as exc:
+            raise CliError(f"--boulders: {exc}") from None
+    s["boulders"] = layers
+    try:
+        s["boulder_shape"] = BoulderShape(flatten=s["boulder_flatten"],
+                                          elongation=s["boulder_elongation"],
+                                          roughness=s["boulder_roughness"])
+    except (TypeError, ValueError) as exc:
+        raise CliError(f"boulder shape: {exc}") from None
+    for la in layers:
+        if la.d_max_m > 0.2 * s["radius_m"] * min(s["stretch"] or (1.0,)):
+            raise CliError(f"--boulders dmax={la.d_max_m:g} m: boulders larger than a fifth "
+                           "of the body's radius are not boulders")
+
+
 def _resolve_craters_and_outputs(s: dict) -> None:
     """Crater layers, render and output checks shared by every base."""
     # craters
@@ -525,11 +584,12 @@ def _resolve_craters_and_outputs(s: dict) -> None:
             raise CliError(f"--craters dmax={la.d_max_m:g} m: the crater (ejecta "
                            f"{3 * la.d_max_m:g} m across) is larger than the body allows "
                            f"(radius {smallest:g} m, limit {s['max_crater_extent_deg']:g} deg)")
+    _resolve_boulders(s)
     check_render(s)
     # outputs
     outputs = [Path(x) for x in (s.get("output") or [])]
     s["output"] = [str(x) for x in outputs]
-    extras = [Path(s[k]) for k in ("preview", "catalog") if s.get(k)]
+    extras = [Path(s[k]) for k in ("preview", "catalog", "boulder_catalog") if s.get(k)]
     if not outputs and not extras:
         raise CliError("nothing to write: give -o/--output, --catalog or --preview")
     if s.get("catalog") and not layers:
@@ -546,6 +606,10 @@ def _resolve_craters_and_outputs(s: dict) -> None:
         check_output_path(s["preview"], force=s["force"], suffixes=(".png",))
     if s.get("catalog"):
         check_output_path(s["catalog"], force=s["force"], suffixes=(".csv",))
+    if s.get("boulder_catalog"):
+        if not s["boulders"]:
+            raise CliError("--boulder-catalog needs boulder layers (--boulders)")
+        check_output_path(s["boulder_catalog"], force=s["force"], suffixes=(".csv",))
     if s.get("seed") is None:
         s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
 
@@ -671,6 +735,8 @@ def build_body(s: dict, *, progress: bool = False) -> Body:
         "crater_morphometry": s["crater_morphometry"],
         "crater_lifetime_gyr": s["crater_lifetime_gyr"],
         "crater_roughness": s["crater_roughness"],
+        "boulders": [dataclasses.asdict(la) for la in s.get("boulders") or []],
+        "boulder_shape": dataclasses.asdict(s["boulder_shape"]) if s.get("boulders") else None,
     }
     body = Body.from_heights(grid, s["radius_m"], heights, stretch=s["stretch"],
                              metadata=metadata)
@@ -682,6 +748,11 @@ def build_body(s: dict, *, progress: bool = False) -> Body:
                              morphometry=s["crater_morphometry"], too_large="skip")
         body = body.replace(metadata={**body.metadata,
                                       "craters_skipped_too_large": len(cat) - len(body.craters)})
+    if s.get("boulders"):
+        from .boulders import boulder_population, place_boulders
+
+        found = boulder_population(body, s["boulders"], rng=rng)
+        body = body.replace(boulders=place_boulders(body, found, shape=s["boulder_shape"]))
     return body
 
 
@@ -690,6 +761,10 @@ def write_outputs(body: Body, s: dict, *, progress: bool = False, on_written=Non
     for out in s["output"]:
         if out.lower().endswith(".npz"):
             body.save(out)
+        elif out.lower().endswith(".glb"):
+            from .gltf import export_glb
+
+            export_glb(body, out, progress=progress)
         else:
             body.export(out, progress=progress)
         if on_written:
@@ -698,6 +773,10 @@ def write_outputs(body: Body, s: dict, *, progress: bool = False, on_written=Non
         _craters.write_catalog(body.craters, s["catalog"])
         if on_written:
             on_written(s["catalog"])
+    if s.get("boulder_catalog"):
+        _craters.write_catalog(body.boulders, s["boulder_catalog"])
+        if on_written:
+            on_written(s["boulder_catalog"])
     if s.get("preview"):
         from .preview import render_from_settings
 

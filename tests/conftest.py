@@ -61,3 +61,17 @@ def tiny_geotiff(tmp_path):
                        transform=Affine(10.0, 0, 500000.0, 0, -10.0, 4000000.0)) as ds:
         ds.write(z, 1)
     return path
+
+
+def assert_one_line_error(proc: subprocess.CompletedProcess, *needles: str) -> None:
+    """The CLI contract for bad input: exit 2, one ``error: ...`` line naming the problem."""
+    assert proc.returncode == 2, proc.stderr
+    lines = proc.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error:"), proc.stderr
+    for needle in needles:
+        assert needle in lines[0], lines[0]
+
+
+@pytest.fixture
+def one_line_error():
+    return assert_one_line_error

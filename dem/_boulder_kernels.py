@@ -1,0 +1,72 @@
+"""Numba kernels for boulders on rasters: bilinear ground, heightfield maximum."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+
+@njit(cache=True, inline="always")
+def _bilinear_one(z, col, row):
+    """Bilinear height at fractional pixel (col, row); NaN outside the pixel centres."""
+    rows, cols = z.shape
+    if not (0.0 <= col <= cols - 1 and 0.0 <= row <= rows - 1):
+        return np.nan
+    c0 = min(int(np.floor(col)), cols - 2) if cols > 1 else 0
+    r0 = min(int(np.floor(row)), rows - 2) if rows > 1 else 0
+    fc = col - c0
+    fr = row - r0
+    c1 = min(c0 + 1, cols - 1)
+    r1 = min(r0 + 1, rows - 1)
+    top = (1.0 - fc) * z[r0, c0] + fc * z[r0, c1]
+    bottom = (1.0 - fc) * z[r1, c0] + fc * z[r1, c1]
+    return (1.0 - fr) * top + fr * bottom
+
+
+@njit(cache=True, parallel=True)
+def _bilinear_kernel(z, cols, rows, out):
+    """:func:`_bilinear_one` at many points."""
+    for i in prange(cols.shape[0]):
+        out[i] = _bilinear_one(z, cols[i], rows[i])
+
+
+@njit(cache=True)
+def _raster_max_kernel(z, verts, faces):
+    """Raise ``z`` to the top of every boulder: heightfield maximum, in place.
+
+    ``verts`` (k, V, 3) are boulder vertices as (column, row, height in metres), the
+    column and row fractional pixel indices; every triangle of ``faces`` is scanned
+    over the pixel centres inside it (seen from above) and each pixel keeps the highest
+    of its height and the triangle's height there: the boulder's top. Serial: a maximum
+    does not depend on the order, so the result is the same whatever the thread count.
+    """
+    rows, cols = z.shape
+    for b in range(verts.shape[0]):
+        for f in range(faces.shape[0]):
+            i0, i1, i2 = faces[f, 0], faces[f, 1], faces[f, 2]
+            x0 = verts[b, i0, 0]
+            y0 = verts[b, i0, 1]
+            x1 = verts[b, i1, 0]
+            y1 = verts[b, i1, 1]
+            x2 = verts[b, i2, 0]
+            y2 = verts[b, i2, 1]
+            det = (x1 - x0) * (y2 - y0) - (x2 - x0) * (y1 - y0)
+            if det == 0.0:
+                continue
+            c_lo = max(int(np.ceil(min(x0, x1, x2))), 0)
+            c_hi = min(int(np.floor(max(x0, x1, x2))), cols - 1)
+            r_lo = max(int(np.ceil(min(y0, y1, y2))), 0)
+            r_hi = min(int(np.floor(max(y0, y1, y2))), rows - 1)
+            z0 = verts[b, i0, 2]
+            z1 = verts[b, i1, 2]
+            z2 = verts[b, i2, 2]
+            for r in range(r_lo, r_hi + 1):
+                for c in range(c_lo, c_hi + 1):
+                    w1 = ((c - x0) * (y2 - y0) - (x2 - x0) * (r - y0)) / det
+                    w2 = ((x1 - x0) * (r - y0) - (c - x0) * (y1 - y0)) / det
+                    w0 = 1.0 - w1 - w2
+                    if w0 < -1e-12 or w1 < -1e-12 or w2 < -1e-12:
+                        continue
+                    h = w0 * z0 + w1 * z1 + w2 * z2
+                    if h > z[r, c]:
+                        z[r, c] = h
