@@ -48,7 +48,7 @@ bicubic = original.replace(heights=spline(np.arange(n), np.arange(n)))
 
 
 def stats(d):
-    return (np.nanmedian(dem.slope_deg(d)), dem.band_power(d), np.nanstd(dem.laplacian(d)))
+    return (np.nanmedian(dem.slope(d)), dem.band_power(d), np.nanstd(dem.laplacian(d)))
 
 
 ref = stats(original)
