@@ -145,6 +145,39 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "ideal craters: no fractal overlay, circular rims", "craters", "store_false"),
     Opt(("--max-crater-extent-deg",), "max_crater_extent_deg", float, 60.0,
         "largest angular size of a crater's ejecta blanket, degrees of arc", "craters"),
+    # the implicit backend (latlong/implicit_cli.py)
+    Opt(("--backend",), "backend", str, None,
+        "latlong (default: the lat/long mesh) or implicit (Li et al.: metaballs over a "
+        "sphere packing of --shape, LCSN craters, Gabor detail, marching cubes)", "implicit"),
+    Opt(("--shape",), "shape", str, None,
+        "constraint mesh of --backend implicit (OBJ, PDS plate .tab/.plt, PLY, STL, VTK; "
+        "units from --shape-units)", "implicit"),
+    Opt(("--polygons",), "polygons", int, None,
+        "about how many triangles the implicit mesh has (default 200000)", "implicit"),
+    Opt(("--voxel-m",), "voxel_m", float, None,
+        "marching-cubes spacing, metres (instead of --polygons)", "implicit"),
+    Opt(("--packing-voxels",), "packing_voxels", int, None,
+        "voxels along the constraint's longest side for the sphere packing (default 128)",
+        "implicit"),
+    Opt(("--min-sphere-m",), "min_sphere_m", float, None,
+        "smallest packed sphere, metres (default 2 packing voxels)", "implicit"),
+    Opt(("--cell-m",), "cell_m", float, None,
+        "cell size of grid level 0, metres (default: the largest dmax)", "implicit"),
+    Opt(("--lcsn",), "lcsn", str, None,
+        "LCSN crater layer kernel=NAME,dmin=M,dmax=M[,B=3,p=0.5,w=1,hd=LO:HI]: NAME of "
+        "craters.LCSN_PRESETS scaled to D in [dmin, dmax] (metres), N(>D) ~ D^-B, p = "
+        "impulse chance per surface cell, w = weight, hd = depth/diameter (repeatable)",
+        "implicit", "append"),
+    Opt(("--gabor",), "gabor", str, None,
+        "Gabor micro-detail f=CYCLES_PER_M,bw=PER_M,amp=RMS_M[,orient=DEG,density=N]",
+        "implicit"),
+    Opt(("--gabor-example",), "gabor_example", str, None,
+        "fit the Gabor noise to an example (.npy heights in metres, or a .png/.jpg/.tif "
+        "picture)", "implicit"),
+    Opt(("--gabor-pixel-m",), "gabor_pixel_m", float, None,
+        "pixel size of --gabor-example on the body, metres", "implicit"),
+    Opt(("--gabor-amplitude-m",), "gabor_amplitude_m", float, None,
+        "rms of the fitted Gabor noise, metres (default: the .npy example's)", "implicit"),
     # outputs
     Opt(("-o", "--output"), "output", str, None,
         "output file, format by suffix: " + " ".join(OUTPUT_SUFFIXES) + " (repeatable)",
@@ -354,6 +387,16 @@ def resolve_settings(given: dict) -> dict:
     unknown = set(given) - set(_BY_KEY)
     if unknown:
         raise CliError(f"unknown setting(s): {', '.join(sorted(unknown))}")
+    backend = given.get("backend") or "latlong"
+    if backend == "implicit":
+        from .implicit_cli import resolve_implicit
+
+        return resolve_implicit(given, {o.key: o.default for o in BUILD_OPTIONS})
+    stray = [k for k, v in given.items() if v is not None and _BY_KEY[k].group == "implicit"
+             and k != "backend"]
+    if backend != "latlong" or stray:
+        raise CliError(f"--backend must be latlong or implicit; got {backend!r}" if
+                       backend != "latlong" else f"{flag(stray[0])} applies to --backend implicit")
     preset = given.get("preset")
     if preset is not None and preset not in PRESETS:
         raise CliError(f"--preset must be one of {', '.join(PRESETS)}; got {preset!r}")
