@@ -34,7 +34,14 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import check_int, check_positive, check_range, normalize_rng, parse_spec
+from craters._infra import (
+    check_choice,
+    check_int,
+    check_positive,
+    check_range,
+    normalize_rng,
+    parse_spec,
+)
 
 from . import _implicit_kernels as _k
 
@@ -283,14 +290,15 @@ def power_spectrum(image, pixel_m: float):
 
 def _block_mean(a: np.ndarray, n_max: int):
     ny, nx = a.shape
-    by, bx = -(-ny // n_max), -(-nx // n_max)
+    by, bx = -(-ny // n_max), -(-nx // n_max)  # block sizes
     ny2, nx2 = (ny // by) * by, (nx // bx) * bx
     return a[:ny2, :nx2].reshape(ny2 // by, by, nx2 // bx, bx).mean(axis=(1, 3)), by, bx
 
 
 def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
-              n_frequencies: int = 12, n_orientations: int = 12, n_bandwidths: int = 3,
-              density: float = 4.0, max_patches: int = 64) -> GaborNoise:
+              n_frequencies: int = 24, n_orientations: int = 12, n_bandwidths: int = 3,
+              density: float = 4.0, max_patches: int = 1000,
+              weighting: str = "relative") -> GaborNoise:
     """Gabor noise whose spectrum fits the power spectrum of a 2-D example (module notes).
 
     Parameters
@@ -305,9 +313,14 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
     n_frequencies, n_orientations, n_bandwidths : int
         The dictionary: patch centres at ``k / n_frequencies`` of the Nyquist frequency
         (k = 1..n) times ``n_orientations`` directions over 180 degrees, plus one at 0;
-        bandwidths 1, 2, 4, ... times the frequency step.
+        bandwidths 0.5, 1, 2, ... times the frequency step.
     max_patches : int
         Keep at most this many patches (largest variance shares).
+    weighting : {"relative", "linear"}
+        Least squares on the power itself (``"linear"``, Galerne et al.'s choice: the
+        strongest part of the spectrum dominates) or relative to a smoothed periodogram
+        (``"relative"``: every frequency counts, so the weak high frequencies of a
+        power-law terrain are kept).
 
     Examples
     --------
@@ -324,14 +337,18 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
     n_orientations = check_int("n_orientations", n_orientations, 1, 64)
     n_bandwidths = check_int("n_bandwidths", n_bandwidths, 1, 6)
     max_patches = check_int("max_patches", max_patches, 1, 10_000)
+    check_choice("weighting", weighting, ("relative", "linear"))
     power, fx, fy = power_spectrum(image, pixel_m)
+    if not power.max() > 0:
+        raise ValueError("`image` has no variance to fit")
     rms = float(np.std(np.asarray(image, dtype=np.float64)))
     amplitude_m = rms if amplitude_m is None else check_positive("amplitude_m", amplitude_m,
                                                                  allow_zero=True)
     p_small, by, bx = _block_mean(power, 96)
-    fxs = _block_mean(np.broadcast_to(fx, power.shape), 96)[0]
-    fys = _block_mean(np.broadcast_to(fy[:, None], power.shape), 96)[0]
-    kx, ky = fxs.ravel(), fys.ravel()
+    # the dictionary is averaged over the same blocks of frequencies (a patch narrower
+    # than a block is otherwise misread); Gaussians are separable: mean = outer product
+    fxb = fx[:p_small.shape[1] * bx].reshape(-1, bx)
+    fyb = fy[:p_small.shape[0] * by].reshape(-1, by)
     nyq = 0.5 / pixel_m
     step = nyq / n_frequencies
     centres = [(0.0, 0.0)]
@@ -339,24 +356,32 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
         for m in range(n_orientations):
             t = math.pi * m / n_orientations
             centres.append((fk * step * math.cos(t), fk * step * math.sin(t)))
-    bands = [step * 2**b for b in range(n_bandwidths)]
+    bands = [step * 2.0 ** (b - 1) for b in range(n_bandwidths)]
     cols, meta = [], []
     for a in bands:
+        c = 2 * math.pi / a**2
         for mx, my in centres:
-            g = np.exp(-2 * math.pi * ((kx - mx) ** 2 + (ky - my) ** 2) / a**2)
+            g = np.outer(np.exp(-c * (fyb - my) ** 2).mean(1), np.exp(-c * (fxb - mx) ** 2).mean(1))
             if mx or my:
-                g = g + np.exp(-2 * math.pi * ((kx + mx) ** 2 + (ky + my) ** 2) / a**2)
-            cols.append(g)
+                g += np.outer(np.exp(-c * (fyb + my) ** 2).mean(1),
+                              np.exp(-c * (fxb + mx) ** 2).mean(1))
+            cols.append(g.ravel())
             meta.append((mx, my, a))
     A = np.stack(cols, axis=1)
-    w, _ = nnls(A, p_small.ravel(), maxiter=50 * A.shape[1])
+    target = p_small.ravel()
+    if weighting == "relative":  # each frequency cell counts by its relative error
+        from scipy.ndimage import gaussian_filter
+
+        scale = np.maximum(gaussian_filter(p_small, 1.5).ravel(), 1e-12 * target.max())
+        A, target = A / scale[:, None], target / scale
+    w, _ = nnls(A, target, maxiter=50 * A.shape[1])
     # variance of each patch: integral of its power over the plane (two lobes)
     share = np.array([wt * a * a / 2 * (2 if (mx or my) else 1)
                       for wt, (mx, my, a) in zip(w, meta, strict=True)])
     if not (share > 0).any():
         raise ValueError("`image` has no variance to fit")
     order = np.argsort(-share, kind="stable")
-    order = order[share[order] > 1e-3 * share[order[0]]][:max_patches]
+    order = order[share[order] > 1e-6 * share[order[0]]][:max_patches]
     patches = []
     for idx in order:
         mx, my, a = meta[idx]
