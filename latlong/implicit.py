@@ -695,6 +695,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
     if gabor is not None and not isinstance(gabor, GaborNoise):
         raise TypeError(f"`gabor` must be a latlong.gabor.GaborNoise; got {type(gabor).__name__}")
     target_polygons = check_int("target_polygons", target_polygons, 100, 10**9)
+    seed = int(rng) if isinstance(rng, int | np.integer) and not isinstance(rng, bool) else None
     rng = normalize_rng(rng)
     centre = constraint.volume_centroid
     model = ShapeModel(constraint.vertices - centre, constraint.faces, constraint.source)
@@ -705,6 +706,10 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
         cell_m = max((la.d_max_m for la in layers), default=1.0)
     cell_m = check_positive("cell_m", cell_m)
     levels = _layer_levels(layers, cell_m)
+    for la in layers:
+        if la.d_max_m < 4.0 * h:
+            logger.warning("LCSN layer %s (%g-%g m) is at most 4 voxels of %.3g m across: its "
+                           "craters are barely resolved", la.kernel, la.d_min_m, la.d_max_m, h)
     shapes = [_measure_shape(la.params) for la in layers]
     # the largest height a layer can add (two overlapping craters) bounds the band of the
     # field where craters can move the surface
@@ -806,7 +811,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                     "max_radius_m": float(packing.radii.max()),
                     "odd_columns": packing.odd_columns},
         "metaballs": {"blend": meta.blend, "iso": meta.iso, "fit_mean_m": meta.fit_mean_m},
-        "cell_m": cell_m, "levels": levels,
+        "seed": seed, "cell_m": cell_m, "levels": levels,
         "layers": [{**dataclasses.asdict(la), "kernel": la.kernel if isinstance(la.kernel, str)
                     else dataclasses.asdict(la.kernel)} for la in layers],
         "gabor": None if gabor is None else {**gabor.describe(), "impulses": n_gabor},

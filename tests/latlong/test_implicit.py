@@ -221,6 +221,57 @@ def test_crater_grid_kernel_matches_reference(rng):
     np.testing.assert_allclose(point, want, rtol=1e-10, atol=1e-12)
 
 
+def closest_reference(origin, h, nearest, seed_id, foot, normal, first):
+    out = np.empty(first.shape)
+    nz, ny, nx = first.shape
+    for k, j, i in np.ndindex(first.shape):
+        k0, j0, i0 = nearest[:, k, j, i]
+        block = seed_id[max(0, k0 - 2):k0 + 3, max(0, j0 - 2):j0 + 3, max(0, i0 - 2):i0 + 3]
+        ids = np.sort(block[block >= 0])
+        p = origin + h * np.array([i, j, k])
+        d2 = ((p - foot[ids]) ** 2).sum(1)
+        s = ids[np.argmin(d2)]
+        d = abs((p - foot[s]) @ normal[s])
+        out[k, j, i] = d if first[k, j, i] > 0 else -d
+    return out
+
+
+def test_closest_distance_kernel_matches_reference(rng):
+    from scipy.ndimage import distance_transform_edt
+
+    shape = (11, 12, 13)
+    seed = rng.random(shape) < 0.08
+    n = int(seed.sum())
+    seed_id = np.full(shape, -1, np.int64)
+    seed_id[seed] = np.arange(n)
+    foot = rng.uniform(0, 6, (n, 3))
+    normal = rng.normal(size=(n, 3))
+    normal /= np.linalg.norm(normal, axis=1, keepdims=True)
+    first = rng.uniform(-1, 1, shape)
+    nearest = distance_transform_edt(~seed, return_distances=False, return_indices=True)
+    origin, h = np.array([0.1, -0.2, 0.3]), 0.5
+    out = np.empty(shape)
+    K._closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first, out)
+    np.testing.assert_allclose(out, closest_reference(origin, h, nearest, seed_id, foot,
+                                                      normal, first), rtol=1e-12)
+
+
+def test_distance_field_is_euclidean_on_a_sphere():
+    """One ball: within 6 voxels of the iso-sphere the field is its distance to within
+    5 % of a voxel (measured 4 %)."""
+    from latlong.implicit import Metaballs, _metaball_distance
+
+    r, h = 1000.0, 97.3
+    meta = Metaballs(np.zeros((1, 3)), np.array([2 * r]), 0.75**3, 2.0, 0.0)
+    grid = _Grid(np.full(3, -1500.0) + 0.31 * h, h, (33, 33, 33))
+    dist = _metaball_distance(meta, grid)
+    k, j, i = np.meshgrid(*(np.arange(n) for n in grid.shape), indexing="ij")
+    true = r - np.linalg.norm(grid.origin + np.stack([i, j, k], -1) * h, axis=-1)
+    band = np.abs(true) < 6 * h
+    assert np.abs(dist - true)[band].max() < 0.05 * h
+    assert np.array_equal(dist > 0, true > 0)
+
+
 # --------------------------------------------------------------------------- packing
 @pytest.mark.parametrize("name", ["itokawa_32.obj", "bennu_radar_sbgat.obj"])
 def test_metaballs_fit_the_constraint(name):
