@@ -392,11 +392,12 @@ def resolve_settings(given: dict) -> dict:
         from .implicit_cli import resolve_implicit
 
         return resolve_implicit(given, {o.key: o.default for o in BUILD_OPTIONS})
+    if backend != "latlong":
+        raise CliError(f"--backend must be latlong or implicit; got {backend!r}")
     stray = [k for k, v in given.items() if v is not None and _BY_KEY[k].group == "implicit"
              and k != "backend"]
-    if backend != "latlong" or stray:
-        raise CliError(f"--backend must be latlong or implicit; got {backend!r}" if
-                       backend != "latlong" else f"{flag(stray[0])} applies to --backend implicit")
+    if stray:
+        raise CliError(f"{flag(stray[0])} applies to --backend implicit")
     preset = given.get("preset")
     if preset is not None and preset not in PRESETS:
         raise CliError(f"--preset must be one of {', '.join(PRESETS)}; got {preset!r}")
