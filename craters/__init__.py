@@ -2,7 +2,8 @@
 
 Pure functions over numpy arrays: the Martin crater profile with degradation, irregular
 rims and roughness (lunar paper III), stamping into 2-D height grids, power-law crater
-populations and catalogs. Imports neither ``latlong`` nor ``dem``.
+populations and catalogs, and the locally controlled spot-noise (LCSN) crater kernels of
+Li et al. 2022 with their morphometry. Imports neither ``latlong`` nor ``dem``.
 """
 
 import logging
@@ -30,6 +31,15 @@ from .degradation import (
     degradation_from_age,
     slope_erosion,
 )
+from .lcsn import (
+    LCSN_PRESETS,
+    LcsnParams,
+    lcsn_degrade,
+    lcsn_kernel,
+    lcsn_morphometry,
+    lcsn_raw,
+    lcsn_scaled,
+)
 from .morphometry import (
     MORPHOMETRY_PRESETS,
     Morphometry,
@@ -55,10 +65,12 @@ __all__ = [
     "BoulderNode",
     "BoulderShape",
     "DEFAULT_EJECTA_EDGE",
+    "LCSN_PRESETS",
     "MORPHOMETRY_PRESETS",
     "Crater",
     "CraterLayer",
     "DegradationModel",
+    "LcsnParams",
     "Morphometry",
     "ProfileParams",
     "Roughness",
@@ -74,6 +86,11 @@ __all__ = [
     "fresh_depth",
     "fresh_rim_height",
     "get_morphometry",
+    "lcsn_degrade",
+    "lcsn_kernel",
+    "lcsn_morphometry",
+    "lcsn_raw",
+    "lcsn_scaled",
     "make_catalog",
     "population",
     "power_law_population",

@@ -25,7 +25,7 @@ __all__ = ["CATALOG_FORMAT", "catalog_dtype", "make_catalog", "read_catalog",
 
 CATALOG_FORMAT = "craterform crater catalog v1"
 _KIND_LEN = 16
-_INT_COLUMNS = {"seed": np.uint64, "layer": np.int64, "index": np.int64,
+_INT_COLUMNS = {"seed": np.uint64, "layer": np.int64, "level": np.int64, "index": np.int64,
                 "n_vertices": np.int64}
 _STR_COLUMNS = {"kind"}
 _PLANE = ("x_m", "y_m")

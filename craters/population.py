@@ -18,7 +18,14 @@ import math
 
 import numpy as np
 
-from ._infra import check_finite, check_int, check_positive, check_range, normalize_rng
+from ._infra import (
+    check_finite,
+    check_int,
+    check_positive,
+    check_range,
+    normalize_rng,
+    parse_spec,
+)
 from .catalog import make_catalog, sort_oldest_first
 from .degradation import degradation_from_age
 
@@ -165,26 +172,8 @@ def parse_layer_spec(spec: str, *, age_max_gyr: float = 3.5) -> CraterLayer:
     >>> parse_layer_spec("c=0.5,k=-2,dmin=2,dmax=50").d_max_m
     50.0
     """
-    if not isinstance(spec, str):
-        raise TypeError(f"a crater layer spec must be a string; got {spec!r}")
-    values: dict = {}
-    for part in spec.split(","):
-        key, sep, raw = part.partition("=")
-        key = key.strip()
-        if not sep or key not in _SPEC_KEYS:
-            raise ValueError(f"crater layer {spec!r}: unknown item {part.strip()!r}; "
-                             f"allowed keys: {', '.join(_SPEC_KEYS)}")
-        if key == "kind":
-            values["kind"] = raw.strip()
-            continue
-        try:
-            values[_SPEC_KEYS[key]] = float(raw)
-        except ValueError:
-            raise ValueError(f"crater layer {spec!r}: {key} must be a number; "
-                             f"got {raw!r}") from None
-    missing = [k for k in ("c", "k", "dmin", "dmax") if _SPEC_KEYS[k] not in values]
-    if missing:
-        raise ValueError(f"crater layer {spec!r}: missing {', '.join(missing)}")
+    items = {key: (field, str if key == "kind" else float) for key, field in _SPEC_KEYS.items()}
+    values = parse_spec(spec, items, ("c", "k", "dmin", "dmax"), "crater layer")
     values.setdefault("age_max_gyr", age_max_gyr)
     try:
         return CraterLayer(**values)

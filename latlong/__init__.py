@@ -1,7 +1,9 @@
 """latlong: asteroid bodies on the evenly spaced 6M^2+2 latitude/longitude sphere mesh.
 
 Martin et al. 2014: the lat/long mesh, two-phase Poisson faulting and Perlin fBm base
-shapes, mesh export and previews. See ``latlong build --help`` for the command line.
+shapes, mesh export and previews; and the implicit backend of Li et al. 2020/2022
+(metaballs over a sphere packing, LCSN craters, Gabor noise, marching cubes). See
+``latlong build --help`` for the command line.
 """
 
 import logging
@@ -27,7 +29,15 @@ from .faulting import (
     random_faults,
     two_phase_faulting,
 )
+from .gabor import GaborNoise, GaborPatch, fit_gabor
 from .grid import LatLongGrid
+from .implicit import (
+    ImplicitSurface,
+    LcsnLayer,
+    fit_metaballs,
+    implicit_surface,
+    sphere_packing,
+)
 from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
 from .scene import PRESETS, body_population, build_body, resolve_settings, surface_positions
 from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
@@ -53,7 +63,11 @@ __all__ = [
     "BoulderShape",
     "FaultingParams",
     "FbmParams",
+    "GaborNoise",
+    "GaborPatch",
+    "ImplicitSurface",
     "LatLongGrid",
+    "LcsnLayer",
     "ShapeModel",
     "apply_faults",
     "area_mean",
@@ -67,9 +81,12 @@ __all__ = [
     "crater_extents_deg",
     "facet_slopes",
     "fbm3",
+    "fit_gabor",
+    "fit_metaballs",
     "from_shape_model",
     "fwhm_to_sigma",
     "heat_smooth",
+    "implicit_surface",
     "load",
     "mesh_slopes",
     "perlin_fbm",
@@ -83,6 +100,7 @@ __all__ = [
     "slopes",
     "slopes_and_areas",
     "smooth",
+    "sphere_packing",
     "stamp_craters",
     "surface_positions",
     "vertex_normals",

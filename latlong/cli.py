@@ -55,6 +55,10 @@ def _cmd_build(args: argparse.Namespace) -> int:
     given = config_settings(args.config) if args.config else {}
     given.update(_given(args, _KEYS))
     s = resolve_settings(given)
+    if s.get("backend") == "implicit":
+        from .implicit_cli import run_implicit
+
+        return run_implicit(s)
     show = not s["quiet"]
     outs = [*s["output"], *[s[k] for k in ("catalog", "boulder_catalog", "preview") if s.get(k)]]
     bar = progress_bar(total=1 + len(outs), enabled=show, desc="build")
@@ -180,6 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
               "shape": b.add_argument_group("shape models (--base shape:PATH)"),
               "craters": b.add_argument_group("craters"),
               "boulders": b.add_argument_group("boulders"),
+              "implicit": b.add_argument_group("implicit backend (--backend implicit)"),
               "output": b.add_argument_group("output"),
               "render": b.add_argument_group("preview picture")}
     _add_options(b, BUILD_OPTIONS, groups)

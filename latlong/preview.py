@@ -123,9 +123,14 @@ def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
                    sun_elevation_deg: float = 20.0, view_lat_deg: float = 0.0,
                    view_lon_deg: float = -90.0, camera_distance_m: float | None = None,
                    width_px: int = 1024, height_px: int = 768, views: int = 1) -> Path:
-    """Render ``body`` off-screen to a PNG at ``path`` (atomic); see the module notes."""
-    if not isinstance(body, Body):
-        raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
+    """Render ``body`` (a Body or a closed ``pyvista.PolyData`` mesh in metres) off-screen
+    to a PNG at ``path`` (atomic); see the module notes."""
+    _headless_setup()  # before VTK loads
+    import pyvista as pv
+
+    if not isinstance(body, Body | pv.PolyData):
+        raise TypeError(f"`body` must be a Body or a pyvista.PolyData; got "
+                        f"{type(body).__name__}")
     path = Path(path)
     if path.suffix.lower() != ".png":
         raise ValueError(f"picture path must end in .png; got {str(path)!r}")
@@ -138,16 +143,16 @@ def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
             math.isfinite(camera_distance_m) and camera_distance_m > 0):
         raise ValueError(f"`camera_distance_m` must be finite and > 0; got {camera_distance_m!r}")
     sun_direction(sun_azimuth_deg, sun_elevation_deg, view_lat_deg, view_lon_deg)  # validate
-    _headless_setup()
-    mesh = _picture_body(body).to_pyvista()
-    if body.boulders is not None and len(body.boulders):
-        import pyvista as pv
+    if isinstance(body, Body):
+        mesh = _picture_body(body).to_pyvista()
+        if body.boulders is not None and len(body.boulders):
+            from .boulders import boulder_world_meshes
 
-        from .boulders import boulder_world_meshes
-
-        bv, bf = boulder_world_meshes(body.boulders)
-        rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())
-        mesh = mesh.merge(rocks)
+            bv, bf = boulder_world_meshes(body.boulders)
+            rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())
+            mesh = mesh.merge(rocks)
+    else:
+        mesh = body
     mesh = mesh.compute_normals(cell_normals=False, point_normals=True, split_vertices=False,
                                 consistent_normals=False, auto_orient_normals=False)
     lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
@@ -187,7 +192,7 @@ def _contact_sheet(images, labels) -> np.ndarray:
     return np.asarray(sheet)
 
 
-def render_from_settings(body: Body, path, s: dict) -> Path:
+def render_from_settings(body, path, s: dict) -> Path:
     """:func:`render_preview` with the render keys of scene settings ``s``."""
     return render_preview(body, path, sun_azimuth_deg=s["sun_azimuth_deg"],
                           sun_elevation_deg=s["sun_elevation_deg"],

@@ -156,6 +156,39 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "boulder length relative to its width", "boulders"),
     Opt(("--boulder-roughness",), "boulder_roughness", float, 0.22,
         "boulder midpoint-displacement amplitude (fraction of the edge length)", "boulders"),
+    # the implicit backend (latlong/implicit_cli.py)
+    Opt(("--backend",), "backend", str, None,
+        "latlong (default: the lat/long mesh) or implicit (Li et al.: metaballs over a "
+        "sphere packing of --shape, LCSN craters, Gabor detail, marching cubes)", "implicit"),
+    Opt(("--shape",), "shape", str, None,
+        "constraint mesh of --backend implicit (OBJ, PDS plate .tab/.plt, PLY, STL, VTK; "
+        "units from --shape-units)", "implicit"),
+    Opt(("--polygons",), "polygons", int, None,
+        "about how many triangles the implicit mesh has (default 200000)", "implicit"),
+    Opt(("--voxel-m",), "voxel_m", float, None,
+        "marching-cubes spacing, metres (instead of --polygons)", "implicit"),
+    Opt(("--packing-voxels",), "packing_voxels", int, None,
+        "voxels along the constraint's longest side for the sphere packing (default 128)",
+        "implicit"),
+    Opt(("--min-sphere-m",), "min_sphere_m", float, None,
+        "smallest packed sphere, metres (default 2 packing voxels)", "implicit"),
+    Opt(("--cell-m",), "cell_m", float, None,
+        "cell size of grid level 0, metres (default: the largest dmax)", "implicit"),
+    Opt(("--lcsn",), "lcsn", str, None,
+        "LCSN crater layer kernel=NAME,dmin=M,dmax=M[,B=3,p=0.5,w=1,hd=LO:HI]: NAME of "
+        "craters.LCSN_PRESETS scaled to D in [dmin, dmax] (metres), N(>D) ~ D^-B, p = "
+        "impulse chance per surface cell, w = weight, hd = depth/diameter (repeatable)",
+        "implicit", "append"),
+    Opt(("--gabor",), "gabor", str, None,
+        "Gabor micro-detail f=CYCLES_PER_M,bw=PER_M,amp=RMS_M[,orient=DEG,density=N]",
+        "implicit"),
+    Opt(("--gabor-example",), "gabor_example", str, None,
+        "fit the Gabor noise to an example (.npy heights in metres, or a .png/.jpg/.tif "
+        "picture)", "implicit"),
+    Opt(("--gabor-pixel-m",), "gabor_pixel_m", float, None,
+        "pixel size of --gabor-example on the body, metres", "implicit"),
+    Opt(("--gabor-amplitude-m",), "gabor_amplitude_m", float, None,
+        "rms of the fitted Gabor noise, metres (default: the .npy example's)", "implicit"),
     # outputs
     Opt(("-o", "--output"), "output", str, None,
         "output file, format by suffix: " + " ".join(OUTPUT_SUFFIXES) + " (repeatable; .glb "
@@ -387,6 +420,17 @@ def resolve_settings(given: dict) -> dict:
     unknown = set(given) - set(_BY_KEY)
     if unknown:
         raise CliError(f"unknown setting(s): {', '.join(sorted(unknown))}")
+    backend = given.get("backend") or "latlong"
+    if backend == "implicit":
+        from .implicit_cli import resolve_implicit
+
+        return resolve_implicit(given, {o.key: o.default for o in BUILD_OPTIONS})
+    if backend != "latlong":
+        raise CliError(f"--backend must be latlong or implicit; got {backend!r}")
+    stray = [k for k, v in given.items() if v is not None and _BY_KEY[k].group == "implicit"
+             and k != "backend"]
+    if stray:
+        raise CliError(f"{flag(stray[0])} applies to --backend implicit")
     preset = given.get("preset")
     if preset is not None and preset not in PRESETS:
         raise CliError(f"--preset must be one of {', '.join(PRESETS)}; got {preset!r}")
@@ -586,32 +630,39 @@ def _resolve_craters_and_outputs(s: dict) -> None:
                            f"(radius {smallest:g} m, limit {s['max_crater_extent_deg']:g} deg)")
     _resolve_boulders(s)
     check_render(s)
-    # outputs
-    outputs = [Path(x) for x in (s.get("output") or [])]
-    s["output"] = [str(x) for x in outputs]
-    extras = [Path(s[k]) for k in ("preview", "catalog", "boulder_catalog") if s.get(k)]
-    if not outputs and not extras:
-        raise CliError("nothing to write: give -o/--output, --catalog or --preview")
     if s.get("catalog") and not layers:
         raise CliError("--catalog needs crater layers (--craters or a cratered --preset)")
+    if s.get("boulder_catalog") and not s["boulders"]:
+        raise CliError("--boulder-catalog needs boulder layers (--boulders)")
+    check_outputs(s, OUTPUT_SUFFIXES, ("preview", "catalog", "boulder_catalog"))
+    if s.get("seed") is None:
+        s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
+
+
+def check_outputs(s: dict, suffixes: tuple[str, ...], extra_keys: tuple[str, ...]) -> None:
+    """Check the ``-o`` outputs (by ``suffixes``) and the single-file outputs named by
+    ``extra_keys`` (``preview`` a .png, the others .csv): something to write, no file
+    twice, folders writable, nothing overwritten without --force. Normalises
+    ``s["output"]`` to a list of strings."""
+    outputs = [Path(x) for x in (s.get("output") or [])]
+    s["output"] = [str(x) for x in outputs]
+    extras = {k: Path(s[k]) for k in extra_keys if s.get(k)}
+    if not outputs and not extras:
+        raise CliError("nothing to write: give -o/--output, --catalog or --preview")
     seen = set()
-    for x in outputs + extras:
+    for x in [*outputs, *extras.values()]:
         key = x.resolve()
         if key in seen:
             raise CliError(f"output {str(x)!r} is given twice")
         seen.add(key)
-    for x in outputs:
-        check_output_path(x, force=s["force"], suffixes=OUTPUT_SUFFIXES)
-    if s.get("preview"):
-        check_output_path(s["preview"], force=s["force"], suffixes=(".png",))
-    if s.get("catalog"):
-        check_output_path(s["catalog"], force=s["force"], suffixes=(".csv",))
-    if s.get("boulder_catalog"):
-        if not s["boulders"]:
-            raise CliError("--boulder-catalog needs boulder layers (--boulders)")
-        check_output_path(s["boulder_catalog"], force=s["force"], suffixes=(".csv",))
-    if s.get("seed") is None:
-        s["seed"] = int(np.random.SeedSequence().entropy % (2**63))
+    try:
+        for x in outputs:
+            check_output_path(x, force=s["force"], suffixes=suffixes)
+        for k, x in extras.items():
+            check_output_path(x, force=s["force"], suffixes=(".png",) if k == "preview"
+                              else (".csv",))
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
 
 
 # --------------------------------------------------------------------------- populations

@@ -1,0 +1,280 @@
+"""LCSN crater kernels (Li et al. 2022 §3.2-3.3): formulas, morphometry, inverse, presets."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import craters
+from craters.lcsn import MORPH_KEYS
+
+PRESETS = craters.LCSN_PRESETS
+NUMERIC_TOL = 0.01  # numeric morphometry vs an independent dense-sampling measurement
+CLOSED_TOL = 0.05  # the acceptance bound for the paper's closed forms
+FRESH = ["table-a1-300m-0gyr", "table-a1-1km-0gyr", "table-a1-3km-0gyr"]
+FIG6 = ["fig6-kernel1", "fig6-kernel2", "fig6-kernel3", "fig6-kernel4"]
+
+
+def reference_profile(kind, r, p):
+    """The kernels written out directly from eq. 3, 6 and 12."""
+    with np.errstate(divide="ignore"):
+        ring = np.where(r > 0, np.exp(-p.get("beta", 1) * np.log(p.get("gamma", 1) * r**2) ** 2),
+                        0.0)
+    if kind == 1:
+        return -p["a"] * np.exp(-p["b"] * r**2)
+    if kind == 2:
+        return -p["a"] * np.exp(-p["b"] * r**4)
+    return p["kappa"] * ring + (1 if kind == 4 else -1) * p["a"] * np.exp(-p["b"] * r**2)
+
+
+def dense_measurement(kind, p, threshold=0.01):
+    """Morphometry read off 2 million uniform samples: no root finding, no refinement."""
+    if kind in (1, 2):
+        span = 8.0 * p["b"] ** (-1.0 / (2 * kind))
+    else:
+        span = 8.0 / math.sqrt(p["gamma"])
+    r = np.linspace(0.0, span, 2_000_001)
+    h = reference_profile(kind, r, p)
+
+    def first(mask, start=0.0):
+        idx = np.flatnonzero(mask[:-1] != mask[1:])
+        idx = idx[r[idx] >= start]
+        if not idx.size:
+            return math.nan
+        i = idx[0]  # linear interpolation between the two samples
+        return float(r[i] + (r[i + 1] - r[i]) * (0 - h[i]) / (h[i + 1] - h[i])) if (
+            h[i + 1] != h[i]) else float(r[i])
+
+    if kind in (1, 2):
+        depth = -h.min()
+        i = np.flatnonzero(h > -depth / 2)[0]
+        half = r[i - 1] + (r[i] - r[i - 1]) * (-depth / 2 - h[i - 1]) / (h[i] - h[i - 1])
+        return {"H_t": depth, "D_a": (2.5 if kind == 1 else 2.0) * 2 * half}
+    peaks = np.flatnonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:])) + 1
+    crest = r[peaks[np.argmax(h[peaks])]] if peaks.size else math.nan
+    out = {"D_rim": 2 * crest, "H_rim": h.max() if kind == 3 else (
+        h[peaks].max() if peaks.size else math.nan)}
+    if kind == 3:
+        out["H_t"] = -h.min()
+        out["D_a"] = 2 * first(h >= 0)
+        out["L_d"] = first(h >= 0, crest) - crest if peaks.size else math.nan
+    else:
+        out["H_c"] = h[0]
+        shifted = h - threshold
+        idx = np.flatnonzero((shifted[:-1] >= 0) & (shifted[1:] < 0) & (r[:-1] >= crest))
+        out["L_d"] = r[idx[0]] - crest if idx.size else math.nan
+    if not peaks.size:
+        out["D_rim"] = out["H_rim"] = math.nan
+    return out
+
+
+def rel(a, b):
+    return abs(a - b) / abs(b)
+
+
+# --------------------------------------------------------------------------- kernels
+@pytest.mark.parametrize("name", sorted(PRESETS))
+def test_kernel_matches_the_equations(name):
+    p = PRESETS[name]
+    r = np.linspace(0.0, 6.0, 601) * p.morphometry()["D_rim" if p.kind > 2 else "D_a"]
+    got = craters.lcsn_kernel(p.kind, r, **p.raw)
+    np.testing.assert_allclose(got, reference_profile(p.kind, r, p.raw), rtol=1e-13,
+                               atol=1e-15 * p.a)
+
+
+def test_kernel_values():
+    k3 = PRESETS["table-a1-300m-0gyr"].raw
+    assert craters.lcsn_kernel(3, 0.0, **k3) == -55.1  # L(0) = 0: the floor is -a
+    k4 = PRESETS["fig6-kernel4"].raw
+    assert craters.lcsn_kernel(4, 0.0, **k4) == pytest.approx(0.2)  # the central uplift
+    # the ring peaks at 1/sqrt(gamma) with height kappa
+    ring = craters.lcsn_kernel(4, 1 / math.sqrt(k4["gamma"]), **{**k4, "a": 0.0})
+    assert ring == pytest.approx(k4["kappa"], rel=1e-14)
+
+
+# --------------------------------------------------------------------------- morphometry
+@pytest.mark.parametrize("name", sorted(PRESETS))
+def test_numeric_agrees_with_independent_measurement(name):
+    p = PRESETS[name]
+    got = p.morphometry("numeric")
+    want = dense_measurement(p.kind, p.raw)
+    assert set(got) == set(MORPH_KEYS[p.kind])
+    for key, value in got.items():
+        if math.isnan(want[key]):
+            assert math.isnan(value), key
+        else:
+            assert rel(value, want[key]) < NUMERIC_TOL, (key, value, want[key])
+
+
+@pytest.mark.parametrize("name", FRESH)
+def test_closed_forms_on_fresh_table_rows(name):
+    """Measured: D_rim and H_t within 5 %; H_rim within 5 % for 1 and 3 km (5.2 % for
+    300 m); D_a 8-11 % and L_d ~50 % short, because eq. 10-11 assume kappa = a."""
+    p = PRESETS[name]
+    closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
+    assert closed["D_rim"] == pytest.approx(2 / math.sqrt(p.gamma))
+    assert rel(closed["D_rim"], numeric["D_rim"]) < CLOSED_TOL
+    assert closed["H_t"] == numeric["H_t"] == p.a
+    assert rel(closed["H_rim"], numeric["H_rim"]) < (0.053 if "300m" in name else CLOSED_TOL)
+    assert 0.08 < rel(closed["D_a"], numeric["D_a"]) < 0.11
+
+
+@pytest.mark.parametrize("name", FIG6)
+def test_closed_forms_on_fig6_cases(name):
+    p = PRESETS[name]
+    closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
+    for key, value in closed.items():
+        if math.isnan(numeric[key]):
+            assert math.isnan(value), key  # fig6-kernel3: the flank never returns to 0
+        else:
+            assert rel(value, numeric[key]) < CLOSED_TOL, (key, value, numeric[key])
+
+
+def test_fig6_caption_values():
+    m1 = PRESETS["fig6-kernel1"].morphometry("numeric")
+    assert m1["D_a"] == pytest.approx(5 * math.sqrt(math.log(2)) / math.sqrt(math.pi))
+    m2 = PRESETS["fig6-kernel2"].morphometry("numeric")
+    assert m2["D_a"] == pytest.approx(4 * math.sqrt(math.log(2)) / math.sqrt(math.pi))
+    m3 = PRESETS["fig6-kernel3"].morphometry("numeric")
+    assert [m3[k] for k in ("H_t", "D_a", "D_rim", "H_rim")] == pytest.approx(
+        [1.0, 1.31, 2.0, 0.309], rel=1e-9)
+    m4 = PRESETS["fig6-kernel4"].morphometry("numeric")
+    assert [m4[k] for k in ("H_c", "D_rim", "H_rim")] == pytest.approx([0.2, 2.0, 0.471],
+                                                                      rel=1e-9)
+
+
+@pytest.mark.parametrize("beta,gamma,b", [(5.0, 1.0, 0.7), (0.5, 4.0, 1.5), (7.0, 4.5e-7, 9e-7)])
+def test_eq10_eq11_are_exact_when_kappa_equals_a(beta, gamma, b):
+    raw = {"kappa": 3.0, "beta": beta, "gamma": gamma, "a": 3.0, "b": b}
+    closed = craters.lcsn_morphometry(3, **raw)
+    numeric = craters.lcsn_morphometry(3, "numeric", **raw)
+    assert closed["D_a"] == pytest.approx(numeric["D_a"], rel=1e-9)
+    if math.isfinite(closed["L_d"]):  # compare the outer zero crossing itself
+        outer_closed = closed["L_d"] + closed["D_rim"] / 2
+        outer_numeric = numeric["L_d"] + numeric["D_rim"] / 2
+        assert outer_closed == pytest.approx(outer_numeric, rel=1e-9)
+
+
+def test_degraded_rows_without_a_rim():
+    p = PRESETS["table-a1-300m-3gyr"]  # kappa = 0: a bare Gaussian, never reaches 0
+    numeric = p.morphometry("numeric")
+    assert numeric["H_t"] == pytest.approx(2.4)
+    assert all(math.isnan(numeric[k]) for k in ("D_a", "D_rim", "H_rim", "L_d"))
+    closed = p.morphometry("closed")
+    assert closed["H_rim"] < 0 and math.isfinite(closed["D_a"])  # formulas still evaluate
+    # 1 km at 2 Gyr: a crest survives (1.17 m) though eq. 7 says -0.13 m
+    m = PRESETS["table-a1-1km-2gyr"].morphometry("numeric")
+    assert m["H_rim"] == pytest.approx(1.1664, abs=1e-4)
+    assert PRESETS["table-a1-1km-2gyr"].morphometry()["H_rim"] < 0
+
+
+def test_table_a1_goldens():
+    """The measured 0 Gyr profiles: realistic fresh craters (d/D ~ 0.19, rim ~0.035 D)."""
+    for name, d_rim, h_rim, d_a in (("table-a1-300m-0gyr", 321.1266, 10.3790, 268.0006),
+                                    ("table-a1-1km-0gyr", 962.3778, 35.5294, 766.7536),
+                                    ("table-a1-3km-0gyr", 3066.8167, 114.9845, 2630.9317)):
+        m = PRESETS[name].morphometry("numeric")
+        assert [m["D_rim"], m["H_rim"], m["D_a"]] == pytest.approx([d_rim, h_rim, d_a],
+                                                                   abs=1e-3)
+        assert 0.17 < m["H_t"] / m["D_rim"] < 0.19
+        assert 0.03 < m["H_rim"] / m["D_rim"] < 0.04
+
+
+# --------------------------------------------------------------------------- inverse
+@pytest.mark.parametrize("name", [*FRESH, *FIG6])
+def test_closed_inverse_round_trip(name):
+    p = PRESETS[name]
+    closed = p.morphometry("closed")
+    extra = {}
+    if p.kind == 3:
+        extra = {"beta": p.beta}
+        closed.pop("L_d")
+    elif p.kind == 4:
+        extra = {"b": p.b}
+    raw = craters.lcsn_raw(p.kind, **extra, **closed)
+    for key, value in p.raw.items():
+        assert raw[key] == pytest.approx(value, rel=1e-9), key
+
+
+@pytest.mark.parametrize("name", ["table-a1-300m-0gyr", "table-a1-3km-0gyr", "fig6-kernel4"])
+def test_numeric_inverse_recovers_the_kernel(name):
+    p = PRESETS[name]
+    m = p.morphometry("numeric")
+    extra = {"beta": p.beta} if p.kind == 3 else {"b": p.b}
+    if p.kind == 3:
+        m.pop("L_d")
+    raw = craters.lcsn_raw(p.kind, "numeric", **extra, **m)
+    for key, value in p.raw.items():
+        assert raw[key] == pytest.approx(value, rel=1e-6), key
+
+
+def test_inverse_with_l_d():
+    p = PRESETS["table-a1-3km-0gyr"]  # beta = 7: the measured L_d pins it
+    raw = craters.lcsn_raw(3, "numeric", **p.morphometry("numeric"))
+    assert raw["beta"] == pytest.approx(p.beta, rel=1e-6)
+    k4 = PRESETS["fig6-kernel4"]
+    raw4 = craters.lcsn_raw(4, b=k4.b, **k4.morphometry())
+    assert raw4["beta"] == pytest.approx(k4.beta, rel=1e-9)
+
+
+# --------------------------------------------------------------------------- degradation
+def test_degradation_vector_fig8():
+    p = PRESETS["fig6-kernel3"].raw
+    q = craters.lcsn_degrade(3, (-0.3, -0.4, -0.25), relative=True, **p)
+    assert q["kappa"] == pytest.approx(0.7 * p["kappa"])
+    assert q["a"] == pytest.approx(0.75)
+    m0, m1 = (craters.lcsn_morphometry(3, "numeric", **x) for x in (p, q))
+    assert m1["D_rim"] > m0["D_rim"] and m1["H_rim"] < m0["H_rim"] and m1["H_t"] < m0["H_t"]
+    absolute = craters.lcsn_degrade(3, (-0.05, -0.2, -0.1), **PRESETS["fig6-kernel4"].raw)
+    assert absolute["gamma"] == pytest.approx(PRESETS["fig6-kernel4"].gamma - 0.2)
+    simple = craters.lcsn_degrade(1, -0.6, **PRESETS["fig6-kernel1"].raw)
+    assert simple["a"] == pytest.approx(0.4) and simple["b"] == math.pi
+
+
+def test_scaled_shapes_scale_every_measure():
+    p = PRESETS["table-a1-1km-0gyr"]
+    m0 = p.morphometry("numeric")
+    m1 = craters.lcsn_morphometry(3, "numeric", **craters.lcsn_scaled(3, 0.1, **p.raw))
+    for key in ("H_t", "D_a", "D_rim", "H_rim"):
+        assert m1[key] == pytest.approx(0.1 * m0[key], rel=1e-9)
+    k2 = craters.lcsn_scaled(2, 3.0, **PRESETS["fig6-kernel2"].raw)
+    assert craters.lcsn_morphometry(2, **k2)["D_a"] == pytest.approx(3 * 1.8789, rel=1e-4)
+
+
+# --------------------------------------------------------------------------- errors
+@pytest.mark.parametrize("call,match", [
+    (lambda: craters.lcsn_kernel(5, 1.0, a=1.0, b=1.0), "`kind`"),
+    (lambda: craters.lcsn_kernel(1.5, 1.0, a=1.0, b=1.0), "`kind`"),
+    (lambda: craters.lcsn_kernel(3, 1.0, a=55.1, b=1.0, beta=5.0, gamma=1.0), "`kappa`"),
+    (lambda: craters.lcsn_kernel(1, 1.0, a=1.0, b=1.0, gamma=2.0), "`gamma`"),
+    (lambda: craters.lcsn_kernel(3, 1.0, kappa=1.0, beta=5.0, gamma=1.0, a=-55.1, b=1.0),
+     "Table A.1"),
+    (lambda: craters.lcsn_kernel(1, 1.0, a=1.0, b=0.0), "`b`"),
+    (lambda: craters.lcsn_kernel(1, 1.0, a=1.0, b=math.inf), "`b`"),
+    (lambda: craters.lcsn_kernel(1, -1.0, a=1.0, b=1.0), "`r`"),
+    (lambda: craters.lcsn_morphometry(1, "exact", a=1.0, b=1.0), "`method`"),
+    (lambda: craters.lcsn_morphometry(4, threshold=0, **PRESETS["fig6-kernel4"].raw),
+     "`threshold`"),
+    (lambda: craters.lcsn_raw(3, H_t=1.0, D_a=1.0, D_rim=2.0, H_rim=0.3), "`beta`"),
+    (lambda: craters.lcsn_raw(3, "numeric", H_t=1.0, D_a=1.0, D_rim=2.0, H_rim=0.3),
+     "`L_d` or `beta`"),
+    (lambda: craters.lcsn_raw(3, beta=5.0, H_t=1.0, D_a=3.0, D_rim=2.0, H_rim=0.3), "`D_a`"),
+    (lambda: craters.lcsn_raw(4, beta=5.0, H_c=0.2, D_rim=2.0, H_rim=0.4), "`b`"),
+    (lambda: craters.lcsn_raw(1, H_t=1.0, D_rim=2.0), "`D_rim`"),
+    (lambda: craters.lcsn_raw(1, H_t=-1.0, D_a=2.0), "`H_t`"),
+    (lambda: craters.lcsn_degrade(3, (-0.1, -2.0, 0.0), **PRESETS["fig6-kernel3"].raw),
+     "`alpha`"),
+    (lambda: craters.lcsn_degrade(3, (-0.1, 0.0), **PRESETS["fig6-kernel3"].raw), "`alpha`"),
+    (lambda: craters.lcsn_scaled(1, 0.0, a=1.0, b=1.0), "`factor`"),
+    (lambda: craters.LcsnParams(3, a=1.0, b=1.0), "`beta`"),
+])
+def test_bad_input_names_the_parameter(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+def test_unreachable_numeric_inverse():
+    with pytest.raises(ValueError, match="no kind-3 kernel"):
+        craters.lcsn_raw(3, "numeric", beta=5.0, H_t=1.0, D_a=1.99, D_rim=2.0, H_rim=0.001)
