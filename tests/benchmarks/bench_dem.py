@@ -6,7 +6,7 @@ GDAL's inverse-distance ``fillnodata`` for gap filling). Usage:
 ``python tests/benchmarks/bench_dem.py [--quick] [--only enhance]``. Uses
 ``../shared/data`` (LOLA LDEM_4, 720 x 1440 = 1.04 Mpx) when present, else the
 257 x 257 crop in tests/data. The ``dem enhance`` / ``dem mesh`` figures run the real
-command line in a child process and report its wall time and peak RSS (``wait4``), the
+command line in a child process and report its wall time and peak RSS (GNU time), the
 machine's load average, the exact consistency of every pair of layers, the crater
 accounting and the byte identity of a rerun with ``NUMBA_NUM_THREADS=1``.
 """
@@ -164,19 +164,25 @@ def figures(quick):
 
 
 def timed_child(args, env=None):
-    """Wall time and peak RSS (MiB) of one child process, through wait4."""
+    """Wall time and peak RSS (MiB) of one child process.
+
+    The peak comes from ``/proc/<pid>/status`` ``VmHWM`` read by GNU time (``%M``) when
+    ``/usr/bin/time`` exists: ``wait4``'s ``ru_maxrss`` of a child spawned from this
+    (large) process starts at this process's own peak on Linux (exec records the old
+    address space's high-water mark), which would report the benchmark, not the command.
+    """
     full = dict(os.environ)
     full.update(env or {})
+    gnu_time = Path("/usr/bin/time")
+    prefix = [str(gnu_time), "-f", "maxrss_kb=%M"] if gnu_time.exists() else []
     t0 = time.perf_counter()
-    proc = subprocess.Popen([sys.executable, "-m", *args], env=full, stdout=subprocess.DEVNULL,
-                            stderr=subprocess.PIPE)
-    _, status, usage = os.wait4(proc.pid, 0)
+    proc = subprocess.run([*prefix, sys.executable, "-m", *args], env=full,
+                          stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
-    err = proc.stderr.read().decode()
-    proc.stderr.close()
-    if status:
-        raise RuntimeError(f"{' '.join(args)} failed: {err}")
-    return wall, usage.ru_maxrss / 1024
+    if proc.returncode:
+        raise RuntimeError(f"{' '.join(args)} failed: {proc.stderr}")
+    lines = [x for x in proc.stderr.splitlines() if x.startswith("maxrss_kb=")]
+    return wall, (int(lines[-1].split("=")[1]) / 1024 if lines else float("nan"))
 
 
 def bench_enhance(quick):
