@@ -7,12 +7,20 @@ plot with a legend and listed in one CSV and one summary table.
 
 from __future__ import annotations
 
-import csv
 from pathlib import Path
 
 import numpy as np
 
-from craters._infra import CliError, atomic_path, check_output_path
+from craters._infra import CliError
+from craters._report import (
+    add_report_arguments,
+    check_report_outputs,
+    plot_slopes,
+    save_figure,
+    slope_csv,
+    slope_table,
+    write_csv,
+)
 
 from .body import Body, load
 from .shapes import ShapeModel, from_shape_model, read_shape_model
@@ -38,30 +46,6 @@ def _labels(inputs, labels) -> list[str]:
     return [n if names.count(n) == 1 else f"{n} ({k})" for k, n in enumerate(names)]
 
 
-def _check_outputs(args) -> None:
-    if args.csv is None and args.plot is None and args.quiet:
-        raise CliError("nothing to do: give --csv, --plot or drop --quiet for the table")
-    if args.csv:
-        check_output_path(args.csv, force=args.force, suffixes=(".csv",))
-    if args.plot:
-        check_output_path(args.plot, force=args.force, suffixes=(".png",))
-
-
-def _write_csv(path, header_comment: str, columns: list[str], rows) -> None:
-    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        fh.write(f"# {header_comment}\n")
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(columns)
-        for row in rows:
-            w.writerow([repr(float(v)) if isinstance(v, float | np.floating) else v
-                        for v in row])
-
-
-def _save(fig, path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-
-
 # --------------------------------------------------------------------------- slopes
 def _slopes_of(obj, radius_deg: float, weighted: bool):
     if isinstance(obj, Body):
@@ -74,66 +58,25 @@ def cmd_slopes(args) -> int:
     labels = _labels(inputs, args.label)
     if not 0 <= args.radius_deg <= 90 or not np.isfinite(args.radius_deg):
         raise CliError(f"--radius-deg must be in [0, 90]; got {args.radius_deg}")
-    _check_outputs(args)
+    check_report_outputs(args)
     objs = [_load_input(p, args.shape_units) for p in inputs]
     results = []
     for label, obj in zip(labels, objs, strict=True):
         s, a = _slopes_of(obj, args.radius_deg, not args.unweighted)
         results.append((label, slope_summary(s, a, bin_deg=SLOPE_BIN_DEG)))
-    edges = results[0][1]["edges_deg"]
-    n_bins = min(len(r["area_fraction"]) for _, r in results)
     if args.csv:
-        cols = ["slope_lo_deg", "slope_hi_deg"]
-        for label, _ in results:
-            cols += [f"area_fraction[{label}]", f"percent_area_steeper_than_lo[{label}]"]
-        rows = []
-        for b in range(n_bins):
-            row = [edges[b], edges[b + 1]]
-            for _, r in results:
-                row += [r["area_fraction"][b], r["above_percent"][b]]
-            rows.append(row)
-        _write_csv(args.csv, f"latlong slopes: {args.radius_deg:g} deg "
-                   f"{'unweighted' if args.unweighted else 'area-weighted'} cap-averaged "
-                   "normals vs radial; bins in degrees; area fractions sum to 1; percent "
-                   "of the area steeper than the bin's lower edge", cols, rows)
+        slope_csv(args.csv, f"latlong slopes: {args.radius_deg:g} deg "
+                  f"{'unweighted' if args.unweighted else 'area-weighted'} cap-averaged "
+                  "normals vs radial; bins in degrees; area fractions sum to 1; percent "
+                  "of the area steeper than the bin's lower edge", results)
     if args.plot:
-        _plot_slopes(results, edges, n_bins, args)
+        plot_slopes(args.plot, results, xlabel="slope (deg), 3 deg bins",
+                    ylabel="share of the surface area (%)",
+                    title=f"slope-area histogram ({args.radius_deg:g} deg averaged normals)",
+                    full_range=True)
     if not args.quiet:
-        print(f"{'input':<28} {'median_deg':>10} {'mean_deg':>9} {'>10deg_%':>9} "
-              f"{'>20deg_%':>9} {'>30deg_%':>9}")
-        for label, r in results:
-            pa = r["percent_above"]
-            print(f"{label[:28]:<28} {r['median_deg']:10.2f} {r['mean_deg']:9.2f} "
-                  f"{pa[10]:9.2f} {pa[20]:9.2f} {pa[30]:9.2f}")
+        print(slope_table(results))
     return 0
-
-
-def _plot_slopes(results, edges, n_bins, args) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 4.8))
-    centres = 0.5 * (edges[:n_bins] + edges[1:n_bins + 1])
-    for label, r in results:
-        ax0.plot(centres, 100 * r["area_fraction"][:n_bins], "o-", ms=3, label=label)
-        above = r["above_percent"][:n_bins]
-        ax1.semilogy(edges[:n_bins], np.where(above > 1e-6, above, np.nan), "o-", ms=3,
-                     label=label)
-    ax0.set_xlabel("slope (deg), 3 deg bins")
-    ax0.set_ylabel("share of the surface area (%)")
-    ax0.set_title(f"slope-area histogram ({args.radius_deg:g} deg averaged normals)")
-    ax1.set_xlabel("slope (deg)")
-    ax1.set_ylabel("area steeper than the slope (%)")
-    ax1.set_title("cumulative slope-frequency")
-    for ax in (ax0, ax1):
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        ax.set_xlim(0, 90)
-    fig.tight_layout()
-    _save(fig, args.plot)
-    plt.close(fig)
 
 
 # --------------------------------------------------------------------------- spectrum
@@ -151,7 +94,7 @@ def cmd_spectrum(args) -> int:
         raise CliError(f"--magnitude must be in [1, 4000]; got {args.magnitude}")
     if args.l_max is not None and args.l_max < 1:
         raise CliError(f"--l-max must be >= 1; got {args.l_max}")
-    _check_outputs(args)
+    check_report_outputs(args)
     bodies = [_as_body(_load_input(p, args.shape_units), args.magnitude) for p in inputs]
     results = []
     for label, body in zip(labels, bodies, strict=True):
@@ -172,7 +115,7 @@ def cmd_spectrum(args) -> int:
                 wl = 2 * np.pi * r / np.sqrt(d[k] * (d[k] + 1)) if d[k] else float("inf")
                 row += [wl, p[k]]
             rows.append(row)
-        _write_csv(args.csv, "latlong spectrum: degree variance S_l = sum_m |a_lm|^2 of the "
+        write_csv(args.csv, "latlong spectrum: degree variance S_l = sum_m |a_lm|^2 of the "
                    "radius (metres) with orthonormal spherical harmonics; wavelength "
                    "2 pi R / sqrt(l(l+1)) at the mean radius R", cols, rows)
     if args.plot:
@@ -190,7 +133,7 @@ def cmd_spectrum(args) -> int:
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=8)
         fig.tight_layout()
-        _save(fig, args.plot)
+        save_figure(fig, args.plot)
         plt.close(fig)
     if not args.quiet:
         print(f"{'input':<28} {'mean_radius_m':>13} {'rms_relief_m':>12} {'slope_l>=2':>10}")
@@ -221,8 +164,5 @@ def add_parsers(sub) -> None:
             p.add_argument("--magnitude", type=int, default=200,
                            help="grid magnitude for mesh inputs (default 200)")
             p.add_argument("--l-max", type=int, help="largest degree (default 2M/3)")
-        p.add_argument("--csv", help="write the table (CSV, units in the header)")
-        p.add_argument("--plot", help="write the plot (PNG)")
-        p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-        p.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+        add_report_arguments(p)
         p.set_defaults(func=func)

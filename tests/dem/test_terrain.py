@@ -127,3 +127,5 @@ def test_cli_slopes_and_spectrum(run_cli, tmp_path):
     proc = run_cli("dem", "slopes", str(crop), "--bin-deg", "0", "--csv", str(tmp_path / "x.csv"))
     assert proc.returncode == 2 and "--bin-deg" in proc.stderr
     assert not (tmp_path / "x.csv").exists()
+    proc = run_cli("dem", "spectrum", str(crop), "-q")  # nothing to write, nothing to print
+    assert proc.returncode == 2 and "nothing to do" in proc.stderr

@@ -1,0 +1,115 @@
+"""Reports shared by the ``latlong`` and ``dem`` analysis commands (slopes, spectra).
+
+Both packages compare several inputs in one CSV (a comment line with the units, then a
+header) and one PNG, and print one summary table; latlong and dem never import each
+other, so the pieces live here. Outputs are written atomically.
+"""
+
+from __future__ import annotations
+
+import csv
+
+import numpy as np
+
+from ._infra import CliError, atomic_path, check_output_path
+
+__all__ = ["add_report_arguments", "check_report_outputs", "plot_slopes", "save_figure",
+           "slope_csv", "slope_table", "write_csv"]
+
+
+def add_report_arguments(parser) -> None:
+    """The output options every analysis command has: --csv, --plot, --force, --quiet."""
+    parser.add_argument("--csv", help="write the table (CSV, units in the header)")
+    parser.add_argument("--plot", help="write the plot (PNG)")
+    parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    parser.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+
+
+def check_report_outputs(args) -> None:
+    """``--csv``/``--plot``: something to do, the right suffixes, no silent overwrite."""
+    if args.csv is None and args.plot is None and args.quiet:
+        raise CliError("nothing to do: give --csv, --plot or drop --quiet for the table")
+    if args.csv:
+        check_output_path(args.csv, force=args.force, suffixes=(".csv",))
+    if args.plot:
+        check_output_path(args.plot, force=args.force, suffixes=(".png",))
+
+
+def write_csv(path, comment: str, columns, rows) -> None:
+    """A ``# comment`` line (units, definitions), the header, the rows; floats by repr."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        fh.write(f"# {comment}\n")
+        w = csv.writer(fh, lineterminator="\n")
+        w.writerow(columns)
+        for row in rows:
+            w.writerow([repr(float(v)) if isinstance(v, float | np.floating) else v
+                        for v in row])
+
+
+def save_figure(fig, path) -> None:
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+
+
+def _common_bins(results):
+    return results[0][1]["edges_deg"], min(len(r["area_fraction"]) for _, r in results)
+
+
+def slope_csv(path, comment: str, results) -> None:
+    """``results``: (label, slope summary) pairs; one row per slope bin, two columns per
+    input (area fraction, percent of the area steeper than the bin's lower edge)."""
+    edges, n_bins = _common_bins(results)
+    cols = ["slope_lo_deg", "slope_hi_deg"]
+    for label, _ in results:
+        cols += [f"area_fraction[{label}]", f"percent_area_steeper_than_lo[{label}]"]
+    rows = []
+    for b in range(n_bins):
+        row = [edges[b], edges[b + 1]]
+        for _, r in results:
+            row += [r["area_fraction"][b], r["above_percent"][b]]
+        rows.append(row)
+    write_csv(path, comment, cols, rows)
+
+
+def plot_slopes(path, results, *, xlabel: str, ylabel: str, title: str,
+                full_range: bool = False) -> None:
+    """Histogram and cumulative slope-frequency panels of every input, side by side."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    edges, n_bins = _common_bins(results)
+    fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 4.8))
+    centres = 0.5 * (edges[:n_bins] + edges[1:n_bins + 1])
+    for label, r in results:
+        ax0.plot(centres, 100 * r["area_fraction"][:n_bins], "o-", ms=3, label=label)
+        above = r["above_percent"][:n_bins]
+        ax1.semilogy(edges[:n_bins], np.where(above > 1e-6, above, np.nan), "o-", ms=3,
+                     label=label)
+    ax0.set_xlabel(xlabel)
+    ax0.set_ylabel(ylabel)
+    ax0.set_title(title)
+    ax1.set_xlabel("slope (deg)")
+    ax1.set_ylabel("area steeper than the slope (%)")
+    ax1.set_title("cumulative slope-frequency")
+    for ax in (ax0, ax1):
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+        if full_range:
+            ax.set_xlim(0, 90)
+    fig.tight_layout()
+    save_figure(fig, path)
+    plt.close(fig)
+
+
+def slope_table(results) -> str:
+    """The summary table of ``(label, slope summary)`` pairs, one line per input."""
+    header = (f"{'input':<28} {'median_deg':>10} {'mean_deg':>9} {'>10deg_%':>9} "
+              f"{'>20deg_%':>9} {'>30deg_%':>9}")
+    lines = [header]
+    for label, r in results:
+        pa = r["percent_above"]
+        lines.append(f"{label[:28]:<28} {r['median_deg']:10.2f} {r['mean_deg']:9.2f} "
+                     f"{pa[10]:9.2f} {pa[20]:9.2f} {pa[30]:9.2f}")
+    return "\n".join(lines)
