@@ -28,6 +28,7 @@ import numpy as np
 
 from ._boulder_kernels import _noise_kernel
 from ._infra import check_finite, check_int, check_positive, check_range, normalize_rng
+from .population import sample_power_law_diameters
 
 __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_meshes",
            "boulder_normals", "boulder_world_meshes", "catalog_shape", "iter_boulder_meshes",
@@ -250,6 +251,30 @@ def parse_boulder_spec(spec: str) -> BoulderLayer:
         return BoulderLayer(**values)
     except ValueError as exc:
         raise ValueError(f"boulder layer {spec!r}: {exc}") from None
+
+
+#: Smallest burial, fraction of the height: every boulder touches the ground.
+MIN_BURIAL = 1e-3
+
+
+def draw_boulder_layer(layer: BoulderLayer, area_m2: float, index: int, rng) -> dict:
+    """Everything of one layer's boulders but their positions, over ``area_m2``.
+
+    The count is Poisson with mean ``area_m2 c (d_min^k - d_max^k)`` (refused above 2e7);
+    returns catalog columns ``diameter_m`` (the truncated power law), ``kind``,
+    ``burial_frac`` (uniform in [``MIN_BURIAL``, ``burial_max``]), ``azimuth_deg``,
+    ``seed`` (of each boulder's shape) and ``layer`` (= ``index``). ``rng``: a Generator.
+    """
+    mean = area_m2 * layer.c * (layer.d_min_m**layer.k - layer.d_max_m**layer.k)
+    if mean > 20_000_000:
+        raise ValueError(f"boulder layer {index} asks for about {mean:.3g} boulders "
+                         "(limit 2e7); raise dmin or lower c")
+    n = int(rng.poisson(mean)) if mean > 0 else 0
+    d = sample_power_law_diameters(n, layer.d_min_m, layer.d_max_m, -layer.k, rng=rng)
+    return {"diameter_m": d, "kind": np.full(n, "boulder"),
+            "burial_frac": np.maximum(rng.uniform(0.0, layer.burial_max, n), MIN_BURIAL),
+            "azimuth_deg": rng.uniform(0.0, 360.0, n),
+            "seed": rng.integers(0, 2**63, n, dtype=np.uint64), "layer": np.full(n, index)}
 
 
 def boulder_normals(vertices, faces) -> np.ndarray:

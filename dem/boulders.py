@@ -28,6 +28,7 @@ from craters.boulders import (
     BoulderLayer,
     BoulderShape,
     boulder_meshes,
+    draw_boulder_layer,
     orientations,
     placed_columns,
     rest_on_ground,
@@ -41,8 +42,6 @@ from .frame import LocalFrame, grid_pixel_size, pixel_affine
 __all__ = ["boulder_population", "stamp_boulders"]
 
 _CHUNK = 4096  # boulders per placement chunk
-#: Smallest burial, fraction of the height (every boulder touches the ground).
-_MIN_BURIAL = 1e-3
 #: Largest horizontal reach of a boulder from its centre, in diameters (unit longest
 #: extent, centred on its bounding box: at most half the box diagonal).
 _REACH = 0.87
@@ -69,18 +68,10 @@ def draw_boulders(layers, x_range_m, y_range_m, *, rng=None) -> np.ndarray:
     area = (x1 - x0) * (y1 - y0)
     parts = []
     for idx, la in enumerate(_layers(layers)):
-        mean = area * la.c * (la.d_min_m**la.k - la.d_max_m**la.k)
-        if mean > 20_000_000:
-            raise ValueError(f"boulder layer {idx} asks for about {mean:.3g} boulders "
-                             "(limit 2e7); raise dmin or lower c")
-        n = int(rng.poisson(mean)) if mean > 0 else 0
-        d = craters.sample_power_law_diameters(n, la.d_min_m, la.d_max_m, -la.k, rng=rng)
-        parts.append(craters.make_catalog(
-            x_m=rng.uniform(x0, x1, n), y_m=rng.uniform(y0, y1, n), diameter_m=d,
-            kind=np.full(n, "boulder"),
-            burial_frac=np.maximum(rng.uniform(0.0, la.burial_max, n), _MIN_BURIAL),
-            azimuth_deg=rng.uniform(0.0, 360.0, n),
-            seed=rng.integers(0, 2**63, n, dtype=np.uint64), layer=np.full(n, idx)))
+        cols = draw_boulder_layer(la, area, idx, rng)
+        n = len(cols["diameter_m"])
+        parts.append(craters.make_catalog(x_m=rng.uniform(x0, x1, n),
+                                          y_m=rng.uniform(y0, y1, n), **cols))
     return np.concatenate(parts)
 
 
@@ -117,14 +108,35 @@ def _bilinear(z, cols, rows):
     return out
 
 
+def _ground_normals(z, nan, p: float, m: np.ndarray, xs, ys, ds) -> np.ndarray:
+    """Unit ground normals (local frame, z up) at pixel positions ``xs, ys``: the mean
+    height gradient over the pixels within half of each size ``ds`` (summed-area tables)."""
+    rows, cols = z.shape
+    g_row, g_col = np.gradient(np.where(nan, 0.0, z), p)  # per metre along rows, columns
+    sat_c = np.zeros((rows + 1, cols + 1))
+    sat_r = np.zeros((rows + 1, cols + 1))
+    sat_c[1:, 1:] = g_col.cumsum(0).cumsum(1)
+    sat_r[1:, 1:] = g_row.cumsum(0).cumsum(1)
+    half = np.maximum(np.rint(0.5 * ds / p), 1).astype(int)
+    ic, ir = np.rint(xs).astype(int), np.rint(ys).astype(int)
+    r0, r1 = np.maximum(ir - half, 0), np.minimum(ir + half + 1, rows)
+    c0, c1 = np.maximum(ic - half, 0), np.minimum(ic + half + 1, cols)
+    count = (r1 - r0) * (c1 - c0)
+    mc = (sat_c[r1, c1] - sat_c[r0, c1] - sat_c[r1, c0] + sat_c[r0, c0]) / count
+    mr = (sat_r[r1, c1] - sat_r[r0, c1] - sat_r[r1, c0] + sat_r[r0, c0]) / count
+    grad = np.stack([mc, mr], axis=1) @ m.T  # (dz/dx, dz/dy): m is orthogonal
+    nrm = np.concatenate([-grad, np.ones((len(ds), 1))], axis=1)
+    return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+
 def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShape,
            max_iterations: int = 12):
     """Place and stamp boulders on a height grid; positions ``x_m, y_m`` in a local frame
     where ``(x, y) = p m (col, row) + t`` (``m`` orthogonal 2 x 2, pixel side ``p``).
 
-    Returns ``(heights, keep, centre, normals, rotations, height, burial, achieved)``:
-    the new heights (a copy), which catalog rows were placed, and per placed boulder its
-    placement in the local frame (x, y, z up).
+    Returns ``(heights, keep, placed)``: the new heights (a copy), which catalog rows
+    were placed, and the placed rows with their placement in the local frame (x, y,
+    z up; see :func:`stamp_boulders`).
     """
     z = np.ascontiguousarray(z, dtype=np.float64)
     rows, cols = z.shape
@@ -154,27 +166,9 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
     sel = np.nonzero(keep)[0]
     n = len(sel)
     out = z.copy()
-    if n == 0:
-        e = np.zeros((0, 3))
-        return out, keep, e, e, np.zeros((0, 3, 3)), np.zeros(0), np.zeros(0), np.zeros(0)
     sub = cat[sel]
     ds, xs, ys = d[sel], cx[sel], cy[sel]
-    # ground normal: mean height gradient over the pixels within half the size
-    g_row, g_col = np.gradient(np.where(nan, 0.0, z), p)  # per metre along rows, columns
-    sat_c = np.zeros((rows + 1, cols + 1))
-    sat_r = np.zeros((rows + 1, cols + 1))
-    sat_c[1:, 1:] = g_col.cumsum(0).cumsum(1)
-    sat_r[1:, 1:] = g_row.cumsum(0).cumsum(1)
-    half = np.maximum(np.rint(0.5 * ds / p), 1).astype(int)
-    ic, ir = np.rint(xs).astype(int), np.rint(ys).astype(int)
-    r0, r1 = np.maximum(ir - half, 0), np.minimum(ir + half + 1, rows)
-    c0, c1 = np.maximum(ic - half, 0), np.minimum(ic + half + 1, cols)
-    count = (r1 - r0) * (c1 - c0)
-    mc = (sat_c[r1, c1] - sat_c[r0, c1] - sat_c[r1, c0] + sat_c[r0, c0]) / count
-    mr = (sat_r[r1, c1] - sat_r[r0, c1] - sat_r[r1, c0] + sat_r[r0, c0]) / count
-    grad = np.stack([mc, mr], axis=1) @ m.T  # (dz/dx, dz/dy): m is orthogonal
-    nrm = np.concatenate([-grad, np.ones((n, 1))], axis=1)
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    nrm = _ground_normals(z, nan, p, m, xs, ys, ds) if n else np.zeros((0, 3))
     rot = orientations(nrm, np.radians(sub["azimuth_deg"]))
     ground = np.stack([sub["x_m"], sub["y_m"], _bilinear(z, xs, ys)], axis=1)
 
@@ -184,7 +178,7 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
         return (h - points[..., 2]) * normals[:, 2:3]
 
     centre = np.empty((n, 3))
-    height, burial, achieved = np.empty(n), np.empty(n), np.empty(n)
+    height, burial, achieved, top = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
     for s0 in range(0, n, _CHUNK):
         sl = slice(s0, min(s0 + _CHUNK, n))
         verts, faces_by_level = boulder_meshes(sub["seed"][sl], shape)
@@ -194,11 +188,14 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
             max_iterations=max_iterations)
         # every boulder rests on the original ground; then the tops are stamped
         placed = world + centre[sl, None, :]
+        top[sl] = placed[..., 2].max(axis=1)
         pc, pr = to_pixels(placed[..., 0], placed[..., 1])
         _raster_max_kernel(out, np.ascontiguousarray(np.stack([pc, pr, placed[..., 2]], -1)),
                            np.ascontiguousarray(faces_by_level[shape.levels[-1]],
                                                 dtype=np.int64))
-    return out, keep, centre, nrm, rot, height, burial, achieved
+    cols = placed_columns(sub, centre, nrm, rot, height, burial, achieved, shape)
+    cols["top_m"] = top
+    return out, keep, craters.make_catalog(**cols)
 
 
 def stamp_boulders(dem: Dem, catalog, *, frame: LocalFrame | None = None,
@@ -242,33 +239,12 @@ def stamp_boulders(dem: Dem, catalog, *, frame: LocalFrame | None = None,
     p = grid_pixel_size(a, "the DEM")
     m = np.array([[a.a, a.b], [a.d, a.e]]) / p
     resolved = np.nonzero(cat["diameter_m"] >= min_px * p)[0]
-    z, keep, centre, nrm, rot, height, burial, achieved = _place(
-        dem.heights, p, m, np.array([a.c, a.f]), cat[resolved], shape=shape)
+    z, keep, placed = _place(dem.heights, p, m, np.array([a.c, a.f]), cat[resolved],
+                             shape=shape)
     rows_placed = resolved[keep]
     out = dem.with_step(z, "dem.stamp_boulders", None,
                         {"boulders": int(len(rows_placed)), "given": int(len(cat)),
                          "unresolved": int(len(cat) - len(resolved)),
                          "off_grid_or_unknown": int(len(resolved) - len(rows_placed)),
                          "min_px": float(min_px)})
-    if not return_catalog:
-        return out
-    return out, _placed_catalog(cat[rows_placed], centre, nrm, rot, height, burial, achieved,
-                                shape)
-
-
-def _placed_catalog(sub, centre, nrm, rot, height, burial, achieved, shape):
-    cols = placed_columns(sub, centre, nrm, rot, height, burial, achieved, shape)
-    cols["top_m"] = _tops(sub, shape, rot, centre)
-    return craters.make_catalog(**cols)
-
-
-def _tops(sub, shape, rot, centre) -> np.ndarray:
-    """Highest point (z) of each placed boulder."""
-    top = np.empty(len(sub))
-    for s0 in range(0, len(sub), _CHUNK):
-        sl = slice(s0, min(s0 + _CHUNK, len(sub)))
-        verts, _ = boulder_meshes(sub["seed"][sl], shape)
-        world = np.einsum("kij,kvj->kvi", rot[sl], verts * sub["diameter_m"][sl, None, None])
-        top[sl] = world[..., 2].max(axis=1) + centre[sl, 2]
-    return top
-
+    return (out, placed) if return_catalog else out

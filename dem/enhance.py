@@ -35,6 +35,14 @@ change stays strictly inside each coarser footprint and the coarser layers stay
 continuous; at the end ``Stack.is_consistent()`` holds exactly (and for the float32
 GeoTIFFs too). Layer k+1 is expanded only after layer k's craters are in.
 
+Boulders (``boulders``, ``min_boulder_px``) are split the same way (by diameter band,
+each into the finest layer that holds its whole footprint and resolves it) and, in each
+layer, placed on the ground after that layer's craters and stamped as a heightfield
+maximum (:func:`dem.stamp_boulders`). What finer layers add later -- RMD detail at odd
+pixels, their own boulders (a maximum again) and their smaller craters -- is superposed
+on everything, so a younger small crater of a finer layer can dent a coarser layer's
+boulder; the synchronisation below carries that up like any crater.
+
 Stamping frames: crater positions are drawn in the *layer-0 grid frame* (metres, pixel
 (i, j) of layer 0 at (j p0, i p0)); layer k's grid frame is the same frame shifted by
 its offset, so no rounding enters. Catalogs are written in the stack's local frame
@@ -483,7 +491,7 @@ def plan_boulders(specs, geometry: _Geometry, *, min_px: float, seed: int):
 def _stamp_boulders_layer(z, cat, geometry: _Geometry, k: int, a0, shape):
     """Place and stamp layer k's boulders (layer-0 grid positions); returns the heights
     and the placed catalog in the local frame."""
-    from .boulders import _place, _placed_catalog
+    from .boulders import _place
 
     if cat is None:
         cat = craters.make_catalog(x_m=[], y_m=[], diameter_m=[], burial_frac=[],
@@ -495,9 +503,8 @@ def _stamp_boulders_layer(z, cat, geometry: _Geometry, k: int, a0, shape):
     r, c = geometry.offsets[k]
     m = np.array([[a0.a, a0.b], [a0.d, a0.e]]) / p0
     t = np.array([a0.a * c + a0.b * r + a0.c, a0.d * c + a0.e * r + a0.f])
-    h, keep, centre, nrm, rot, height, burial, achieved = _place(
-        z, geometry.pixel_m(k), m, t, local, shape=shape)
-    return h, _placed_catalog(local[keep], centre, nrm, rot, height, burial, achieved, shape)
+    h, _, placed = _place(z, geometry.pixel_m(k), m, t, local, shape=shape)
+    return h, placed
 
 
 # --------------------------------------------------------------------------- build

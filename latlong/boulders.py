@@ -9,6 +9,8 @@ triangle mesh a renderer draws.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 import craters as _craters
@@ -22,6 +24,7 @@ from craters.boulders import (
     boulder_normals,
     boulder_world_meshes,
     catalog_shape,
+    draw_boulder_layer,
     iter_boulder_meshes,
     orientations,
     parse_boulder_spec,
@@ -36,7 +39,6 @@ __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_me
            "iter_boulder_meshes", "parse_boulder_spec", "place_boulders"]
 
 _CHUNK = 4096  # boulders per placement chunk
-_MIN_BURIAL = 1e-3  # smallest burial, fraction of the height
 
 
 def _move(lat_deg, lon_deg, dist_rad, az):
@@ -68,12 +70,8 @@ def boulder_population(body: Body, layers, *, rng=None) -> np.ndarray:
     parts = []
     cat = body.craters
     for idx, la in enumerate(layers):
-        mean = area * la.c * (la.d_min_m**la.k - la.d_max_m**la.k)
-        if mean > 20_000_000:
-            raise ValueError(f"boulder layer {idx} asks for about {mean:.3g} boulders "
-                             "(limit 2e7); raise d_min or lower c")
-        n = int(rng.poisson(mean))
-        d = _craters.sample_power_law_diameters(n, la.d_min_m, la.d_max_m, -la.k, rng=rng)
+        cols = draw_boulder_layer(la, area, idx, rng)
+        n = len(cols["diameter_m"])
         lat, lon, _ = _sample_surface(body, totals, n, rng)
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
@@ -84,12 +82,7 @@ def boulder_population(body: Body, layers, *, rng=None) -> np.ndarray:
             la2, lo2 = _move(cat["lat_deg"][pick], cat["lon_deg"][pick], r / rloc,
                              rng.uniform(0, 2 * np.pi, n_near))
             lat[:n_near], lon[:n_near] = la2, lo2
-        # at least 0.1 % of the height: every boulder touches the ground
-        burial = np.maximum(rng.uniform(0.0, la.burial_max, n), _MIN_BURIAL)
-        parts.append(_craters.make_catalog(
-            lat_deg=lat, lon_deg=lon, diameter_m=d, kind=np.full(n, "boulder"),
-            burial_frac=burial, azimuth_deg=rng.uniform(0.0, 360.0, n),
-            seed=rng.integers(0, 2**63, n, dtype=np.uint64), layer=np.full(n, idx)))
+        parts.append(_craters.make_catalog(lat_deg=lat, lon_deg=lon, **cols))
     return np.concatenate(parts)
 
 
@@ -134,6 +127,7 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     for name in ("lat_deg", "lon_deg", "diameter_m", "burial_frac", "azimuth_deg", "seed"):
         if name not in (cat.dtype.names or ()):
             raise ValueError(f"boulder catalog needs a {name!r} column")
+    check_int("max_iterations", max_iterations, 1, 100)
     n = len(cat)
     grid = body.grid
     stretch = np.asarray(body.stretch)
@@ -146,13 +140,9 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     nrm = np.stack([grid.interpolate(normals[:, c], colat, lon) for c in range(3)], 1)
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     rot = orientations(nrm, np.radians(cat["azimuth_deg"]))
-    check_int("max_iterations", max_iterations, 1, 100)
     centre = np.empty((n, 3))
     achieved, height, burial = np.empty(n), np.empty(n), np.empty(n)
-
-    def depths(points, normals):
-        return _depths(body, points, normals)
-
+    depths = functools.partial(_depths, body)
     for s0 in range(0, n, _CHUNK):  # a chunk of boulders at a time (bounded memory)
         sl = slice(s0, min(s0 + _CHUNK, n))
         verts, _ = boulder_meshes(cat["seed"][sl], shape)
