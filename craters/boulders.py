@@ -88,10 +88,11 @@ class BoulderShape:
     """Displacements shrink by 2^-hurst per level beyond the edge-length scaling."""
 
     def __post_init__(self):
-        check_int("base_level", self.base_level, 0, 6)
-        check_int("n_levels", self.n_levels, 1, 6)
+        object.__setattr__(self, "base_level", check_int("base_level", self.base_level, 0, 6))
+        object.__setattr__(self, "n_levels", check_int("n_levels", self.n_levels, 1, 6))
         if self.base_level + self.n_levels > 7:
-            raise ValueError("`base_level` + `n_levels` must be <= 7 (163 842 vertices)")
+            raise ValueError(f"`base_level` + `n_levels` must be <= 7 (finest level 6: 40 962 "
+                             f"vertices); got {self.base_level} + {self.n_levels}")
         check_range("flatten", self.flatten, 0.1, 2.0)
         check_range("elongation", self.elongation, 0.5, 4.0)
         check_range("roughness", self.roughness, 0.0, 1.0)
@@ -100,6 +101,12 @@ class BoulderShape:
     @property
     def levels(self) -> range:
         return range(self.base_level, self.base_level + self.n_levels)
+
+
+def mesh_chunk(shape: BoulderShape) -> int:
+    """How many boulders to build at once: about 4 M finest-level vertices (~100 MB of
+    float64 coordinates), at most 4096 boulders."""
+    return max(1, min(4096, (1 << 22) // (10 * 4**shape.levels[-1] + 2)))
 
 
 def boulder_meshes(seeds, shape: BoulderShape = BoulderShape()):
@@ -162,7 +169,8 @@ class BoulderNode:
 
     level: int
     low: tuple
-    high: BoulderNode | tuple
+    high: BoulderNode | tuple | None
+    """None when the boulder has a single level."""
 
     def meshes(self) -> list[tuple]:
         """The (vertices, faces) of every level, coarse to fine."""
@@ -171,7 +179,7 @@ class BoulderNode:
         while isinstance(node, BoulderNode):
             out.append(node.low)
             node = node.high
-        return out + [node]
+        return out if node is None else [*out, node]
 
 
 def boulder(*, rng=None, shape: BoulderShape = BoulderShape()) -> BoulderNode:
@@ -190,7 +198,7 @@ def boulder(*, rng=None, shape: BoulderShape = BoulderShape()) -> BoulderNode:
     for lv, mesh in zip(list(shape.levels)[-2::-1], meshes[-2::-1], strict=True):
         node = BoulderNode(lv, mesh, node)
     if isinstance(node, tuple):  # a single level
-        return BoulderNode(shape.base_level, node, node)
+        return BoulderNode(shape.base_level, node, None)
     return node
 
 
@@ -299,13 +307,19 @@ def catalog_shape(catalog) -> BoulderShape:
     cat = np.asarray(catalog)
     if len(cat) == 0 or "shape_flatten" not in cat.dtype.names:
         return BoulderShape()
-    vals = {f.name: cat[f"shape_{f.name}"][0] for f in dataclasses.fields(BoulderShape)}
+    vals = {}
+    for f in dataclasses.fields(BoulderShape):
+        col = cat[f"shape_{f.name}"]
+        if not (col == col[0]).all():
+            raise ValueError(f"the catalog mixes boulder shapes (column shape_{f.name} is not "
+                             "constant); keep one catalog per BoulderShape")
+        vals[f.name] = col[0]
     vals["base_level"] = int(vals["base_level"])
     vals["n_levels"] = int(vals["n_levels"])
     return BoulderShape(**vals)
 
 
-def iter_boulder_meshes(catalog, level: int | None = None, chunk: int = 4096):
+def iter_boulder_meshes(catalog, level: int | None = None, chunk: int | None = None):
     """Placed boulders a chunk at a time: yields ``(first, vertices (k, V, 3) m, faces
     (F, 3))`` with the faces shared by the k boulders (outward). A placed catalog has
     ``seed, diameter_m``, the centre ``centre_x_m, centre_y_m, centre_z_m`` and the
@@ -319,6 +333,7 @@ def iter_boulder_meshes(catalog, level: int | None = None, chunk: int = 4096):
                                                             shape.base_level,
                                                             shape.levels[-1])
     nv = 10 * 4**level + 2
+    chunk = mesh_chunk(shape) if chunk is None else check_int("chunk", chunk, 1, 1 << 30)
     for s0 in range(0, len(cat), chunk):
         sub = cat[s0:s0 + chunk]
         verts, faces = boulder_meshes(sub["seed"], shape)
@@ -384,18 +399,41 @@ def quaternions(rot) -> np.ndarray:
 def _converge(depths, centre, cand, nrm, burial, size, max_iterations):
     """Move each boulder along its normal until its deepest candidate point is ``burial``
     below the ground (within 1e-9 of its size): the depth grows one for one with the
-    move where the ground is smooth. Updates ``centre`` in place."""
+    move where the ground is smooth. Updates ``centre`` in place; a boulder whose depth
+    is not finite (its points left the ground's domain) is left where it is."""
     achieved = depths(centre[:, None, :] + cand, nrm).max(axis=1)
     active = np.arange(len(centre))
     for _ in range(max_iterations):
         miss = burial[active] - achieved[active]
-        keep = np.abs(miss) >= 1e-9 * size[active]
+        keep = np.abs(miss) >= 1e-9 * size[active]  # False for NaN: nothing to move by
         active, miss = active[keep], miss[keep]
         if len(active) == 0:
             break
         centre[active] -= nrm[active] * miss[:, None]
         achieved[active] = depths(centre[active, None, :] + cand[active],
                                   nrm[active]).max(axis=1)
+
+
+def _bisect(depths, centre, world, nrm, burial, size, steps: int = 60):
+    """Fallback for boulders the Newton-like moves did not settle (very rough ground):
+    bisection along the normal on the deepest-vertex depth, which only grows as the
+    boulder moves down. Updates ``centre`` in place where a bracket is found."""
+    def miss(t):
+        return depths(centre[:, None, :] - (nrm * t[:, None])[:, None, :] + world,
+                      nrm).max(axis=1) - burial
+
+    lo, hi = -size.copy(), size.copy()
+    for _ in range(8):  # widen until the depth is too small at lo and too large at hi
+        m_lo, m_hi = miss(lo), miss(hi)
+        lo = np.where(m_lo > 0, 2 * lo, lo)
+        hi = np.where(m_hi < 0, 2 * hi, hi)
+    ok = (miss(lo) <= 0) & (miss(hi) >= 0)
+    for _ in range(steps):
+        mid = 0.5 * (lo + hi)
+        up = miss(mid) > 0
+        hi, lo = np.where(up, mid, hi), np.where(up, lo, mid)
+    # the bracket end that is buried (never the floating one)
+    centre[ok] -= nrm[ok] * hi[ok, None]
 
 
 def rest_on_ground(depths, world, ground, nrm, burial_frac, size, *, max_iterations=12):
@@ -438,14 +476,22 @@ def rest_on_ground(depths, world, ground, nrm, burial_frac, size, *, max_iterati
     _converge(depths, centre, cand, nrm, burial, size, max_iterations)
     achieved = np.empty(k)
     todo = np.arange(k)
-    for _ in range(4):  # check every vertex; move the boulders that were wrong
+    for attempt in range(5):  # check every vertex; move the boulders that were wrong
         depth = depths(centre[todo, None, :] + world[todo], nrm[todo])
         achieved[todo] = depth.max(axis=1)
-        bad = np.abs(achieved[todo] - burial[todo]) >= 1e-9 * size[todo]
+        bad = ~(np.abs(achieved[todo] - burial[todo]) < 1e-9 * size[todo])  # NaN is bad
         if not bad.any():
             break
         todo, depth = todo[bad], depth[bad]
-        idx = np.sort(np.argpartition(-depth, kc - 1, axis=1)[:, :kc], axis=1)
+        if attempt == 4:  # not settled: bisect, then measure once more
+            sub = centre[todo]
+            _bisect(depths, sub, world[todo], nrm[todo], burial[todo], size[todo])
+            centre[todo] = sub
+            achieved[todo] = depths(centre[todo, None, :] + world[todo],
+                                    nrm[todo]).max(axis=1)
+            break
+        idx = np.sort(np.argpartition(-np.nan_to_num(depth, nan=-np.inf), kc - 1,
+                                      axis=1)[:, :kc], axis=1)
         sub = centre[todo]
         _converge(depths, sub, np.take_along_axis(world[todo], idx[:, :, None], axis=1),
                   nrm[todo], burial[todo], size[todo], max_iterations)

@@ -1,4 +1,5 @@
-"""Numba kernels for boulders on rasters: bilinear ground, heightfield maximum."""
+"""Numba kernels for boulders on rasters: bilinear ground, footprint gradients,
+heightfield maximum."""
 
 from __future__ import annotations
 
@@ -28,6 +29,46 @@ def _bilinear_kernel(z, cols, rows, out):
     """:func:`_bilinear_one` at many points."""
     for i in prange(cols.shape[0]):
         out[i] = _bilinear_one(z, cols[i], rows[i])
+
+
+@njit(cache=True)
+def _bilinear_serial_kernel(z, cols, rows, out):
+    """:func:`_bilinear_kernel` without a parallel region (small calls)."""
+    for i in range(cols.shape[0]):
+        out[i] = _bilinear_one(z, cols[i], rows[i])
+
+
+@njit(cache=True, inline="always")
+def _gradient_at(z, known, r, c, axis, p):
+    """``numpy.gradient(where(known, z, 0), p)[axis]`` at pixel (r, c): central
+    differences inside, one-sided on the border."""
+    n = z.shape[axis]
+    i = r if axis == 0 else c
+    lo = i - 1 if i > 0 else i
+    hi = i + 1 if i < n - 1 else i
+    if axis == 0:
+        a = z[hi, c] if known[hi, c] else 0.0
+        b = z[lo, c] if known[lo, c] else 0.0
+    else:
+        a = z[r, hi] if known[r, hi] else 0.0
+        b = z[r, lo] if known[r, lo] else 0.0
+    return (a - b) / ((hi - lo) * p)
+
+
+@njit(cache=True)
+def _window_gradient_kernel(z, known, p, r0, r1, c0, c1, out):
+    """Mean height gradient (d/dcol, d/drow per metre) over the windows
+    ``[r0[k]:r1[k], c0[k]:c1[k]]``, unknown pixels read as 0 -> out (k, 2)."""
+    for k in range(r0.shape[0]):
+        gc = 0.0
+        gr = 0.0
+        for r in range(r0[k], r1[k]):
+            for c in range(c0[k], c1[k]):
+                gc += _gradient_at(z, known, r, c, 1, p)
+                gr += _gradient_at(z, known, r, c, 0, p)
+        count = (r1[k] - r0[k]) * (c1[k] - c0[k])
+        out[k, 0] = gc / count
+        out[k, 1] = gr / count
 
 
 @njit(cache=True)

@@ -29,19 +29,24 @@ from craters.boulders import (
     BoulderShape,
     boulder_meshes,
     draw_boulder_layer,
+    mesh_chunk,
     orientations,
     placed_columns,
     rest_on_ground,
 )
 
-from ._boulder_kernels import _bilinear_kernel, _raster_max_kernel
+from ._boulder_kernels import (
+    _bilinear_kernel,
+    _bilinear_serial_kernel,
+    _raster_max_kernel,
+    _window_gradient_kernel,
+)
 from .core import Dem
 from .craterfill import _check_common
 from .frame import LocalFrame, grid_pixel_size, pixel_affine
 
 __all__ = ["boulder_population", "stamp_boulders"]
 
-_CHUNK = 4096  # boulders per placement chunk
 #: Largest horizontal reach of a boulder from its centre, in diameters (unit longest
 #: extent, centred on its bounding box: at most half the box diagonal).
 _REACH = 0.87
@@ -104,27 +109,23 @@ def _bilinear(z, cols, rows):
     cols = np.ascontiguousarray(cols, dtype=np.float64).ravel()
     rows = np.ascontiguousarray(rows, dtype=np.float64).ravel()
     out = np.empty(len(cols))
-    _bilinear_kernel(z, cols, rows, out)
+    # a parallel region per small call stalls when the other core is busy
+    (_bilinear_kernel if len(cols) >= 65536 else _bilinear_serial_kernel)(z, cols, rows, out)
     return out
 
 
 def _ground_normals(z, nan, p: float, m: np.ndarray, xs, ys, ds) -> np.ndarray:
     """Unit ground normals (local frame, z up) at pixel positions ``xs, ys``: the mean
-    height gradient over the pixels within half of each size ``ds`` (summed-area tables)."""
+    height gradient (``numpy.gradient``, unknown pixels read as 0) over the pixels within
+    half of each size ``ds``, summed window by window (no whole-raster arrays)."""
     rows, cols = z.shape
-    g_row, g_col = np.gradient(np.where(nan, 0.0, z), p)  # per metre along rows, columns
-    sat_c = np.zeros((rows + 1, cols + 1))
-    sat_r = np.zeros((rows + 1, cols + 1))
-    sat_c[1:, 1:] = g_col.cumsum(0).cumsum(1)
-    sat_r[1:, 1:] = g_row.cumsum(0).cumsum(1)
-    half = np.maximum(np.rint(0.5 * ds / p), 1).astype(int)
-    ic, ir = np.rint(xs).astype(int), np.rint(ys).astype(int)
+    half = np.maximum(np.rint(0.5 * ds / p), 1).astype(np.int64)
+    ic, ir = np.rint(xs).astype(np.int64), np.rint(ys).astype(np.int64)
     r0, r1 = np.maximum(ir - half, 0), np.minimum(ir + half + 1, rows)
     c0, c1 = np.maximum(ic - half, 0), np.minimum(ic + half + 1, cols)
-    count = (r1 - r0) * (c1 - c0)
-    mc = (sat_c[r1, c1] - sat_c[r0, c1] - sat_c[r1, c0] + sat_c[r0, c0]) / count
-    mr = (sat_r[r1, c1] - sat_r[r0, c1] - sat_r[r1, c0] + sat_r[r0, c0]) / count
-    grad = np.stack([mc, mr], axis=1) @ m.T  # (dz/dx, dz/dy): m is orthogonal
+    mean = np.empty((len(ds), 2))
+    _window_gradient_kernel(z, ~nan, float(p), r0, r1, c0, c1, mean)
+    grad = mean @ m.T  # (dz/dx, dz/dy): m is orthogonal
     nrm = np.concatenate([-grad, np.ones((len(ds), 1))], axis=1)
     return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
@@ -154,8 +155,8 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
     # no unknown pixel under the footprint: integral image of the NaN mask
     nan = np.isnan(z)
     if nan.any():
-        sat = np.zeros((rows + 1, cols + 1))
-        sat[1:, 1:] = nan.cumsum(0).cumsum(1)
+        sat = np.zeros((rows + 1, cols + 1), dtype=np.int64)
+        sat[1:, 1:] = nan.cumsum(0, dtype=np.int64).cumsum(1)
         idx = np.nonzero(keep)[0]
         r0 = np.floor(cy[idx] - reach[idx]).astype(int)
         r1 = np.ceil(cy[idx] + reach[idx]).astype(int) + 1
@@ -179,22 +180,30 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
 
     centre = np.empty((n, 3))
     height, burial, achieved, top = np.empty(n), np.empty(n), np.empty(n), np.empty(n)
-    for s0 in range(0, n, _CHUNK):
-        sl = slice(s0, min(s0 + _CHUNK, n))
+    settled = np.zeros(n, dtype=bool)
+    chunk = mesh_chunk(shape)
+    for s0 in range(0, n, chunk):
+        sl = slice(s0, min(s0 + chunk, n))
         verts, faces_by_level = boulder_meshes(sub["seed"][sl], shape)
         world = np.einsum("kij,kvj->kvi", rot[sl], verts * ds[sl, None, None])
         centre[sl], achieved[sl], height[sl], burial[sl] = rest_on_ground(
             depths, world, ground[sl], nrm[sl], sub["burial_frac"][sl], ds[sl],
             max_iterations=max_iterations)
+        # a boulder whose points left the raster while settling (extremely rough ground)
+        # is left out like one off the grid: no floating or unmeasured boulders
+        ok = np.abs(achieved[sl] - burial[sl]) <= 1e-6 * ds[sl]
+        settled[sl] = ok
         # every boulder rests on the original ground; then the tops are stamped
-        placed = world + centre[sl, None, :]
-        top[sl] = placed[..., 2].max(axis=1)
+        placed = world[ok] + centre[sl][ok, None, :]
+        top[sl][ok] = placed[..., 2].max(axis=1)
         pc, pr = to_pixels(placed[..., 0], placed[..., 1])
         _raster_max_kernel(out, np.ascontiguousarray(np.stack([pc, pr, placed[..., 2]], -1)),
                            np.ascontiguousarray(faces_by_level[shape.levels[-1]],
                                                 dtype=np.int64))
-    cols = placed_columns(sub, centre, nrm, rot, height, burial, achieved, shape)
-    cols["top_m"] = top
+    keep[sel[~settled]] = False
+    cols = placed_columns(sub[settled], centre[settled], nrm[settled], rot[settled],
+                          height[settled], burial[settled], achieved[settled], shape)
+    cols["top_m"] = top[settled]
     return out, keep, craters.make_catalog(**cols)
 
 

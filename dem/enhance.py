@@ -301,10 +301,10 @@ def _geometry(size: int, windows, pixel0_m: float) -> _Geometry:
 
 
 # --------------------------------------------------------------------------- craters
-def _poisson(rng: np.random.Generator, mean: float, what: str) -> int:
+def _poisson(rng: np.random.Generator, mean: float, what: str, noun: str = "craters") -> int:
     if mean > _MAX_COUNT_MEAN:
-        raise ValueError(f"{what}: about {mean:.3g} craters; the crater layers ask for an "
-                         f"absurd number of small craters (raise dmin or lower c)")
+        raise ValueError(f"{what}: about {mean:.3g} {noun}; the {noun[:-1]} layers ask for an "
+                         f"absurd number of small {noun} (raise dmin or lower c)")
     return int(rng.poisson(mean)) if mean > 0 else 0
 
 
@@ -471,7 +471,7 @@ def plan_boulders(specs, geometry: _Geometry, *, min_px: float, seed: int):
         outside = area0 - geometry.area_m2(b)
         n_out = _poisson(_stream(seed, _STREAM_BOULDER_OUTSIDE, b),
                          sum(count(outside, s, s.d_min_m, s.d_max_m) for _, s in trunc),
-                         f"boulder diameter band {b}")
+                         f"boulder diameter band {b}", "boulders")
         keep, next_index = _assign(cat, _REACH * cat["diameter_m"], geometry, b, per_layer,
                                    next_index)
         entry.update(drawn=len(cat) + n_out, assigned=int(keep.sum()),
@@ -479,7 +479,7 @@ def plan_boulders(specs, geometry: _Geometry, *, min_px: float, seed: int):
     small = sum(count(area0, s, s.d_min_m, min(s.d_max_m, lo[-1])) for s in specs
                 if s.d_min_m < min(s.d_max_m, lo[-1]))
     n_small = _poisson(_stream(seed, _STREAM_BOULDER_SMALL), small,
-                       "boulders below the finest layer")
+                       "boulders below the finest layer", "boulders")
     catalogs = [np.concatenate(parts) if parts else None for parts in per_layer]
     assigned = [0 if c is None else len(c) for c in catalogs]
     accounting = {"drawn": sum(e["drawn"] for e in bands) + n_small, "assigned": assigned,

@@ -184,7 +184,7 @@ class _Rocks:
     """The boulders of a stack, meshed a chunk at a time after the terrain."""
 
     def __init__(self, stack: Stack):
-        from craters.boulders import catalog_shape
+        from craters.boulders import catalog_shape, mesh_chunk
 
         parts, layers = [], []
         for k, cat in enumerate(stack.boulders):
@@ -195,11 +195,12 @@ class _Rocks:
         self.layer = np.concatenate(layers) if layers else np.zeros(0, np.uint8)
         n = 0 if self.cat is None else len(self.cat)
         if n:
-            self.level = catalog_shape(self.cat).levels[-1]
+            shape = catalog_shape(self.cat)
+            self.level, self.chunk = shape.levels[-1], mesh_chunk(shape)
             self.ids = (self.cat["index"].astype(np.int32) if "index" in self.cat.dtype.names
                         else np.arange(n, dtype=np.int32))
         else:
-            self.level = 0
+            self.level, self.chunk = 0, 1
         self.nv = 10 * 4**self.level + 2
         self.n_vertices = n * self.nv
         self.n_faces = n * 20 * 4**self.level
@@ -211,7 +212,7 @@ class _Rocks:
         """(xyz (m, 3), layer (m,), boulder_id (m,)) per chunk."""
         from craters.boulders import iter_boulder_meshes
 
-        for s0, world, _ in iter_boulder_meshes(self.cat, self.level, chunk=1024):
+        for s0, world, _ in iter_boulder_meshes(self.cat, self.level, chunk=self.chunk):
             k = len(world)
             yield (world.reshape(-1, 3), np.repeat(self.layer[s0:s0 + k], self.nv),
                    np.repeat(self.ids[s0:s0 + k], self.nv))
@@ -221,8 +222,8 @@ class _Rocks:
 
         faces = _topology(self.level)[0][self.level]
         n = len(self.cat)
-        for s0 in range(0, n, 1024):
-            k = min(1024, n - s0)
+        for s0 in range(0, n, self.chunk):
+            k = min(self.chunk, n - s0)
             offsets = base + (s0 + np.arange(k))[:, None, None] * self.nv
             yield (faces[None] + offsets).reshape(-1, 3)
 

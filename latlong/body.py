@@ -98,6 +98,11 @@ class Body:
             from craters import validate_catalog
 
             boulders = np.array(validate_catalog(boulders), copy=True)
+            missing = [c for c in ("centre_x_m", "quat_w", "seed", "shape_flatten")
+                       if c not in boulders.dtype.names]
+            if missing:
+                raise ValueError(f"`boulders` must be a placed catalog "
+                                 f"(latlong.place_boulders); it has no {missing[0]!r} column")
             boulders.setflags(write=False)
         self._boulders = boulders
 
@@ -117,7 +122,9 @@ class Body:
 
     def replace(self, **changes) -> Body:
         """A new body with some of ``radii_m, radius_m, stretch, metadata, craters,
-        boulders`` replaced."""
+        boulders`` replaced. When the surface changes (``radii_m`` or ``stretch``) and
+        ``boulders`` is not given, the body's boulders are placed again on the new surface
+        (same positions, sizes, burials and shapes), so they never float or sink."""
         kw = {"radii_m": self._radii, "radius_m": self._radius_m,
               "stretch": self._stretch, "metadata": self._metadata,
               "craters": self._craters, "boulders": self._boulders}
@@ -125,6 +132,15 @@ class Body:
         if unknown:
             raise TypeError(f"unknown Body fields: {', '.join(sorted(unknown))}")
         kw.update(changes)
+        rocks = kw["boulders"]
+        moved = {"radii_m", "stretch"} & set(changes) and "boulders" not in changes
+        if moved and rocks is not None and len(rocks):
+            from .boulders import catalog_shape, place_boulders
+
+            kw["boulders"] = None
+            bare = Body(self._grid, kw.pop("radii_m"), **kw)
+            return bare.replace(boulders=place_boulders(bare, rocks,
+                                                        shape=catalog_shape(rocks)))
         return Body(self._grid, kw.pop("radii_m"), **kw)
 
     # ------------------------------------------------------------------ data

@@ -26,6 +26,7 @@ from craters.boulders import (
     catalog_shape,
     draw_boulder_layer,
     iter_boulder_meshes,
+    mesh_chunk,
     orientations,
     parse_boulder_spec,
     placed_columns,
@@ -38,7 +39,6 @@ __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_me
            "boulder_normals", "boulder_population", "boulder_world_meshes", "catalog_shape",
            "iter_boulder_meshes", "parse_boulder_spec", "place_boulders"]
 
-_CHUNK = 4096  # boulders per placement chunk
 
 
 def _move(lat_deg, lon_deg, dist_rad, az):
@@ -143,8 +143,9 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     centre = np.empty((n, 3))
     achieved, height, burial = np.empty(n), np.empty(n), np.empty(n)
     depths = functools.partial(_depths, body)
-    for s0 in range(0, n, _CHUNK):  # a chunk of boulders at a time (bounded memory)
-        sl = slice(s0, min(s0 + _CHUNK, n))
+    chunk = mesh_chunk(shape)
+    for s0 in range(0, n, chunk):  # a chunk of boulders at a time (bounded memory)
+        sl = slice(s0, min(s0 + chunk, n))
         verts, _ = boulder_meshes(cat["seed"][sl], shape)
         world = np.einsum("kij,kvj->kvi", rot[sl], verts * cat["diameter_m"][sl, None, None])
         centre[sl], achieved[sl], height[sl], burial[sl] = rest_on_ground(

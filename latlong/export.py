@@ -128,19 +128,20 @@ def write_ply(body, path, *, progress: bool = False) -> Path:
 
 def _boulder_face_chunks(body, base: int = 0):
     """Boulder triangles a chunk at a time, indices after the body's vertices (+ base)."""
-    from .boulders import _CHUNK, catalog_shape
+    from .boulders import catalog_shape, mesh_chunk
 
     cat = _boulders(body)
     if cat is None:
         return
-    top = catalog_shape(cat).levels[-1]
+    shape = catalog_shape(cat)
+    top, chunk = shape.levels[-1], mesh_chunk(shape)
     nv = 10 * 4**top + 2
     from craters.boulders import _topology
 
     faces = _topology(top)[0][top]
     n = body.grid.n_vertices + base
-    for s0 in range(0, len(cat), _CHUNK):
-        k = min(_CHUNK, len(cat) - s0)
+    for s0 in range(0, len(cat), chunk):
+        k = min(chunk, len(cat) - s0)
         offsets = n + (s0 + np.arange(k))[:, None, None] * nv
         yield (faces[None] + offsets).reshape(-1, 3)
 

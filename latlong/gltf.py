@@ -254,9 +254,10 @@ def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
     and {level: first mesh index} (boulder i's mesh at level l = first[l] + i)."""
     from craters.boulders import boulder_meshes, boulder_normals
 
-    from .boulders import _CHUNK, catalog_shape
+    from .boulders import catalog_shape, mesh_chunk
 
     shape = catalog_shape(cat)
+    chunk = mesh_chunk(shape)
     first = {}
 
     def view(raw: bytes, target: int) -> int:
@@ -281,8 +282,8 @@ def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
     for lv in shape.levels:
         first[lv] = len(gl["meshes"])
         nv = 10 * 4**lv + 2
-        for s0 in range(0, len(cat), _CHUNK):
-            verts, _ = boulder_meshes(cat["seed"][s0:s0 + _CHUNK], shape)
+        for s0 in range(0, len(cat), chunk):
+            verts, _ = boulder_meshes(cat["seed"][s0:s0 + chunk], shape)
             v = verts[:, :nv]
             nrm = boulder_normals(v, faces[lv]).astype(np.float32)
             v = v.astype(np.float32)

@@ -471,3 +471,35 @@ def test_cli_bad_boulder_input(run_cli, tmp_path, args, needles, one_line_error)
                    "-o", "out.npz", cwd=tmp_path)
     one_line_error(proc, *needles)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_shape_levels_chunks_and_mixed_catalogs(rough_body):
+    from craters.boulders import catalog_shape, mesh_chunk
+
+    s = BoulderShape(base_level=1.0, n_levels=2.0)  # integral floats become ints
+    assert s.levels == range(1, 3) and isinstance(s.base_level, int)
+    assert [len(v) for v, _ in boulder(rng=1, shape=BoulderShape(n_levels=1)).meshes()] == [12]
+    # chunks keep about 4 M finest vertices: 4096 boulders of 642, 102 of 40 962
+    assert mesh_chunk(BoulderShape()) == 4096
+    assert mesh_chunk(BoulderShape(base_level=3, n_levels=4)) == 102
+    layer = BoulderLayer(c=1e-4, k=-3.0, d_min_m=2.0, d_max_m=20.0)
+    found = boulder_population(rough_body, layer, rng=2)
+    a = place_boulders(rough_body, found[:5])
+    b = place_boulders(rough_body, found[5:10], shape=BoulderShape(flatten=1.2))
+    assert catalog_shape(b).flatten == 1.2
+    with pytest.raises(ValueError, match="mixes boulder shapes"):
+        boulder_world_meshes(np.concatenate([a, b]))
+
+
+def test_new_surface_places_the_boulders_again(rough_body):
+    """Cratering (or any new radii) after placement: the boulders follow the surface."""
+    layer = BoulderLayer(c=2e-4, k=-3.0, d_min_m=2.0, d_max_m=20.0)
+    body = rough_body.replace(boulders=place_boulders(
+        rough_body, boulder_population(rough_body, layer, rng=3)))
+    assert len(body.boulders) > 20
+    lifted = body.replace(radii_m=body.radii_m + 7.0)
+    again = place_boulders(lifted.replace(boulders=None), body.boulders)
+    assert np.array_equal(lifted.boulders, again)
+    assert not np.allclose(lifted.boulders["centre_x_m"], body.boulders["centre_x_m"])
+    with pytest.raises(ValueError, match="placed catalog"):
+        rough_body.replace(boulders=boulder_population(rough_body, layer, rng=3))
