@@ -329,20 +329,22 @@ def _crater_value(px, py, pz, q, centers, normals, kinds, params, support, zhalf
 
 
 @njit(cache=True, parallel=True)
-def _crater_grid_kernel(origin, h, active, bsize, nbins, offsets, items, centers, normals,
-                        kinds, params, support, zhalf, base, band, out):
-    """out += sum of crater kernels at grid points whose |base| < band."""
+def _crater_grid_kernel(origin, h, active, bsize, nbins, offsets, items, lo, hi, centers,
+                        normals, kinds, params, support, zhalf, base, band, out):
+    """out += sum of crater kernels at grid points whose |base| < band; each crater is
+    evaluated on its index box (``lo``, ``hi``: inclusive (i, j, k), holding its whole
+    support) within each bin."""
     shape = out.shape
     for t in prange(active.shape[0]):
         b = active[t]
         i0, i1, j0, j1, k0, k1 = _bin_box(b, bsize, nbins, shape)
         for p in range(offsets[b], offsets[b + 1]):
             q = items[p]
-            for k in range(k0, k1):
+            for k in range(max(k0, lo[q, 2]), min(k1, hi[q, 2] + 1)):
                 pz = origin[2] + k * h
-                for j in range(j0, j1):
+                for j in range(max(j0, lo[q, 1]), min(j1, hi[q, 1] + 1)):
                     py = origin[1] + j * h
-                    for i in range(i0, i1):
+                    for i in range(max(i0, lo[q, 0]), min(i1, hi[q, 0] + 1)):
                         if abs(base[k, j, i]) >= band:
                             continue
                         out[k, j, i] += _crater_value(origin[0] + i * h, py, pz, q, centers,
@@ -375,20 +377,22 @@ def _gabor_value(px, py, pz, q, pos, wave, env, amp, phase, cutoff2):
 
 
 @njit(cache=True, parallel=True)
-def _gabor_grid_kernel(origin, h, active, bsize, nbins, offsets, items, pos, wave, env, amp,
-                       phase, cutoff2, base, band, out):
-    """out += Gabor sparse convolution at grid points whose |base| < band."""
+def _gabor_grid_kernel(origin, h, active, bsize, nbins, offsets, items, lo, hi, pos, wave,
+                       env, amp, phase, cutoff2, base, band, out):
+    """out += Gabor sparse convolution at grid points whose |base| < band; each impulse is
+    evaluated on its index box (``lo``, ``hi``: inclusive (i, j, k), its cutoff) within
+    each bin."""
     shape = out.shape
     for t in prange(active.shape[0]):
         b = active[t]
         i0, i1, j0, j1, k0, k1 = _bin_box(b, bsize, nbins, shape)
         for p in range(offsets[b], offsets[b + 1]):
             q = items[p]
-            for k in range(k0, k1):
+            for k in range(max(k0, lo[q, 2]), min(k1, hi[q, 2] + 1)):
                 pz = origin[2] + k * h
-                for j in range(j0, j1):
+                for j in range(max(j0, lo[q, 1]), min(j1, hi[q, 1] + 1)):
                     py = origin[1] + j * h
-                    for i in range(i0, i1):
+                    for i in range(max(i0, lo[q, 0]), min(i1, hi[q, 0] + 1)):
                         if abs(base[k, j, i]) >= band:
                             continue
                         out[k, j, i] += _gabor_value(origin[0] + i * h, py, pz, q, pos, wave,
@@ -416,8 +420,10 @@ def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_or
     unit inward normal of each seed. The foot point closest to the grid point is
     searched among the seeds in the 5 x 5 x 5 block around that seed; the distance is
     measured to its tangent plane (feet are about a voxel apart: the distance to the
-    nearest foot itself would be off by (gap / 2)^2 / (2 depth)). The sign is the
-    first-order field's.
+    nearest foot itself would be off by (gap / 2)^2 / (2 depth)) -- unless the point lies
+    more than two voxels along that plane from the foot (the plane's extension says
+    nothing there: near a fold it reads ~0 deep inside the body); then the distance to
+    the foot itself. The sign is the first-order field's. Needs at least one seed.
     """
     nz, ny, nx = out.shape
     for k in prange(nz):
@@ -446,4 +452,6 @@ def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_or
                                 arg = s
                 d = abs((px - foot[arg, 0]) * normal[arg, 0] + (py - foot[arg, 1]) *
                         normal[arg, 1] + (pz - foot[arg, 2]) * normal[arg, 2])
+                if best - d * d > 4.0 * h * h:  # far along the plane: the foot itself
+                    d = np.sqrt(best)
                 out[k, j, i] = d if first_order[k, j, i] > 0 else -d

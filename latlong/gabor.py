@@ -131,18 +131,33 @@ def parse_gabor_spec(spec: str) -> GaborNoise:
         raise ValueError(f"Gabor spec {spec!r}: {exc}") from None
 
 
+_MAX_CELLS = 5e8  # cells listed (a million at a time) for one noise
+_MAX_IMPULSES = 3e7  # impulses of one noise (~100 B each, plus the grid work)
+
+
 # --------------------------------------------------------------------------- impulses
 def _draw(noise: GaborNoise, lo, hi, rng, keep=None):
     """Poisson impulses in the boxes of side s covering [lo, hi] (optionally filtered)."""
     a_min = min(p.bandwidth for p in noise.patches)
     s = math.sqrt(_CUTOFF2) / a_min  # the widest kernel's cut-off radius
     n_cells = np.maximum(np.ceil((np.asarray(hi) - np.asarray(lo)) / s).astype(np.int64), 1)
-    idx = np.arange(int(np.prod(n_cells)))
-    k, j, i = np.unravel_index(idx, n_cells[::-1])
-    corner = np.asarray(lo) + np.stack([i, j, k], axis=1) * s
-    if keep is not None:
-        corner = corner[keep(corner + 0.5 * s, s)]
+    total = int(np.prod(n_cells.astype(float)))
     lam = noise.impulse_density
+    if total > _MAX_CELLS:
+        raise ValueError(f"Gabor noise: bandwidth {a_min:.3g} 1/m makes {total:.3g} cells of "
+                         f"{s:.3g} m over the region (limit {_MAX_CELLS:.0e}); lower the "
+                         "bandwidth (wider impulses)")
+    corners = []
+    for start in range(0, total, 1 << 20):  # listed a million cells at a time
+        k, j, i = np.unravel_index(np.arange(start, min(start + (1 << 20), total)),
+                                   n_cells[::-1])
+        corner = np.asarray(lo) + np.stack([i, j, k], axis=1) * s
+        corners.append(corner if keep is None else corner[keep(corner + 0.5 * s, s)])
+    corner = np.concatenate(corners)
+    expected = lam * s**3 * len(corner)
+    if expected > _MAX_IMPULSES:
+        raise ValueError(f"Gabor noise: about {expected:.3g} impulses (limit "
+                         f"{_MAX_IMPULSES:.0e}); lower the bandwidth or the density")
     counts = rng.poisson(lam * s**3, len(corner))
     n = int(counts.sum())
     pos = np.repeat(corner, counts, axis=0) + rng.random((n, 3)) * s
@@ -228,8 +243,8 @@ def gabor_image(noise: GaborNoise, shape, pixel_m: float, *, rng=None) -> np.nda
     if len(d["pos"]):
         lo_i, hi_i = grid.index_boxes(d["pos"], d["reach"])
         nbins, offsets, items, active = grid.bins(lo_i, hi_i)
-        _k._gabor_grid_kernel(grid.origin, pixel_m, active, _BIN, nbins, offsets, items,
-                              d["pos"], d["wave"], d["env"], d["amp"], d["phase"],
+        _k._gabor_grid_kernel(grid.origin, pixel_m, active, _BIN, nbins, offsets, items, lo_i,
+                              hi_i, d["pos"], d["wave"], d["env"], d["amp"], d["phase"],
                               d["cutoff2"], np.zeros_like(out), np.inf, out)
     return out[0]
 

@@ -59,7 +59,6 @@ import numpy as np
 import craters as _craters
 from craters._infra import (
     atomic_path,
-    check_finite,
     check_int,
     check_positive,
     check_range,
@@ -79,6 +78,8 @@ __all__ = ["MESH_SUFFIXES", "ImplicitSurface", "LcsnLayer", "Metaballs", "Sphere
 logger = logging.getLogger(__name__)
 MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk")
 _BIN = 16  # grid points per bin edge
+_PACK_BYTES_PER_VOXEL = 48  # peak of the packing per voxel (measured 42.6: EDT + flags)
+_GROWTH_STEPS = 6  # enlargements (x 1.5 margin each) of the grid around a bulging surface
 _BLENDS = (1.25, 1.5, 1.75, 2.0, 2.5, 3.0)
 _FIT_SAMPLES = 20000
 # triangles per (constraint area / voxel^2) of the flying-edges metaball surfaces:
@@ -146,6 +147,11 @@ def sphere_packing(model: ShapeModel, *, n_voxels: int = 128, min_radius_m: floa
     h = float((hi - lo).max()) / n_voxels
     r_min = 2.0 * h if min_radius_m is None else check_positive("min_radius_m", min_radius_m)
     origin, dims = _voxel_grid(lo, hi, h, 2)
+    need = _PACK_BYTES_PER_VOXEL * float(np.prod(np.asarray(dims, dtype=float)))
+    if need > 0.6 * physical_memory_bytes():
+        raise ValueError(f"`n_voxels` = {n_voxels}: the packing grid {dims[0]} x {dims[1]} x "
+                         f"{dims[2]} needs about {need / 2**30:.1f} GiB; this machine has "
+                         f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer voxels")
     inside = np.zeros((dims[2], dims[1], dims[0]), dtype=np.uint8)
     odd = _k._voxelize_kernel(np.ascontiguousarray(model.vertices, np.float64),
                               np.ascontiguousarray(model.faces, np.int64), origin, h, inside)
@@ -356,7 +362,8 @@ class LcsnLayer:
     """Crater shape: a name of :data:`craters.LCSN_PRESETS` or LcsnParams; it is scaled
     to every drawn diameter."""
     d_min_m: float
-    """Smallest diameter, metres (rim crest; apparent diameter for rimless kernels)."""
+    """Smallest diameter, metres (rim crest; apparent diameter for rimless kernels; the
+    nominal 2/sqrt(gamma) for degraded kernels with neither)."""
     d_max_m: float
     """Largest diameter, metres; sets the layer's grid level (cells >= d_max_m)."""
     exponent: float = 3.0
@@ -381,7 +388,7 @@ class LcsnLayer:
         hi = check_positive("d_max_m", self.d_max_m)
         if lo >= hi:
             raise ValueError(f"`d_min_m` must be < d_max_m ({hi!r}); got {lo!r}")
-        check_finite("exponent", self.exponent)
+        check_range("exponent", self.exponent, -10.0, 10.0)
         p = check_range("probability", self.probability, 0.0, 1.0)
         if p == 0:
             raise ValueError("`probability` must be in (0, 1]; got 0.0")
@@ -449,9 +456,13 @@ def _measure_shape(params: _craters.LcsnParams) -> _Shape:
     d = morph.get("D_rim", math.nan)
     if not math.isfinite(d):
         d = morph.get("D_a", math.nan)
+    if not math.isfinite(d) and kind in (3, 4):
+        # a degraded kernel whose rim has decayed into the bowl and that never returns to
+        # the datum (Table A.1, 300 m at 2-3 Gyr): its nominal rim diameter 2 / sqrt(gamma)
+        d = 2.0 / math.sqrt(raw["gamma"])
     if not math.isfinite(d):
-        raise ValueError(f"LCSN kernel (kind {kind}) has neither a rim nor an apparent "
-                         "diameter to scale by; choose another kernel")
+        raise ValueError(f"LCSN kernel (kind {kind}) has no apparent diameter to scale by; "
+                         "choose another kernel")
     r = np.linspace(0.0, 10.0 * d, 200_001)
     v = np.abs(_craters.lcsn_kernel(kind, r, **raw))
     amp = float(v.max())
@@ -733,14 +744,20 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
     # boundary (a bulge of the metaballs past the constraint)
     lo, hi = model.vertices.min(axis=0), model.vertices.max(axis=0)
     margin = 0.05 * float((hi - lo).max()) + band
-    while True:
+    for attempt in range(_GROWTH_STEPS + 1):
+        if attempt == _GROWTH_STEPS:
+            raise ValueError(f"the metaball surface still reaches the border of a grid "
+                             f"{margin:.4g} m larger than the constraint after "
+                             f"{_GROWTH_STEPS} enlargements; check the constraint mesh "
+                             "(closed, consistently oriented)")
         glo, ghi = lo - margin, hi + margin
         shape = tuple(int(v) for v in (np.ceil((ghi - glo) / h).astype(np.int64) + 1)[::-1])
         need = _estimate_bytes(shape)
         if need > 0.6 * physical_memory_bytes():
             raise ValueError(f"`voxel_m` = {h:.4g} m needs a {shape[2]} x {shape[1]} x "
                              f"{shape[0]} grid, about {need / 2**30:.1f} GiB; this machine has "
-                             f"{physical_memory_bytes() / 2**30:.1f} GiB: use a larger voxel")
+                             f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer polygons "
+                             "or a larger voxel")
         grid = _Grid(glo, h, shape)
         bar.set_description("metaballs")
         base = _metaball_distance(meta, grid)
@@ -758,10 +775,11 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                               rng)
     field = base.copy()
     if len(imp["centers"]):
-        lo_i, hi_i = grid.index_boxes(imp["centers"], np.maximum(imp["support"],
-                                                                 2.0 * imp["zhalf"]))
+        # the ball around the support cylinder (radius support, half-height 2 zhalf)
+        lo_i, hi_i = grid.index_boxes(imp["centers"], np.hypot(imp["support"],
+                                                               2.0 * imp["zhalf"]))
         nbins, offsets, items, active = grid.bins(lo_i, hi_i)
-        _k._crater_grid_kernel(grid.origin, h, active, _BIN, nbins, offsets, items,
+        _k._crater_grid_kernel(grid.origin, h, active, _BIN, nbins, offsets, items, lo_i, hi_i,
                                imp["centers"], imp["normals"], imp["kinds"], imp["params"],
                                imp["support"], imp["zhalf"], base, band, field)
     times["craters_s"] = time.perf_counter() - t0 - sum(times.values())
@@ -770,14 +788,19 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
     bar.set_description("gabor")
     n_gabor = 0
     if gabor is not None:
+        finest = max(p.frequency + p.bandwidth for p in gabor.patches)
+        if finest * 2.0 * h > 1.0:
+            logger.warning("Gabor noise reaches %.3g cycles/m, finer than the %.3g m voxels "
+                           "resolve (%.3g cycles/m): that part aliases; use more polygons or "
+                           "coarser noise", finest, h, 0.5 / h)
         g = _gabor_impulses(gabor, base, grid, max_disp + gabor_band, rng)
         n_gabor = len(g["pos"])
         if n_gabor:
             lo_i, hi_i = grid.index_boxes(g["pos"], g["reach"])
             nbins, offsets, items, active = grid.bins(lo_i, hi_i)
             noise = np.zeros_like(field)
-            _k._gabor_grid_kernel(grid.origin, h, active, _BIN, nbins, offsets, items,
-                                  g["pos"], g["wave"], g["env"], g["amp"], g["phase"],
+            _k._gabor_grid_kernel(grid.origin, h, active, _BIN, nbins, offsets, items, lo_i,
+                                  hi_i, g["pos"], g["wave"], g["env"], g["amp"], g["phase"],
                                   g["cutoff2"], field, gabor_band + 2.0 * h, noise)
             field += noise
     times["gabor_s"] = time.perf_counter() - t0 - sum(times.values())
@@ -854,11 +877,18 @@ def _metaball_distance(meta: Metaballs, grid: _Grid) -> np.ndarray:
         cross = inside[tuple(a)] != inside[tuple(b)]
         seed[tuple(a)] |= cross
         seed[tuple(b)] |= cross
+    if not seed.any():
+        raise ValueError(f"`voxel_m` = {grid.h:.4g} m: no grid point falls inside the body "
+                         "(the voxel is coarser than the body); use a smaller voxel or more "
+                         "polygons")
     idx = np.argwhere(seed)  # (k, j, i), C order
     pts = grid.origin + idx[:, ::-1] * grid.h
     grad = grid.gradient(first, pts)
     unit = grad / np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
-    foot = np.ascontiguousarray(pts - first[seed][:, None] * unit)
+    # a seed is less than one voxel from the crossing next to it: the first-order
+    # estimate can overshoot where the field is flat
+    reach = np.clip(first[seed], -grid.h, grid.h)
+    foot = np.ascontiguousarray(pts - reach[:, None] * unit)
     seed_id = np.full(grid.shape, -1, dtype=np.int64)
     seed_id[seed] = np.arange(len(idx))
     nearest = distance_transform_edt(~seed, return_distances=False, return_indices=True)

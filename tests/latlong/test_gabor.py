@@ -57,8 +57,8 @@ def test_grid_kernel_matches_reference(rng):
     lo, hi = grid.index_boxes(pos, math.sqrt(cutoff2) / env)
     nbins, offsets, items, active = grid.bins(lo, hi)
     out = np.zeros(grid.shape)
-    K._gabor_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, pos, wave,
-                         env, amp, phase, cutoff2, base, 1.0, out)
+    K._gabor_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, lo, hi, pos,
+                         wave, env, amp, phase, cutoff2, base, 1.0, out)
     k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")
     pts = grid.origin + np.stack([i, j, k], -1).reshape(-1, 3) * grid.h
     want = gabor_reference(pts, pos, wave, env, amp, phase, cutoff2)

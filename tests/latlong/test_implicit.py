@@ -204,11 +204,11 @@ def test_crater_grid_kernel_matches_reference(rng):
     grid = _Grid(np.zeros(3), 0.5, (40, 41, 42))
     base = rng.uniform(-3.0, 3.0, grid.shape)
     band = 2.0
-    lo, hi = grid.index_boxes(centers, np.maximum(support, 2 * zhalf))
+    lo, hi = grid.index_boxes(centers, np.hypot(support, 2 * zhalf))
     nbins, offsets, items, active = grid.bins(lo, hi)
     out = base.copy()
-    K._crater_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, centers,
-                          normals, kinds, params, support, zhalf, base, band, out)
+    K._crater_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, lo, hi,
+                          centers, normals, kinds, params, support, zhalf, base, band, out)
     k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")
     pts = np.stack([i, j, k], -1).reshape(-1, 3) * grid.h
     want = crater_reference(pts, centers, normals, kinds, params, support, zhalf)
@@ -232,6 +232,8 @@ def closest_reference(origin, h, nearest, seed_id, foot, normal, first):
         d2 = ((p - foot[ids]) ** 2).sum(1)
         s = ids[np.argmin(d2)]
         d = abs((p - foot[s]) @ normal[s])
+        if d2.min() - d * d > 4 * h * h:  # far along the tangent plane: the foot itself
+            d = np.sqrt(d2.min())
         out[k, j, i] = d if first[k, j, i] > 0 else -d
     return out
 
@@ -436,6 +438,7 @@ def test_mesh_writers(tmp_path, suffix):
     ({"probability": 1.5}, "`probability`"),
     ({"weight": 2.0}, "`weight`"),
     ({"exponent": math.nan}, "`exponent`"),
+    ({"exponent": 300.0}, "`exponent`"),
     ({"depth_ratio": (0.3, 0.1)}, "`depth_ratio`"),
 ])
 def test_layer_errors(kwargs, match):
@@ -465,3 +468,27 @@ def test_spec_errors():
         parse_lcsn_spec("kernel=fig6-kernel1,dmin=1")
     with pytest.raises(ValueError, match="`d_min_m`"):
         parse_lcsn_spec("kernel=fig6-kernel1,dmin=3,dmax=2")
+
+
+def test_small_seed_free_grid_and_rimless_presets():
+    """Review fixes: a grid with no point inside the body is refused (it read foot[-1]);
+    the field far along a tangent plane is the distance to the foot (it read ~0 deep
+    inside, craters then cut voids); Table A.1's rimless 300 m 2-3 Gyr rows scale by
+    their nominal 2/sqrt(gamma)."""
+    from latlong.implicit import _Grid, _metaball_distance, fit_metaballs, sphere_packing
+    from latlong.shapes import ShapeModel
+
+    bennu = read_shape_model(DATA / "bennu_radar_sbgat.obj", units="km")
+    with pytest.raises(ValueError, match="`n_voxels` = 1024.*GiB"):  # ~41 GiB: refused
+        sphere_packing(bennu, n_voxels=1024)
+    m = read_shape_model(DATA / "itokawa_32.obj", units="km")
+    model = ShapeModel(m.vertices - m.volume_centroid, m.faces)
+    meta = fit_metaballs(sphere_packing(model), model, rng=0)
+    with pytest.raises(ValueError, match="`voxel_m`.*no grid point"):
+        _metaball_distance(meta, _Grid(model.vertices.min(0) - 950.0, 400.0, (7, 7, 8)))
+    for name in ("table-a1-300m-2gyr", "table-a1-300m-3gyr"):
+        surf = implicit_surface(m, [LcsnLayer(name, 20, 60)], target_polygons=20_000, rng=1)
+        assert len(surf.catalog) > 20
+    surf = implicit_surface(bennu, [LcsnLayer("table-a1-300m-0gyr", 20, 60)],
+                            target_polygons=20_000, rng=3)
+    assert surf.metadata["pieces"] == 1  # no voids carved inside the body (was 6)
