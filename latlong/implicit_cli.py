@@ -30,6 +30,10 @@ IMPLICIT_KEYS = ("backend", "shape", "shape_units", "polygons", "voxel_m", "pack
 _OUTPUT_KEYS = ("output", "catalog", "preview", "quiet", "force")
 OUTPUT_SUFFIXES = (*MESH_SUFFIXES, ".npz")
 _DEFAULTS = {"polygons": 200_000, "packing_voxels": 128}
+#: Library parameter names in error messages -> the build options that set them.
+_OPTION_NAMES = {"`n_voxels`": "--packing-voxels", "`voxel_m`": "--voxel-m",
+                 "`target_polygons`": "--polygons", "`cell_m`": "--cell-m",
+                 "`min_radius_m`": "--min-sphere-m"}
 
 
 def _flag(key: str) -> str:
@@ -150,10 +154,17 @@ def run_implicit(s: dict) -> int:
     from .scene import human_bytes
 
     show = not s["quiet"]
-    surf = implicit_surface(s["_constraint"], s["_layers"], gabor=s["_gabor"],
-                            voxel_m=s.get("voxel_m"), target_polygons=s["polygons"],
-                            cell_m=s.get("cell_m"), packing_voxels=s["packing_voxels"],
-                            min_sphere_m=s.get("min_sphere_m"), rng=s["seed"], progress=show)
+    try:
+        surf = implicit_surface(s["_constraint"], s["_layers"], gabor=s["_gabor"],
+                                voxel_m=s.get("voxel_m"), target_polygons=s["polygons"],
+                                cell_m=s.get("cell_m"), packing_voxels=s["packing_voxels"],
+                                min_sphere_m=s.get("min_sphere_m"), rng=s["seed"],
+                                progress=show)
+    except ValueError as exc:  # name the options, not the library's parameters
+        msg = str(exc)
+        for name, flag in _OPTION_NAMES.items():
+            msg = msg.replace(name, flag)
+        raise CliError(msg) from None
     meta = {**surf.metadata, "seed": s["seed"], "version": package_version(),
             "shape_units": s["shape_units"]}
     surf = type(surf)(surf.vertices, surf.faces, surf.catalog, meta, surf.packing,

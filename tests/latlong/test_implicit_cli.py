@@ -111,6 +111,8 @@ def test_config_file(run_cli, tmp_path):
     ([*BENNU, "--polygons", "5"], ["--polygons"]),
     ([*BENNU, "--voxel-m", "-1"], ["--voxel-m"]),
     ([*BENNU, "--packing-voxels", "3"], ["--packing-voxels"]),
+    ([*BENNU, "--packing-voxels", "1024"], ["--packing-voxels = 1024", "GiB"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=10,dmax=20,B=-300"], ["--lcsn", "exponent"]),
     ([*BENNU, "--gabor", "f=1,bw=1"], ["--gabor", "missing amp"]),
     ([*BENNU, "--gabor-example", "x.npy"], ["--gabor-pixel-m"]),
     ([*BENNU, "--gabor-pixel-m", "2"], ["--gabor-pixel-m", "--gabor-example"]),
