@@ -200,7 +200,11 @@ def _sample_radii(kind: int, p: dict) -> np.ndarray:
         lo = scale
     else:
         r_rim = 1.0 / math.sqrt(p["gamma"])
-        ring = r_rim * math.exp(0.5 * math.sqrt(37.0 / p["beta"]))  # L < 1e-16 beyond
+        spread = 0.5 * math.sqrt(37.0 / p["beta"])  # L < 1e-16 beyond r_rim e^spread
+        if spread > 300.0:
+            raise ValueError(f"`beta` must be >= {37.0 / 600.0**2:.2g} for the numeric method "
+                             f"(the ring spreads over e^{spread:.0f} rim radii); got {p['beta']!r}")
+        ring = r_rim * math.exp(spread)
         r_max = max(ring, 7.0 / math.sqrt(p["b"]), 4.0 * r_rim)
         lo = min(r_rim, 1.0 / math.sqrt(p["b"]))
     uniform = np.linspace(0.0, r_max, 16385)

@@ -269,6 +269,8 @@ def test_scaled_shapes_scale_every_measure():
     (lambda: craters.lcsn_degrade(3, (-0.1, 0.0), **PRESETS["fig6-kernel3"].raw), "`alpha`"),
     (lambda: craters.lcsn_scaled(1, 0.0, a=1.0, b=1.0), "`factor`"),
     (lambda: craters.LcsnParams(3, a=1.0, b=1.0), "`beta`"),
+    (lambda: craters.lcsn_morphometry(3, "numeric", kappa=1.0, beta=1e-5, gamma=1.0, a=1.0,
+                                      b=1.0), "`beta` must be >= 0.0001"),  # was OverflowError
 ])
 def test_bad_input_names_the_parameter(call, match):
     with pytest.raises(ValueError, match=match):
