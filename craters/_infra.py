@@ -27,6 +27,7 @@ __all__ = [
     "OneLineParser",
     "atomic_path",
     "check_choice",
+    "check_parent_folder",
     "check_finite",
     "check_int",
     "check_output_path",
@@ -131,6 +132,16 @@ def physical_memory_bytes() -> int:
 
 
 # --------------------------------------------------------------------------- files
+def check_parent_folder(path) -> None:
+    """The folder an output goes into exists and is writable (one-line ValueError)."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} is not writable")
+
+
 def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = None) -> Path:
     """Validate an output path before any work is done.
 
@@ -143,11 +154,7 @@ def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = Non
             f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}; "
             f"allowed: {' '.join(suffixes)}"
         )
-    folder = path.parent if str(path.parent) else Path(".")
-    if not folder.is_dir():
-        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} does not exist")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} is not writable")
+    check_parent_folder(path)
     if path.is_dir():
         raise ValueError(f"output {str(path)!r} is a folder")
     if path.exists() and not force:

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from craters import make_catalog, read_catalog, validate_catalog, write_catalog, write_geojson
-from craters._infra import check_int, package_version, progress_bar
+from craters._infra import check_int, check_parent_folder, package_version, progress_bar
 
 from .core import Dem, crs_label
 from .frame import LocalFrame, grid_pixel_size, pixel_affine
@@ -303,11 +303,7 @@ class Stack:
 def check_stack_folder(folder, *, force: bool) -> Path:
     """Validate an output stack folder before any work (see :meth:`Stack.write`)."""
     folder = Path(folder)
-    parent = folder.parent if str(folder.parent) else Path(".")
-    if not parent.is_dir():
-        raise ValueError(f"output {str(folder)!r}: folder {str(parent)!r} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"output {str(folder)!r}: folder {str(parent)!r} is not writable")
+    check_parent_folder(folder)
     if folder.exists():
         if not folder.is_dir():
             raise ValueError(f"output {str(folder)!r} exists and is not a folder")
