@@ -12,7 +12,7 @@ from craters.lcsn import MORPH_KEYS
 
 PRESETS = craters.LCSN_PRESETS
 NUMERIC_TOL = 0.01  # numeric morphometry vs an independent dense-sampling measurement
-CLOSED_TOL = 0.05  # the acceptance bound for the paper's closed forms
+CLOSED_TOL = 0.05  # the acceptance bound for the closed forms
 FRESH = ["table-a1-300m-0gyr", "table-a1-1km-0gyr", "table-a1-3km-0gyr"]
 FIG6 = ["fig6-kernel1", "fig6-kernel2", "fig6-kernel3", "fig6-kernel4"]
 
@@ -78,7 +78,7 @@ def rel(a, b):
 @pytest.mark.parametrize("name", sorted(PRESETS))
 def test_kernel_matches_the_equations(name):
     p = PRESETS[name]
-    r = np.linspace(0.0, 6.0, 601) * p.morphometry()["D_rim" if p.kind > 2 else "D_a"]
+    r = np.linspace(0.0, 6.0, 601) * p.morphometry("paper")["D_rim" if p.kind > 2 else "D_a"]
     got = craters.lcsn_kernel(p.kind, r, **p.raw)
     np.testing.assert_allclose(got, reference_profile(p.kind, r, p.raw), rtol=1e-13,
                                atol=1e-15 * p.a)
@@ -110,15 +110,49 @@ def test_numeric_agrees_with_independent_measurement(name):
 
 @pytest.mark.parametrize("name", FRESH)
 def test_closed_forms_on_fresh_table_rows(name):
-    """Measured: D_rim and H_t within 5 %; H_rim within 5 % for 1 and 3 km (5.2 % for
-    300 m); D_a 8-11 % and L_d ~50 % short, because eq. 10-11 assume kappa = a."""
+    """The acceptance bound: every closed-form quantity within 5 % of the measured one
+    (measured: <= 0.17 %, the largest L_d of the 3 km crater)."""
     p = PRESETS[name]
     closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
-    assert closed["D_rim"] == pytest.approx(2 / math.sqrt(p.gamma))
-    assert rel(closed["D_rim"], numeric["D_rim"]) < CLOSED_TOL
     assert closed["H_t"] == numeric["H_t"] == p.a
-    assert rel(closed["H_rim"], numeric["H_rim"]) < (0.053 if "300m" in name else CLOSED_TOL)
-    assert 0.08 < rel(closed["D_a"], numeric["D_a"]) < 0.11
+    for key, value in closed.items():
+        if math.isnan(numeric[key]):
+            assert math.isnan(value), key  # 1 km: the flank never returns to the datum
+        else:
+            assert rel(value, numeric[key]) < 0.002, (key, value, numeric[key])
+            assert rel(value, numeric[key]) < CLOSED_TOL
+
+
+@pytest.mark.parametrize("name", FRESH)
+def test_printed_forms_on_fresh_table_rows(name):
+    """As printed, eq. 9-11 put the crest at 1/sqrt(gamma) and assume kappa = a: D_a
+    8-11 % short, L_d ~50 % long on Table A.1 (kappa = 0.22-0.34 a), D_rim 2-4 % short,
+    H_rim 1-5.3 % low (measured)."""
+    p = PRESETS[name]
+    printed, numeric = p.morphometry("paper"), p.morphometry("numeric")
+    assert printed["D_rim"] == pytest.approx(2 / math.sqrt(p.gamma))
+    assert printed["H_rim"] == pytest.approx(p.kappa - p.a * math.exp(-p.b / p.gamma))
+    assert printed["H_t"] == p.a
+    assert 0.02 < rel(printed["D_rim"], numeric["D_rim"]) < 0.04
+    assert 0.01 < rel(printed["H_rim"], numeric["H_rim"]) < 0.053
+    assert 0.08 < rel(printed["D_a"], numeric["D_a"]) < 0.11
+    if math.isfinite(numeric["L_d"]):
+        assert 0.5 < rel(printed["L_d"], numeric["L_d"]) < 0.53
+
+
+@pytest.mark.parametrize("name", [k for k in PRESETS if k.startswith("table-a1")])
+def test_closed_forms_on_every_table_row(name):
+    """Closed and numeric agree on which features exist, and within the measured bounds
+    (degraded rims are shallow: 1 km at 3 Gyr keeps a 6 cm crest, where two Newton steps
+    from 1/sqrt(gamma) are not enough)."""
+    p = PRESETS[name]
+    closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
+    tol = {"table-a1-300m-1gyr": 0.19, "table-a1-1km-2gyr": 0.013,
+           "table-a1-1km-3gyr": 0.49}.get(name, 0.002)
+    for key, value in closed.items():
+        assert math.isnan(value) == math.isnan(numeric[key]), key
+        if math.isfinite(value):
+            assert rel(value, numeric[key]) < tol, (key, value, numeric[key])
 
 
 @pytest.mark.parametrize("name", FIG6)
@@ -145,16 +179,52 @@ def test_fig6_caption_values():
                                                                       rel=1e-9)
 
 
+@pytest.mark.parametrize("method", ["paper", "closed"])
 @pytest.mark.parametrize("beta,gamma,b", [(5.0, 1.0, 0.7), (0.5, 4.0, 1.5), (7.0, 4.5e-7, 9e-7)])
-def test_eq10_eq11_are_exact_when_kappa_equals_a(beta, gamma, b):
+def test_eq10_eq11_are_exact_when_kappa_equals_a(beta, gamma, b, method):
+    """With kappa = a the Lambert-W roots are exact and the refinement leaves them."""
     raw = {"kappa": 3.0, "beta": beta, "gamma": gamma, "a": 3.0, "b": b}
-    closed = craters.lcsn_morphometry(3, **raw)
+    closed = craters.lcsn_morphometry(3, method, **raw)
     numeric = craters.lcsn_morphometry(3, "numeric", **raw)
     assert closed["D_a"] == pytest.approx(numeric["D_a"], rel=1e-9)
-    if math.isfinite(closed["L_d"]):  # compare the outer zero crossing itself
-        outer_closed = closed["L_d"] + closed["D_rim"] / 2
+    if math.isfinite(numeric["L_d"]):  # compare the outer zero crossing itself
+        crest = 1 / math.sqrt(gamma) if method == "paper" else closed["D_rim"] / 2
         outer_numeric = numeric["L_d"] + numeric["D_rim"] / 2
-        assert outer_closed == pytest.approx(outer_numeric, rel=1e-9)
+        assert closed["L_d"] + crest == pytest.approx(outer_numeric, rel=1e-9)
+
+
+def test_closed_forms_on_random_fresh_kernels():
+    """Away from Table A.1: 300 random fresh-looking kernels (kappa/a 0.1-1, beta 2-10,
+    b/gamma 0.5-4) with a rim at least 5 % of the depth. Measured: median worst-quantity
+    error 1e-5, 90 % of kernels below 0.3 %; the flank width L_d is the weakest (up to
+    ~50 % on a low rim); the printed forms' median is ~10 %."""
+    rng = np.random.default_rng(0)
+    closed_err, paper_err = [], []
+    while len(closed_err) < 300:
+        raw = {"kappa": rng.uniform(0.1, 1.0), "beta": rng.uniform(2.0, 10.0), "gamma": 1.0,
+               "a": 1.0, "b": rng.uniform(0.5, 4.0)}
+        numeric = craters.lcsn_morphometry(3, "numeric", **raw)
+        if not numeric["H_rim"] > 0.05 * numeric["H_t"]:
+            continue
+        for method, errs in (("closed", closed_err), ("paper", paper_err)):
+            got = craters.lcsn_morphometry(3, method, **raw)
+            errs.append(max(rel(got[k], numeric[k]) for k in numeric
+                            if math.isfinite(numeric[k]) and math.isfinite(got[k])))
+    assert np.median(closed_err) < 1e-4 and np.percentile(closed_err, 90) < 0.005
+    assert np.median(paper_err) > 0.05
+
+
+def test_refinement_matches_a_plain_newton_reference():
+    """The closed forms' steps, written out independently: ds = -g/g' with
+    g = ln(kappa/a) - beta ln(gamma r^2)^2 + b r^2, twice from eq. 10's root."""
+    p = PRESETS["table-a1-300m-0gyr"]
+    kappa, beta, gamma, a, b = p.kappa, p.beta, p.gamma, p.a, p.b
+    r = 0.5 * p.morphometry("paper")["D_a"]
+    for _ in range(2):
+        g = math.log(kappa / a) - beta * math.log(gamma * r * r) ** 2 + b * r * r
+        dg_dlnr = -4 * beta * math.log(gamma * r * r) + 2 * b * r * r
+        r *= math.exp(-g / dg_dlnr)
+    assert p.morphometry()["D_a"] == pytest.approx(2 * r, rel=1e-12)
 
 
 def test_degraded_rows_without_a_rim():
@@ -162,12 +232,16 @@ def test_degraded_rows_without_a_rim():
     numeric = p.morphometry("numeric")
     assert numeric["H_t"] == pytest.approx(2.4)
     assert all(math.isnan(numeric[k]) for k in ("D_a", "D_rim", "H_rim", "L_d"))
-    closed = p.morphometry("closed")
-    assert closed["H_rim"] < 0 and math.isfinite(closed["D_a"])  # formulas still evaluate
+    printed = p.morphometry("paper")
+    assert printed["H_rim"] < 0 and math.isfinite(printed["D_a"])  # formulas still evaluate
+    closed = p.morphometry("closed")  # no maximum, so no rim and no datum crossing
+    assert all(math.isnan(closed[k]) for k in ("D_a", "D_rim", "H_rim", "L_d"))
     # 1 km at 2 Gyr: a crest survives (1.17 m) though eq. 7 says -0.13 m
     m = PRESETS["table-a1-1km-2gyr"].morphometry("numeric")
     assert m["H_rim"] == pytest.approx(1.1664, abs=1e-4)
-    assert PRESETS["table-a1-1km-2gyr"].morphometry()["H_rim"] < 0
+    assert PRESETS["table-a1-1km-2gyr"].morphometry("paper")["H_rim"] < 0
+    assert PRESETS["table-a1-1km-2gyr"].morphometry()["H_rim"] == pytest.approx(1.1664,
+                                                                                abs=1e-3)
 
 
 def test_table_a1_goldens():
@@ -183,17 +257,18 @@ def test_table_a1_goldens():
 
 
 # --------------------------------------------------------------------------- inverse
+@pytest.mark.parametrize("method", ["closed", "paper"])
 @pytest.mark.parametrize("name", [*FRESH, *FIG6])
-def test_closed_inverse_round_trip(name):
+def test_closed_inverse_round_trip(name, method):
     p = PRESETS[name]
-    closed = p.morphometry("closed")
+    closed = p.morphometry(method)
     extra = {}
     if p.kind == 3:
         extra = {"beta": p.beta}
         closed.pop("L_d")
     elif p.kind == 4:
         extra = {"b": p.b}
-    raw = craters.lcsn_raw(p.kind, **extra, **closed)
+    raw = craters.lcsn_raw(p.kind, method, **extra, **closed)
     for key, value in p.raw.items():
         assert raw[key] == pytest.approx(value, rel=1e-9), key
 

@@ -181,7 +181,7 @@ def test_numba_lcsn_matches_craters(name):
     p = craters.LCSN_PRESETS[name]
     raw = {"kappa": 0.0, "beta": 0.0, "gamma": 0.0, **p.raw}
     params = np.array([raw[k] for k in ("kappa", "beta", "gamma", "a", "b")])
-    r = np.linspace(0, 4 * p.morphometry()["D_rim" if p.kind > 2 else "D_a"], 999)
+    r = np.linspace(0, 4 * p.morphometry("paper")["D_rim" if p.kind > 2 else "D_a"], 999)
     out = np.empty_like(r)
     K._lcsn_profile_kernel(p.kind, r, params, out)
     np.testing.assert_allclose(out, craters.lcsn_kernel(p.kind, r, **p.raw), rtol=1e-13,
