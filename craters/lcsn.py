@@ -231,16 +231,19 @@ def _terms(kind: int, p: dict, s: float):
             gauss, -2.0 * e * gauss, (4.0 * e * e - 4.0 * e) * gauss)
 
 
+_MAX_LN_R = 300.0  # |ln r| beyond this (r outside 1e-130 ... 1e130 m): a step ran away
+
+
 def _newton(step, s: float) -> float:
     """``_NEWTON_STEPS`` explicit Newton steps ``s - g/g'``; NaN if one is undefined."""
     for _ in range(_NEWTON_STEPS):
-        if not math.isfinite(s):
-            return math.nan
         try:
             s = step(s)
         except (ZeroDivisionError, OverflowError, ValueError):  # g' = 0, e^s, log(0)
             return math.nan
-    return s if math.isfinite(s) else math.nan
+        if not abs(s) <= _MAX_LN_R:  # also NaN
+            return math.nan
+    return s
 
 
 def _crest_closed(kind: int, p: dict) -> float:

@@ -214,6 +214,22 @@ def test_closed_forms_on_random_fresh_kernels():
     assert np.median(paper_err) > 0.05
 
 
+@pytest.mark.parametrize("kind", [3, 4])
+def test_closed_forms_never_raise(kind):
+    """Over 12 decades of every raw parameter the formulas give numbers or NaN (a Newton
+    step that runs away, an underflowing radius), never an exception or a length <= 0."""
+    rng = np.random.default_rng(kind)
+    for _ in range(1500):
+        raw = {"kappa": 10 ** rng.uniform(-6, 4) * (rng.random() > 0.05),
+               "beta": 10 ** rng.uniform(-3, 2), "gamma": 10 ** rng.uniform(-9, 3),
+               "a": 10 ** rng.uniform(-6, 4) * (rng.random() > 0.05),
+               "b": 10 ** rng.uniform(-9, 3)}
+        for method in ("closed", "paper"):
+            out = craters.lcsn_morphometry(kind, method, **raw)
+            lengths = [out[k] for k in ("D_a", "D_rim", "L_d") if k in out]
+            assert all(not x <= 0 for x in lengths), (method, raw, out)
+
+
 def test_refinement_matches_a_plain_newton_reference():
     """The closed forms' steps, written out independently: ds = -g/g' with
     g = ln(kappa/a) - beta ln(gamma r^2)^2 + b r^2, twice from eq. 10's root."""
