@@ -106,7 +106,7 @@ def morphometry_table():
                                                for k in numeric if np.isfinite(numeric[k])])
         print(f"  {name:20s} numeric~samples {100 * agree:.1e} % "
               f"{'' if same_nan else '(NaN mismatch!) '}| {errs}")
-    print(f"  0 Gyr Table A.1 rows: largest closed-form error {100 * worst_fresh:.3f} %")
+    print(f"  0 Gyr Table A.1 rows: largest closed-form error {100 * worst_fresh:.1e} %")
     print(f"  time per kernel (mean over the presets): printed {1e6 * times['paper']:.1f} us, "
           f"closed {1e6 * times['closed']:.1f} us, numeric {1e3 * times['numeric']:.2f} ms "
           f"(x{times['numeric'] / times['closed']:.0f} the closed forms)")

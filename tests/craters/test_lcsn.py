@@ -110,8 +110,8 @@ def test_numeric_agrees_with_independent_measurement(name):
 
 @pytest.mark.parametrize("name", FRESH)
 def test_closed_forms_on_fresh_table_rows(name):
-    """The acceptance bound: every closed-form quantity within 5 % of the measured one
-    (measured: <= 0.17 %, the largest L_d of the 3 km crater)."""
+    """The acceptance asks for 5 % (CLOSED_TOL); measured: below 1e-5 for every quantity
+    (asserted 1e-4, twenty times inside the 0.5 % verification window)."""
     p = PRESETS[name]
     closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
     assert closed["H_t"] == numeric["H_t"] == p.a
@@ -119,8 +119,7 @@ def test_closed_forms_on_fresh_table_rows(name):
         if math.isnan(numeric[key]):
             assert math.isnan(value), key  # 1 km: the flank never returns to the datum
         else:
-            assert rel(value, numeric[key]) < 0.002, (key, value, numeric[key])
-            assert rel(value, numeric[key]) < CLOSED_TOL
+            assert rel(value, numeric[key]) < 1e-4 < CLOSED_TOL, (key, value, numeric[key])
 
 
 @pytest.mark.parametrize("name", FRESH)
@@ -140,18 +139,26 @@ def test_printed_forms_on_fresh_table_rows(name):
         assert 0.5 < rel(printed["L_d"], numeric["L_d"]) < 0.53
 
 
+# Measured closed-form errors of the degraded rows (golden values, not bounds in
+# principle): the shallow 1 Gyr 300 m rim (17 cm) has L_d 1.4 % long; 1 km at 3 Gyr keeps
+# a 6 cm crest that three steps from 1/sqrt(gamma) do not reach within 0.5 %, so closed
+# declines it (NaN) while numeric measures it.
+TABLE_GOLDEN_TOL = {"table-a1-300m-1gyr": 0.015, "table-a1-1km-2gyr": 3e-4}
+CLOSED_DECLINES = {"table-a1-1km-3gyr": {"D_a", "D_rim", "H_rim"}}
+
+
 @pytest.mark.parametrize("name", [k for k in PRESETS if k.startswith("table-a1")])
 def test_closed_forms_on_every_table_row(name):
-    """Closed and numeric agree on which features exist, and within the measured bounds
-    (degraded rims are shallow: 1 km at 3 Gyr keeps a 6 cm crest, where two Newton steps
-    from 1/sqrt(gamma) are not enough)."""
     p = PRESETS[name]
     closed, numeric = p.morphometry("closed"), p.morphometry("numeric")
-    tol = {"table-a1-300m-1gyr": 0.19, "table-a1-1km-2gyr": 0.013,
-           "table-a1-1km-3gyr": 0.49}.get(name, 0.002)
+    declined = CLOSED_DECLINES.get(name, set())
     for key, value in closed.items():
+        if key in declined:
+            assert math.isnan(value) and math.isfinite(numeric[key]), key
+            continue
         assert math.isnan(value) == math.isnan(numeric[key]), key
         if math.isfinite(value):
+            tol = TABLE_GOLDEN_TOL.get(name, 1e-4)
             assert rel(value, numeric[key]) < tol, (key, value, numeric[key])
 
 
@@ -193,54 +200,105 @@ def test_eq10_eq11_are_exact_when_kappa_equals_a(beta, gamma, b, method):
         assert closed["L_d"] + crest == pytest.approx(outer_numeric, rel=1e-9)
 
 
-def test_closed_forms_on_random_fresh_kernels():
-    """Away from Table A.1: 300 random fresh-looking kernels (kappa/a 0.1-1, beta 2-10,
-    b/gamma 0.5-4) with a rim at least 5 % of the depth. Measured: median worst-quantity
-    error 1e-5, 90 % of kernels below 0.3 %; the flank width L_d is the weakest (up to
-    ~50 % on a low rim); the printed forms' median is ~10 %."""
-    rng = np.random.default_rng(0)
-    closed_err, paper_err = [], []
-    while len(closed_err) < 300:
-        raw = {"kappa": rng.uniform(0.1, 1.0), "beta": rng.uniform(2.0, 10.0), "gamma": 1.0,
-               "a": 1.0, "b": rng.uniform(0.5, 4.0)}
-        numeric = craters.lcsn_morphometry(3, "numeric", **raw)
-        if not numeric["H_rim"] > 0.05 * numeric["H_t"]:
-            continue
-        for method, errs in (("closed", closed_err), ("paper", paper_err)):
-            got = craters.lcsn_morphometry(3, method, **raw)
-            errs.append(max(rel(got[k], numeric[k]) for k in numeric
-                            if math.isfinite(numeric[k]) and math.isfinite(got[k])))
-    assert np.median(closed_err) < 1e-4 and np.percentile(closed_err, 90) < 0.005
-    assert np.median(paper_err) > 0.05
+def random_kernels(rng, kind, n):
+    """``n`` kernels with a distinct rim (kind 3: at least 5 % of the depth), log-uniform
+    in kappa/a 0.05-2, beta 0.5-20, b/gamma 0.1-10, and their measured morphometry."""
+    out = []
+    while len(out) < n:
+        raw = {"kappa": 10 ** rng.uniform(math.log10(0.05), math.log10(2.0)),
+               "beta": 10 ** rng.uniform(math.log10(0.5), math.log10(20.0)), "gamma": 1.0,
+               "a": 1.0, "b": 10 ** rng.uniform(-1.0, 1.0)}
+        numeric = craters.lcsn_morphometry(kind, "numeric", **raw)
+        if kind == 4 and math.isfinite(numeric["H_rim"]) or (
+                kind == 3 and numeric["H_rim"] > 0.05 * numeric["H_t"]):
+            out.append((raw, numeric))
+    return out
+
+
+@pytest.mark.parametrize("kind", [3, 4])
+def test_closed_forms_on_random_kernels(kind):
+    """Away from Table A.1 (300 kernels per kind). Every finite closed value exists in the
+    measured profile and is within the 0.5 % verification window (radii; H_rim at the
+    refined crest closer still), L_d within 7 %; closed declines (NaN) where numeric
+    measures for under 2 % of the quantities. Measured (1000 per kind, other seeds):
+    worst D_rim 0.5 %, D_a 0.07 %, L_d 1.6 %; declined 0.3 % (kind 3) / 0.5 % (kind 4,
+    mostly an uplift wider than the rim). The printed forms' median error is ~10 %."""
+    rng = np.random.default_rng(kind)
+    worst, paper_worst, declined, total = [], [], 0, 0
+    for raw, numeric in random_kernels(rng, kind, 300):
+        closed = craters.lcsn_morphometry(kind, **raw)
+        printed = craters.lcsn_morphometry(kind, "paper", **raw)
+        errs = []
+        for key, value in closed.items():
+            if math.isfinite(value):
+                assert math.isfinite(numeric[key]), (key, raw, closed, numeric)
+                errs.append(rel(value, numeric[key]))
+                bound = 0.07 if key == "L_d" else 0.0051
+                assert rel(value, numeric[key]) < bound, (key, raw, value, numeric[key])
+            elif math.isfinite(numeric[key]):
+                declined += 1
+            total += math.isfinite(numeric[key])
+        worst.append(max(errs))
+        paper_worst.append(max(rel(printed[k], numeric[k]) for k in numeric
+                               if math.isfinite(printed[k]) and math.isfinite(numeric[k])))
+    assert np.median(worst) < 1e-5
+    assert declined < 0.02 * total, (declined, total)
+    assert np.median(paper_worst) > 0.05
 
 
 @pytest.mark.parametrize("kind", [3, 4])
 def test_closed_forms_never_raise(kind):
-    """Over 12 decades of every raw parameter the formulas give numbers or NaN (a Newton
-    step that runs away, an underflowing radius), never an exception or a length <= 0."""
+    """Over 9-12 decades of every raw parameter the formulas give numbers or NaN (a Newton
+    step that runs away, an overflowing radius), never an exception or a length <= 0."""
     rng = np.random.default_rng(kind)
     for _ in range(1500):
         raw = {"kappa": 10 ** rng.uniform(-6, 4) * (rng.random() > 0.05),
-               "beta": 10 ** rng.uniform(-3, 2), "gamma": 10 ** rng.uniform(-9, 3),
+               "beta": 10 ** rng.uniform(-7, 2), "gamma": 10 ** rng.uniform(-9, 3),
                "a": 10 ** rng.uniform(-6, 4) * (rng.random() > 0.05),
                "b": 10 ** rng.uniform(-9, 3)}
         for method in ("closed", "paper"):
             out = craters.lcsn_morphometry(kind, method, **raw)
-            lengths = [out[k] for k in ("D_a", "D_rim", "L_d") if k in out]
-            assert all(not x <= 0 for x in lengths), (method, raw, out)
+            for key in ("D_a", "D_rim", "L_d"):
+                if key in out:
+                    assert math.isnan(out[key]) or out[key] > 0, (method, raw, out)
 
 
-def test_refinement_matches_a_plain_newton_reference():
-    """The closed forms' steps, written out independently: ds = -g/g' with
-    g = ln(kappa/a) - beta ln(gamma r^2)^2 + b r^2, twice from eq. 10's root."""
-    p = PRESETS["table-a1-300m-0gyr"]
-    kappa, beta, gamma, a, b = p.kappa, p.beta, p.gamma, p.a, p.b
-    r = 0.5 * p.morphometry("paper")["D_a"]
-    for _ in range(2):
-        g = math.log(kappa / a) - beta * math.log(gamma * r * r) ** 2 + b * r * r
-        dg_dlnr = -4 * beta * math.log(gamma * r * r) + 2 * b * r * r
-        r *= math.exp(-g / dg_dlnr)
-    assert p.morphometry()["D_a"] == pytest.approx(2 * r, rel=1e-12)
+def dlnr(f, s, h=1e-4):
+    """First and second derivative of f(e^s) by central differences."""
+    return ((f(math.exp(s + h)) - f(math.exp(s - h))) / (2 * h),
+            (f(math.exp(s + h)) - 2 * f(math.exp(s)) + f(math.exp(s - h))) / h**2)
+
+
+@pytest.mark.parametrize("name", ["table-a1-300m-0gyr", "table-a1-3km-1gyr", "fig6-kernel4"])
+def test_refinement_matches_a_plain_newton_reference(name):
+    """The closed forms' steps written out independently from the profile itself: three
+    Newton steps in s = ln r with derivatives by finite differences, from 1/sqrt(gamma)
+    (crest), eq. 10's root (D_a, kind 3) and eq. 16's root (border, kind 4)."""
+    p = PRESETS[name]
+    printed, closed = p.morphometry("paper"), p.morphometry()
+
+    def f(r):
+        return float(reference_profile(p.kind, np.array(r), p.raw))
+
+    s = math.log(0.5 * printed["D_rim"])
+    for _ in range(3):
+        d1, d2 = dlnr(f, s)
+        s -= d1 / d2
+    assert closed["D_rim"] == pytest.approx(2 * math.exp(s), rel=1e-6)
+    crest = s
+    if p.kind == 3:
+        s = math.log(0.5 * printed["D_a"])
+        g = lambda r: math.log(p.kappa / p.a) - p.beta * math.log(p.gamma * r * r) ** 2 + (  # noqa: E731
+            p.b * r * r)
+        for _ in range(3):
+            s -= g(math.exp(s)) / dlnr(g, s)[0]
+        assert closed["D_a"] == pytest.approx(2 * math.exp(s), rel=1e-6)
+    else:
+        s = math.log(printed["L_d"] + 0.5 * printed["D_rim"])
+        for _ in range(3):
+            s -= (math.log(f(math.exp(s))) - math.log(0.01)) / dlnr(
+                lambda r: math.log(f(r)), s)[0]
+        assert closed["L_d"] == pytest.approx(math.exp(s) - math.exp(crest), rel=1e-6)
 
 
 def test_degraded_rows_without_a_rim():
@@ -275,7 +333,7 @@ def test_table_a1_goldens():
 # --------------------------------------------------------------------------- inverse
 @pytest.mark.parametrize("method", ["closed", "paper"])
 @pytest.mark.parametrize("name", [*FRESH, *FIG6])
-def test_closed_inverse_round_trip(name, method):
+def test_inverse_round_trip(name, method):
     p = PRESETS[name]
     closed = p.morphometry(method)
     extra = {}
@@ -287,6 +345,37 @@ def test_closed_inverse_round_trip(name, method):
     raw = craters.lcsn_raw(p.kind, method, **extra, **closed)
     for key, value in p.raw.items():
         assert raw[key] == pytest.approx(value, rel=1e-9), key
+
+
+@pytest.mark.parametrize("kind", [3, 4])
+def test_closed_inverse_on_random_kernels(kind):
+    """lcsn_raw(kind, "closed") on 80 random kernels' closed morphometry: a kernel with
+    that morphometry to 1e-8, or a ValueError naming the closest error - never another
+    exception. Measured (300 per kind): 2 % (kind 3) and 5 % (kind 4) ValueErrors; the
+    kernel returned is not always the original (flat directions, see lcsn_raw)."""
+    rng = np.random.default_rng(10 + kind)
+    failed = tried = 0
+    for raw, _ in random_kernels(rng, kind, 80):
+        m = {k: v for k, v in craters.lcsn_morphometry(kind, **raw).items()
+             if math.isfinite(v)}
+        if "D_rim" not in m or kind == 3 and "D_a" not in m:
+            continue
+        extra = {"b": raw["b"]}
+        if kind == 3 or tried % 2:  # kind 4: every other one gives L_d instead of beta
+            m.pop("L_d", None)
+            extra = {"beta": raw["beta"]} if kind == 3 else {**extra, "beta": raw["beta"]}
+        elif "L_d" not in m:
+            continue
+        tried += 1
+        try:
+            got = craters.lcsn_raw(kind, **extra, **m)
+        except ValueError as exc:
+            assert "closest: relative error" in str(exc)
+            failed += 1
+            continue
+        again = craters.lcsn_morphometry(kind, **got)
+        assert all(rel(again[k], m[k]) <= 1e-8 for k in m), (raw, got, m, again)
+    assert tried > 50 and failed <= 0.1 * tried, (failed, tried)
 
 
 @pytest.mark.parametrize("name", ["table-a1-300m-0gyr", "table-a1-3km-0gyr", "fig6-kernel4"])
@@ -369,5 +458,5 @@ def test_bad_input_names_the_parameter(call, match):
 
 
 def test_unreachable_numeric_inverse():
-    with pytest.raises(ValueError, match="no kind-3 kernel"):
+    with pytest.raises(ValueError, match="found no kind-3 kernel"):
         craters.lcsn_raw(3, "numeric", beta=5.0, H_t=1.0, D_a=1.99, D_rim=2.0, H_rim=0.001)
