@@ -44,8 +44,7 @@ is 8-11 % short and L_d 50-60 % long (tests and benchmark).
 each printed root is refined by three explicit Newton steps in ``s = ln r`` on the exact
 equation (the crest on ``d kernel/ds = 0`` from ``1/sqrt(gamma)``; the datum crossings
 of kind 3 on ``ln(kappa L) - ln(a exp(-b r^2)) = 0``, whose value at eq. 10-11's roots
-is ``ln(kappa/a)``, so the steps vanish when ``kappa = a`` - where eq. 11 has no root,
-``x > 1/e``, from its limit ``r = 1/(x sqrt(gamma))``; kind 4's border on
+is ``ln(kappa/a)``, so the steps vanish when ``kappa = a``; kind 4's border on
 ``ln kernel_4 = ln t`` from the farther of eq. 16's root and the Gaussian's own,
 ``sqrt(ln(a/t)/b)``). Each refined root is then *verified*: it is kept only if the
 equation changes sign within 0.5 % of its radius (the right way: rising for D_a,
@@ -56,26 +55,33 @@ outer crossing minus the refined crest radius (NaN unless it lies beyond the cre
 Without a verified crest, ``D_rim``, ``H_rim`` and ``L_d`` are NaN, and so is kind 3's
 ``D_a`` (it is also NaN unless the rim rises above the datum: only then must the
 profile cross it). A fixed number of steps and checks keeps it a formula (no iteration
-to convergence). Measured: within 1.3e-6 of ``"numeric"`` on the 0 Gyr Table A.1 rows;
-on 1000 random kernels per kind with a distinct rim (kappa/a 0.05-2, beta 0.5-20,
-b/gamma 0.1-10) every finite closed value is within 0.5 % (D_rim), 0.07 % (D_a) and
-1.6 % (L_d) of the measured one, and closed is NaN where numeric measures a value for
-0.3 % (kind 3) / 0.5 % (kind 4) of the quantities (the benchmark and the tests print
-or pin these figures).
+to convergence). Measured (``tests/benchmarks/bench_implicit.py`` prints these):
+within 1.3e-6 of ``"numeric"`` on the 0 Gyr Table A.1 rows; on 1000 random kernels per
+kind with a distinct rim (kappa/a 0.05-2, beta 0.5-20, b/gamma 0.1-10) every finite
+closed value exists in the measured profile and is within 0.5 % (D_rim), 0.13 % (D_a)
+and 0.4 % (L_d) of it, and closed is NaN where numeric measures for 0.18 % (kind 3) /
+0.45 % (kind 4) of the quantities; other seeds give up to 0.2 % (D_a), 1.6 % (L_d, on
+a rim barely 5 % of the depth) and 0.9 % NaN. The tests hold looser bounds. ``L_d`` is
+a difference of two radii, so near a very low rim its error can exceed 0.5 %. Past
+``x > 1/e``, where eq. 11 has no root, closed ``L_d`` is NaN (numeric may measure it).
 
 ``"numeric"`` - measured on the profile itself: it is sampled densely (uniform plus
 geometric spacing out to where every term is below 1e-16 of its amplitude), and the
 features found there are refined with Brent's root finder / bounded minimisation to
-machine precision. ``H_t = -min``, ``H_c = kernel(0)``; the rim crest is the highest
-interior local maximum; ``D_a`` is twice the first zero crossing (kind 3) or 2.5 / 2
-times the measured FWHM (kinds 1-2); ``L_d`` is the first crossing of the datum
-(kind 3) or of ``t`` (kind 4) beyond the crest, minus the crest radius.
+machine precision. ``H_t = -min``, ``H_c = kernel(0)``; the rim crest is the interior
+local maximum nearest (in ln r) the ring's peak ``1/sqrt(gamma)`` - not the highest: far
+out, where the bowl has died away, the ring's tail leaves a local maximum ~1e-20 high
+that would outrank a rim below the datum; ``D_a`` is twice the first zero crossing if
+it lies inside the crest (kind 3) or 2.5 / 2 times the measured FWHM (kinds 1-2);
+``L_d`` is the first crossing of the datum (kind 3) or of ``t`` (kind 4) beyond the
+crest, minus the crest radius.
 
 Where a profile has no distinct rim (degraded rows of Table A.1: the rim decays into
 the bowl), ``"numeric"`` returns NaN for ``D_rim``, ``H_rim`` and ``L_d`` (no interior
-local maximum), NaN for ``D_a`` when the profile never reaches the datum, and NaN for
-``L_d`` when the flank never returns to the datum; ``"paper"`` always evaluates its
-formulas (``H_rim`` can then be <= 0, the formula's way of saying "no rim").
+local maximum), NaN for ``D_a`` when the profile does not reach the datum inside the
+crest, and NaN for ``L_d`` when the flank never returns to the datum; ``"paper"``
+always evaluates its formulas (``H_rim`` can then be <= 0, the formula's way of saying
+"no rim").
 
 Table A.1 (kernel_3 fits of Fassett & Thomson's degradation of 300 m, 1 km and 3 km
 craters at 0-3 Gyr) lists ``a`` as a negative number: it is the signed coefficient of
@@ -207,6 +213,9 @@ def _paper(kind: int, p: dict, threshold: float) -> dict:
     kappa, beta, gamma, a, b = (p[k] for k in RAW_KEYS[kind])
     r_rim = 1.0 / math.sqrt(gamma)
     if kind == 3:
+        if beta * gamma == 0.0:  # underflow: the printed formulas divide by it
+            return {"H_t": a, "D_a": math.nan, "D_rim": 2.0 * r_rim,
+                    "H_rim": kappa - a * math.exp(-b / gamma), "L_d": math.nan}
         x = 0.5 * math.sqrt(b / (beta * gamma))
         s = math.sqrt(beta / b)
         w_out = _lambertw(-x)
@@ -331,11 +340,9 @@ def _closed(kind: int, p: dict, threshold: float) -> dict:
         s_in = _verified(kernel_minus(0.0), _newton(step, math.log(0.5 * printed["D_a"])),
                          rising=True)
         out["D_a"] = 2.0 * math.exp(s_in) if s_in < s_crest else math.nan
-        x = 0.5 * math.sqrt(b / (beta * gamma))  # eq. 11's argument; past 1/e it has no
-        start = (math.log(printed["L_d"] + 0.5 * printed["D_rim"])  # root, so start at
-                 if math.isfinite(printed["L_d"]) else s_ring - math.log(x))  # its limit
-        s_out = _verified(kernel_minus(0.0), _newton(step, start), rising=False)
-        out["L_d"] = _beyond(s_out, s_crest)
+        if math.isfinite(printed["L_d"]):
+            s_out = _newton(step, math.log(printed["L_d"] + 0.5 * printed["D_rim"]))
+            out["L_d"] = _beyond(_verified(kernel_minus(0.0), s_out, rising=False), s_crest)
         return out
 
     def step4(s):  # kernel_4 = threshold, in logarithms
@@ -374,14 +381,14 @@ def _sample_radii(kind: int, p: dict) -> np.ndarray:
     return np.unique(np.concatenate([uniform, geometric]))
 
 
-def _crest(f, r: np.ndarray, h: np.ndarray) -> float:
-    """Radius of the highest interior local maximum of the sampled profile, or NaN."""
+def _crest(f, r: np.ndarray, h: np.ndarray, ring: float) -> float:
+    """Radius of the interior local maximum nearest (in ln r) the ring's peak, or NaN."""
     from scipy.optimize import minimize_scalar
 
     interior = np.flatnonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:])) + 1
     if not interior.size:
         return math.nan
-    i = int(interior[np.argmax(h[interior])])
+    i = int(interior[np.argmin(np.abs(np.log(r[interior] / ring)))])
     res = minimize_scalar(lambda x: -float(f(x)), bounds=(r[i - 1], r[i + 1]),
                           method="bounded", options={"xatol": 1e-12 * r[i + 1]})
     return float(res.x) if float(f(res.x)) >= h[i] else float(r[i])
@@ -398,8 +405,11 @@ def _crossing(f, r: np.ndarray, h: np.ndarray, level: float, start: float,
     if not idx.size:
         return math.nan
     i = int(idx[0])
-    return float(brentq(lambda x: float(f(x)) - level, r[i], r[i + 1], xtol=1e-14 * r[i + 1],
-                        rtol=1e-15))
+    try:
+        return float(brentq(lambda x: float(f(x)) - level, r[i], r[i + 1],
+                            xtol=1e-14 * r[i + 1], rtol=1e-15))
+    except RuntimeError:  # no convergence at extreme scales (e.g. a < 1e-169 m)
+        return math.nan
 
 
 def _numeric(kind: int, p: dict, threshold: float) -> dict:
@@ -412,7 +422,7 @@ def _numeric(kind: int, p: dict, threshold: float) -> dict:
         depth = -float(h[0])
         half = _crossing(f, r, h, -0.5 * depth, 0.0, falling=False)
         return {"H_t": depth, "D_a": (2.5 if kind == 1 else 2.0) * 2.0 * half}
-    crest = _crest(f, r, h)
+    crest = _crest(f, r, h, 1.0 / math.sqrt(p["gamma"]))
     rim = {"D_rim": 2.0 * crest, "H_rim": float(f(crest))} if math.isfinite(crest) else {
         "D_rim": math.nan, "H_rim": math.nan}
     if kind == 3:
@@ -421,6 +431,7 @@ def _numeric(kind: int, p: dict, threshold: float) -> dict:
         out = math.nan
         if math.isfinite(crest):
             out = _crossing(f, r, h, 0.0, crest, falling=True) - crest
+        zero = zero if zero < crest else math.nan  # the bowl's edge lies inside the rim
         return {"H_t": depth, "D_a": 2.0 * zero, **rim, "L_d": out}
     out = math.nan
     if math.isfinite(crest):
@@ -437,7 +448,7 @@ def lcsn_morphometry(kind: int, method: str = "closed", *, threshold: float = BO
     kind : {1, 2, 3, 4}
     method : {"closed", "paper", "numeric"}
         ``"closed"``: the paper's formulas (eq. 4-5, 7-11, 13-16) with the roots of eq.
-        9-11 and 16 refined by two explicit Newton steps, which removes their kappa = a
+        9-11 and 16 refined by three explicit Newton steps, which removes their kappa = a
         simplification; ``"paper"``: the formulas exactly as printed; ``"numeric"``: a
         measurement of the profile (module notes; NaN where a feature does not exist).
     threshold : float
@@ -575,10 +586,18 @@ def lcsn_raw(kind: int, method: str = "closed", *, beta: float | None = None,
             b = check_positive("b", b)
         elif b is not None:
             raise ValueError("`b` follows from D_a for kind 3; do not give it")
-    raw = _paper_inverse(kind, m, beta, b, threshold)
-    if method == "paper" or kind in (1, 2) and method == "closed":  # eq. 4-5 are exact
-        return raw
-    return _solve_inverse(kind, m, raw, beta, b, threshold, method)
+    beyond = (f"the morphometry {morph!r} is beyond what the kind-{kind} formulas can "
+              "evaluate in float64 (b or gamma would overflow or underflow: use lengths in "
+              "metres between about 1e-70 and 1e70)")
+    try:
+        raw = _paper_inverse(kind, m, beta, b, threshold)
+        if not (method == "paper" or kind in (1, 2) and method == "closed"):  # eq. 4-5 exact
+            raw = _solve_inverse(kind, m, raw, beta, b, threshold, method)
+    except (OverflowError, ZeroDivisionError):
+        raise ValueError(beyond) from None
+    if not all(math.isfinite(v) and v > 0.0 for v in raw.values()):  # b = inf, gamma = 0 ...
+        raise ValueError(beyond)
+    return raw
 
 
 _INVERSE_TOL = 1e-8  # relative; flat directions (see lcsn_raw) stop the fit near 1e-9

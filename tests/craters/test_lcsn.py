@@ -52,13 +52,14 @@ def dense_measurement(kind, p, threshold=0.01):
         i = np.flatnonzero(h > -depth / 2)[0]
         half = r[i - 1] + (r[i] - r[i - 1]) * (-depth / 2 - h[i - 1]) / (h[i] - h[i - 1])
         return {"H_t": depth, "D_a": (2.5 if kind == 1 else 2.0) * 2 * half}
-    peaks = np.flatnonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:])) + 1
-    crest = r[peaks[np.argmax(h[peaks])]] if peaks.size else math.nan
-    out = {"D_rim": 2 * crest, "H_rim": h.max() if kind == 3 else (
-        h[peaks].max() if peaks.size else math.nan)}
+    peaks = np.flatnonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:])) + 1  # the crest: the
+    near = np.argmin(np.abs(np.log(r[peaks] * math.sqrt(p["gamma"])))) if peaks.size else 0
+    crest = r[peaks[near]] if peaks.size else math.nan  # one nearest the ring's peak
+    out = {"D_rim": 2 * crest, "H_rim": h[peaks[near]] if peaks.size else math.nan}
     if kind == 3:
         out["H_t"] = -h.min()
-        out["D_a"] = 2 * first(h >= 0)
+        inner = first(h >= 0)
+        out["D_a"] = 2 * inner if inner < crest else math.nan
         out["L_d"] = first(h >= 0, crest) - crest if peaks.size else math.nan
     else:
         out["H_c"] = h[0]
@@ -316,6 +317,32 @@ def test_degraded_rows_without_a_rim():
     assert PRESETS["table-a1-1km-2gyr"].morphometry("paper")["H_rim"] < 0
     assert PRESETS["table-a1-1km-2gyr"].morphometry()["H_rim"] == pytest.approx(1.1664,
                                                                                 abs=1e-3)
+
+
+def test_rim_below_the_datum_and_the_ring_tail():
+    """A rim 0.32 below the datum: far out, where the bowl has died away, the ring's
+    tail leaves a local maximum ~1e-21 high. The crest is the maximum nearest the ring's
+    peak (not that speck), and with the rim under the datum there is no D_a or L_d."""
+    raw = {"kappa": 0.405, "beta": 1.756, "gamma": 1.0, "a": 1.0, "b": 0.29}
+    r = np.geomspace(1.0, 40.0, 20001)
+    h = craters.lcsn_kernel(3, r, **raw)
+    tail = r[np.flatnonzero((h[1:-1] > h[:-2]) & (h[1:-1] >= h[2:])) + 1]
+    assert tail.max() > 10 and h.max() < 1e-15  # the speck exists
+    for method in ("numeric", "closed"):
+        m = craters.lcsn_morphometry(3, method, **raw)
+        assert m["D_rim"] == pytest.approx(2.19207, abs=1e-5)
+        assert m["H_rim"] == pytest.approx(-0.32406, abs=1e-5)
+        assert math.isnan(m["D_a"]) and math.isnan(m["L_d"])
+
+
+@pytest.mark.parametrize("call", [
+    lambda: craters.lcsn_raw(3, beta=5.0, H_t=1e160, D_a=1e160, D_rim=2e160, H_rim=1e159),
+    lambda: craters.lcsn_raw(2, H_t=1.0, D_a=1e80),
+    lambda: craters.lcsn_raw(1, "closed", H_t=1.0, D_a=1e-160),
+])
+def test_extreme_scales_are_a_value_error(call):
+    with pytest.raises(ValueError, match="beyond what the kind-"):
+        call()
 
 
 def test_table_a1_goldens():
