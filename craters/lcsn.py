@@ -213,15 +213,16 @@ def _paper(kind: int, p: dict, threshold: float) -> dict:
     kappa, beta, gamma, a, b = (p[k] for k in RAW_KEYS[kind])
     r_rim = 1.0 / math.sqrt(gamma)
     if kind == 3:
-        if beta * gamma == 0.0:  # underflow: the printed formulas divide by it
-            return {"H_t": a, "D_a": math.nan, "D_rim": 2.0 * r_rim,
-                    "H_rim": kappa - a * math.exp(-b / gamma), "L_d": math.nan}
-        x = 0.5 * math.sqrt(b / (beta * gamma))
-        s = math.sqrt(beta / b)
-        w_out = _lambertw(-x)
-        return {"H_t": a, "D_a": 4.0 * s * _lambertw(x), "D_rim": 2.0 * r_rim,
-                "H_rim": kappa - a * math.exp(-b / gamma),
-                "L_d": -2.0 * s * w_out - r_rim if math.isfinite(w_out) else math.nan}
+        out = {"H_t": a, "D_a": math.nan, "D_rim": 2.0 * r_rim,
+               "H_rim": kappa - a * math.exp(-b / gamma), "L_d": math.nan}
+        if beta * gamma > 0.0:  # else it underflowed, and eq. 10-11 divide by it
+            x = 0.5 * math.sqrt(b / (beta * gamma))
+            s = math.sqrt(beta / b)
+            w_out = _lambertw(-x)
+            out["D_a"] = 4.0 * s * _lambertw(x)
+            if math.isfinite(w_out):
+                out["L_d"] = -2.0 * s * w_out - r_rim
+        return out
     l_d = math.nan
     if kappa > threshold:
         try:
