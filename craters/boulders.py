@@ -27,7 +27,7 @@ import functools
 import numpy as np
 
 from ._boulder_kernels import _noise_kernel
-from ._infra import check_finite, check_int, check_positive, check_range, normalize_rng
+from ._shared import check_finite, check_int, check_positive, check_range, normalize_rng
 from .population import sample_power_law_diameters
 
 __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_meshes",

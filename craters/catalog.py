@@ -18,7 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ._infra import atomic_path
+from ._shared import atomic_path
 
 __all__ = ["CATALOG_FORMAT", "catalog_dtype", "make_catalog", "read_catalog",
            "sort_oldest_first", "write_catalog", "write_geojson"]

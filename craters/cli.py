@@ -8,15 +8,9 @@ import sys
 
 import numpy as np
 
-from ._infra import (
-    CliError,
-    OneLineParser,
-    atomic_path,
-    check_output_path,
-    package_version,
-    parse_seed,
-    run_cli,
-)
+from ._shared import atomic_path, check_output_path, package_version
+from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
+from ._shared.report import save_figure
 from .catalog import write_catalog
 from .degradation import degradation_from_age
 from .population import CraterLayer, expected_count, parse_layer_spec, population
@@ -41,9 +35,6 @@ def _pair(text: str) -> tuple[float, float]:
     return a, b
 
 
-def _save_figure(fig, path) -> None:
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
 
 
 # --------------------------------------------------------------------------- profile
@@ -92,7 +83,7 @@ def _cmd_profile(args) -> int:
         ax.set_title(f"Crater profile, D = {d:g} m ({args.morphometry}); rim at {d / 2:g} m")
         ax.legend(fontsize=8)
         fig.tight_layout()
-        _save_figure(fig, args.plot)
+        save_figure(fig, args.plot)
         plt.close(fig)
     if not args.quiet:
         print(f"D = {d:g} m, degradation {deg:.3f}: depth {p.depth_m:.4g} m, rim height "
@@ -159,7 +150,7 @@ def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
     fig.tight_layout()
-    _save_figure(fig, path)
+    save_figure(fig, path)
     plt.close(fig)
 
 

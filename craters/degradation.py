@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from ._infra import check_positive, check_range
+from ._shared import check_positive, check_range
 
 __all__ = ["DegradationModel", "degradation_factors", "degradation_from_age",
            "slope_erosion"]

@@ -97,7 +97,7 @@ import math
 
 import numpy as np
 
-from ._infra import check_choice, check_finite, check_positive
+from ._shared import check_choice, check_finite, check_positive
 
 __all__ = ["LCSN_PRESETS", "LcsnParams", "lcsn_degrade", "lcsn_kernel", "lcsn_morphometry",
            "lcsn_raw", "lcsn_scaled"]

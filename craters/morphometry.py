@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from ._infra import check_choice, check_positive
+from ._shared import check_choice, check_positive
 
 __all__ = ["MORPHOMETRY_PRESETS", "Morphometry", "fresh_depth", "fresh_rim_height",
            "get_morphometry"]

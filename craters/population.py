@@ -18,14 +18,7 @@ import math
 
 import numpy as np
 
-from ._infra import (
-    check_finite,
-    check_int,
-    check_positive,
-    check_range,
-    normalize_rng,
-    parse_spec,
-)
+from ._shared import check_finite, check_int, check_positive, check_range, normalize_rng, parse_spec
 from .catalog import make_catalog, sort_oldest_first
 from .degradation import degradation_from_age
 

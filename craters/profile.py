@@ -33,7 +33,7 @@ import dataclasses
 
 import numpy as np
 
-from ._infra import check_finite, check_positive, check_range
+from ._shared import check_finite, check_positive, check_range
 from .degradation import DEFAULT_DEGRADATION, DegradationModel, degradation_factors
 from .morphometry import Morphometry, fresh_depth, fresh_rim_height
 

@@ -24,13 +24,7 @@ import logging
 
 import numpy as np
 
-from ._infra import (
-    check_finite,
-    check_positive,
-    check_range,
-    normalize_rng,
-    progress_bar,
-)
+from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
 from ._stamp_kernels import N_RIM, _stamp_many_kernel
 from .catalog import make_catalog, sort_oldest_first, validate_catalog
 from .degradation import DEFAULT_DEGRADATION, DegradationModel

@@ -66,7 +66,7 @@ def key_from_rng(rng) -> tuple[int, int | None]:
     seed always gives the same key. The recorded seed is the int itself, or None for a
     Generator / fresh entropy (the key is recorded too, which is enough to reproduce).
     """
-    from craters._infra import normalize_rng
+    from craters._shared import normalize_rng
 
     gen = normalize_rng(rng)  # validates ``rng``
     seed = None if rng is None or isinstance(rng, np.random.Generator) else int(rng)

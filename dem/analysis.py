@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from craters._infra import check_range
+from craters._shared import check_range
 
 from .core import Dem
 

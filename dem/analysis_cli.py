@@ -9,16 +9,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from craters._infra import CliError
-from craters._report import (
-    add_report_arguments,
-    check_report_outputs,
-    plot_slopes,
-    save_figure,
-    slope_csv,
-    slope_table,
-    write_csv,
-)
+from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
+from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
 
 from .io import read
 from .stack import read_stack

@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 import craters
-from craters._infra import check_range, normalize_rng
+from craters._shared import check_range, normalize_rng
 from craters.boulders import (
     BoulderLayer,
     BoulderShape,

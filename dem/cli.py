@@ -22,16 +22,8 @@ from rasterio.coords import BoundingBox
 from rasterio.windows import Window
 
 import craters
-from craters._infra import (
-    CliError,
-    OneLineParser,
-    check_output_path,
-    load_toml,
-    package_version,
-    parse_seed,
-    progress_bar,
-    run_cli,
-)
+from craters._shared import check_output_path, load_toml, package_version, progress_bar
+from craters._shared.cli import CliError, OneLineParser, parse_seed, run_cli
 
 from .analysis_cli import add_parsers as add_analysis_parsers
 from .core import crs_label

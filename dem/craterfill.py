@@ -54,7 +54,7 @@ import scipy.sparse.linalg
 from rasterio.windows import Window
 
 import craters
-from craters._infra import check_range, normalize_rng
+from craters._shared import check_range, normalize_rng
 
 from .core import Dem
 from .enhance import _propagate_up

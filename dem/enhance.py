@@ -65,17 +65,18 @@ import numpy as np
 from rasterio.windows import Window
 
 import craters
-from craters._infra import (
+from craters._shared import (
     check_int,
     check_positive,
     check_range,
+    human_bytes,
     normalize_rng,
     physical_memory_bytes,
     progress_bar,
 )
 
 from .core import Dem
-from .expansion import _human_bytes, expand
+from .expansion import expand
 from .fractal import fractal_fit
 from .frame import grid_pixel_size, local_frame, pixel_affine
 from .io import read
@@ -592,8 +593,8 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     need = cfg.layers * cfg.size**2 * 8 * 2.5 + (2 * cfg.size + 8) ** 2 * 8 * 2.3
     if need > 0.85 * physical_memory_bytes():
         raise ValueError(f"{cfg.layers} layers of {cfg.size}^2 pixels need about "
-                         f"{_human_bytes(need)} of memory; this machine has "
-                         f"{_human_bytes(physical_memory_bytes())}")
+                         f"{human_bytes(need)} of memory; this machine has "
+                         f"{human_bytes(physical_memory_bytes())}")
     base = dem if dem is not None else read(cfg.input, band=cfg.band,
                                             pixel_size_m=cfg.pixel_size_m,
                                             body_radius_m=cfg.body_radius_m)

@@ -75,10 +75,11 @@ import math
 import numpy as np
 from affine import Affine
 
-from craters._infra import (
+from craters._shared import (
     check_int,
     check_positive,
     check_range,
+    human_bytes,
     physical_memory_bytes,
     progress_bar,
 )
@@ -141,13 +142,6 @@ def _check_dem(dem) -> Dem:
         raise ValueError("`dem` has no known pixel (all NaN)")
     return dem
 
-
-def _human_bytes(n: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB"):
-        if n < 1024 or unit == "TiB":
-            return f"{n:.1f} {unit}"
-        n /= 1024
-    return f"{n:.1f} TiB"  # pragma: no cover
 
 
 def _region(dem: Dem, region) -> tuple[int, int, int]:
@@ -230,8 +224,8 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     have = physical_memory_bytes()
     if need > 0.85 * have:
         raise ValueError(f"expanding {width} x {width} pixels {levels} levels gives {side} x "
-                         f"{side} pixels and needs about {_human_bytes(need)} of memory; this "
-                         f"machine has {_human_bytes(have)}")
+                         f"{side} pixels and needs about {human_bytes(need)} of memory; this "
+                         f"machine has {human_bytes(have)}")
     if fractal_dimension is not None:
         fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
     if roughness is not None:

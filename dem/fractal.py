@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from craters._infra import check_int
+from craters._shared import check_int
 
 from .core import Dem
 

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from affine import Affine
 
-from craters._infra import check_finite, check_positive
+from craters._shared import check_finite, check_positive
 
 from .core import Dem, crs_label
 

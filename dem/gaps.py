@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from craters._infra import check_positive
+from craters._shared import check_positive
 
 from ._fill_kernels import _fill_gaps_kernel
 from ._rng_kernels import key_from_rng

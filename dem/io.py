@@ -18,7 +18,7 @@ from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.profiles import DefaultGTiffProfile
 
-from craters._infra import atomic_path, check_int
+from craters._shared import atomic_path, check_int
 
 from ._pds import Quantity, find_object, parse_label
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem

@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import atomic_path, progress_bar
+from craters._shared import atomic_path, progress_bar
 
 from .core import Dem
 from .frame import local_frame, pixel_affine

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from craters import make_catalog, read_catalog, validate_catalog, write_catalog, write_geojson
-from craters._infra import check_int, check_parent_folder, package_version, progress_bar
+from craters._shared import check_int, check_parent_folder, package_version, progress_bar
 
 from .core import Dem, crs_label
 from .frame import LocalFrame, grid_pixel_size, pixel_affine

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from craters._infra import area_slope_summary, check_choice, check_int
+from craters._shared import area_slope_summary, check_choice, check_int
 
 from .core import Dem
 from .fractal import FractalFit, fractal_fit

@@ -11,16 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import CliError
-from craters._report import (
-    add_report_arguments,
-    check_report_outputs,
-    plot_slopes,
-    save_figure,
-    slope_csv,
-    slope_table,
-    write_csv,
-)
+from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
+from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
 
 from .body import Body, load
 from .shapes import ShapeModel, from_shape_model, read_shape_model

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import atomic_path, check_positive
+from craters._shared import atomic_path, check_positive
 
 from .grid import LatLongGrid
 
@@ -194,7 +194,7 @@ class Body:
     def lod(self, level: int) -> Body:
         """The nested coarser body of magnitude M / 2^level: exactly this body's vertices
         on the even rings / even positions, ``level`` times (no resampling)."""
-        from craters._infra import check_int
+        from craters._shared import check_int
 
         level = check_int("level", level, 0, 30)
         factor = 2**level

@@ -14,7 +14,7 @@ import functools
 import numpy as np
 
 import craters as _craters
-from craters._infra import check_int, normalize_rng
+from craters._shared import check_int, normalize_rng
 from craters.boulders import (
     BoulderLayer,
     BoulderNode,

@@ -12,14 +12,8 @@ import logging
 import sys
 from pathlib import Path
 
-from craters._infra import (
-    CliError,
-    OneLineParser,
-    check_output_path,
-    package_version,
-    progress_bar,
-    run_cli,
-)
+from craters._shared import check_output_path, package_version, progress_bar
+from craters._shared.cli import CliError, OneLineParser, run_cli
 
 from .analysis_cli import add_parsers as add_analysis_parsers
 from .body import load

@@ -7,7 +7,7 @@ import logging
 import numpy as np
 
 import craters as _craters
-from craters._infra import check_choice, check_range, normalize_rng, progress_bar
+from craters._shared import check_choice, check_range, normalize_rng, progress_bar
 from craters.degradation import DEFAULT_DEGRADATION, DegradationModel
 from craters.morphometry import Morphometry, get_morphometry
 from craters.profile import DEFAULT_EJECTA_EDGE

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import atomic_path, progress_bar
+from craters._shared import atomic_path, progress_bar
 
 __all__ = ["write_mesh", "write_obj", "write_ply", "write_stl"]
 

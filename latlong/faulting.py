@@ -7,12 +7,7 @@ import logging
 
 import numpy as np
 
-from craters._infra import (
-    check_int,
-    check_positive,
-    normalize_rng,
-    progress_bar,
-)
+from craters._shared import check_int, check_positive, normalize_rng, progress_bar
 
 from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid

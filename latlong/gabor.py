@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import (
+from craters._shared import (
     check_choice,
     check_int,
     check_positive,

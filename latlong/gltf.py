@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import atomic_path, check_int, package_version, progress_bar
+from craters._shared import atomic_path, check_int, package_version, progress_bar
 
 from ._grid_kernels import _normals_from_radii_kernel
 from .body import Body

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 
-from craters._infra import check_int
+from craters._shared import check_int
 
 from ._grid_kernels import (
     _interpolate_kernel,

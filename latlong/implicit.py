@@ -57,7 +57,7 @@ from pathlib import Path
 import numpy as np
 
 import craters as _craters
-from craters._infra import (
+from craters._shared import (
     atomic_path,
     check_int,
     check_positive,

@@ -17,7 +17,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import CliError, package_version
+from craters._shared import package_version
+from craters._shared.cli import CliError
 
 from .implicit import MESH_SUFFIXES
 
@@ -148,7 +149,7 @@ def resolve_implicit(given: dict, defaults: dict) -> dict:
 def run_implicit(s: dict) -> int:
     """Build the implicit body of resolved settings and write its outputs."""
     from craters import write_catalog
-    from craters._infra import progress_bar
+    from craters._shared import progress_bar
 
     from .implicit import implicit_surface
     from .scene import human_bytes

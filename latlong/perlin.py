@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 
-from craters._infra import check_finite, check_int, check_positive, check_range, normalize_rng
+from craters._shared import check_finite, check_int, check_positive, check_range, normalize_rng
 
 from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
 from .grid import LatLongGrid

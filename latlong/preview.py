@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import atomic_path, check_finite, check_int
+from craters._shared import atomic_path, check_finite, check_int
 
 from .body import Body
 from .grid import LatLongGrid

@@ -18,15 +18,15 @@ from typing import Any
 import numpy as np
 
 import craters as _craters
-from craters._infra import (
-    CliError,
+from craters._shared import (
     check_output_path,
+    human_bytes,
     load_toml,
     normalize_rng,
     package_version,
-    parse_seed,
     physical_memory_bytes,
 )
+from craters._shared.cli import CliError, parse_seed
 
 from .body import EXPORT_SUFFIXES, Body
 from .faulting import FAULTING_PRESETS, FaultingParams, two_phase_faulting
@@ -378,12 +378,6 @@ def _count(key: str, value: int, lo: int, hi: int) -> int:
     return value
 
 
-def human_bytes(n: float) -> str:
-    for unit in ("B", "KiB", "MiB", "GiB", "TiB", "PiB", "EiB"):
-        if n < 1024 or unit == "EiB":
-            return f"{n:.1f} {unit}"
-        n /= 1024
-    return f"{n:.1f} EiB"  # pragma: no cover
 
 
 def _check_memory(magnitude: int) -> None:

@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._infra import check_choice, check_int
+from craters._shared import check_choice, check_int
 
 from ._shape_kernels import _brute_force_kernel, _raycast_kernel
 from .body import Body
@@ -382,7 +382,7 @@ def _as_polydata(obj):
 
 def sample_surface(mesh, n: int, *, rng=None) -> np.ndarray:
     """``n`` points uniform on a triangle surface (Body, ShapeModel or PolyData), (n, 3)."""
-    from craters._infra import normalize_rng
+    from craters._shared import normalize_rng
 
     rng = normalize_rng(rng)
     poly = _as_polydata(mesh).triangulate()
@@ -405,7 +405,7 @@ def mean_surface_distance(a, b, *, n_points: int = 20000, rng=None) -> float:
     """
     import pyvista as pv
 
-    from craters._infra import normalize_rng
+    from craters._shared import normalize_rng
 
     rng = normalize_rng(rng)
     n_points = check_int("n_points", n_points, 10, 10**8)

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from craters._infra import area_slope_summary, check_int, check_range
+from craters._shared import area_slope_summary, check_int, check_range
 
 from ._slope_kernels import _cap_average_kernel, _ring_prefix_kernel, _vertex_normals_kernel
 from .body import Body

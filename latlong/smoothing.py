@@ -19,7 +19,7 @@ import math
 import numpy as np
 import scipy.sparse as sp
 
-from craters._infra import check_int, check_positive
+from craters._shared import check_int, check_positive
 
 from .grid import LatLongGrid
 

@@ -25,7 +25,7 @@ import dataclasses
 
 import numpy as np
 
-from craters._infra import check_int
+from craters._shared import check_int
 
 from ._grid_kernels import _band_strip_kernel
 from .grid import LatLongGrid

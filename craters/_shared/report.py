@@ -11,28 +11,9 @@ import csv
 
 import numpy as np
 
-from ._infra import CliError, atomic_path, check_output_path
+from .files import atomic_path
 
-__all__ = ["add_report_arguments", "check_report_outputs", "plot_slopes", "save_figure",
-           "slope_csv", "slope_table", "write_csv"]
-
-
-def add_report_arguments(parser) -> None:
-    """The output options every analysis command has: --csv, --plot, --force, --quiet."""
-    parser.add_argument("--csv", help="write the table (CSV, units in the header)")
-    parser.add_argument("--plot", help="write the plot (PNG)")
-    parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no summary table")
-
-
-def check_report_outputs(args) -> None:
-    """``--csv``/``--plot``: something to do, the right suffixes, no silent overwrite."""
-    if args.csv is None and args.plot is None and args.quiet:
-        raise CliError("nothing to do: give --csv, --plot or drop --quiet for the table")
-    if args.csv:
-        check_output_path(args.csv, force=args.force, suffixes=(".csv",))
-    if args.plot:
-        check_output_path(args.plot, force=args.force, suffixes=(".png",))
+__all__ = ["plot_slopes", "save_figure", "slope_csv", "slope_table", "write_csv"]
 
 
 def write_csv(path, comment: str, columns, rows) -> None:
@@ -47,6 +28,7 @@ def write_csv(path, comment: str, columns, rows) -> None:
 
 
 def save_figure(fig, path) -> None:
+    """Write a matplotlib figure as PNG (110 dpi), atomically."""
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
 

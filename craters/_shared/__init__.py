@@ -1,0 +1,29 @@
+"""Plumbing shared by the three packages, kept out of crater science (like scikit-image's
+``_shared``): argument checks and random generators, files (atomic writes, output checks,
+TOML), progress bars, machine facts, ``key=value`` specs, slope statistics, reports and
+mesh writers. ``craters`` is the ground floor of the import graph
+(``latlong -> craters <- dem``), so it lives here, privately.
+
+The command-line helpers are in :mod:`craters._shared.cli`; nothing here imports them, so
+importing a library never loads argparse.
+"""
+
+from .files import atomic_path, check_output_path, check_parent_folder, load_toml
+from .progress import progress_bar
+from .spec import parse_spec
+from .stats import area_slope_summary
+from .system import human_bytes, package_version, physical_memory_bytes
+from .validation import (
+    RngLike,
+    check_choice,
+    check_finite,
+    check_int,
+    check_positive,
+    check_range,
+    normalize_rng,
+)
+
+__all__ = ["RngLike", "area_slope_summary", "atomic_path", "check_choice", "check_finite",
+           "check_int", "check_output_path", "check_parent_folder", "check_positive",
+           "check_range", "human_bytes", "load_toml", "normalize_rng", "package_version",
+           "parse_spec", "physical_memory_bytes", "progress_bar"]

@@ -1,0 +1,76 @@
+"""Files: output checks before any work, atomic writes, TOML scene files."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+import tomllib
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+
+__all__ = ["atomic_path", "check_output_path", "check_parent_folder", "load_toml"]
+
+
+def check_parent_folder(path) -> None:
+    """The folder an output goes into exists and is writable (one-line ValueError)."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if not folder.is_dir():
+        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} does not exist")
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} is not writable")
+
+
+def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = None) -> Path:
+    """Validate an output path before any work is done.
+
+    Raises ValueError for an unknown suffix, an existing file without ``force``, or a
+    folder that does not exist or is not writable.
+    """
+    path = Path(path)
+    if suffixes is not None and path.suffix.lower() not in suffixes:
+        raise ValueError(
+            f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}; "
+            f"allowed: {' '.join(suffixes)}"
+        )
+    check_parent_folder(path)
+    if path.is_dir():
+        raise ValueError(f"output {str(path)!r} is a folder")
+    if path.exists() and not force:
+        raise ValueError(f"output {str(path)!r} exists; use --force to overwrite")
+    return path
+
+
+@contextlib.contextmanager
+def atomic_path(path) -> Iterator[Path]:
+    """Yield a temporary path in the target folder; move it onto ``path`` on success.
+
+    On any exception the temporary file is removed and ``path`` is left untouched.
+    """
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
+                               dir=folder)
+    os.close(fd)
+    tmp = Path(tmp)
+    try:
+        yield tmp
+        os.chmod(tmp, 0o644)
+        os.replace(tmp, path)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            tmp.unlink()
+        raise
+
+
+def load_toml(path) -> dict:
+    """Read a TOML scene file; errors become ValueError naming the file."""
+    path = Path(path)
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise ValueError(f"config file {str(path)!r} does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
