@@ -1,0 +1,199 @@
+"""The architecture of DESIGN.md §1, checked on the source with ``ast``.
+
+* one direction between packages: latlong -> craters <- dem (craters imports neither,
+  latlong and dem never import each other);
+* no import circle inside a package, counting every static import, also those inside
+  functions;
+* the libraries never import a command line (``*/cli/``, ``*/cli.py``,
+  ``craters._shared.cli``, argparse), and importing them does not load argparse;
+* no module reads another module's private (``_``-prefixed) name, except the numba
+  kernels of its own package (``_*kernels`` modules);
+* no module over 500 lines.
+"""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+PACKAGES = ("craters", "latlong", "dem")
+MAX_LINES = 500
+
+
+def _module_name(path: Path) -> str:
+    parts = list(path.relative_to(ROOT).with_suffix("").parts)
+    if parts[-1] == "__init__":
+        parts.pop()
+    return ".".join(parts)
+
+
+def _sources() -> dict[str, Path]:
+    out = {}
+    for pkg in PACKAGES:
+        for path in sorted((ROOT / pkg).rglob("*.py")):
+            out[_module_name(path)] = path
+    return out
+
+
+SOURCES = _sources()
+
+
+def _is_package(name: str) -> bool:
+    return SOURCES[name].name == "__init__.py"
+
+
+def _resolve(module: str, node: ast.ImportFrom) -> str:
+    """The absolute module an ``ImportFrom`` names, relative imports resolved."""
+    if not node.level:
+        return node.module or ""
+    base = module.split(".")
+    if not _is_package(module):
+        base = base[:-1]
+    base = base[: len(base) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
+def _imports(module: str):
+    """(target module, imported name or None, line) of every static import of ``module``."""
+    tree = ast.parse(SOURCES[module].read_text(), str(SOURCES[module]))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                yield alias.name, None, node.lineno
+        elif isinstance(node, ast.ImportFrom):
+            target = _resolve(module, node)
+            for alias in node.names:
+                sub = f"{target}.{alias.name}"
+                if sub in SOURCES:  # `from . import export`: the submodule itself
+                    yield sub, None, node.lineno
+                else:
+                    yield target, alias.name, node.lineno
+
+
+GRAPH = {m: list(_imports(m)) for m in SOURCES}
+
+
+def _is_cli(name: str) -> bool:
+    parts = name.split(".")
+    return "cli" in parts or name == "craters._shared.cli"
+
+
+def _is_kernels(name: str) -> bool:
+    last = name.split(".")[-1]
+    return last.startswith("_") and last.endswith("kernels")
+
+
+def test_package_direction():
+    bad = []
+    for module, edges in GRAPH.items():
+        pkg = module.split(".")[0]
+        for target, _, line in edges:
+            other = target.split(".")[0]
+            if other in PACKAGES and other != pkg and (pkg == "craters" or other != "craters"):
+                bad.append(f"{module}:{line} imports {target}")
+    assert not bad, "\n".join(bad)
+
+
+def _cycles() -> list[list[str]]:
+    """Strongly connected components (Tarjan) of more than one module within a package."""
+    edges = {m: sorted({t for t, _, _ in e if t in SOURCES and t.split(".")[0] == m.split(".")[0]
+                        and t != m}) for m, e in GRAPH.items()}
+    index, low, stack, on, out = {}, {}, [], set(), []
+
+    def visit(v):
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on.add(v)
+        for w in edges[v]:
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            comp = []
+            while True:
+                w = stack.pop()
+                on.discard(w)
+                comp.append(w)
+                if w == v:
+                    break
+            if len(comp) > 1:
+                out.append(sorted(comp))
+
+    sys.setrecursionlimit(10_000)
+    for v in edges:
+        if v not in index:
+            visit(v)
+    return out
+
+
+def test_no_import_circle_inside_a_package():
+    cycles = _cycles()
+    assert not cycles, "\n".join(" <-> ".join(c) for c in cycles)
+
+
+def test_libraries_never_import_a_command_line():
+    bad = []
+    for module, edges in GRAPH.items():
+        if _is_cli(module) or module.endswith("__main__"):
+            continue
+        for target, _, line in edges:
+            if target == "argparse" or (target.split(".")[0] in PACKAGES and _is_cli(target)):
+                bad.append(f"{module}:{line} imports {target}")
+    assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_importing_a_library_does_not_load_argparse(package):
+    code = f"import sys, {package}; print('argparse' in sys.modules)"
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, check=True)
+    assert proc.stdout.strip() == "False"
+
+
+def test_no_private_name_crosses_a_file():
+    bad = []
+    for module, edges in GRAPH.items():
+        pkg = module.split(".")[0]
+        for target, name, line in edges:
+            if target.split(".")[0] not in PACKAGES:
+                continue
+            private_module = target.split(".")[-1].startswith("_") and target in SOURCES \
+                and not _is_package(target) and name is None
+            if name is not None and name.startswith("_") or private_module:
+                if _is_kernels(target) and target.split(".")[0] == pkg:
+                    continue  # a module's own numba kernels
+                bad.append(f"{module}:{line} uses {target}{'.' + name if name else ''}")
+        # attribute access to a private name of an imported module (`export._write`)
+        tree = ast.parse(SOURCES[module].read_text())
+        modules = {}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.ImportFrom):
+                for alias in node.names:
+                    sub = f"{_resolve(module, node)}.{alias.name}"
+                    if sub in SOURCES:
+                        modules[alias.asname or alias.name] = sub
+            elif isinstance(node, ast.Import):
+                for alias in node.names:
+                    if alias.name in SOURCES:
+                        modules[(alias.asname or alias.name).split(".")[0]] = alias.name
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
+                    and node.value.id in modules and node.attr.startswith("_") \
+                    and not node.attr.startswith("__"):
+                target = modules[node.value.id]
+                if not (_is_kernels(target) and target.split(".")[0] == pkg):
+                    bad.append(f"{module}:{node.lineno} uses {target}.{node.attr}")
+    assert not bad, "\n".join(bad)
+
+
+def test_no_module_over_500_lines():
+    long = {m: n for m, p in SOURCES.items()
+            if (n := len(p.read_text().splitlines())) > MAX_LINES}
+    assert not long, long
