@@ -17,8 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
-from latlong import build_body, resolve_settings  # noqa: E402
-from latlong.preview import render_preview  # noqa: E402
+from latlong import Scene, build, render_preview  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
@@ -40,8 +39,7 @@ scenes = [
 ]
 fig, axes = plt.subplots(2, 2, figsize=(13, 9.5))
 for ax, (title, given) in zip(axes.ravel(), scenes, strict=True):
-    settings = resolve_settings({**given, "seed": 2014, "preview": str(png), "force": True})
-    body = build_body(settings)
+    body = build(Scene.from_settings({**given, "seed": 2014}))
     render_preview(body, png, sun_azimuth_deg=60, sun_elevation_deg=25, width_px=800,
                    height_px=560)
     ax.imshow(mpimg.imread(png))

@@ -23,9 +23,9 @@ from latlong import (  # noqa: E402
     LatLongGrid,
     perlin_fbm,
     poisson_faulting,
+    render_preview,  # noqa: E402
     smooth,
 )
-from latlong.preview import render_preview  # noqa: E402
 
 magnitude = int(os.environ.get("CRATERFORM_EXAMPLE_MAGNITUDE", "200"))
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))

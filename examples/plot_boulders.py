@@ -20,8 +20,7 @@ import numpy as np  # noqa: E402
 
 import craters  # noqa: E402
 import dem  # noqa: E402
-from latlong import build_body, resolve_settings  # noqa: E402
-from latlong.preview import render_preview  # noqa: E402
+from latlong import Scene, build, render_preview  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
@@ -63,11 +62,10 @@ fig.savefig(out / "boulder_levels.png", dpi=90)
 plt.close(fig)
 
 # 2. a boulder field on a small cratered asteroid, seen from close by
-s = resolve_settings({"preset": "fig5a", "magnitude": 60 if small else 500, "radius_m": 250.0,
-                      "craters": ["c=0.1,k=-2,dmin=4,dmax=60"],
-                      "boulders": ["c=0.02,k=-3,dmin=1.5,dmax=25,near=0.3"],
-                      "seed": 3, "output": [str(out / "_tmp.npz")], "force": True})
-body = build_body(s)
+body = build(Scene.from_settings({
+    "preset": "fig5a", "magnitude": 60 if small else 500, "radius_m": 250.0,
+    "craters": ["c=0.1,k=-2,dmin=4,dmax=60"],
+    "boulders": ["c=0.02,k=-3,dmin=1.5,dmax=25,near=0.3"], "seed": 3}))
 print(f"body: M = {body.magnitude}, {len(body.craters)} craters, {len(body.boulders)} "
       f"boulders")
 render_preview(body, out / "boulder_body.png", sun_elevation_deg=12.0,

@@ -17,8 +17,7 @@ import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from latlong import Body, build_body, from_shape_model, read_shape_model, resolve_settings  # noqa: E402, I001
-from latlong.preview import render_preview  # noqa: E402
+from latlong import Body, Scene, build, from_shape_model, read_shape_model, render_preview  # noqa: E402, I001
 from latlong.shapes import mean_surface_distance  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
@@ -55,11 +54,10 @@ panels = [
     (f"Itokawa q = 32 ({len(q32.vertices)} vertices, drawn smoothed)",
      as_body(q32, "butterfly")),
 ]
-settings = resolve_settings({
+bennu = build(Scene.from_settings({
     "base": f"shape:{data / 'bennu_radar_sbgat.obj'}", "shape_units": "km",
     "magnitude": 2 * magnitude, "craters": ["c=0.9,k=-3,dmin=4,dmax=40"], "amplitude_m": 0.5,
-    "seed": 1, "preview": str(png), "force": True})
-bennu = build_body(settings)
+    "seed": 1}))
 title = f"Bennu radar model + {len(bennu.craters):,} craters 4-40 m, M = {2 * magnitude}"
 panels.append((title, bennu))
 

@@ -18,10 +18,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from latlong import (  # noqa: E402
-    build_body,
+    Scene,
+    build,
     mesh_slopes,
     read_shape_model,
-    resolve_settings,
     slope_summary,
     slopes_and_areas,
 )
@@ -38,10 +38,8 @@ cases = [("two-phase faulting", {"preset": "paper"})]
 cases += [(f"Perlin {name}", {"preset": name}) for name in ("fig5a", "fig5b", "fig5c")]
 results = []
 for label, given in cases:
-    s = resolve_settings({**given, "magnitude": magnitude, "radius_m": radius_m,
-                          "craters": craters, "seed": 9, "output": [str(out / "_tmp.npz")],
-                          "force": True})
-    body = build_body(s)
+    body = build(Scene.from_settings({**given, "magnitude": magnitude, "radius_m": radius_m,
+                                      "craters": craters, "seed": 9}))
     slope_deg, area = slopes_and_areas(body, 3.0)
     results.append((f"{label} + craters", slope_summary(slope_deg, area)))
 data = Path(__file__).parents[1] / "tests" / "data"

@@ -1,9 +1,24 @@
 """latlong: asteroid bodies on the evenly spaced 6M^2+2 latitude/longitude sphere mesh.
 
 Martin et al. 2014: the lat/long mesh, two-phase Poisson faulting and Perlin fBm base
-shapes, mesh export and previews; and the implicit backend of Li et al. 2020/2022
-(metaballs over a sphere packing, LCSN craters, Gabor noise, marching cubes). See
-``latlong build --help`` for the command line.
+shapes, crater stamping via local DEM mapping, boulders, slopes, renderer export and
+previews; and the implicit backend of Li et al. 2020/2022 (metaballs over a sphere
+packing, LCSN craters, Gabor noise, marching cubes).
+
+::
+
+    grid (LatLongGrid) -> base radii: faulting | perlin | shapes (real models)
+                       -> body (Body: radii + stretch + catalogs; .npz)
+                       -> cratering (catalog on the true surface: surface; stamping)
+                       -> boulders (populations, placement)
+                       -> export (PLY/OBJ/STL/VTP/VTK) | gltf + strips (patches, LODs)
+                          | slopes, preview
+    scene (Scene: settings, presets) -> build(scene) -> Body   (writes nothing)
+    implicit/ (packing, metaballs, LCSN layers, Gabor, marching cubes) -> to_body
+    cli/ (the `latlong` command; the library never imports it)
+
+Imports point down that picture and into ``craters`` (never ``dem``). ``latlong build
+--help`` describes the command line.
 """
 
 import logging
@@ -19,7 +34,8 @@ from .boulders import (
     boulder_world_meshes,
     place_boulders,
 )
-from .cratering import crater_extents_deg, stamp_craters
+from .build import build
+from .cratering import body_population, crater_extents_deg, stamp_craters
 from .faulting import (
     FAULTING_PRESETS,
     FaultingParams,
@@ -30,6 +46,7 @@ from .faulting import (
     two_phase_faulting,
 )
 from .gabor import GaborNoise, GaborPatch, fit_gabor
+from .gltf import export_glb, export_vtp_strips
 from .grid import LatLongGrid
 from .implicit import (
     ImplicitSurface,
@@ -39,7 +56,19 @@ from .implicit import (
     sphere_packing,
 )
 from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
-from .scene import PRESETS, body_population, build_body, resolve_settings, surface_positions
+from .presets import PRESETS
+from .preview import PreviewSettings, render_preview
+from .scene import SETTING_DEFAULTS, SETTINGS, Scene
+from .settings import (
+    BodySettings,
+    BoulderSettings,
+    CraterSettings,
+    FaultingBase,
+    FbmBase,
+    ImplicitSettings,
+    ShapeBase,
+    SphereBase,
+)
 from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
 from .slopes import (
     facet_slopes,
@@ -51,13 +80,26 @@ from .slopes import (
     vertex_normals,
 )
 from .smoothing import fwhm_to_sigma, heat_smooth, smooth
+from .surface import surface_positions
 
 __all__ = [
     "EXPORT_SUFFIXES",
     "FAULTING_PRESETS",
     "FBM_PRESETS",
     "PRESETS",
+    "SETTINGS",
+    "SETTING_DEFAULTS",
     "Body",
+    "BodySettings",
+    "BoulderSettings",
+    "CraterSettings",
+    "FaultingBase",
+    "FbmBase",
+    "ImplicitSettings",
+    "PreviewSettings",
+    "Scene",
+    "ShapeBase",
+    "SphereBase",
     "BoulderLayer",
     "BoulderNode",
     "BoulderShape",
@@ -76,9 +118,11 @@ __all__ = [
     "boulder_meshes",
     "boulder_population",
     "boulder_world_meshes",
-    "build_body",
+    "build",
     "cast_radii",
     "crater_extents_deg",
+    "export_glb",
+    "export_vtp_strips",
     "facet_slopes",
     "fbm3",
     "fit_gabor",
@@ -95,7 +139,7 @@ __all__ = [
     "radius_spectrum",
     "random_faults",
     "read_shape_model",
-    "resolve_settings",
+    "render_preview",
     "slope_summary",
     "slopes",
     "slopes_and_areas",

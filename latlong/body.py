@@ -8,8 +8,10 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, check_positive
+from craters import validate_catalog
+from craters._shared import atomic_path, check_int, check_positive
 
+from .export import write_mesh
 from .grid import LatLongGrid
 
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
@@ -89,14 +91,10 @@ class Body:
             raise TypeError(f"`metadata` must be JSON-serialisable: {exc}") from None
         self._metadata = meta
         if craters is not None:
-            from craters import validate_catalog
-
             craters = np.array(validate_catalog(craters), copy=True)
             craters.setflags(write=False)
         self._craters = craters
         if boulders is not None:
-            from craters import validate_catalog
-
             boulders = np.array(validate_catalog(boulders), copy=True)
             missing = [c for c in ("centre_x_m", "quat_w", "seed", "shape_flatten")
                        if c not in boulders.dtype.names]
@@ -122,25 +120,24 @@ class Body:
 
     def replace(self, **changes) -> Body:
         """A new body with some of ``radii_m, radius_m, stretch, metadata, craters,
-        boulders`` replaced. When the surface changes (``radii_m`` or ``stretch``) and
-        ``boulders`` is not given, the body's boulders are placed again on the new surface
-        (same positions, sizes, burials and shapes), so they never float or sink."""
+        boulders`` replaced. Pure: nothing is recomputed. A body with boulders whose
+        surface changes (``radii_m`` or ``stretch``) must be given its boulders again,
+        placed on the new surface (``boulders=latlong.place_boulders(new, old.boulders)``
+        or ``boulders=None``): boulders are never left floating or buried silently."""
         kw = {"radii_m": self._radii, "radius_m": self._radius_m,
               "stretch": self._stretch, "metadata": self._metadata,
               "craters": self._craters, "boulders": self._boulders}
         unknown = set(changes) - set(kw)
         if unknown:
             raise TypeError(f"unknown Body fields: {', '.join(sorted(unknown))}")
+        moved = {"radii_m", "stretch"} & set(changes)
+        if moved and "boulders" not in changes and self._boulders is not None \
+                and len(self._boulders):
+            raise ValueError(
+                f"the body's surface changes ({', '.join(sorted(moved))}) but it has "
+                f"{len(self._boulders)} placed boulders: pass `boulders` too (None, or the "
+                "catalog placed again with latlong.place_boulders on the new body)")
         kw.update(changes)
-        rocks = kw["boulders"]
-        moved = {"radii_m", "stretch"} & set(changes) and "boulders" not in changes
-        if moved and rocks is not None and len(rocks):
-            from .boulders import catalog_shape, place_boulders
-
-            kw["boulders"] = None
-            bare = Body(self._grid, kw.pop("radii_m"), **kw)
-            return bare.replace(boulders=place_boulders(bare, rocks,
-                                                        shape=catalog_shape(rocks)))
         return Body(self._grid, kw.pop("radii_m"), **kw)
 
     # ------------------------------------------------------------------ data
@@ -194,8 +191,6 @@ class Body:
     def lod(self, level: int) -> Body:
         """The nested coarser body of magnitude M / 2^level: exactly this body's vertices
         on the even rings / even positions, ``level`` times (no resampling)."""
-        from craters._shared import check_int
-
         level = check_int("level", level, 0, 30)
         factor = 2**level
         if self.magnitude % factor:
@@ -213,6 +208,11 @@ class Body:
         """Vertex positions in metres, (N, 3) float64 (or the rows ``lo:hi``)."""
         u = self._grid.unit_vectors_range(lo, hi)
         return u * (self._radii[lo:hi, None] * self._stretch)
+
+    def vertex_normals(self) -> np.ndarray:
+        """Unit area-weighted vertex normals of the body's triangle mesh, float32 (N, 3),
+        computed band by band (:meth:`LatLongGrid.vertex_normals`)."""
+        return self._grid.vertex_normals(self._radii, self._stretch)
 
     def __repr__(self) -> str:
         return (f"Body(magnitude={self.magnitude}, n_vertices={self.n_vertices}, "
@@ -257,9 +257,7 @@ class Body:
         PLY (binary, float32 x y z and ``height_m`` per vertex), OBJ and STL (binary)
         are streamed ring band by ring band; VTP/VTK go through pyvista.
         """
-        from . import export as _export
-
-        return _export.write_mesh(self, path, progress=progress)
+        return write_mesh(self, path, progress=progress)
 
     def to_pyvista(self):
         """A ``pyvista.PolyData`` with point array ``height_m`` (radius minus reference)."""

@@ -34,6 +34,7 @@ from craters.boulders import (
 )
 
 from .body import Body
+from .surface import band_areas, sample_surface_points
 
 __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_meshes",
            "boulder_normals", "boulder_population", "boulder_world_meshes", "catalog_shape",
@@ -58,21 +59,19 @@ def boulder_population(body: Body, layers, *, rng=None) -> np.ndarray:
     Columns: ``lat_deg, lon_deg, diameter_m, burial_frac, azimuth_deg, seed, layer`` plus
     the crater-catalog defaults (``age_gyr = degradation = 0``, ``kind = "boulder"``).
     """
-    from .scene import _band_totals, _sample_surface
-
     if isinstance(layers, BoulderLayer):
         layers = [layers]
     if not layers or not all(isinstance(la, BoulderLayer) for la in layers):
         raise TypeError("`layers` must be a BoulderLayer or a non-empty list of them")
     rng = normalize_rng(rng)
-    totals = _band_totals(body)
+    totals = band_areas(body)
     area = float(totals.sum())
     parts = []
     cat = body.craters
     for idx, la in enumerate(layers):
         cols = draw_boulder_layer(la, area, idx, rng)
         n = len(cols["diameter_m"])
-        lat, lon, _ = _sample_surface(body, totals, n, rng)
+        lat, lon, _ = sample_surface_points(body, totals, n, rng)
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
             weights = cat["diameter_m"] ** 2
@@ -116,8 +115,6 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     ``burial_m`` and
     ``bottom_depth_m`` (the burial achieved: depth of the deepest vertex).
     """
-    from .gltf import body_normals
-
     if not isinstance(body, Body):
         raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
     shape = BoulderShape() if shape is None else shape
@@ -136,7 +133,7 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     u = np.stack([np.sin(colat) * np.cos(lon), np.sin(colat) * np.sin(lon), np.cos(colat)], 1)
     # the surface is the triangle mesh itself (what a renderer draws), not an interpolation
     surface = grid.surface_radii(body.radii_m, colat, lon)[:, None] * u * stretch
-    normals = body_normals(body).astype(np.float64)
+    normals = body.vertex_normals().astype(np.float64)
     nrm = np.stack([grid.interpolate(normals[:, c], colat, lon) for c in range(3)], 1)
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     rot = orientations(nrm, np.radians(cat["azimuth_deg"]))

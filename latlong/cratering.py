@@ -15,11 +15,30 @@ from craters.stamp import resolve_roughness
 
 from ._crater_kernels import _stamp_body_kernel
 from .body import Body
+from .surface import band_areas, sample_surface_points
 
-__all__ = ["crater_extents_deg", "stamp_craters"]
+__all__ = ["body_population", "crater_extents_deg", "stamp_craters"]
 
 logger = logging.getLogger(__name__)
 _BATCH = 256  # craters per kernel call when a progress bar is shown
+
+
+def body_population(body: Body, layers, *, rng=None, degradation_kwargs=None) -> np.ndarray:
+    """A crater catalog for ``body``: counts from its actual surface area, positions
+    uniform on its actual surface (:func:`latlong.surface_positions`), oldest first.
+
+    ``layers``: :class:`craters.CraterLayer` s; ``degradation_kwargs`` go to
+    :func:`craters.degradation_from_age`.
+    """
+    if not isinstance(body, Body):
+        raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
+    rng = normalize_rng(rng)
+    totals = band_areas(body)
+    cat = _craters.population(layers, area_m2=float(totals.sum()), rng=rng,
+                              degradation_kwargs=degradation_kwargs)
+    lat, lon, _ = sample_surface_points(body, totals, len(cat), rng)
+    cat["lat_deg"], cat["lon_deg"] = lat, lon
+    return cat
 
 
 def _local_radii(body: Body, lat_deg, lon_deg) -> np.ndarray:

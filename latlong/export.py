@@ -45,7 +45,7 @@ def _boulders(body):
 
 def _boulder_counts(body):
     """(vertices, triangles) the boulders add at their finest level."""
-    from .boulders import catalog_shape
+    from craters.boulders import catalog_shape
 
     cat = _boulders(body)
     if cat is None:
@@ -68,7 +68,7 @@ def _vertex_chunks(n, chunk=1 << 21):
 def write_ply(body, path, *, progress: bool = False) -> Path:
     """Binary little-endian PLY: float32 ``x y z height_m`` per vertex (plus int32
     ``boulder_id`` when the body has boulders), int32 triangles."""
-    from .boulders import iter_boulder_meshes
+    from craters.boulders import iter_boulder_meshes
 
     grid = body.grid
     n, t = grid.n_vertices, grid.n_triangles
@@ -128,7 +128,7 @@ def write_ply(body, path, *, progress: bool = False) -> Path:
 
 def _boulder_face_chunks(body, base: int = 0):
     """Boulder triangles a chunk at a time, indices after the body's vertices (+ base)."""
-    from .boulders import catalog_shape, mesh_chunk
+    from craters.boulders import catalog_shape, mesh_chunk
 
     cat = _boulders(body)
     if cat is None:
@@ -151,7 +151,7 @@ def write_stl(body, path, *, progress: bool = False) -> Path:
     grid = body.grid
     tdt = np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
     header = b"craterform lat/long body, metres".ljust(80, b" ")
-    from .boulders import iter_boulder_meshes
+    from craters.boulders import iter_boulder_meshes
 
     def facets(corners):
         normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
@@ -180,7 +180,7 @@ def write_stl(body, path, *, progress: bool = False) -> Path:
 
 def write_obj(body, path, *, progress: bool = False) -> Path:
     """Wavefront OBJ text (``v x y z`` in metres, 9 significant digits; 1-based faces)."""
-    from .boulders import iter_boulder_meshes
+    from craters.boulders import iter_boulder_meshes
 
     grid = body.grid
     with atomic_path(path) as tmp, open(tmp, "w", encoding="ascii", newline="\n") as fh:
@@ -213,7 +213,7 @@ def _write_pyvista(body, path, *, progress: bool = False) -> Path:
     if cat is not None:
         import pyvista as pv
 
-        from .boulders import boulder_world_meshes
+        from craters.boulders import boulder_world_meshes
 
         bv, bf = boulder_world_meshes(cat)
         rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())

@@ -36,12 +36,11 @@ import numpy as np
 
 from craters._shared import atomic_path, check_int, package_version, progress_bar
 
-from ._grid_kernels import _normals_from_radii_kernel
 from .body import Body
 from .grid import LatLongGrid
 from .strips import join_strips, patch_tree, strip_triangles
 
-__all__ = ["body_normals", "export_glb", "export_vtp_strips", "unit_vectors_of"]
+__all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
 
 _ARRAY_BUFFER = 34962
 _ELEMENT_ARRAY_BUFFER = 34963
@@ -55,21 +54,6 @@ _TRIANGLE_STRIP = 5
 def unit_vectors_of(grid: LatLongGrid, idx) -> np.ndarray:
     """Unit vectors of the vertices ``idx`` without the whole-grid cache."""
     return grid.unit_vectors_of(idx)
-
-
-def body_normals(body: Body) -> np.ndarray:
-    """Unit vertex normals (area-weighted), float32 (N, 3), streamed band by band."""
-    grid = body.grid
-    acc = np.zeros((grid.n_vertices, 3), dtype=np.float32)  # 12 B per vertex, no copies
-    _normals_from_radii_kernel(grid.magnitude, grid.ring_offsets(), grid.band_offsets(),
-                               np.asarray(body.radii_m, dtype=np.float64),
-                               np.asarray(body.stretch, dtype=np.float64), acc)
-    step = 1 << 22
-    for s in range(0, grid.n_vertices, step):  # normalise in place, in chunks
-        block = acc[s:s + step]
-        norm = np.sqrt((block.astype(np.float64) ** 2).sum(axis=1))
-        block /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
-    return acc
 
 
 def _pad4(n: int) -> int:
@@ -191,7 +175,7 @@ def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict,
     """Write one level's patches to ``binf`` (buffer = the level); returns its size."""
     offset = 0
     grid = body.grid
-    normals = body_normals(body)
+    normals = body.vertex_normals()
     radii = np.asarray(body.radii_m)
     stretch = np.asarray(body.stretch)
     root = patch_tree(grid, patch_k)
@@ -333,7 +317,7 @@ def export_vtp_strips(body: Body, path) -> Path:
     strips = triangle_strips(body.grid)
     cells = np.concatenate([np.concatenate([[len(s)], s]) for s in strips])
     mesh = pv.PolyData(body.vertices(), strips=cells)
-    mesh.point_data["Normals"] = body_normals(body)
+    mesh.point_data["Normals"] = body.vertex_normals()
     mesh.point_data["height_m"] = body.heights_m
     with atomic_path(path) as tmp:
         mesh.save(str(tmp), binary=True)

@@ -10,6 +10,7 @@ from craters._shared import check_int
 
 from ._grid_kernels import (
     _interpolate_kernel,
+    _normals_from_radii_kernel,
     _surface_radius_kernel,
     _triangles_kernel,
     _triangles_serial,
@@ -343,6 +344,31 @@ class LatLongGrid:
         stretching maps the rays from the centre and the triangles onto themselves.
         """
         return self._sample(_surface_radius_kernel, "radii", radii, colatitudes, longitudes)
+
+    def vertex_normals(self, radii, stretch=(1.0, 1.0, 1.0)) -> np.ndarray:
+        """Unit area-weighted vertex normals, float32 (N, 3), of the mesh whose vertex
+        ``i`` is ``stretch * radii[i] * u_i``; accumulated band by band (12 B a vertex,
+        no triangle array) and normalised in chunks.
+
+        Examples
+        --------
+        >>> g = LatLongGrid(4)
+        >>> n = g.vertex_normals(np.full(g.n_vertices, 2.0))
+        >>> bool(np.allclose(n, g.unit_vectors(), atol=0.2))
+        True
+        """
+        radii = np.ascontiguousarray(radii, dtype=np.float64)
+        if radii.shape != (self.n_vertices,):
+            raise ValueError(f"`radii` must have shape ({self.n_vertices},); got {radii.shape}")
+        acc = np.zeros((self.n_vertices, 3), dtype=np.float32)
+        _normals_from_radii_kernel(self._m, self.ring_offsets(), self.band_offsets(), radii,
+                                   np.ascontiguousarray(stretch, dtype=np.float64), acc)
+        step = 1 << 22
+        for s in range(0, self.n_vertices, step):  # normalise in place, in chunks
+            block = acc[s:s + step]
+            norm = np.sqrt((block.astype(np.float64) ** 2).sum(axis=1))
+            block /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
+        return acc
 
     def _sample(self, kernel, name: str, values, colatitudes, longitudes) -> np.ndarray:
         """Run a per-point kernel(m, ring_offsets, values, colat, lon, out) after checks."""

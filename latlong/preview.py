@@ -11,18 +11,27 @@ writes a contact sheet of six views along +x, -x, +y, -y, +z, -z with the same s
 from __future__ import annotations
 
 import ctypes.util
+import dataclasses
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, check_finite, check_int
+from craters._shared import (
+    ParameterError,
+    atomic_path,
+    check_finite,
+    check_int,
+    check_positive,
+    check_range,
+)
 
 from .body import Body
 from .grid import LatLongGrid
 
-__all__ = ["VIEW_DIRECTIONS", "camera_frame", "render_from_settings", "render_preview",
+__all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "render_preview",
            "sun_direction"]
 
 #: Bodies above this magnitude are resampled to it for pictures (a picture of a few
@@ -31,6 +40,43 @@ PREVIEW_MAX_MAGNITUDE = 1000
 #: The six views of a contact sheet: (label, view latitude, view longitude) in degrees.
 VIEW_DIRECTIONS = (("+x", 0.0, 0.0), ("-x", 0.0, 180.0), ("+y", 0.0, 90.0),
                    ("-y", 0.0, -90.0), ("+z", 90.0, 0.0), ("-z", -90.0, 0.0))
+
+
+@dataclass(frozen=True, slots=True)
+class PreviewSettings:
+    """Camera, sun and size of a preview picture (module notes)."""
+
+    sun_azimuth_deg: float = 60.0
+    """Sun azimuth from the viewer, degrees (0 = behind the camera, 90 = from the right)."""
+    sun_elevation_deg: float = 20.0
+    """Sun elevation above the picture's horizontal plane, degrees, [-90, 90]."""
+    view_lon_deg: float = -90.0
+    """Longitude of the camera direction (body-fixed), degrees."""
+    view_lat_deg: float = 0.0
+    """Latitude of the camera direction, degrees, [-90, 90]."""
+    camera_distance_m: float | None = None
+    """Camera distance from the body centre, metres (default: frame the body)."""
+    width_px: int = 1024
+    """Picture width, pixels, [16, 8192]."""
+    height_px: int = 768
+    """Picture height, pixels, [16, 8192]."""
+    views: int = 1
+    """1 = one view; 6 = a contact sheet from +x, -x, +y, -y, +z, -z."""
+
+    def __post_init__(self):
+        for key in ("sun_azimuth_deg", "view_lon_deg"):
+            object.__setattr__(self, key, check_finite(key, getattr(self, key)))
+        for key in ("sun_elevation_deg", "view_lat_deg"):
+            object.__setattr__(self, key, check_range(key, getattr(self, key), -90.0, 90.0))
+        if self.camera_distance_m is not None:
+            object.__setattr__(self, "camera_distance_m",
+                               check_positive("camera_distance_m", self.camera_distance_m))
+        for key in ("width_px", "height_px"):
+            object.__setattr__(self, key, check_int(key, getattr(self, key), 16, 8192))
+        views = check_int("views", self.views, 1, 6)
+        if views not in (1, 6):
+            raise ParameterError("views", f"must be 1 or 6; got {views}")
+        object.__setattr__(self, "views", views)
 
 
 def _headless_setup() -> None:
@@ -119,12 +165,20 @@ def _render(mesh, centre, extent, *, sun, view, width_px, height_px, camera_dist
         plotter.close()
 
 
-def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
-                   sun_elevation_deg: float = 20.0, view_lat_deg: float = 0.0,
-                   view_lon_deg: float = -90.0, camera_distance_m: float | None = None,
-                   width_px: int = 1024, height_px: int = 768, views: int = 1) -> Path:
+def render_preview(body: Body, path, settings: PreviewSettings | None = None, **kwargs) -> Path:
     """Render ``body`` (a Body or a closed ``pyvista.PolyData`` mesh in metres) off-screen
-    to a PNG at ``path`` (atomic); see the module notes."""
+    to a PNG at ``path`` (atomic); see the module notes. The camera and sun are
+    ``settings`` (:class:`PreviewSettings`) or its fields as keyword arguments."""
+    if settings is None:
+        settings = PreviewSettings(**kwargs)
+    elif kwargs:
+        settings = dataclasses.replace(settings, **kwargs)
+    if not isinstance(settings, PreviewSettings):
+        raise TypeError(f"`settings` must be a PreviewSettings; got {type(settings).__name__}")
+    sun_azimuth_deg, sun_elevation_deg = settings.sun_azimuth_deg, settings.sun_elevation_deg
+    view_lat_deg, view_lon_deg = settings.view_lat_deg, settings.view_lon_deg
+    width_px, height_px, views = settings.width_px, settings.height_px, settings.views
+    camera_distance_m = settings.camera_distance_m
     _headless_setup()  # before VTK loads
     import pyvista as pv
 
@@ -134,19 +188,10 @@ def render_preview(body: Body, path, *, sun_azimuth_deg: float = 60.0,
     path = Path(path)
     if path.suffix.lower() != ".png":
         raise ValueError(f"picture path must end in .png; got {str(path)!r}")
-    width_px = check_int("width_px", width_px, 16, 8192)
-    height_px = check_int("height_px", height_px, 16, 8192)
-    views = check_int("views", views, 1, 6)
-    if views not in (1, 6):
-        raise ValueError(f"`views` must be 1 or 6; got {views}")
-    if camera_distance_m is not None and not (
-            math.isfinite(camera_distance_m) and camera_distance_m > 0):
-        raise ValueError(f"`camera_distance_m` must be finite and > 0; got {camera_distance_m!r}")
-    sun_direction(sun_azimuth_deg, sun_elevation_deg, view_lat_deg, view_lon_deg)  # validate
     if isinstance(body, Body):
         mesh = _picture_body(body).to_pyvista()
         if body.boulders is not None and len(body.boulders):
-            from .boulders import boulder_world_meshes
+            from craters.boulders import boulder_world_meshes
 
             bv, bf = boulder_world_meshes(body.boulders)
             rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())
@@ -190,12 +235,3 @@ def _contact_sheet(images, labels) -> np.ndarray:
         ImageDraw.Draw(tile).text((8, 6), f"view from {label}", fill=(230, 230, 230))
         sheet.paste(tile, ((k % 3) * w, (k // 3) * h))
     return np.asarray(sheet)
-
-
-def render_from_settings(body, path, s: dict) -> Path:
-    """:func:`render_preview` with the render keys of scene settings ``s``."""
-    return render_preview(body, path, sun_azimuth_deg=s["sun_azimuth_deg"],
-                          sun_elevation_deg=s["sun_elevation_deg"],
-                          view_lat_deg=s["view_lat_deg"], view_lon_deg=s["view_lon_deg"],
-                          camera_distance_m=s.get("camera_distance_m"),
-                          width_px=s["width_px"], height_px=s["height_px"], views=s["views"])

@@ -17,7 +17,6 @@ import functools
 import math
 
 import numpy as np
-import scipy.sparse as sp
 
 from craters._shared import check_int, check_positive
 
@@ -41,6 +40,8 @@ def fwhm_to_sigma(width: float) -> float:
 @functools.lru_cache(maxsize=8)
 def _operator(magnitude: int):
     """Cotangent Laplacian (CSR, unit sphere), lumped masses and a stable time step."""
+    import scipy.sparse as sp  # here: importing scipy loads argparse
+
     grid = LatLongGrid(magnitude)
     p = grid.unit_vectors()
     t = grid.triangles()

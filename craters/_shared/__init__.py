@@ -14,6 +14,8 @@ from .spec import parse_spec
 from .stats import area_slope_summary
 from .system import human_bytes, package_version, physical_memory_bytes
 from .validation import (
+    ParameterError,
+    ParameterTypeError,
     RngLike,
     check_choice,
     check_finite,
@@ -23,7 +25,8 @@ from .validation import (
     normalize_rng,
 )
 
-__all__ = ["RngLike", "area_slope_summary", "atomic_path", "check_choice", "check_finite",
-           "check_int", "check_output_path", "check_parent_folder", "check_positive",
-           "check_range", "human_bytes", "load_toml", "normalize_rng", "package_version",
-           "parse_spec", "physical_memory_bytes", "progress_bar"]
+__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "area_slope_summary",
+           "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
+           "check_parent_folder", "check_positive", "check_range", "human_bytes", "load_toml",
+           "normalize_rng", "package_version", "parse_spec", "physical_memory_bytes",
+           "progress_bar"]

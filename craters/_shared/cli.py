@@ -10,9 +10,10 @@ import argparse
 import logging
 import os
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping
 
 from .files import check_output_path
+from .validation import ParameterError, ParameterTypeError
 
 __all__ = ["CliError", "OneLineParser", "add_report_arguments", "check_report_outputs",
            "parse_seed", "run_cli"]
@@ -41,9 +42,11 @@ class OneLineParser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def run_cli(func: Callable[[], int | None], *, logger_names: Sequence[str] = ()) -> int:
+def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None = None) -> int:
     """Run a CLI body; user errors become one line on stderr and exit code 2.
 
+    ``flags`` maps library parameters / setting keys to the command's flags: an error
+    about one of them (:class:`~craters._shared.ParameterError`) is shown under its flag.
     Set the environment variable ``CRATERFORM_DEBUG=1`` to get the traceback instead.
     """
     logging.basicConfig(format="%(levelname)s: %(message)s", level=logging.WARNING)
@@ -52,7 +55,10 @@ def run_cli(func: Callable[[], int | None], *, logger_names: Sequence[str] = ())
     except (CliError, ValueError, TypeError, OSError, MemoryError) as exc:
         if os.environ.get("CRATERFORM_DEBUG"):
             raise
-        msg = str(exc) if str(exc) else exc.__class__.__name__
+        if isinstance(exc, ParameterError | ParameterTypeError) and exc.name in (flags or {}):
+            msg = exc.shown_as(flags[exc.name], lambda k: flags.get(k, f"`{k}`"))
+        else:
+            msg = str(exc) if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"error: {msg}\n".replace("\n", " ").rstrip() + "\n")
         return 2
     except KeyboardInterrupt:

@@ -12,10 +12,50 @@ from collections.abc import Sequence
 
 import numpy as np
 
-__all__ = ["RngLike", "check_choice", "check_finite", "check_int", "check_positive",
-           "check_range", "normalize_rng"]
+__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "check_choice", "check_finite",
+           "check_int", "check_positive", "check_range", "normalize_rng"]
 
 RngLike = int | np.random.Generator | None
+
+
+class _Named:
+    """A bad value of one named parameter: ``str()`` reads "`name` rule".
+
+    ``name`` is the parameter of the function the user called (or the scene key); a
+    command line shows the same rule under its own flag with :meth:`shown_as`, so
+    messages are mapped through an option table, never by editing their text. A rule
+    that names other parameters has ``{}`` where they go and lists them in ``see``.
+    """
+
+    def __init__(self, name: str, rule: str, *, see: tuple[str, ...] = ()):
+        self.name, self.rule, self.see = name, rule, tuple(see)
+        super().__init__(self.shown_as(f"`{name}`"))
+
+    def shown_as(self, label: str, name_of=None) -> str:
+        """The message with ``label`` (a flag, a key) in place of the parameter name and
+        ``name_of(other)`` in place of each other parameter it names."""
+        name_of = name_of or (lambda other: f"`{other}`")
+        rule = self.rule.format(*map(name_of, self.see)) if self.see else self.rule
+        return f"{label} {rule}"
+
+    def renamed(self, name: str):
+        """The same error for the parameter ``name`` (the caller's name for the value)."""
+        return type(self)(name, self.rule, see=self.see)
+
+
+class ParameterError(_Named, ValueError):
+    """A bad value of one named parameter (a ``ValueError``).
+
+    Examples
+    --------
+    >>> e = ParameterError("radius_m", "must be > 0; got -1.0")
+    >>> str(e), e.shown_as("--radius-m")
+    ('`radius_m` must be > 0; got -1.0', '--radius-m must be > 0; got -1.0')
+    """
+
+
+class ParameterTypeError(_Named, TypeError):
+    """The wrong kind of object for one named parameter (a ``TypeError``)."""
 
 
 def normalize_rng(rng: RngLike) -> np.random.Generator:
@@ -25,21 +65,20 @@ def normalize_rng(rng: RngLike) -> np.random.Generator:
     if rng is None:
         return np.random.default_rng()
     if isinstance(rng, bool | float) or not isinstance(rng, numbers.Integral):
-        raise TypeError(
-            f"`rng` must be an int seed, a numpy.random.Generator or None; got {rng!r}"
-        )
+        raise ParameterTypeError(
+            "rng", f"must be an int seed, a numpy.random.Generator or None; got {rng!r}")
     if int(rng) < 0:
-        raise ValueError(f"`rng` seed must be >= 0; got {rng!r}")
+        raise ParameterError("rng", f"seed must be >= 0; got {rng!r}")
     return np.random.default_rng(int(rng))
 
 
 def check_finite(name: str, value) -> float:
     """Return ``value`` as a float, raising if it is not a finite real number."""
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(f"`{name}` must be a real number; got {value!r}")
+        raise ParameterTypeError(name, f"must be a real number; got {value!r}")
     value = float(value)
     if not math.isfinite(value):
-        raise ValueError(f"`{name}` must be finite; got {value!r}")
+        raise ParameterError(name, f"must be finite; got {value!r}")
     return value
 
 
@@ -48,7 +87,7 @@ def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
     value = check_finite(name, value)
     if value < 0 or (value == 0 and not allow_zero):
         rule = ">= 0" if allow_zero else "> 0"
-        raise ValueError(f"`{name}` must be finite and {rule}; got {value!r}")
+        raise ParameterError(name, f"must be finite and {rule}; got {value!r}")
     return value
 
 
@@ -58,7 +97,7 @@ def check_range(name: str, value, lo: float | None, hi: float | None) -> float:
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         lo_s = "-inf" if lo is None else f"{lo:g}"
         hi_s = "inf" if hi is None else f"{hi:g}"
-        raise ValueError(f"`{name}` must be in [{lo_s}, {hi_s}]; got {value!r}")
+        raise ParameterError(name, f"must be in [{lo_s}, {hi_s}]; got {value!r}")
     return value
 
 
@@ -68,17 +107,17 @@ def check_int(name: str, value, lo: int | None = None, hi: int | None = None) ->
         if isinstance(value, float) and value.is_integer():
             value = int(value)
         else:
-            raise TypeError(f"`{name}` must be an integer; got {value!r}")
+            raise ParameterTypeError(name, f"must be an integer; got {value!r}")
     value = int(value)
     if (lo is not None and value < lo) or (hi is not None and value > hi):
         lo_s = "-inf" if lo is None else str(lo)
         hi_s = "inf" if hi is None else str(hi)
-        raise ValueError(f"`{name}` must be an integer in [{lo_s}, {hi_s}]; got {value!r}")
+        raise ParameterError(name, f"must be an integer in [{lo_s}, {hi_s}]; got {value!r}")
     return value
 
 
 def check_choice(name: str, value, choices: Sequence[str]) -> str:
     """Return ``value`` if it is one of ``choices``, else raise ValueError."""
     if value not in choices:
-        raise ValueError(f"`{name}` must be one of {', '.join(map(str, choices))}; got {value!r}")
+        raise ParameterError(name, f"must be one of {', '.join(map(str, choices))}; got {value!r}")
     return value

@@ -22,8 +22,8 @@ import numpy as np
 
 import craters
 import craters.boulders as bmod
-from latlong import BoulderLayer, boulder_population, build_body, place_boulders, resolve_settings
-from latlong.scene import _band_totals
+from latlong import BoulderLayer, Scene, boulder_population, build, place_boulders
+from latlong.surface import band_areas
 
 
 def main():
@@ -32,11 +32,10 @@ def main():
     parser.add_argument("--boulders", type=int, default=10_000)
     parser.add_argument("--k", type=float, default=-3.0)
     args = parser.parse_args()
-    s = resolve_settings({"preset": "fig5a", "magnitude": args.magnitude, "radius_m": 1000.0,
-                          "craters": ["c=0.05,k=-2,dmin=10,dmax=200"], "seed": 1,
-                          "output": ["unused.npz"], "force": True, "quiet": True})
-    body = build_body(s)
-    area = float(_band_totals(body).sum())
+    body = build(Scene.from_settings({"preset": "fig5a", "magnitude": args.magnitude,
+                                      "radius_m": 1000.0, "seed": 1,
+                                      "craters": ["c=0.05,k=-2,dmin=10,dmax=200"]}))
+    area = float(band_areas(body).sum())
     d_min, d_max = 1.0, 30.0
     c = args.boulders / (area * (d_min**args.k - d_max**args.k))
     layer = BoulderLayer(c=c, k=args.k, d_min_m=d_min, d_max_m=d_max, near=0.3)

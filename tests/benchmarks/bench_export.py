@@ -15,7 +15,7 @@ import tempfile
 import time
 from pathlib import Path
 
-from latlong import build_body, resolve_settings
+from latlong import Scene, build
 from latlong.gltf import export_glb
 
 
@@ -29,12 +29,11 @@ def main():
     folder = Path(args.out or tempfile.mkdtemp(prefix="craterform-bench-"))
     folder.mkdir(parents=True, exist_ok=True)
     glb = folder / f"body_M{args.magnitude}.glb"
-    s = resolve_settings({"preset": "fig5a", "magnitude": args.magnitude, "radius_m": 1000.0,
-                          "craters": ["c=0.05,k=-2,dmin=2,dmax=100"], "seed": 1,
-                          "output": [str(folder / "unused.npz")], "force": True,
-                          "quiet": True})
+    scene = Scene.from_settings({"preset": "fig5a", "magnitude": args.magnitude,
+                                 "radius_m": 1000.0, "seed": 1,
+                                 "craters": ["c=0.05,k=-2,dmin=2,dmax=100"]})
     t0 = time.perf_counter()
-    body = build_body(s)
+    body = build(scene)
     t_build = time.perf_counter() - t0
     print(f"build M={body.magnitude} ({body.n_vertices:,} vertices, {len(body.craters):,} "
           f"craters): {t_build:.1f} s")

@@ -236,9 +236,9 @@ def test_surface_radii_matches_brute_force(rough_body):
 def test_population_counts_and_size_frequency_exponent(rough_body):
     layer = BoulderLayer(c=1e-3, k=-2.5, d_min_m=1.0, d_max_m=50.0)
     cat = boulder_population(rough_body, layer, rng=9)
-    from latlong.scene import _band_totals
+    from latlong.surface import band_areas
 
-    area = float(_band_totals(rough_body).sum())
+    area = float(band_areas(rough_body).sum())
     mean = area * layer.c * (layer.d_min_m**layer.k - layer.d_max_m**layer.k)
     assert abs(len(cat) - mean) < 4 * np.sqrt(mean)
     k_fit = craters.fit_power_law_exponent(cat["diameter_m"], layer.d_min_m, layer.d_max_m)
@@ -491,15 +491,20 @@ def test_shape_levels_chunks_and_mixed_catalogs(rough_body):
         boulder_world_meshes(np.concatenate([a, b]))
 
 
-def test_new_surface_places_the_boulders_again(rough_body):
-    """Cratering (or any new radii) after placement: the boulders follow the surface."""
+def test_replace_is_pure_and_a_new_surface_needs_its_boulders_placed(rough_body):
+    """Body.replace recomputes nothing: new radii on a body with boulders are refused
+    unless its boulders are given (placed again explicitly, or dropped)."""
     layer = BoulderLayer(c=2e-4, k=-3.0, d_min_m=2.0, d_max_m=20.0)
     body = rough_body.replace(boulders=place_boulders(
         rough_body, boulder_population(rough_body, layer, rng=3)))
     assert len(body.boulders) > 20
-    lifted = body.replace(radii_m=body.radii_m + 7.0)
-    again = place_boulders(lifted.replace(boulders=None), body.boulders)
-    assert np.array_equal(lifted.boulders, again)
+    with pytest.raises(ValueError, match="boulders"):
+        body.replace(radii_m=body.radii_m + 7.0)
+    bare = body.replace(radii_m=body.radii_m + 7.0, boulders=None)
+    lifted = bare.replace(boulders=place_boulders(bare, body.boulders))
+    assert np.array_equal(lifted.radii_m, body.radii_m + 7.0)
     assert not np.allclose(lifted.boulders["centre_x_m"], body.boulders["centre_x_m"])
+    same = body.replace(metadata={"note": "x"})  # not the surface: boulders kept as they are
+    assert np.array_equal(same.boulders, body.boulders)
     with pytest.raises(ValueError, match="placed catalog"):
         rough_body.replace(boulders=boulder_population(rough_body, layer, rng=3))

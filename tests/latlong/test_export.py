@@ -9,7 +9,7 @@ import pytest
 import pyvista as pv
 
 from latlong import Body, LatLongGrid, perlin_fbm
-from latlong.gltf import body_normals, export_glb, export_vtp_strips, unit_vectors_of
+from latlong.gltf import export_glb, export_vtp_strips, unit_vectors_of
 from latlong.slopes import vertex_normals
 from latlong.strips import (
     band_strip,
@@ -86,7 +86,7 @@ def test_lod_is_the_nested_body(body):
 
 
 def test_normals_and_unit_vectors(body):
-    assert np.abs(body_normals(body) - vertex_normals(body)[0]).max() < 1e-6
+    assert np.abs(body.vertex_normals() - vertex_normals(body)[0]).max() < 1e-6
     g = body.grid
     idx = np.array([0, 1, 7, 500, g.n_vertices - 2, g.n_vertices - 1])
     assert np.array_equal(unit_vectors_of(g, idx), g.unit_vectors()[idx])

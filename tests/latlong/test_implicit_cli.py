@@ -96,7 +96,7 @@ def test_config_file(run_cli, tmp_path):
 
 @pytest.mark.parametrize("args,needles", [
     (["--backend", "implicit"], ["--shape"]),
-    (["--backend", "voxels"], ["--backend", "latlong or implicit"]),
+    (["--backend", "voxels"], ["--backend", "latlong, implicit"]),
     (["--shape", "x.obj"], ["--shape", "--backend implicit"]),
     ([*BENNU[:4]], ["--shape-units"]),
     ([*BENNU, "--radius-m", "100"], ["--radius-m", "does not apply"]),

@@ -13,10 +13,18 @@ import numpy as np
 
 from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
 from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
-
-from .body import Body, load
-from .shapes import ShapeModel, from_shape_model, read_shape_model
-from .slopes import SLOPE_BIN_DEG, mesh_slopes, radius_spectrum, slope_summary, slopes_and_areas
+from latlong import (
+    Body,
+    ShapeModel,
+    from_shape_model,
+    load,
+    mesh_slopes,
+    radius_spectrum,
+    read_shape_model,
+    slope_summary,
+    slopes_and_areas,
+)
+from latlong.slopes import SLOPE_BIN_DEG
 
 
 def _load_input(path: str, units: str | None):

@@ -1,0 +1,135 @@
+"""The build: a :class:`~latlong.Scene` in, a body out, nothing written.
+
+Lat/long backend: the base radii (sphere, two-phase faulting, Perlin fBm or a shape
+model ray-cast onto the grid, with fBm detail), then the crater catalog drawn on the
+body's actual surface and stamped oldest first, then boulders drawn and placed on the
+cratered surface; the body's metadata records the scene (seed, base parameters, layers).
+Implicit backend: :func:`latlong.implicit_surface` of the scene's constraint and layers.
+Both draw every random number from one generator seeded with the scene's seed, in a
+fixed order, so the same scene gives the same bytes whatever the thread count.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from craters._shared import package_version
+
+from .body import Body
+from .boulders import boulder_population, place_boulders
+from .cratering import body_population, stamp_craters
+from .faulting import FaultingParams, two_phase_faulting
+from .grid import LatLongGrid
+from .perlin import perlin_fbm
+from .scene import Scene
+from .settings import FaultingBase, FbmBase, ShapeBase, SphereBase
+from .shapes import from_shape_model
+
+__all__ = ["build"]
+
+GENERATOR = "craterform latlong build"
+
+
+def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
+    """(heights above the reference radius in metres, reference radius, parameters for
+    the metadata) of the scene's base shape."""
+    base, body = scene.base, scene.body
+    if isinstance(base, SphereBase):
+        return np.zeros(grid.n_vertices), body.radius_m, {}
+    if isinstance(base, FaultingBase):
+        fp = FaultingParams(base.n_faults_1, base.max_fault_1_m, base.smooth_width_m,
+                            base.smooth_passes, base.n_faults_2, base.max_fault_2_m,
+                            tuple(body.stretch))
+        heights = two_phase_faulting(grid, body.radius_m, fp, rng=rng, progress=progress)
+        return heights, body.radius_m, dataclasses.asdict(fp)
+    if isinstance(base, FbmBase):
+        params = {"frequency": base.frequency, "octaves": base.octaves,
+                  "persistence": base.persistence, "lacunarity": base.lacunarity,
+                  "amplitude_m": base.amplitude_m}
+        return perlin_fbm(grid, *params.values(), rng=rng), body.radius_m, params
+    assert isinstance(base, ShapeBase)
+    shaped = from_shape_model(base.model, grid.magnitude, center=base.center,
+                              crossings=base.crossings, smooth=base.smooth)
+    params = {"frequency": base.detail_frequency, "octaves": base.detail_octaves,
+              "persistence": base.detail_persistence, "lacunarity": base.detail_lacunarity,
+              "amplitude_m": base.detail_amplitude_m}
+    detail = perlin_fbm(grid, *params.values(), rng=rng) if base.detail_amplitude_m else 0.0
+    params["shape"] = shaped.metadata
+    return shaped.radii_m - shaped.radius_m + detail, shaped.radius_m, params
+
+
+def build(scene: Scene, *, progress: bool = False):
+    """Make the body a scene describes; writes nothing.
+
+    Parameters
+    ----------
+    scene : Scene
+    progress : bool
+        Progress bars on a terminal for the long steps.
+
+    Returns
+    -------
+    Body
+        For the lat/long backend: the base, then the craters (``body.craters``, the
+        catalog as stamped), then the boulders (``body.boulders``, as placed).
+    latlong.implicit.ImplicitSurface
+        For the implicit backend (``.to_body(magnitude)`` casts it onto a grid).
+
+    Examples
+    --------
+    >>> from latlong import BodySettings, FbmBase, Scene
+    >>> body = build(Scene(BodySettings(magnitude=8), FbmBase(octaves=3), seed=1))
+    >>> body.n_vertices, body.metadata["seed"]
+    (386, 1)
+    """
+    if not isinstance(scene, Scene):
+        raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+    if scene.implicit is not None:
+        return _build_implicit(scene, progress)
+    grid = LatLongGrid(scene.body.magnitude)
+    rng = np.random.default_rng(scene.seed)
+    heights, radius_m, params = _base_heights(scene, grid, rng, progress)
+    craters, boulders = scene.craters, scene.boulders
+    metadata = {
+        "generator": GENERATOR,
+        "version": package_version(),
+        "seed": scene.seed,
+        "base": scene.base.name,
+        "preset": scene.preset,
+        "parameters": params,
+        "craters": [dataclasses.asdict(la) for la in craters.layers],
+        "crater_morphometry": craters.morphometry,
+        "crater_lifetime_gyr": craters.lifetime_gyr,
+        "crater_roughness": craters.roughness,
+        "boulders": [dataclasses.asdict(la) for la in boulders.layers],
+        "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
+    }
+    body = Body.from_heights(grid, radius_m, heights, stretch=scene.body.stretch,
+                             metadata=metadata)
+    if craters.layers:
+        cat = body_population(body, craters.layers, rng=rng, degradation_kwargs={
+            "baseline_lifetime_gyr": craters.lifetime_gyr})
+        body = stamp_craters(body, cat, roughness=craters.roughness, rng=rng,
+                             progress=progress, max_extent_deg=craters.max_extent_deg,
+                             morphometry=craters.morphometry, too_large="skip")
+        body = body.replace(metadata={**body.metadata,
+                                      "craters_skipped_too_large": len(cat) - len(body.craters)})
+    if boulders.layers:
+        found = boulder_population(body, boulders.layers, rng=rng)
+        body = body.replace(boulders=place_boulders(body, found, shape=boulders.shape))
+    return body
+
+
+def _build_implicit(scene: Scene, progress: bool):
+    from .implicit import implicit_surface
+
+    imp = scene.implicit
+    surf = implicit_surface(imp.shape, imp.layers, gabor=imp.gabor, voxel_m=imp.voxel_m,
+                            target_polygons=imp.polygons, cell_m=imp.cell_m,
+                            packing_voxels=imp.packing_voxels, min_sphere_m=imp.min_sphere_m,
+                            rng=scene.seed, progress=progress)
+    meta = {**surf.metadata, "seed": scene.seed, "version": package_version(),
+            "shape_units": imp.units}
+    return dataclasses.replace(surf, metadata=meta)

@@ -1,0 +1,398 @@
+"""The parts of a :class:`latlong.Scene`: body, base shapes, crater and boulder layers,
+the implicit backend. Frozen, slotted records that validate themselves when made
+(errors name the field); :mod:`latlong.scene` checks how they fit together.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import craters as _craters
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    check_choice,
+    check_finite,
+    check_int,
+    check_positive,
+    human_bytes,
+    physical_memory_bytes,
+)
+
+from .grid import LatLongGrid
+from .perlin import FBM_PRESETS
+from .shapes import ShapeModel, read_shape_model
+
+__all__ = ["BASES", "BYTES_PER_VERTEX", "BodySettings", "BoulderSettings", "CraterSettings",
+           "FaultingBase", "FbmBase", "ImplicitSettings", "ShapeBase", "SphereBase",
+           "check_memory"]
+
+#: Names of the base shapes (``shape`` takes a model file).
+BASES = ("sphere", "faulting", "fbm", "shape")
+#: Memory per vertex of a build with export (radii, unit vectors, vertices, caches).
+BYTES_PER_VERTEX = 160
+CROSSINGS = ("error", "outermost", "innermost")
+
+
+def check_memory(magnitude: int) -> None:
+    """Refuse up front a grid that cannot fit in this machine's memory (the estimate)."""
+    need = LatLongGrid.estimate_bytes(magnitude, BYTES_PER_VERTEX)
+    have = physical_memory_bytes()
+    if need > 0.85 * have:
+        n = 6 * magnitude * magnitude + 2
+        raise ParameterError("magnitude", f"{magnitude} needs about {human_bytes(need)} of "
+                             f"memory ({n:.3g} vertices x {BYTES_PER_VERTEX} B); this machine "
+                             f"has {human_bytes(have)}")
+
+
+def _set(obj, name, value) -> None:
+    object.__setattr__(obj, name, value)
+
+
+def parse_stretch(value) -> tuple[float, float, float]:
+    """Three factors X,Y,Z from ``"2,1,1"`` or a sequence; finite and > 0."""
+    parts = value.split(",") if isinstance(value, str) else value
+    try:
+        vals = tuple(float(p) for p in parts)
+    except (TypeError, ValueError):
+        raise ParameterTypeError("stretch", f"must be three factors X,Y,Z; got {value!r}") \
+            from None
+    if len(vals) != 3:
+        raise ParameterError("stretch", f"must be three factors X,Y,Z; got {value!r}")
+    if any(not math.isfinite(v) or v <= 0 for v in vals):
+        raise ParameterError("stretch", f"factors must be finite and > 0; got {vals}")
+    return vals
+
+
+@dataclass(frozen=True, slots=True)
+class BodySettings:
+    """The lat/long body: grid, size and stretch."""
+
+    magnitude: int = 200
+    """Grid magnitude M >= 1 (6M^2+2 vertices); refused up front if it cannot fit."""
+    radius_m: float | None = None
+    """Reference radius, metres; default 50 m (a shape base sets its own)."""
+    stretch: tuple[float, float, float] | None = None
+    """Scale factors along x, y, z; default 1, 1, 1 (a shape base sets its own)."""
+
+    def __post_init__(self):
+        _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
+        check_memory(self.magnitude)
+        if self.radius_m is not None:
+            _set(self, "radius_m", check_positive("radius_m", self.radius_m))
+        if self.stretch is not None:
+            _set(self, "stretch", parse_stretch(self.stretch))
+
+
+# --------------------------------------------------------------------------- bases
+@dataclass(frozen=True, slots=True)
+class SphereBase:
+    """A plain sphere (craters and boulders only)."""
+
+    name = "sphere"
+
+
+@dataclass(frozen=True, slots=True)
+class FaultingBase:
+    """Two-phase Poisson faulting (Martin 2014 IV.A; :func:`latlong.two_phase_faulting`);
+    defaults: the paper's set."""
+
+    n_faults_1: int = 1000
+    """Phase-1 (large) faults."""
+    max_fault_1_m: float = 5.0
+    """Largest phase-1 fault offset, metres."""
+    smooth_width_m: float = 20.0
+    """Smoothing filter width between the phases (Gaussian FWHM), metres."""
+    smooth_passes: int = 3
+    """Smoothing passes."""
+    n_faults_2: int = 20000
+    """Phase-2 (small) faults."""
+    max_fault_2_m: float = 0.03
+    """Largest phase-2 fault offset, metres."""
+    name = "faulting"
+
+    def __post_init__(self):
+        for key in ("n_faults_1", "n_faults_2"):
+            _set(self, key, check_int(key, getattr(self, key), 0, 10**8))
+        _set(self, "smooth_passes", check_int("smooth_passes", self.smooth_passes, 0, 1000))
+        for key in ("max_fault_1_m", "max_fault_2_m", "smooth_width_m"):
+            value = check_finite(key, getattr(self, key))
+            if value < 0:
+                raise ParameterError(key, f"must be >= 0; got {value!r}")
+            _set(self, key, value)
+
+
+def _check_fbm(obj, prefix: str = "") -> None:
+    """frequency > 0, octaves in [1, 30], persistence > 0, lacunarity >= 1 (the fields of
+    an fBm record whose names start with ``prefix``)."""
+    key = prefix + "frequency"
+    if getattr(obj, key) is not None:
+        _set(obj, key, check_positive(key, getattr(obj, key)))
+    key = prefix + "octaves"
+    _set(obj, key, check_int(key, getattr(obj, key), 1, 30))
+    key = prefix + "persistence"
+    _set(obj, key, check_positive(key, getattr(obj, key)))
+    key = prefix + "lacunarity"
+    lac = check_finite(key, getattr(obj, key))
+    if lac < 1:
+        raise ParameterError(key, f"must be >= 1; got {lac!r}")
+    _set(obj, key, lac)
+
+
+@dataclass(frozen=True, slots=True)
+class FbmBase:
+    """Perlin fBm on the unit sphere (Martin 2014 IV.B; :func:`latlong.perlin_fbm`);
+    defaults: Fig. 5a."""
+
+    frequency: float = 1.5
+    """First-octave frequency on the unit sphere."""
+    octaves: int = 10
+    """Number of octaves."""
+    persistence: float = 0.5
+    """Amplitude ratio per octave."""
+    lacunarity: float = 1.75
+    """Frequency ratio per octave (>= 1)."""
+    amplitude_m: float | None = None
+    """Height scale, metres; default ``amplitude_fraction`` x the radius."""
+    amplitude_fraction: float = FBM_PRESETS["fig5a"].amplitude
+    """Height scale as a fraction of the radius when ``amplitude_m`` is not given."""
+    name = "fbm"
+
+    def __post_init__(self):
+        _check_fbm(self)
+        if self.amplitude_m is not None:
+            _set(self, "amplitude_m", check_positive("amplitude_m", self.amplitude_m,
+                                                     allow_zero=True))
+        _set(self, "amplitude_fraction", check_positive("amplitude_fraction",
+                                                        self.amplitude_fraction,
+                                                        allow_zero=True))
+
+
+@dataclass(frozen=True, slots=True)
+class ShapeBase:
+    """A real shape model ray-cast onto the grid (:func:`latlong.from_shape_model`),
+    with optional fBm detail below its resolution. The model is read once, here."""
+
+    model: ShapeModel | str | Path
+    """The model, or its file (OBJ, PDS plate .tab/.plt, PLY, STL; needs ``units``)."""
+    units: str | None = None
+    """Units of the file: ``km`` or ``m``."""
+    center: str | tuple[float, float, float] = "volume-centroid"
+    """Ray origin: volume-centroid, area-centroid, origin or (x, y, z) metres."""
+    crossings: str = "error"
+    """Where a ray crosses the surface more than once: error, outermost, innermost."""
+    smooth: str = "butterfly"
+    """Subdivision before casting: butterfly, linear, loop, none."""
+    detail_frequency: float | None = None
+    """fBm detail frequency on the unit sphere; default: wavelength = the resolution."""
+    detail_octaves: int = 6
+    """fBm detail octaves."""
+    detail_persistence: float = 0.5
+    """fBm detail amplitude ratio per octave."""
+    detail_lacunarity: float = 2.0
+    """fBm detail frequency ratio per octave."""
+    detail_amplitude_m: float = 0.0
+    """fBm detail height scale, metres (0 = no detail)."""
+    name = "shape"
+
+    def __post_init__(self):
+        if not isinstance(self.model, ShapeModel):
+            if self.units not in ("km", "m"):
+                raise ParameterError("units", f"must be km or m with a shape model file; "
+                                     f"got {self.units!r}")
+            try:
+                _set(self, "model", read_shape_model(self.model, units=self.units))
+            except ValueError as exc:
+                raise ParameterError("model", f"{self.model}: {exc}") from None
+        check_choice("crossings", self.crossings, CROSSINGS)
+        check_choice("smooth", self.smooth, ("butterfly", "linear", "loop", "none"))
+        _set(self, "center", _center(self.center))
+        if self.detail_frequency is None:
+            _set(self, "detail_frequency", self.radius_m / self.model.mean_edge_m)
+        _check_fbm(self, "detail_")
+        _set(self, "detail_amplitude_m", check_positive("detail_amplitude_m",
+                                                        self.detail_amplitude_m,
+                                                        allow_zero=True))
+
+    @property
+    def radius_m(self) -> float:
+        """Volume-equivalent radius of the model, metres."""
+        return (3.0 * self.model.volume_m3 / (4.0 * math.pi)) ** (1.0 / 3.0)
+
+
+def _center(value):
+    named = ("volume-centroid", "area-centroid", "origin")
+    if isinstance(value, str) and value in named:
+        return value
+    parts = value.split(",") if isinstance(value, str) else value
+    try:
+        xyz = tuple(float(v) for v in parts)
+    except (TypeError, ValueError):
+        xyz = ()
+    if len(xyz) != 3 or not all(math.isfinite(v) for v in xyz):
+        raise ParameterError("center", f"must be volume-centroid, area-centroid, origin or "
+                             f"X,Y,Z in metres; got {value!r}")
+    return xyz
+
+
+# --------------------------------------------------------------------------- layers
+def _layers(value, kind, parse, name: str) -> tuple:
+    """A tuple of ``kind`` records from records, spec strings or TOML tables."""
+    items = [value] if isinstance(value, str | dict | kind) else list(value)
+    out = []
+    for item in items:
+        if isinstance(item, kind):
+            out.append(item)
+        elif isinstance(item, str):
+            try:
+                out.append(parse(item))
+            except ValueError as exc:
+                raise ParameterError(name, f": {exc}") from None
+        elif isinstance(item, dict):
+            allowed = {f.name for f in dataclasses.fields(kind)}
+            unknown = set(item) - allowed
+            if unknown:
+                raise ParameterError(name, f": unknown key(s) {', '.join(sorted(unknown))}; "
+                                     f"allowed: {', '.join(sorted(allowed))}")
+            try:
+                out.append(kind(**item))
+            except (TypeError, ValueError) as exc:
+                raise ParameterError(name, f": {exc}") from None
+        else:
+            raise ParameterTypeError(name, f"must be {kind.__name__}s, spec strings or "
+                                     f"tables; got {item!r}")
+    return tuple(out)
+
+
+@dataclass(frozen=True, slots=True)
+class CraterSettings:
+    """Crater layers on the body and how they are stamped (:func:`latlong.stamp_craters`)."""
+
+    layers: tuple[_craters.CraterLayer, ...] = ()
+    """Power-law layers (:class:`craters.CraterLayer`, spec strings or tables)."""
+    morphometry: str = "lunar-simple"
+    """Fresh crater laws: a name of :data:`craters.MORPHOMETRY_PRESETS`."""
+    lifetime_gyr: float = 10.0
+    """Time for a 1 km crater to degrade fully, Gyr (ages -> degradation)."""
+    roughness: bool = True
+    """Fractal overlay and irregular rims (False: ideal craters)."""
+    max_extent_deg: float = 60.0
+    """Largest angular size of a crater's ejecta blanket, degrees of arc, (0, 180]."""
+
+    def __post_init__(self):
+        _set(self, "layers", _layers(self.layers, _craters.CraterLayer,
+                                     _craters.parse_layer_spec, "layers"))
+        check_choice("morphometry", self.morphometry, tuple(_craters.MORPHOMETRY_PRESETS))
+        _set(self, "lifetime_gyr", check_positive("lifetime_gyr", self.lifetime_gyr))
+        if not isinstance(self.roughness, bool):
+            raise ParameterTypeError("roughness", f"must be true or false; got "
+                                     f"{self.roughness!r}")
+        ext = check_positive("max_extent_deg", self.max_extent_deg)
+        if ext > 180:
+            raise ParameterError("max_extent_deg", f"must be <= 180; got {ext!r}")
+        _set(self, "max_extent_deg", ext)
+
+    def check_fits(self, smallest_radius_m: float, resolution_m: float | None) -> None:
+        """Refuse layers whose craters cannot fit on the body (ejecta 3 D across within
+        ``max_extent_deg`` of arc at the smallest semi-axis) or that a shape model of
+        mean edge ``resolution_m`` already holds."""
+        for la in self.layers:
+            span = math.degrees(3.0 * la.d_max_m * 1.02 / smallest_radius_m)
+            if span > self.max_extent_deg:
+                raise ParameterError(
+                    "layers", f"dmax={la.d_max_m:g} m: the crater (ejecta {3 * la.d_max_m:g} m "
+                    f"across) is larger than the body allows (radius {smallest_radius_m:g} m, "
+                    f"limit {self.max_extent_deg:g} deg)")
+            if resolution_m is not None and la.d_max_m > 2.0 * resolution_m:
+                raise ParameterError(
+                    "layers", f"dmax={la.d_max_m:g} m is above the shape model's resolution "
+                    f"(mean edge {resolution_m:.3g} m): the model already holds craters that "
+                    f"large; keep crater layers below {2 * resolution_m:.3g} m")
+
+
+@dataclass(frozen=True, slots=True)
+class BoulderSettings:
+    """Boulder layers and the boulders' shape (:func:`latlong.place_boulders`)."""
+
+    layers: tuple[_craters.BoulderLayer, ...] = ()
+    """Power-law layers (:class:`craters.BoulderLayer`, spec strings or tables)."""
+    shape: _craters.BoulderShape = dataclasses.field(default_factory=_craters.BoulderShape)
+    """Flattening, elongation and roughness of the procedural rocks."""
+
+    def __post_init__(self):
+        _set(self, "layers", _layers(self.layers, _craters.BoulderLayer,
+                                     _craters.parse_boulder_spec, "layers"))
+        if not isinstance(self.shape, _craters.BoulderShape):
+            raise ParameterTypeError("shape", f"must be a craters.BoulderShape; got "
+                                     f"{type(self.shape).__name__}")
+
+    def check_fits(self, smallest_radius_m: float) -> None:
+        """Refuse boulders larger than a fifth of the body's smallest semi-axis."""
+        for la in self.layers:
+            if la.d_max_m > 0.2 * smallest_radius_m:
+                raise ParameterError("layers", f"dmax={la.d_max_m:g} m: boulders larger than "
+                                     "a fifth of the body's radius are not boulders")
+
+
+# --------------------------------------------------------------------------- implicit
+@dataclass(frozen=True, slots=True)
+class ImplicitSettings:
+    """The implicit backend (Li et al.; :func:`latlong.implicit_surface`): metaballs over a
+    sphere packing of a constraint mesh, LCSN craters, Gabor detail, marching cubes."""
+
+    shape: ShapeModel | str | Path
+    """The constraint mesh, or its file (needs ``units``)."""
+    units: str | None = None
+    """Units of the constraint file: ``km`` or ``m``."""
+    layers: tuple = ()
+    """LCSN crater layers (:class:`latlong.LcsnLayer` or spec strings)."""
+    gabor: object | None = None
+    """Gabor micro-detail (:class:`latlong.GaborNoise` or a spec string)."""
+    polygons: int = 200_000
+    """About how many triangles the mesh has (when ``voxel_m`` is not given)."""
+    voxel_m: float | None = None
+    """Marching-cubes spacing, metres."""
+    packing_voxels: int = 128
+    """Voxels along the constraint's longest side for the sphere packing, [8, 1024]."""
+    min_sphere_m: float | None = None
+    """Smallest packed sphere, metres (default 2 packing voxels)."""
+    cell_m: float | None = None
+    """Cell size of grid level 0, metres (default: the largest d_max_m); >= every d_max_m."""
+    crossings: str = "error"
+    """Casting onto a lat/long grid where a ray crosses twice: error, outermost, innermost."""
+
+    def __post_init__(self):
+        from .gabor import GaborNoise, parse_gabor_spec
+        from .implicit import LcsnLayer, parse_lcsn_spec
+
+        if not isinstance(self.shape, ShapeModel):
+            if self.units not in ("km", "m"):
+                raise ParameterError("units", f"must be km or m with a constraint file; "
+                                     f"got {self.units!r}")
+            try:
+                _set(self, "shape", read_shape_model(self.shape, units=self.units))
+            except ValueError as exc:
+                raise ParameterError("shape", f"{self.shape}: {exc}") from None
+        _set(self, "layers", _layers(self.layers, LcsnLayer, parse_lcsn_spec, "layers"))
+        if isinstance(self.gabor, str):
+            try:
+                _set(self, "gabor", parse_gabor_spec(self.gabor))
+            except ValueError as exc:
+                raise ParameterError("gabor", f": {exc}") from None
+        elif self.gabor is not None and not isinstance(self.gabor, GaborNoise):
+            raise ParameterTypeError("gabor", f"must be a GaborNoise or a spec string; got "
+                                     f"{type(self.gabor).__name__}")
+        _set(self, "polygons", check_int("polygons", self.polygons, 100, 10**9))
+        _set(self, "packing_voxels", check_int("packing_voxels", self.packing_voxels, 8, 1024))
+        for key in ("voxel_m", "min_sphere_m", "cell_m"):
+            if getattr(self, key) is not None:
+                _set(self, key, check_positive(key, getattr(self, key)))
+        check_choice("crossings", self.crossings, CROSSINGS)
+        if self.layers and self.cell_m is not None:
+            biggest = max(la.d_max_m for la in self.layers)
+            if self.cell_m < biggest:
+                raise ParameterError("cell_m", f"{self.cell_m:g} is smaller than the largest "
+                                     f"crater (dmax {biggest:g} m): level-0 cells must hold it")
