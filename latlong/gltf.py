@@ -36,7 +36,7 @@ import numpy as np
 
 from craters._shared import atomic_path, check_int, package_version, progress_bar
 
-from ._grid_kernels import _normals_from_radii_kernel
+from ._slope_kernels import _normals_from_radii_kernel
 from .body import Body
 from .grid import LatLongGrid
 from .strips import join_strips, patch_tree, strip_triangles
