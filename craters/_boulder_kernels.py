@@ -5,10 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from .kernels import mix64
-
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_TWO_POW_M53 = 1.0 / 9007199254740992.0
+from ._rng_kernels import GOLDEN, _hash_normal, _mix64, _splitmix64
 
 
 @njit(cache=True, parallel=True)
@@ -17,10 +14,6 @@ def _noise_kernel(seeds, out):
     two 53-bit uniforms from splitmix64): a boulder's shape depends only on its seed."""
     n, m = out.shape
     for i in prange(n):
-        s = mix64(seeds[i] + _GOLDEN)
+        s = _splitmix64(seeds[i])
         for k in range(m):
-            a = mix64(s ^ (np.uint64(k) * _GOLDEN))
-            b = mix64(a + _GOLDEN)
-            u1 = ((a >> np.uint64(11)) + np.uint64(1)) * _TWO_POW_M53
-            u2 = (b >> np.uint64(11)) * _TWO_POW_M53
-            out[i, k] = np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2)
+            out[i, k] = _hash_normal(_mix64(s ^ (np.uint64(k) * GOLDEN)))

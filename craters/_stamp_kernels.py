@@ -3,13 +3,17 @@
 Scalar versions of the profile (``craters.profile``) and degradation curves
 (``craters.degradation``) - the tests compare them with the numpy versions - plus a
 counter-based 2-D gradient noise for the roughness overlay (a pure function of the
-crater's seed and the position, so results never depend on threads or tiling).
+crater's seed and the position, so results never depend on threads or tiling). The
+plane fit, bilinear sampling and hash come from ``_raster_kernels`` and ``_rng_kernels``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+from ._raster_kernels import PLANE_SUMS0, _bilinear, _plane_solve, _plane_sums_add
+from ._rng_kernels import GOLDEN, _mix64
 
 N_RIM = 64  # samples of the rim perturbation and of the rim offset around a crater
 
@@ -102,16 +106,8 @@ def _profile_kernel(x, diameter_m, d, morph, deg, xe, delta, out):
 
 # --------------------------------------------------------------------------- noise
 @njit(cache=True, inline="always")
-def _mix64(z):
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    return z ^ (z >> np.uint64(31))
-
-
-@njit(cache=True, inline="always")
 def _hash2(seed, ix, iy):
-    k = np.uint64(ix) * np.uint64(0x9E3779B97F4A7C15) ^ np.uint64(iy) * np.uint64(
-        0xC2B2AE3D27D4EB4F)
+    k = np.uint64(ix) * GOLDEN ^ np.uint64(iy) * np.uint64(0xC2B2AE3D27D4EB4F)
     return _mix64(seed ^ _mix64(k))
 
 
@@ -159,23 +155,6 @@ def _fbm2(seed, x, y, wavelength, octaves, gain):
 
 # --------------------------------------------------------------------------- helpers
 @njit(cache=True)
-def _bilinear(h, fy, fx):
-    """Bilinear sample at fractional (row, col); NaN outside the grid."""
-    ny, nx = h.shape
-    if fy < 0.0 or fx < 0.0 or fy > ny - 1 or fx > nx - 1:
-        return np.nan
-    i0 = min(int(fy), ny - 2) if ny > 1 else 0
-    j0 = min(int(fx), nx - 2) if nx > 1 else 0
-    ty = fy - i0
-    tx = fx - j0
-    i1 = min(i0 + 1, ny - 1)
-    j1 = min(j0 + 1, nx - 1)
-    a = h[i0, j0] + tx * (h[i0, j1] - h[i0, j0])
-    b = h[i1, j0] + tx * (h[i1, j1] - h[i1, j0])
-    return a + ty * (b - a)
-
-
-@njit(cache=True)
 def _fit_plane(h, cy, cx, r_px, pixel):
     """Least-squares plane over the pixels within ``r_px`` of (cy, cx).
 
@@ -187,15 +166,7 @@ def _fit_plane(h, cy, cx, r_px, pixel):
     i_hi = min(ny - 1, int(np.floor(cy + r_px)))
     j_lo = max(0, int(np.ceil(cx - r_px)))
     j_hi = min(nx - 1, int(np.floor(cx + r_px)))
-    s1 = 0.0
-    sx = 0.0
-    sy = 0.0
-    sxx = 0.0
-    syy = 0.0
-    sxy = 0.0
-    sh = 0.0
-    shx = 0.0
-    shy = 0.0
+    s = PLANE_SUMS0
     r2 = r_px * r_px
     for i in range(i_lo, i_hi + 1):
         dy = i - cy
@@ -203,36 +174,13 @@ def _fit_plane(h, cy, cx, r_px, pixel):
             dx = j - cx
             if dx * dx + dy * dy > r2:
                 continue
-            v = h[i, j]
-            s1 += 1.0
-            sx += dx
-            sy += dy
-            sxx += dx * dx
-            syy += dy * dy
-            sxy += dx * dy
-            sh += v
-            shx += v * dx
-            shy += v * dy
-    if s1 >= 3.0:
-        # normal equations [[s1 sx sy][sx sxx sxy][sy sxy syy]] p = [sh shx shy]
-        a00, a01, a02 = s1, sx, sy
-        a11, a12, a22 = sxx, sxy, syy
-        det = (a00 * (a11 * a22 - a12 * a12) - a01 * (a01 * a22 - a12 * a02)
-               + a02 * (a01 * a12 - a11 * a02))
-        scale = s1 * max(sxx, syy, 1.0) * max(sxx, syy, 1.0)
-        if abs(det) > 1e-9 * scale:
-            c00 = a11 * a22 - a12 * a12
-            c01 = -(a01 * a22 - a02 * a12)
-            c02 = a01 * a12 - a02 * a11
-            c11 = a00 * a22 - a02 * a02
-            c12 = -(a00 * a12 - a01 * a02)
-            c22 = a00 * a11 - a01 * a01
-            p0 = (c00 * sh + c01 * shx + c02 * shy) / det
-            px = (c01 * sh + c11 * shx + c12 * shy) / det
-            py = (c02 * sh + c12 * shx + c22 * shy) / det
-            return p0, px / pixel, py / pixel, s1
-    v = _bilinear(h, min(max(cy, 0.0), ny - 1.0), min(max(cx, 0.0), nx - 1.0))
-    return v, 0.0, 0.0, s1
+            s = _plane_sums_add(s, dx, dy, h[i, j])
+    big = max(s[3], s[4], 1.0)  # a determinant's size: n * max(sxx, syy, 1)^2
+    ok, p0, px, py = _plane_solve(s, s[0] * big * big)
+    if ok:
+        return p0, px / pixel, py / pixel, s[0]
+    v = _bilinear(h, min(max(cy, 0.0), ny - 1.0), min(max(cx, 0.0), nx - 1.0), False)
+    return v, 0.0, 0.0, s[0]
 
 
 @njit(cache=True, inline="always")
@@ -259,6 +207,25 @@ def _roughness_amp(x, xe, a_bowl, a_wall, a_ejecta):
     if x >= xe:
         return 0.0
     return a_ejecta * (xe - x) / (xe - 1.1)
+
+
+@njit(cache=True, inline="always")
+def _eroded_degradation(d, slope, onset_deg, full_deg):
+    """Slope erosion: degradation ``d`` raised linearly towards 1 between ``onset_deg``
+    and ``full_deg`` of ground slope (degrees; the caller erases the crater at or above
+    ``full_deg``)."""
+    frac = min(max((slope - onset_deg) / (full_deg - onset_deg), 0.0), 1.0)
+    return d + (1.0 - d) * frac
+
+
+@njit(cache=True, inline="always")
+def _roughness_octaves(wavelength, spacing):
+    """Octaves of the roughness fBm from ``wavelength`` (metres) halving down to two
+    sample spacings (metres): 1 to 10."""
+    octaves = 1
+    while octaves < 10 and wavelength / 2.0**octaves >= 2.0 * spacing:
+        octaves += 1
+    return octaves
 
 
 # --------------------------------------------------------------------------- stamping
@@ -340,7 +307,7 @@ def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
         r = radius * (1.0 + rim_tab[k])
         dx = r * np.cos(theta)
         dy = r * np.sin(theta)
-        t = _bilinear(h, cy + dy / pixel, cx + dx / pixel)
+        t = _bilinear(h, cy + dy / pixel, cx + dx / pixel, False)
         out[k] = 0.0 if np.isnan(t) else (p0 + gx * dx + gy * dy) - t
 
 
@@ -366,18 +333,12 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg
             if slope >= full_deg:
                 out_erased[c] = True
                 continue
-            frac = (slope - onset_deg) / (full_deg - onset_deg)
-            frac = min(max(frac, 0.0), 1.0)
-            d = d + (1.0 - d) * frac
+            d = _eroded_degradation(d, slope, onset_deg, full_deg)
         radius, depth, rim_h, alpha, beta, e0 = _profile_params(diam[c], d, morph, deg)
         _rim_offsets(h, cy[c], cx[c], pixel, radius, rim_tabs[c], p0, gx, gy, delta)
-        wavelength = radius
-        octaves = 1
-        while octaves < 10 and wavelength / 2.0**octaves >= 2.0 * pixel:
-            octaves += 1
         _write_crater(h, cy[c], cx[c], pixel, radius, depth, rim_h, alpha, beta, e0, xe,
-                      rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], wavelength, octaves,
-                      gain)
+                      rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], radius,
+                      _roughness_octaves(radius, pixel), gain)
         out_deg[c] = d
         out_depth[c] = depth
         out_rim[c] = rim_h

@@ -1,29 +1,58 @@
-"""Numba-compiled crater building blocks for packages that stamp on other geometries.
+"""Numba-compiled building blocks shared with the packages that build on craters.
 
 ``latlong`` maps each crater's region of the body to a local height grid and uses these
 to evaluate the same profile, plane fit, rim offsets and roughness as
-:func:`craters.stamp_many`. They take no validation: callers validate first.
+:func:`craters.stamp_many`; ``dem`` uses the raster helpers and the counter-based
+Gaussian. They take no validation: callers validate first.
+
+Crater profile and stamping:
 
 * ``profile_params(diameter_m, d, morph, deg)`` -> (R, H, Hr, alpha, beta, E0)
 * ``inside(x, H, Hr, alpha)`` and ``outside(x, Hr + delta, beta, E0, x_e)``: the profile
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane
 * ``rim_offsets(h, cy, cx, pixel, R, rim_tab, p0, gx, gy, out)``: plane - terrain at the rim
 * ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
-* ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)`` and ``fbm2(seed, x, y, ...)``
-* ``mix64(z)``: the splitmix64 finaliser (uint64 -> uint64), for counter-based noise
+* ``eroded_degradation(d, slope, onset_deg, full_deg)``: slope erosion of the degradation
+* ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
+  spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
 * ``N_RIM``: samples per azimuth table
+
+Counter-based random numbers:
+
+* ``mix64(z)``: the splitmix64 finaliser (uint64 -> uint64); ``splitmix64(x)`` =
+  ``mix64(x + GOLDEN)``; ``hash_normal(a)``: a standard normal from a 64-bit hash
+
+Grids and point sets:
+
+* ``bilinear(h, fy, fx, blend)``: bilinear sample at fractional (row, col), NaN outside
+* ``PLANE_SUMS0``, ``plane_sums_add(s, x, y, v)``, ``plane_solve(s, scale)``: the
+  least-squares plane from its nine running sums
+* ``idw8(z, known, r, c, step_len, empty)``: 8-direction inverse-distance hole fill;
+  ``DR8``, ``DC8``: its directions
 """
 
+from ._raster_kernels import DC8, DR8, PLANE_SUMS0
+from ._raster_kernels import _bilinear as bilinear
+from ._raster_kernels import _idw8 as idw8
+from ._raster_kernels import _plane_solve as plane_solve
+from ._raster_kernels import _plane_sums_add as plane_sums_add
+from ._rng_kernels import GOLDEN
+from ._rng_kernels import _hash_normal as hash_normal
+from ._rng_kernels import _mix64 as mix64
+from ._rng_kernels import _splitmix64 as splitmix64
 from ._stamp_kernels import N_RIM
+from ._stamp_kernels import _eroded_degradation as eroded_degradation
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
 from ._stamp_kernels import _inside as inside
-from ._stamp_kernels import _mix64 as mix64
 from ._stamp_kernels import _outside as outside
 from ._stamp_kernels import _profile_params as profile_params
 from ._stamp_kernels import _rim_offsets as rim_offsets
 from ._stamp_kernels import _roughness_amp as roughness_amp
+from ._stamp_kernels import _roughness_octaves as roughness_octaves
 from ._stamp_kernels import _table as table
 
-__all__ = ["N_RIM", "fbm2", "fit_plane", "inside", "mix64", "outside", "profile_params",
-           "rim_offsets", "roughness_amp", "table"]
+__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "eroded_degradation",
+           "fbm2", "fit_plane", "hash_normal", "idw8", "inside", "mix64", "outside",
+           "plane_solve", "plane_sums_add", "profile_params", "rim_offsets", "roughness_amp",
+           "roughness_octaves", "splitmix64", "table"]

@@ -6,36 +6,22 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-
-@njit(cache=True, inline="always")
-def _bilinear_one(z, col, row):
-    """Bilinear height at fractional pixel (col, row); NaN outside the pixel centres."""
-    rows, cols = z.shape
-    if not (0.0 <= col <= cols - 1 and 0.0 <= row <= rows - 1):
-        return np.nan
-    c0 = min(int(np.floor(col)), cols - 2) if cols > 1 else 0
-    r0 = min(int(np.floor(row)), rows - 2) if rows > 1 else 0
-    fc = col - c0
-    fr = row - r0
-    c1 = min(c0 + 1, cols - 1)
-    r1 = min(r0 + 1, rows - 1)
-    top = (1.0 - fc) * z[r0, c0] + fc * z[r0, c1]
-    bottom = (1.0 - fc) * z[r1, c0] + fc * z[r1, c1]
-    return (1.0 - fr) * top + fr * bottom
+from craters.kernels import bilinear
 
 
 @njit(cache=True, parallel=True)
 def _bilinear_kernel(z, cols, rows, out):
-    """:func:`_bilinear_one` at many points."""
+    """Bilinear heights at fractional pixels (cols[i], rows[i]) into ``out``; NaN outside
+    the pixel centres (``craters.kernels.bilinear``, blend form)."""
     for i in prange(cols.shape[0]):
-        out[i] = _bilinear_one(z, cols[i], rows[i])
+        out[i] = bilinear(z, rows[i], cols[i], True)
 
 
 @njit(cache=True)
 def _bilinear_serial_kernel(z, cols, rows, out):
     """:func:`_bilinear_kernel` without a parallel region (small calls)."""
     for i in range(cols.shape[0]):
-        out[i] = _bilinear_one(z, cols[i], rows[i])
+        out[i] = bilinear(z, rows[i], cols[i], True)
 
 
 @njit(cache=True, inline="always")

@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import bilinear
+
 from ._rng_kernels import STREAM_EXPAND, _pixel_normal
 
 # the four axis neighbours of a diamond-phase pixel
@@ -24,15 +26,7 @@ def _amplitude(amp, y, x):
         x = 0.0
     elif x >= n_c - 1:
         x = n_c - 1.0
-    i = min(int(y), n_r - 2) if n_r > 1 else 0
-    j = min(int(x), n_c - 2) if n_c > 1 else 0
-    fy = y - i
-    fx = x - j
-    i1 = min(i + 1, n_r - 1)
-    j1 = min(j + 1, n_c - 1)
-    top = amp[i, j] + fx * (amp[i, j1] - amp[i, j])
-    bot = amp[i1, j] + fx * (amp[i1, j1] - amp[i1, j])
-    return top + fy * (bot - top)
+    return bilinear(amp, y, x, False)
 
 
 @njit(cache=True, inline="always")

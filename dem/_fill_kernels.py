@@ -5,37 +5,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from craters.kernels import DC8, DR8, idw8
+
 from ._rng_kernels import STREAM_FILL, _pixel_normal
-
-# the eight directions (row step, col step)
-_DR = np.array([-1, -1, -1, 0, 0, 1, 1, 1], dtype=np.int64)
-_DC = np.array([-1, 0, 1, -1, 1, -1, 0, 1], dtype=np.int64)
-
-
-@njit(cache=True)
-def _idw8(z, known, r, c, step_len):
-    """Inverse-distance average of the nearest known pixel along each of 8 directions."""
-    rows, cols = z.shape
-    s = 0.0
-    w = 0.0
-    for d in range(8):
-        dr = _DR[d]
-        dc = _DC[d]
-        rr = r + dr
-        cc = c + dc
-        k = 1
-        while 0 <= rr < rows and 0 <= cc < cols:
-            if known[rr, cc]:
-                wt = 1.0 / (k * step_len[d])
-                s += wt * z[rr, cc]
-                w += wt
-                break
-            rr += dr
-            cc += dc
-            k += 1
-    if w == 0.0:
-        return np.nan
-    return s / w
 
 
 @njit(cache=True)
@@ -75,8 +47,8 @@ def _fill_gaps_kernel(z, key, level, row0, col0, sigma, step_len, order):
                 continue
             n = 0
             for d in range(8):
-                rr = r + _DR[d]
-                cc = c + _DC[d]
+                rr = r + DR8[d]
+                cc = c + DC8[d]
                 if 0 <= rr < rows and 0 <= cc < cols and known[rr, cc]:
                     n += 1
             count[r, c] = n
@@ -109,7 +81,7 @@ def _fill_gaps_kernel(z, key, level, row0, col0, sigma, step_len, order):
             p = wave[t]
             r = p // cols
             c = p - r * cols
-            v = _idw8(z, known, r, c, step_len)
+            v = idw8(z, known, r, c, step_len, np.nan)
             if sigma > 0.0:
                 v += sigma * _pixel_normal(key, STREAM_FILL, level, row0 + r, col0 + c)
             vals[t] = v
@@ -125,8 +97,8 @@ def _fill_gaps_kernel(z, key, level, row0, col0, sigma, step_len, order):
             r = p // cols
             c = p - r * cols
             for d in range(8):
-                rr = r + _DR[d]
-                cc = c + _DC[d]
+                rr = r + DR8[d]
+                cc = c + DC8[d]
                 if 0 <= rr < rows and 0 <= cc < cols and not known[rr, cc]:
                     n = count[rr, cc] + 1
                     count[rr, cc] = n

@@ -6,8 +6,9 @@ gap filling), ``level`` is the expansion level and ``row, col`` the *global* pix
 index at that level. Nothing depends on the order in which pixels are visited, on the
 thread count or on how a raster is cut into tiles (DESIGN §3).
 
-Hash: Steele, Lea & Flood's splitmix64 finaliser (the ``java.util.SplittableRandom``
-mix), chained over the five integers; two 53-bit uniforms; Box–Muller (cosine branch).
+Hash: Steele, Lea & Flood's splitmix64 (``craters.kernels.splitmix64``) chained over
+the five integers; the deviate is ``craters.kernels.hash_normal`` of the hash (two 53-bit
+uniforms, Box–Muller, cosine branch).
 """
 
 from __future__ import annotations
@@ -15,41 +16,25 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from craters.kernels import mix64
+from craters.kernels import hash_normal, splitmix64
 
 STREAM_EXPAND = 1
 STREAM_FILL = 2
-
-_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
-_S11 = np.uint64(11)
-_ONE = np.uint64(1)
-_TWO_POW_M53 = 1.0 / 9007199254740992.0  # 2**-53
-_TWO_PI = 2.0 * np.pi
-
-
-@njit(cache=True, inline="always")
-def _splitmix64(x):
-    """The splitmix64 step: add the golden gamma, then the variant-13 finaliser."""
-    return mix64(x + _GOLDEN)
 
 
 @njit(cache=True, inline="always")
 def _pixel_hash(key, stream, level, row, col):
     """64-bit hash of (key, stream, level, row, col); all arguments are integers."""
-    h = _splitmix64(np.uint64(key) ^ np.uint64(stream))
-    h = _splitmix64(h ^ np.uint64(level))
-    h = _splitmix64(h ^ np.uint64(row))
-    return _splitmix64(h ^ np.uint64(col))
+    h = splitmix64(np.uint64(key) ^ np.uint64(stream))
+    h = splitmix64(h ^ np.uint64(level))
+    h = splitmix64(h ^ np.uint64(row))
+    return splitmix64(h ^ np.uint64(col))
 
 
 @njit(cache=True, inline="always")
 def _pixel_normal(key, stream, level, row, col):
     """A standard normal deviate determined by (key, stream, level, row, col)."""
-    a = _pixel_hash(key, stream, level, row, col)
-    b = _splitmix64(a)
-    u1 = ((a >> _S11) + _ONE) * _TWO_POW_M53  # (0, 1]
-    u2 = (b >> _S11) * _TWO_POW_M53  # [0, 1)
-    return np.sqrt(-2.0 * np.log(u1)) * np.cos(_TWO_PI * u2)
+    return hash_normal(_pixel_hash(key, stream, level, row, col))
 
 
 @njit(cache=True)

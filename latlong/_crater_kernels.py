@@ -6,12 +6,20 @@ import numpy as np
 from numba import njit, prange
 
 from craters.kernels import (
+    DC8,
+    DR8,
+    PLANE_SUMS0,
+    eroded_degradation,
     fbm2,
+    idw8,
     inside,
     outside,
+    plane_solve,
+    plane_sums_add,
     profile_params,
     rim_offsets,
     roughness_amp,
+    roughness_octaves,
     table,
 )
 
@@ -77,36 +85,18 @@ def _fit_plane_points(x, y, h, dist, n, r_fit):
 
     Fewer than 3 points, or a degenerate set: flat at the height of the nearest point.
     """
-    s1 = sx = sy = sxx = syy = sxy = sh = shx = shy = 0.0
+    s = PLANE_SUMS0
     nearest = 0
     for q in range(n):
         if dist[q] < dist[nearest]:
             nearest = q
         if dist[q] > r_fit:
             continue
-        s1 += 1.0
-        sx += x[q]
-        sy += y[q]
-        sxx += x[q] * x[q]
-        syy += y[q] * y[q]
-        sxy += x[q] * y[q]
-        sh += h[q]
-        shx += h[q] * x[q]
-        shy += h[q] * y[q]
-    if s1 >= 3.0:
-        c00 = sxx * syy - sxy * sxy
-        c01 = -(sx * syy - sy * sxy)
-        c02 = sx * sxy - sy * sxx
-        c11 = s1 * syy - sy * sy
-        c12 = -(s1 * sxy - sx * sy)
-        c22 = s1 * sxx - sx * sx
-        det = s1 * c00 + sx * c01 + sy * c02
-        scale = s1 * (sxx + syy) * (sxx + syy)
-        if abs(det) > 1e-9 * scale:
-            p0 = (c00 * sh + c01 * shx + c02 * shy) / det
-            gx = (c01 * sh + c11 * shx + c12 * shy) / det
-            gy = (c02 * sh + c12 * shx + c22 * shy) / det
-            return p0, gx, gy
+        s = plane_sums_add(s, x[q], y[q], h[q])
+    spread = s[3] + s[4]  # a determinant's size: n * (sxx + syy)^2
+    ok, p0, gx, gy = plane_solve(s, s[0] * spread * spread)
+    if ok:
+        return p0, gx, gy
     return (h[nearest] if n else 0.0), 0.0, 0.0
 
 
@@ -165,6 +155,10 @@ def _scan_all(unit, c0, c1, c2, cos_ang):
     return hit[:k]
 
 
+# length of one step along each of the 8 directions of ``idw8``, in cells
+_STEP8 = np.sqrt((DR8 * DR8 + DC8 * DC8).astype(np.float64))
+
+
 @njit(cache=True)
 def _fill_holes(grid, known):
     """Fill unknown cells by the inverse-distance average of the nearest known cell in
@@ -181,29 +175,18 @@ def _fill_holes(grid, known):
     out = grid.copy()
     for i in range(g):
         for j in range(g):
-            if known[i, j]:
-                continue
-            acc = 0.0
-            wsum = 0.0
-            for di in range(-1, 2):
-                for dj in range(-1, 2):
-                    if di == 0 and dj == 0:
-                        continue
-                    step_len = np.sqrt(di * di + dj * dj)
-                    ii = i + di
-                    jj = j + dj
-                    s = 1
-                    while 0 <= ii < g and 0 <= jj < g:
-                        if known[ii, jj]:
-                            w = 1.0 / (s * step_len)
-                            acc += w * grid[ii, jj]
-                            wsum += w
-                            break
-                        ii += di
-                        jj += dj
-                        s += 1
-            out[i, j] = acc / wsum if wsum > 0.0 else mean
+            if not known[i, j]:
+                out[i, j] = idw8(grid, known, i, j, _STEP8, mean)
     return out
+
+
+@njit(cache=True, inline="always")
+def _stretched(stretch, r, ux, uy, uz):
+    """Position ``stretch * r * u`` of radius r along unit vector u, and its length."""
+    px = stretch[0] * r * ux
+    py = stretch[1] * r * uy
+    pz = stretch[2] * r * uz
+    return px, py, pz, np.sqrt(px * px + py * py + pz * pz)
 
 
 # vertices above which a crater is written in parallel: a parallel region costs tens of
@@ -279,10 +262,7 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         uc1 = np.cos(la) * np.sin(lo)
         uc2 = np.sin(la)
         rc = _interpolate_one(m, ring_offsets, radii, colat, lo)
-        pc0 = stretch[0] * rc * uc0
-        pc1 = stretch[1] * rc * uc1
-        pc2 = stretch[2] * rc * uc2
-        rloc = np.sqrt(pc0 * pc0 + pc1 * pc1 + pc2 * pc2)
+        pc0, pc1, pc2, rloc = _stretched(stretch, rc, uc0, uc1, uc2)
         a0 = pc0 / rloc
         a1 = pc1 / rloc
         a2 = pc2 / rloc
@@ -330,10 +310,7 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
             ring = np.searchsorted(ring_offsets, i, side="right") - 1
             o = ring_offsets[ring]
             ux, uy, uz = _unit_of(m, ring, i - o, ring_offsets[ring + 1] - o)
-            p0v = stretch[0] * r * ux
-            p1v = stretch[1] * r * uy
-            p2v = stretch[2] * r * uz
-            pm = np.sqrt(p0v * p0v + p1v * p1v + p2v * p2v)
+            p0v, p1v, p2v, pm = _stretched(stretch, r, ux, uy, uz)
             b0 = p0v / pm
             b1 = p1v / pm
             b2 = p2v / pm
@@ -413,14 +390,11 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
             out_erased[c] = True  # steeper than the angle of repose: erased, not stamped
             continue
         if slope_erosion:
-            frac = min(max((slope - onset_deg) / (full_deg - onset_deg), 0.0), 1.0)
-            d = d + (1.0 - d) * frac
+            d = eroded_degradation(d, slope, onset_deg, full_deg)
         _, depth, rim_h, alpha, beta, e0 = profile_params(diam[c], d, morph, deg)
         # delta = plane - terrain at the rim = -(residual grid) there
         rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
-        octaves = 1
-        while octaves < 10 and radius / 2.0**octaves >= 2.0 * sp:
-            octaves += 1
+        octaves = roughness_octaves(radius, sp)
         dh = np.empty(keep)
         if keep >= PARALLEL_MIN:
             _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],

@@ -199,53 +199,6 @@ def _ring_positions(m, r, o, radii, stretch, out):
         out[j, 2] = stretch[2] * radii[o + j] * c
 
 
-@njit(cache=True, parallel=True)
-def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, acc):
-    """Area-weighted vertex normals of the body, streamed band by band (no triangle or
-    vertex array of the whole body). Even bands first, then odd bands: the bands of one
-    pass share no ring, so they run in parallel and every vertex receives its two bands'
-    contributions in a fixed order (deterministic)."""
-    n_bands = 2 * m
-    for parity in range(2):
-        for hb in prange((n_bands - parity + 1) // 2):
-            band = 2 * hb + parity
-            if band >= n_bands:
-                continue
-            if band < m:
-                ra, rb, south = band, band + 1, False
-            else:
-                ra, rb, south = band + 1, band, True
-            na = _ring_size(ra, m)
-            nb = _ring_size(rb, m)
-            oa = ring_offsets[ra]
-            ob = ring_offsets[rb]
-            pa = np.empty((na, 3))
-            pb = np.empty((nb, 3))
-            _ring_positions(m, ra, oa, radii, stretch, pa)
-            _ring_positions(m, rb, ob, radii, stretch, pb)
-            nt = band_offsets[band + 1] - band_offsets[band]
-            tris = np.empty((nt, 3), dtype=np.int64)
-            _band_triangles_kernel(oa, na, ob, nb, south, tris, 0)
-            for t in range(nt):
-                p = np.empty((3, 3))
-                for c in range(3):
-                    v = tris[t, c]
-                    if oa <= v < oa + na:
-                        p[c] = pa[v - oa]
-                    else:
-                        p[c] = pb[v - ob]
-                e1 = p[1] - p[0]
-                e2 = p[2] - p[0]
-                nx = 0.5 * (e1[1] * e2[2] - e1[2] * e2[1])
-                ny = 0.5 * (e1[2] * e2[0] - e1[0] * e2[2])
-                nz = 0.5 * (e1[0] * e2[1] - e1[1] * e2[0])
-                for c in range(3):
-                    v = tris[t, c]
-                    acc[v, 0] += nx
-                    acc[v, 1] += ny
-                    acc[v, 2] += nz
-
-
 @njit(cache=True, inline="always")
 def _unit_of(m, r, j, n):
     """Unit vector of vertex j of ring r (n vertices): the one definition used everywhere."""
@@ -320,29 +273,39 @@ def _vertex_point(m, r, j, ring_offsets, radii, out):
 
 
 @njit(cache=True, inline="always")
-def _ray_triangle(d, p0, p1, p2, best):
-    """Ray from the origin along d against triangle (p0, p1, p2), two-sided.
+def _ray_triangle(dx, dy, dz, a, b, c):
+    """Moller-Trumbore for the ray from the origin along d and the triangle (a, b, c),
+    two-sided: (u, v, t), the barycentric coordinates of the crossing (b and c weights)
+    and its distance along d (in units of |d|); t = -1 when the ray is parallel to the
+    triangle. The caller decides what counts as a hit (u, v, 1 - u - v >= 0, t > 0)."""
+    e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+    e2x, e2y, e2z = c[0] - a[0], c[1] - a[1], c[2] - a[2]
+    px = dy * e2z - dz * e2y
+    py = dz * e2x - dx * e2z
+    pz = dx * e2y - dy * e2x
+    det = e1x * px + e1y * py + e1z * pz
+    if det == 0.0:
+        return np.nan, np.nan, -1.0
+    inv = 1.0 / det
+    tx, ty, tz = -a[0], -a[1], -a[2]
+    u = (tx * px + ty * py + tz * pz) * inv
+    qx = ty * e1z - tz * e1y
+    qy = tz * e1x - tx * e1z
+    qz = tx * e1y - ty * e1x
+    v = (dx * qx + dy * qy + dz * qz) * inv
+    t = (e2x * qx + e2y * qy + e2z * qz) * inv
+    return u, v, t
+
+
+@njit(cache=True, inline="always")
+def _closer_hit(d, p0, p1, p2, best):
+    """The ray from the origin along d against triangle (p0, p1, p2), two-sided.
 
     best = (outside-ness, distance): replaced when this triangle contains the ray
     better (outside-ness = how far the barycentric coordinates leave [0, 1]; <= 0
     inside).
     """
-    e1x, e1y, e1z = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
-    e2x, e2y, e2z = p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]
-    hx = d[1] * e2z - d[2] * e2y
-    hy = d[2] * e2x - d[0] * e2z
-    hz = d[0] * e2y - d[1] * e2x
-    det = e1x * hx + e1y * hy + e1z * hz
-    if det == 0.0:
-        return
-    inv = 1.0 / det
-    sx, sy, sz = -p0[0], -p0[1], -p0[2]
-    u = (sx * hx + sy * hy + sz * hz) * inv
-    qx = sy * e1z - sz * e1y
-    qy = sz * e1x - sx * e1z
-    qz = sx * e1y - sy * e1x
-    v = (d[0] * qx + d[1] * qy + d[2] * qz) * inv
-    t = (e2x * qx + e2y * qy + e2z * qz) * inv
+    u, v, t = _ray_triangle(d[0], d[1], d[2], p0, p1, p2)
     if t <= 0.0:
         return
     out = max(-u, -v, u + v - 1.0)
@@ -384,7 +347,7 @@ def _surface_radius_one(m, ring_offsets, radii, colat, lon, p0, p1, p2, d, best)
             for k in range(3):
                 _vertex_point(m, rb, j + k, ring_offsets, radii, p1)
                 _vertex_point(m, rb, j + k + 1, ring_offsets, radii, p2)
-                _ray_triangle(d, p0, p1, p2, best)
+                _closer_hit(d, p0, p1, p2, best)
                 if best[0] <= 0.0:
                     return best[1]
             continue
@@ -395,12 +358,12 @@ def _surface_radius_one(m, ring_offsets, radii, colat, lon, p0, p1, p2, d, best)
         while j < j_end:
             if (i + 1) * nb <= (j + 1) * na:
                 _vertex_point(m, ra, i + 1, ring_offsets, radii, p2)
-                _ray_triangle(d, p0, p1, p2, best)
+                _closer_hit(d, p0, p1, p2, best)
                 i += 1
                 p0[0], p0[1], p0[2] = p2[0], p2[1], p2[2]
             else:
                 _vertex_point(m, rb, j + 1, ring_offsets, radii, p2)
-                _ray_triangle(d, p0, p1, p2, best)
+                _closer_hit(d, p0, p1, p2, best)
                 j += 1
                 p1[0], p1[1], p1[2] = p2[0], p2[1], p2[2]
             if best[0] <= 0.0:  # inside (a hit on a shared edge is the same point)

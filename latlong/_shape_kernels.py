@@ -6,33 +6,18 @@ import numpy as np
 from numba import njit, prange
 
 from ._crater_kernels import _gather_kernel
+from ._grid_kernels import _ray_triangle
 
 _BARY_TOL = 1e-10  # accept hits this far outside a triangle: edges are hit twice, never missed
 
 
 @njit(cache=True, inline="always")
-def _ray_triangle(dx, dy, dz, a, b, c):
-    """Moller-Trumbore for a ray from the origin along d; t of the hit or -1."""
-    e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-    e2x, e2y, e2z = c[0] - a[0], c[1] - a[1], c[2] - a[2]
-    px = dy * e2z - dz * e2y
-    py = dz * e2x - dx * e2z
-    pz = dx * e2y - dy * e2x
-    det = e1x * px + e1y * py + e1z * pz
-    if det == 0.0:
+def _ray_hit(dx, dy, dz, a, b, c):
+    """t of the ray from the origin along d through triangle (a, b, c), or -1 (hits up
+    to ``_BARY_TOL`` outside the triangle count)."""
+    u, v, t = _ray_triangle(dx, dy, dz, a, b, c)
+    if u < -_BARY_TOL or u > 1.0 + _BARY_TOL or v < -_BARY_TOL or u + v > 1.0 + _BARY_TOL:
         return -1.0
-    inv = 1.0 / det
-    tx, ty, tz = -a[0], -a[1], -a[2]
-    u = (tx * px + ty * py + tz * pz) * inv
-    if u < -_BARY_TOL or u > 1.0 + _BARY_TOL:
-        return -1.0
-    qx = ty * e1z - tz * e1y
-    qy = tz * e1x - tx * e1z
-    qz = tx * e1y - ty * e1x
-    v = (dx * qx + dy * qy + dz * qz) * inv
-    if v < -_BARY_TOL or u + v > 1.0 + _BARY_TOL:
-        return -1.0
-    t = (e2x * qx + e2y * qy + e2z * qz) * inv
     return t if t > 0.0 else -1.0
 
 
@@ -77,7 +62,7 @@ def _raycast_kernel(m, ring_offsets, unit, verts, faces, margin, count, tmin, tm
         _gather_kernel(m, ring_offsets, colat, lon, ang, cand, False)
         for q in range(n_cand):
             i = cand[q]
-            t = _ray_triangle(unit[i, 0], unit[i, 1], unit[i, 2], a, b, c)
+            t = _ray_hit(unit[i, 0], unit[i, 1], unit[i, 2], a, b, c)
             if t <= 0.0:
                 continue
             if count[i] == 0:
@@ -103,7 +88,7 @@ def _brute_force_kernel(unit, verts, faces, count, tmin, tmax):
         lo = np.inf
         hi = 0.0
         for f in range(faces.shape[0]):
-            t = _ray_triangle(unit[i, 0], unit[i, 1], unit[i, 2], verts[faces[f, 0]],
+            t = _ray_hit(unit[i, 0], unit[i, 1], unit[i, 2], verts[faces[f, 0]],
                               verts[faces[f, 1]], verts[faces[f, 2]])
             if t <= 0.0:
                 continue

@@ -1,17 +1,21 @@
-"""Numba kernels for slopes on the lat/long body: vertex normals and cap averages."""
+"""Numba kernels for slopes and shading on the lat/long body: vertex normals (from a
+vertex array, or streamed band by band from the radii) and cap averages."""
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
 
-from ._grid_kernels import _ring_size
+from ._grid_kernels import _band_triangles_kernel, _ring_positions, _ring_size
 
 
 @njit(cache=True)
 def _vertex_normals_kernel(verts, tris, out, area):
     """Add each triangle's area vector (cross product / 2) to its vertices' normals and
-    a third of its area to their areas."""
+    a third of its area to their areas (none when ``area`` is empty), triangle by
+    triangle: the one vertex-normal accumulation (``out`` may be float32: each addition
+    is done in float64 and stored)."""
+    with_area = area.shape[0] > 0
     for t in range(tris.shape[0]):
         a = tris[t, 0]
         b = tris[t, 1]
@@ -25,12 +29,45 @@ def _vertex_normals_kernel(verts, tris, out, area):
         nx = 0.5 * (e1y * e2z - e1z * e2y)
         ny = 0.5 * (e1z * e2x - e1x * e2z)
         nz = 0.5 * (e1x * e2y - e1y * e2x)
-        third = np.sqrt(nx * nx + ny * ny + nz * nz) / 3.0
+        third = np.sqrt(nx * nx + ny * ny + nz * nz) / 3.0 if with_area else 0.0
         for v in (a, b, c):
             out[v, 0] += nx
             out[v, 1] += ny
             out[v, 2] += nz
-            area[v] += third
+            if with_area:
+                area[v] += third
+
+
+@njit(cache=True, parallel=True)
+def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, acc):
+    """Area-weighted vertex normals of the body into ``acc``, streamed band by band (no
+    triangle or vertex array of the whole body): each band's two rings (consecutive
+    vertex numbers) are positioned and triangulated locally and passed to
+    :func:`_vertex_normals_kernel`. Even bands first, then odd bands: the bands of one
+    pass share no ring, so they run in parallel and every vertex receives its two bands'
+    contributions in a fixed order (deterministic)."""
+    n_bands = 2 * m
+    no_area = np.empty(0)
+    for parity in range(2):
+        for hb in prange((n_bands - parity + 1) // 2):
+            band = 2 * hb + parity
+            if band >= n_bands:
+                continue
+            if band < m:
+                ra, rb, south = band, band + 1, False
+            else:
+                ra, rb, south = band + 1, band, True
+            na = _ring_size(ra, m)
+            nb = _ring_size(rb, m)
+            oa = ring_offsets[ra]
+            ob = ring_offsets[rb]
+            lo = min(oa, ob)
+            pos = np.empty((na + nb, 3))
+            _ring_positions(m, ra, oa, radii, stretch, pos[oa - lo:oa - lo + na])
+            _ring_positions(m, rb, ob, radii, stretch, pos[ob - lo:ob - lo + nb])
+            tris = np.empty((band_offsets[band + 1] - band_offsets[band], 3), dtype=np.int64)
+            _band_triangles_kernel(oa - lo, na, ob - lo, nb, south, tris, 0)
+            _vertex_normals_kernel(pos, tris, acc[lo:lo + na + nb], no_area)
 
 
 @njit(cache=True, parallel=True)

@@ -10,7 +10,6 @@ from craters._shared import check_int
 
 from ._grid_kernels import (
     _interpolate_kernel,
-    _normals_from_radii_kernel,
     _surface_radius_kernel,
     _triangles_kernel,
     _triangles_serial,
@@ -18,6 +17,7 @@ from ._grid_kernels import (
     _unit_range_kernel,
     _unit_range_serial,
 )
+from ._slope_kernels import _normals_from_radii_kernel
 
 __all__ = ["LatLongGrid", "MAX_MAGNITUDE"]
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from latlong import LatLongGrid
+from latlong._grid_kernels import _ray_triangle
 
 MAGNITUDES = [*range(1, 65), 200]
 EDGE_RATIO_LIMIT = 2.5
@@ -214,3 +215,16 @@ def test_readonly_arrays():
     for a in (g.unit_vectors(), g.triangles(), g.ring_sizes(), g.latitudes()):
         with pytest.raises(ValueError):
             a[0] = 0
+
+
+def test_ray_triangle_matches_a_linear_solve(rng):
+    """Moller-Trumbore against numpy: origin + t d = a + u (b - a) + v (c - a)."""
+    for _ in range(200):
+        a, b, c = rng.normal(size=(3, 3)) + np.array([0.0, 0.0, 2.0])
+        d = rng.normal(size=3)
+        u, v, t = _ray_triangle(d[0], d[1], d[2], a, b, c)
+        want = np.linalg.solve(np.stack([d, a - b, a - c], axis=1), a)
+        np.testing.assert_allclose([t, u, v], want, rtol=1e-8, atol=1e-8)
+    # parallel to the triangle's plane: no crossing
+    a, b, c = np.array([0.0, 0, 1]), np.array([1.0, 0, 1]), np.array([0.0, 1, 1])
+    assert _ray_triangle(1.0, 1.0, 0.0, a, b, c)[2] == -1.0

@@ -21,6 +21,7 @@ from latlong import (
     slopes_and_areas,
     vertex_normals,
 )
+from latlong._slope_kernels import _normals_from_radii_kernel, _vertex_normals_kernel
 from latlong.shapes import ShapeModel
 
 DATA = Path(__file__).parents[1] / "data"
@@ -133,3 +134,42 @@ def test_bad_inputs():
         slopes("body")
     with pytest.raises(ValueError, match="radius_deg"):
         slopes(Body.sphere(LatLongGrid(3), 1.0), -1.0)
+
+
+def reference_vertex_normals(verts, tris):
+    """Pure numpy: half cross products summed at the corners; a third of each area."""
+    a, b, c = verts[tris[:, 0]], verts[tris[:, 1]], verts[tris[:, 2]]
+    fn = 0.5 * np.cross(b - a, c - a)
+    acc = np.zeros_like(verts)
+    area = np.zeros(len(verts))
+    for k in range(3):
+        np.add.at(acc, tris[:, k], fn)
+        np.add.at(area, tris[:, k], np.linalg.norm(fn, axis=1) / 3.0)
+    return acc, area
+
+
+def test_vertex_normals_kernel_matches_numpy(rng):
+    verts = rng.normal(size=(30, 3))
+    tris = rng.integers(0, 30, size=(80, 3))
+    tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2])
+                & (tris[:, 0] != tris[:, 2])]
+    acc, area = np.zeros((30, 3)), np.zeros(30)
+    _vertex_normals_kernel(verts, tris, acc, area)
+    want_acc, want_area = reference_vertex_normals(verts, tris)
+    np.testing.assert_allclose(acc, want_acc, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(area, want_area, rtol=1e-12, atol=1e-12)
+    # without areas, into float32: the same sums, rounded at every addition
+    acc32 = np.zeros((30, 3), dtype=np.float32)
+    _vertex_normals_kernel(verts, tris, acc32, np.empty(0))
+    np.testing.assert_allclose(acc32, want_acc, rtol=1e-5, atol=1e-5)
+
+
+@pytest.mark.parametrize("m", [1, 2, 5, 12])
+def test_streamed_normals_match_the_vertex_array(rng, m):
+    grid = LatLongGrid(m)
+    body = Body(grid, 50.0 + rng.uniform(0, 5, grid.n_vertices), stretch=(1.0, 1.3, 0.8))
+    acc = np.zeros((grid.n_vertices, 3))
+    _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), body.radii_m,
+                               np.asarray(body.stretch), acc)
+    want, _ = reference_vertex_normals(body.vertices(), grid.triangles())
+    np.testing.assert_allclose(acc, want, rtol=1e-10, atol=1e-9)

@@ -1,0 +1,160 @@
+"""The shared numba building blocks of ``craters.kernels`` against pure numpy/Python."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from craters import kernels as K
+
+MASK = 2**64 - 1
+
+
+def reference_mix64(z: int) -> int:
+    """splitmix64 finaliser (Steele, Lea & Flood) in Python integers."""
+    z = ((z ^ (z >> 30)) * 0xBF58476D1CE4E5B9) & MASK
+    z = ((z ^ (z >> 27)) * 0x94D049BB133111EB) & MASK
+    return z ^ (z >> 31)
+
+
+def reference_hash_normal(a: int) -> float:
+    b = reference_mix64((a + 0x9E3779B97F4A7C15) & MASK)
+    u1 = ((a >> 11) + 1) * 2.0**-53
+    u2 = (b >> 11) * 2.0**-53
+    return float(np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2))
+
+
+@pytest.mark.parametrize("z", [0, 1, 12345, 2**63 - 1, 2**64 - 1, 0x9E3779B97F4A7C15])
+def test_mix64_splitmix64_hash_normal_match_python(z):
+    u = np.uint64(z)
+    assert int(K.mix64(u)) == reference_mix64(z)
+    assert int(K.splitmix64(u)) == reference_mix64((z + 0x9E3779B97F4A7C15) & MASK)
+    assert K.hash_normal(u) == pytest.approx(reference_hash_normal(z), rel=1e-14, abs=1e-14)
+
+
+def reference_bilinear(h, fy, fx, blend):
+    """Pure numpy: NaN outside the cell centres, else the two-step linear blend."""
+    ny, nx = h.shape
+    if not (0 <= fy <= ny - 1 and 0 <= fx <= nx - 1):
+        return np.nan
+    i0, j0 = min(int(np.floor(fy)), max(ny - 2, 0)), min(int(np.floor(fx)), max(nx - 2, 0))
+    i1, j1 = min(i0 + 1, ny - 1), min(j0 + 1, nx - 1)
+    ty, tx = fy - i0, fx - j0
+    if blend:
+        a = (1 - tx) * h[i0, j0] + tx * h[i0, j1]
+        b = (1 - tx) * h[i1, j0] + tx * h[i1, j1]
+        return (1 - ty) * a + ty * b
+    a = h[i0, j0] + tx * (h[i0, j1] - h[i0, j0])
+    b = h[i1, j0] + tx * (h[i1, j1] - h[i1, j0])
+    return a + ty * (b - a)
+
+
+@pytest.mark.parametrize("shape", [(1, 1), (1, 5), (4, 1), (6, 7)])
+@pytest.mark.parametrize("blend", [False, True])
+def test_bilinear_matches_reference(rng, shape, blend):
+    h = rng.normal(size=shape)
+    pts = rng.uniform(-1.0, max(shape) + 0.5, size=(300, 2))
+    pts[:10] = [[0, 0], [shape[0] - 1, shape[1] - 1], [np.nan, 0], [0, np.nan],
+                [-1e-300, 0], [0, shape[1] - 1 + 1e-12], [0.5, 0.5], [shape[0] - 1, 0],
+                [0, shape[1] - 1], [0.25, 0]]
+    for fy, fx in pts:
+        got = K.bilinear(h, fy, fx, blend)
+        want = reference_bilinear(h, fy, fx, blend)
+        assert got == want or (np.isnan(got) and np.isnan(want))
+    # both forms are the same interpolation; exact at the cell centres and on a plane
+    i, j = np.mgrid[: shape[0], : shape[1]]
+    plane = 2.0 + 0.5 * i - 0.25 * j
+    for fy, fx in pts[10:]:
+        if 0 <= fy <= shape[0] - 1 and 0 <= fx <= shape[1] - 1:
+            assert K.bilinear(plane, fy, fx, blend) == pytest.approx(2.0 + 0.5 * fy - 0.25 * fx)
+
+
+def plane_sums(x, y, h):
+    s = K.PLANE_SUMS0
+    for xq, yq, hq in zip(x, y, h, strict=True):
+        s = K.plane_sums_add(s, xq, yq, hq)
+    return s
+
+
+def test_plane_sums_and_solve_match_lstsq(rng):
+    x, y = rng.uniform(-5, 5, 40), rng.uniform(-5, 5, 40)
+    h = 1.5 + 0.3 * x - 0.7 * y + 0.01 * rng.standard_normal(40)
+    s = plane_sums(x, y, h)
+    np.testing.assert_allclose(s, [40, x.sum(), y.sum(), (x * x).sum(), (y * y).sum(),
+                                   (x * y).sum(), h.sum(), (h * x).sum(), (h * y).sum()])
+    ok, p0, gx, gy = K.plane_solve(s, 1.0)
+    want = np.linalg.lstsq(np.stack([np.ones(40), x, y], 1), h, rcond=None)[0]
+    assert ok
+    np.testing.assert_allclose([p0, gx, gy], want, rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("n", [0, 1, 2])
+def test_plane_solve_refuses_too_few_points(n):
+    s = plane_sums(np.arange(n, dtype=float), np.zeros(n), np.ones(n))
+    assert K.plane_solve(s, 0.0) == (False, 0.0, 0.0, 0.0)
+
+
+def test_plane_solve_refuses_collinear_points():
+    x = np.arange(6, dtype=float)
+    s = plane_sums(x, 2.0 * x, x)
+    assert not K.plane_solve(s, s[0] * (s[3] + s[4]) ** 2)[0]
+
+
+def test_fit_plane_matches_lstsq_and_falls_back(rng):
+    h = 3.0 + 0.2 * np.arange(15)[:, None] - 0.1 * np.arange(12)[None, :]
+    h = h + 0.01 * rng.standard_normal(h.shape)
+    cy, cx, r_px, pixel = 7.3, 5.6, 4.2, 2.0
+    p0, gx, gy, n = K.fit_plane(h, cy, cx, r_px, pixel)
+    i, j = np.mgrid[: h.shape[0], : h.shape[1]]
+    sel = (j - cx) ** 2 + (i - cy) ** 2 <= r_px**2
+    a = np.stack([np.ones(sel.sum()), j[sel] - cx, i[sel] - cy], 1)
+    want = np.linalg.lstsq(a, h[sel], rcond=None)[0]
+    assert n == sel.sum()
+    np.testing.assert_allclose([p0, gx * pixel, gy * pixel], want, rtol=1e-10)
+    # too few pixels: flat at the (clamped) bilinear height of the centre
+    p0, gx, gy, n = K.fit_plane(h, -3.5, 40.0, 0.4, pixel)
+    assert (p0, gx, gy, n) == (h[0, -1], 0.0, 0.0, 0.0)
+
+
+def reference_idw8(z, known, r, c, step_len, empty):
+    acc = wsum = 0.0
+    for d, (dr, dc) in enumerate(zip((-1, -1, -1, 0, 0, 1, 1, 1),
+                                     (-1, 0, 1, -1, 1, -1, 0, 1), strict=True)):
+        k = 1
+        while 0 <= r + k * dr < z.shape[0] and 0 <= c + k * dc < z.shape[1]:
+            if known[r + k * dr, c + k * dc]:
+                w = 1.0 / (k * step_len[d])
+                acc += w * z[r + k * dr, c + k * dc]
+                wsum += w
+                break
+            k += 1
+    return acc / wsum if wsum > 0 else empty
+
+
+@pytest.mark.parametrize("frac", [0.0, 0.1, 0.6, 1.0])
+def test_idw8_matches_reference(rng, frac):
+    z = rng.normal(size=(7, 9))
+    known = rng.random(z.shape) < frac
+    step = np.array([1.5, 1.2, 1.5, 0.9, 0.9, 1.5, 1.2, 1.5])
+    np.testing.assert_array_equal(K.DR8, [-1, -1, -1, 0, 0, 1, 1, 1])
+    np.testing.assert_array_equal(K.DC8, [-1, 0, 1, -1, 1, -1, 0, 1])
+    for r in range(z.shape[0]):
+        for c in range(z.shape[1]):
+            got = K.idw8(z, known, r, c, step, -7.0)
+            assert got == pytest.approx(reference_idw8(z, known, r, c, step, -7.0), rel=1e-14)
+
+
+@pytest.mark.parametrize("slope", [0.0, 10.0, 20.0, 30.0, 44.9, 60.0])
+def test_eroded_degradation_is_linear_in_slope(slope):
+    frac = np.clip((slope - 20.0) / 25.0, 0.0, 1.0)
+    assert K.eroded_degradation(0.2, slope, 20.0, 45.0) == pytest.approx(0.2 + 0.8 * frac)
+
+
+@pytest.mark.parametrize(("wavelength", "spacing"), [(1.0, 1.0), (8.0, 1.0), (9.0, 1.0),
+                                                     (1e6, 1.0), (100.0, 3.0)])
+def test_roughness_octaves(wavelength, spacing):
+    want = 1
+    while want < 10 and wavelength / 2.0**want >= 2.0 * spacing:
+        want += 1
+    assert K.roughness_octaves(wavelength, spacing) == want
+    assert 1 <= want <= 10
