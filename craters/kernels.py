@@ -11,9 +11,12 @@ to evaluate the same profile, plane fit, rim offsets and roughness as
 * ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)`` and ``fbm2(seed, x, y, ...)``
 * ``mix64(z)``: the splitmix64 finaliser (uint64 -> uint64), for counter-based noise
+* ``lcsn_height(kind, r2, kappa, beta, gamma, a, b)``: LCSN crater kernel ``kind`` at
+  squared distance r2 (the formulas of :func:`craters.lcsn_kernel`)
 * ``N_RIM``: samples per azimuth table
 """
 
+from ._lcsn_kernels import _lcsn_height as lcsn_height
 from ._stamp_kernels import N_RIM
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
@@ -25,5 +28,5 @@ from ._stamp_kernels import _rim_offsets as rim_offsets
 from ._stamp_kernels import _roughness_amp as roughness_amp
 from ._stamp_kernels import _table as table
 
-__all__ = ["N_RIM", "fbm2", "fit_plane", "inside", "mix64", "outside", "profile_params",
-           "rim_offsets", "roughness_amp", "table"]
+__all__ = ["N_RIM", "fbm2", "fit_plane", "inside", "lcsn_height", "mix64", "outside",
+           "profile_params", "rim_offsets", "roughness_amp", "table"]
