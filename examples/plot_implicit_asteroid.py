@@ -22,8 +22,7 @@ import numpy as np  # noqa: E402
 
 import craters  # noqa: E402
 import dem  # noqa: E402
-from latlong.gabor import fit_gabor  # noqa: E402
-from latlong.implicit import LcsnLayer, implicit_surface  # noqa: E402
+from latlong.implicit import LcsnLayer, fit_gabor, implicit_surface  # noqa: E402
 from latlong.preview import render_preview  # noqa: E402
 from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model  # noqa: E402
 

@@ -50,7 +50,7 @@ def _positive(s: dict, key: str) -> None:
 
 
 def _gabor(s: dict):
-    from .gabor import fit_gabor, parse_gabor_spec, read_example
+    from .implicit import fit_gabor, parse_gabor_spec, read_example
 
     if s.get("gabor") and s.get("gabor_example"):
         raise CliError("give either --gabor or --gabor-example, not both")
