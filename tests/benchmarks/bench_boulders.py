@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import craters
-import craters.boulders as bmod
+import craters.boulders.placement as bmod
 from latlong import BoulderLayer, boulder_population, build_body, place_boulders, resolve_settings
 from latlong.scene import _band_totals
 
