@@ -15,6 +15,8 @@ Crater profile and stamping:
 * ``eroded_degradation(d, slope, onset_deg, full_deg)``: slope erosion of the degradation
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
   spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
+* ``lcsn_height(kind, r2, kappa, beta, gamma, a, b)``: LCSN crater kernel ``kind`` at
+  squared distance r2 (the formulas of :func:`craters.lcsn_kernel`)
 * ``N_RIM``: samples per azimuth table
 
 Counter-based random numbers:
@@ -31,6 +33,7 @@ Grids and point sets:
   ``DR8``, ``DC8``: its directions
 """
 
+from ._lcsn_kernels import _lcsn_height as lcsn_height
 from ._raster_kernels import DC8, DR8, PLANE_SUMS0
 from ._raster_kernels import _bilinear as bilinear
 from ._raster_kernels import _idw8 as idw8
@@ -53,6 +56,6 @@ from ._stamp_kernels import _roughness_octaves as roughness_octaves
 from ._stamp_kernels import _table as table
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "eroded_degradation",
-           "fbm2", "fit_plane", "hash_normal", "idw8", "inside", "mix64", "outside",
-           "plane_solve", "plane_sums_add", "profile_params", "rim_offsets", "roughness_amp",
-           "roughness_octaves", "splitmix64", "table"]
+           "fbm2", "fit_plane", "hash_normal", "idw8", "inside", "lcsn_height", "mix64",
+           "outside", "plane_solve", "plane_sums_add", "profile_params", "rim_offsets",
+           "roughness_amp", "roughness_octaves", "splitmix64", "table"]

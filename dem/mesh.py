@@ -218,9 +218,9 @@ class _Rocks:
                    np.repeat(self.ids[s0:s0 + k], self.nv))
 
     def face_chunks(self, base: int):
-        from craters.boulders import _topology
+        from craters.boulders import boulder_faces
 
-        faces = _topology(self.level)[0][self.level]
+        faces = boulder_faces(self.level)
         n = len(self.cat)
         for s0 in range(0, n, self.chunk):
             k = min(self.chunk, n - s0)

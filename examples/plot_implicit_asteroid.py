@@ -23,8 +23,7 @@ import numpy as np  # noqa: E402
 import craters  # noqa: E402
 import dem  # noqa: E402
 from latlong import render_preview  # noqa: E402
-from latlong.gabor import fit_gabor  # noqa: E402
-from latlong.implicit import LcsnLayer, implicit_surface  # noqa: E402
+from latlong.implicit import LcsnLayer, fit_gabor, implicit_surface  # noqa: E402
 from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"

@@ -45,12 +45,14 @@ from .faulting import (
     random_faults,
     two_phase_faulting,
 )
-from .gabor import GaborNoise, GaborPatch, fit_gabor
 from .gltf import export_glb, export_vtp_strips
 from .grid import LatLongGrid
 from .implicit import (
+    GaborNoise,
+    GaborPatch,
     ImplicitSurface,
     LcsnLayer,
+    fit_gabor,
     fit_metaballs,
     implicit_surface,
     sphere_packing,

@@ -136,9 +136,9 @@ def _boulder_face_chunks(body, base: int = 0):
     shape = catalog_shape(cat)
     top, chunk = shape.levels[-1], mesh_chunk(shape)
     nv = 10 * 4**top + 2
-    from craters.boulders import _topology
+    from craters.boulders import boulder_faces
 
-    faces = _topology(top)[0][top]
+    faces = boulder_faces(top)
     n = body.grid.n_vertices + base
     for s0 in range(0, len(cat), chunk):
         k = min(chunk, len(cat) - s0)

@@ -308,7 +308,7 @@ def _fit_example(given: dict):
     :mod:`latlong.implicit`)."""
     from craters._shared import check_positive, check_range
 
-    from .gabor import fit_gabor, read_example
+    from .implicit import fit_gabor, read_example
 
     if given.get("gabor_pixel_m") is None:
         raise ParameterError("gabor_example", "needs {} (the example's pixel size on the "

@@ -365,8 +365,7 @@ class ImplicitSettings:
     """Casting onto a lat/long grid where a ray crosses twice: error, outermost, innermost."""
 
     def __post_init__(self):
-        from .gabor import GaborNoise, parse_gabor_spec
-        from .implicit import LcsnLayer, parse_lcsn_spec
+        from .implicit import GaborNoise, LcsnLayer, parse_gabor_spec, parse_lcsn_spec
 
         if not isinstance(self.shape, ShapeModel):
             if self.units not in ("km", "m"):

@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import craters
-import craters.boulders as bmod
+import craters.boulders.placement as bmod
 from latlong import BoulderLayer, Scene, boulder_population, build, place_boulders
 from latlong.surface import band_areas
 

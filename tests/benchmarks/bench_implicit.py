@@ -28,8 +28,8 @@ from pathlib import Path
 import numpy as np
 from scipy import stats
 
-from latlong import _implicit_kernels as K
 from latlong.implicit import LcsnLayer, implicit_surface
+from latlong.implicit import _kernels as K
 from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model
 
 DATA = Path(__file__).parents[1] / "data"
@@ -242,13 +242,14 @@ def main():
     # reference 2: VTK's distance to the coarse mesh vs the closest-point distance field
     import pyvista as pv
 
-    from latlong.implicit import _Grid, _metaball_distance
+    from latlong.implicit import VoxelGrid
+    from latlong.implicit.metaballs import metaball_distance
 
     h = surf.metadata["voxel_m"]
     lo, hi = coarse.vertices.min(axis=0) - 6 * h, coarse.vertices.max(axis=0) + 6 * h
-    grid = _Grid(lo, h, tuple(int(v) for v in (np.ceil((hi - lo) / h) + 1)[::-1]))
+    grid = VoxelGrid(lo, h, tuple(int(v) for v in (np.ceil((hi - lo) / h) + 1)[::-1]))
     t0 = time.perf_counter()
-    field = _metaball_distance(surf.metaballs, grid)
+    field = metaball_distance(surf.metaballs, grid)
     ours = (time.perf_counter() - t0) / field.size
     near = np.flatnonzero(np.abs(field.ravel()) < 6 * h)
     pick = rng.choice(near, 5000, replace=False)

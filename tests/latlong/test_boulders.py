@@ -9,7 +9,8 @@ import pytest
 
 import craters
 from craters._boulder_kernels import _noise_kernel
-from craters.boulders import _boulder_meshes, parse_boulder_spec
+from craters.boulders import parse_boulder_spec
+from craters.boulders.meshes import _boulder_meshes
 from latlong import (
     Body,
     BoulderLayer,

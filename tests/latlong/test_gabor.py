@@ -8,17 +8,19 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from latlong import _implicit_kernels as K
-from latlong.gabor import (
+from latlong.implicit import (
     GaborNoise,
     GaborPatch,
+    LcsnLayer,
+    VoxelGrid,
     fit_gabor,
     gabor_image,
+    implicit_surface,
     parse_gabor_spec,
     power_spectrum,
     read_example,
 )
-from latlong.implicit import _BIN, LcsnLayer, _Grid, implicit_surface
+from latlong.implicit import _kernels as K
 from latlong.shapes import ShapeModel
 
 DATA = Path(__file__).parents[1] / "data"
@@ -52,13 +54,13 @@ def test_grid_kernel_matches_reference(rng):
     amp = rng.uniform(0.5, 2.0, n)
     phase = rng.uniform(0, 2 * np.pi, n)
     cutoff2 = math.log(1e3) / math.pi
-    grid = _Grid(np.array([-1.0, 0.0, 1.0]), 0.4, (30, 31, 32))
+    grid = VoxelGrid(np.array([-1.0, 0.0, 1.0]), 0.4, (30, 31, 32))
     base = rng.uniform(-2, 2, grid.shape)
     lo, hi = grid.index_boxes(pos, math.sqrt(cutoff2) / env)
     nbins, offsets, items, active = grid.bins(lo, hi)
     out = np.zeros(grid.shape)
-    K._gabor_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, lo, hi, pos,
-                         wave, env, amp, phase, cutoff2, base, 1.0, out)
+    K._gabor_grid_kernel(grid.origin, grid.h, active, grid.bin_size, nbins, offsets, items, lo,
+                         hi, pos, wave, env, amp, phase, cutoff2, base, 1.0, out)
     k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")
     pts = grid.origin + np.stack([i, j, k], -1).reshape(-1, 3) * grid.h
     want = gabor_reference(pts, pos, wave, env, amp, phase, cutoff2)

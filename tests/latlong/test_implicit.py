@@ -11,18 +11,18 @@ import pyvista as pv
 from scipy import stats
 
 import craters
-from latlong import _implicit_kernels as K
 from latlong.implicit import (
-    _BIN,
     ImplicitSurface,
     LcsnLayer,
-    _Grid,
+    VoxelGrid,
     fit_metaballs,
     implicit_surface,
     parse_lcsn_spec,
     sphere_packing,
     write_mesh,
 )
+from latlong.implicit import _kernels as K
+from latlong.implicit.metaballs import Metaballs, metaball_distance
 from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model
 
 DATA = Path(__file__).parents[1] / "data"
@@ -162,30 +162,18 @@ def test_metaball_kernels_match_reference(rng):
     f, g = metaball_reference(pts, centers, support)
     np.testing.assert_allclose(out[:, 0], f, rtol=1e-12, atol=1e-14)
     np.testing.assert_allclose(out[:, 1:], g, rtol=1e-10, atol=1e-14)
-    grid = _Grid(np.array([-1.0, -2.0, 0.5]), 0.7, (30, 33, 35))
+    grid = VoxelGrid(np.array([-1.0, -2.0, 0.5]), 0.7, (30, 33, 35))
     lo, hi = grid.index_boxes(centers, support)
     nbins, offsets, items, active = grid.bins(lo, hi)
     iso, floor = 0.3, 1e-3
     dist = np.full(grid.shape, -iso / floor)
-    K._metaball_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, centers,
-                            support, iso, floor, dist)
+    K._metaball_grid_kernel(grid.origin, grid.h, active, grid.bin_size, nbins, offsets, items,
+                            centers, support, iso, floor, dist)
     k, j, i = np.meshgrid(*(np.arange(n) for n in grid.shape), indexing="ij")
     pts = grid.origin + np.stack([i, j, k], -1).reshape(-1, 3) * grid.h
     f, g = metaball_reference(pts, centers, support)
     want = (f - iso) / np.maximum(np.linalg.norm(g, axis=1), floor)
     np.testing.assert_allclose(dist.ravel(), want, rtol=1e-10, atol=1e-12)
-
-
-@pytest.mark.parametrize("name", sorted(craters.LCSN_PRESETS))
-def test_numba_lcsn_matches_craters(name):
-    p = craters.LCSN_PRESETS[name]
-    raw = {"kappa": 0.0, "beta": 0.0, "gamma": 0.0, **p.raw}
-    params = np.array([raw[k] for k in ("kappa", "beta", "gamma", "a", "b")])
-    r = np.linspace(0, 4 * p.morphometry("paper")["D_rim" if p.kind > 2 else "D_a"], 999)
-    out = np.empty_like(r)
-    K._lcsn_profile_kernel(p.kind, r, params, out)
-    np.testing.assert_allclose(out, craters.lcsn_kernel(p.kind, r, **p.raw), rtol=1e-13,
-                               atol=1e-14 * p.a)
 
 
 def test_crater_grid_kernel_matches_reference(rng):
@@ -201,14 +189,14 @@ def test_crater_grid_kernel_matches_reference(rng):
         params[q] = [raw.get(k, 0.0) for k in ("kappa", "beta", "gamma", "a", "b")]
     support = rng.uniform(3.0, 7.0, n)
     zhalf = rng.uniform(1.0, 3.0, n)
-    grid = _Grid(np.zeros(3), 0.5, (40, 41, 42))
+    grid = VoxelGrid(np.zeros(3), 0.5, (40, 41, 42))
     base = rng.uniform(-3.0, 3.0, grid.shape)
     band = 2.0
     lo, hi = grid.index_boxes(centers, np.hypot(support, 2 * zhalf))
     nbins, offsets, items, active = grid.bins(lo, hi)
     out = base.copy()
-    K._crater_grid_kernel(grid.origin, grid.h, active, _BIN, nbins, offsets, items, lo, hi,
-                          centers, normals, kinds, params, support, zhalf, base, band, out)
+    K._crater_grid_kernel(grid.origin, grid.h, active, grid.bin_size, nbins, offsets, items, lo,
+                          hi, centers, normals, kinds, params, support, zhalf, base, band, out)
     k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")
     pts = np.stack([i, j, k], -1).reshape(-1, 3) * grid.h
     want = crater_reference(pts, centers, normals, kinds, params, support, zhalf)
@@ -261,12 +249,10 @@ def test_closest_distance_kernel_matches_reference(rng):
 def test_distance_field_is_euclidean_on_a_sphere():
     """One ball: within 6 voxels of the iso-sphere the field is its distance to within
     5 % of a voxel (measured 4 %)."""
-    from latlong.implicit import Metaballs, _metaball_distance
-
     r, h = 1000.0, 97.3
     meta = Metaballs(np.zeros((1, 3)), np.array([2 * r]), 0.75**3, 2.0, 0.0)
-    grid = _Grid(np.full(3, -1500.0) + 0.31 * h, h, (33, 33, 33))
-    dist = _metaball_distance(meta, grid)
+    grid = VoxelGrid(np.full(3, -1500.0) + 0.31 * h, h, (33, 33, 33))
+    dist = metaball_distance(meta, grid)
     k, j, i = np.meshgrid(*(np.arange(n) for n in grid.shape), indexing="ij")
     true = r - np.linalg.norm(grid.origin + np.stack([i, j, k], -1) * h, axis=-1)
     band = np.abs(true) < 6 * h
@@ -475,7 +461,6 @@ def test_small_seed_free_grid_and_rimless_presets():
     the field far along a tangent plane is the distance to the foot (it read ~0 deep
     inside, craters then cut voids); Table A.1's rimless 300 m 2-3 Gyr rows scale by
     their nominal 2/sqrt(gamma)."""
-    from latlong.implicit import _Grid, _metaball_distance, fit_metaballs, sphere_packing
     from latlong.shapes import ShapeModel
 
     bennu = read_shape_model(DATA / "bennu_radar_sbgat.obj", units="km")
@@ -485,7 +470,7 @@ def test_small_seed_free_grid_and_rimless_presets():
     model = ShapeModel(m.vertices - m.volume_centroid, m.faces)
     meta = fit_metaballs(sphere_packing(model), model, rng=0)
     with pytest.raises(ValueError, match="`voxel_m`.*no grid point"):
-        _metaball_distance(meta, _Grid(model.vertices.min(0) - 950.0, 400.0, (7, 7, 8)))
+        metaball_distance(meta, VoxelGrid(model.vertices.min(0) - 950.0, 400.0, (7, 7, 8)))
     for name in ("table-a1-300m-2gyr", "table-a1-300m-3gyr"):
         surf = implicit_surface(m, [LcsnLayer(name, 20, 60)], target_polygons=20_000, rng=1)
         assert len(surf.catalog) > 20

@@ -1,4 +1,4 @@
-"""Numba kernels of the implicit backend (:mod:`latlong.implicit`, :mod:`latlong.gabor`).
+"""Numba kernels of the implicit backend (:mod:`latlong.implicit`).
 
 Grids are point lattices ``origin + (i, j, k) * h`` stored as C arrays ``[k, j, i]``
 (x fastest, VTK's order). Work that adds many local items (metaballs, crater impulses,
@@ -6,13 +6,17 @@ Gabor impulses) into a grid is organised by *bins* of ``B^3`` grid points: each 
 is listed in every bin its support box overlaps (``_bin_count`` / ``_bin_fill``, item
 order kept), and one parallel loop runs over the bins. Every grid point belongs to one
 bin and sums its items in list order, so the result does not depend on the number of
-threads, and no parallel region is opened per item.
+threads, and no parallel region is opened per item. The crater kernels evaluate the
+LCSN formulas of :mod:`craters.lcsn` through their one compiled definition,
+``craters.kernels.lcsn_height``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
+
+from craters.kernels import lcsn_height
 
 
 # --------------------------------------------------------------------------- voxelising
@@ -272,30 +276,6 @@ def _metaball_grid_kernel(origin, h, active, bsize, nbins, offsets, items, cente
 
 # --------------------------------------------------------------------------- craters
 @njit(cache=True, inline="always")
-def _lcsn(kind, r2, kappa, beta, gamma, a, b):
-    """LCSN kernel ``kind`` at squared distance r2 (craters.lcsn_kernel, numba)."""
-    if kind == 1:
-        return -a * np.exp(-b * r2)
-    if kind == 2:
-        return -a * np.exp(-b * r2 * r2)
-    ring = 0.0
-    if r2 > 0.0:
-        lg = np.log(gamma * r2)
-        ring = kappa * np.exp(-beta * lg * lg)
-    if kind == 3:
-        return ring - a * np.exp(-b * r2)
-    return ring + a * np.exp(-b * r2)
-
-
-@njit(cache=True)
-def _lcsn_profile_kernel(kind, r, params, out):
-    """Reference entry point for tests: the kernel at distances r (metres)."""
-    for q in range(r.shape[0]):
-        out[q] = _lcsn(kind, r[q] * r[q], params[0], params[1], params[2], params[3],
-                       params[4])
-
-
-@njit(cache=True, inline="always")
 def _smooth_fall(u):
     """1 for u <= 0, 0 for u >= 1, C1 smoothstep in between."""
     if u <= 0.0:
@@ -323,8 +303,8 @@ def _crater_value(px, py, pz, q, centers, normals, kinds, params, support, zhalf
     if r2 >= rs * rs:
         return 0.0
     u = np.sqrt(r2) / rs
-    v = _lcsn(kinds[q], r2, params[q, 0], params[q, 1], params[q, 2], params[q, 3],
-              params[q, 4])
+    v = lcsn_height(kinds[q], r2, params[q, 0], params[q, 1], params[q, 2], params[q, 3],
+                    params[q, 4])
     return v * _smooth_fall((u - 0.8) / 0.2) * _smooth_fall(az / zh - 1.0)
 
 

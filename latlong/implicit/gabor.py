@@ -43,10 +43,11 @@ from craters._shared import (
     parse_spec,
 )
 
-from . import _implicit_kernels as _k
+from . import _kernels as _k
+from .grid import VoxelGrid
 
-__all__ = ["GaborNoise", "GaborPatch", "fit_gabor", "gabor_image", "parse_gabor_spec",
-           "power_spectrum", "read_example"]
+__all__ = ["GaborNoise", "GaborPatch", "add_gabor", "fit_gabor", "gabor_image",
+           "gabor_impulses", "parse_gabor_spec", "power_spectrum", "read_example"]
 
 _EPS = 1e-3
 _CUTOFF2 = math.log(1.0 / _EPS) / math.pi  # envelope < EPS beyond r^2 a^2 = this
@@ -196,9 +197,12 @@ def _waves(d: dict, east: np.ndarray, north: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(d["freq"][:, None] * (c * east + s * north))
 
 
-def _gabor_impulses(noise, base, grid, reach_m, rng):
+def gabor_impulses(noise: GaborNoise, base: np.ndarray, grid: VoxelGrid, reach_m: float,
+                   rng) -> dict:
     """Impulses within reach_m (+ the kernel radius) of the coarse surface ``base``
-    (first-order distance on ``grid``), with tangent frames from its gradient."""
+    (signed distance on ``grid``, metres), with tangent frames from its gradient.
+    ``rng``: a Generator. Returns arrays for :func:`add_gabor` (``pos``, ``wave``,
+    ``env``, ``amp``, ``phase``, ``reach``) and ``cutoff2``."""
     rho = math.sqrt(_CUTOFF2) / min(p.bandwidth for p in noise.patches)
     inner = base > -(reach_m + rho)
     idx = np.argwhere(inner)
@@ -212,6 +216,18 @@ def _gabor_impulses(noise, base, grid, reach_m, rng):
     normals = -grid.gradient(base, d["pos"]) if len(d["pos"]) else np.zeros((0, 3))
     d["wave"] = _waves(d, *_frames(normals))
     return d
+
+
+def add_gabor(impulses: dict, grid: VoxelGrid, base: np.ndarray, band_m: float,
+              out: np.ndarray) -> None:
+    """Add the impulses' Gabor kernels (:func:`gabor_impulses`) to ``out`` (a field on
+    ``grid``) at the grid points where ``|base| < band_m``."""
+    d = impulses
+    lo_i, hi_i = grid.index_boxes(d["pos"], d["reach"])
+    nbins, offsets, items, active = grid.bins(lo_i, hi_i)
+    _k._gabor_grid_kernel(grid.origin, grid.h, active, grid.bin_size, nbins, offsets, items,
+                          lo_i, hi_i, d["pos"], d["wave"], d["env"], d["amp"], d["phase"],
+                          d["cutoff2"], base, band_m, out)
 
 
 def gabor_image(noise: GaborNoise, shape, pixel_m: float, *, rng=None) -> np.ndarray:
@@ -236,16 +252,10 @@ def gabor_image(noise: GaborNoise, shape, pixel_m: float, *, rng=None) -> np.nda
     d = _draw(noise, lo, hi, rng)
     n = len(d["pos"])
     d["wave"] = _waves(d, np.tile([1.0, 0.0, 0.0], (n, 1)), np.tile([0.0, 1.0, 0.0], (n, 1)))
-    from .implicit import _BIN, _Grid
-
-    grid = _Grid(np.zeros(3), pixel_m, (1, ny, nx))
+    grid = VoxelGrid(np.zeros(3), pixel_m, (1, ny, nx))
     out = np.zeros((1, ny, nx))
     if len(d["pos"]):
-        lo_i, hi_i = grid.index_boxes(d["pos"], d["reach"])
-        nbins, offsets, items, active = grid.bins(lo_i, hi_i)
-        _k._gabor_grid_kernel(grid.origin, pixel_m, active, _BIN, nbins, offsets, items, lo_i,
-                              hi_i, d["pos"], d["wave"], d["env"], d["amp"], d["phase"],
-                              d["cutoff2"], np.zeros_like(out), np.inf, out)
+        add_gabor(d, grid, np.zeros_like(out), np.inf, out)
     return out[0]
 
 

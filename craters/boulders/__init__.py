@@ -1,0 +1,40 @@
+"""Boulders (Martin 2014, V.C): multi-resolution procedural shapes and size populations.
+
+Pure functions over numpy; placing boulders on a body is ``latlong.boulders``, on a DEM
+``dem.boulders``.
+
+* :mod:`~craters.boulders.meshes`: the shapes (icosahedron refined by random midpoint
+  displacement, exact subsets level to level), :class:`BoulderShape`,
+  :class:`BoulderNode`, the meshes of placed catalogs, :func:`boulder_faces`
+* :mod:`~craters.boulders.placement`: :class:`BoulderLayer` populations (N_cum = c D^k),
+  their draw, orientations and resting on the ground, the placed catalog columns
+"""
+
+from .meshes import (
+    BoulderNode,
+    BoulderShape,
+    boulder,
+    boulder_faces,
+    boulder_meshes,
+    boulder_normals,
+    boulder_world_meshes,
+    catalog_shape,
+    iter_boulder_meshes,
+    mesh_chunk,
+)
+from .placement import (
+    MIN_BURIAL,
+    BoulderLayer,
+    draw_boulder_layer,
+    orientations,
+    parse_boulder_spec,
+    placed_columns,
+    quaternions,
+    rest_on_ground,
+)
+
+__all__ = ["MIN_BURIAL", "BoulderLayer", "BoulderNode", "BoulderShape", "boulder",
+           "boulder_faces", "boulder_meshes", "boulder_normals", "boulder_world_meshes",
+           "catalog_shape", "draw_boulder_layer", "iter_boulder_meshes", "mesh_chunk",
+           "orientations", "parse_boulder_spec", "placed_columns", "quaternions",
+           "rest_on_ground"]

@@ -1,0 +1,79 @@
+"""The implicit backend (Li et al. 2020, 2022): metaballs over a sphere packing, LCSN
+craters on a multi-level 3-D grid, Gabor micro-detail, marching cubes.
+
+Pipeline (:func:`implicit_surface`):
+
+1. **Sphere packing** (:func:`sphere_packing`) of a closed constraint mesh: the mesh is
+   voxelised by ray parity along x (a numba scan of every grid column), the inside is
+   distance-transformed (``scipy.ndimage.distance_transform_edt``; the boundary lies half
+   a voxel beyond the last inside voxel), and balls are placed greedily, the largest
+   free ball first (inside the shape, not overlapping the balls already placed: a
+   non-uniform packing in the spirit of Weller & Zachmann's ProtoSphere), down to a
+   minimum radius. Coverage = packed volume / mesh volume.
+2. **Metaballs** (:func:`fit_metaballs`): Wyvill's soft-object kernel
+   ``(1 - d^2/R^2)^3`` (compact support R = blend x ball radius, so every ball's own
+   iso-surface sits at the same fraction of its radius) summed over the balls; the
+   blend factor and the iso-value T are *fitted to the constraint*: on 20 000 points
+   uniform on the constraint surface, T is the median of f weighted by 1/|grad f|,
+   which minimises the mean first-order distance |f - T| / |grad f| of those points to
+   the iso-surface, and the blend factor with the smallest such mean is kept.
+3. **Field**: on a grid of spacing ``voxel_m`` the signed distance to the metaball
+   surface (> 0 inside), from the first-order ``(f - T) / |grad f|`` next to the surface
+   (:func:`~latlong.implicit.metaballs.metaball_distance`).
+4. **Craters** (:class:`LcsnLayer`): the multi-level grid has cells of ``cell_m / 2^l``
+   at level l (each cell holds 2^3 cells of the next level); a layer uses the finest
+   level whose cells hold its largest crater. Every cell of that level that the coarse
+   surface passes through (a triangle of the base mesh has its centroid in it) receives
+   one impulse with the layer's probability, at a uniform random point of the surface
+   inside the cell (a Poisson point conditioned on the cell); its diameter is drawn by
+   inversion sampling in [d_min, d_max] (Li 2022 eq. 17-21,
+   :func:`craters.sample_power_law_diameters`). The layer's kernel
+   (:mod:`craters.lcsn`) is scaled self-similarly to that diameter (rim-crest diameter,
+   or apparent diameter for kernels without a rim), its heights times the layer weight
+   omega (eq. 2) and optionally set to a random depth/diameter ratio, and added to d in
+   the impulse's tangent frame: r = distance from the surface normal through the
+   impulse, z = height along it; the kernel fades to 0 over the last 20 % of its
+   support radius (where it is < 1e-3 of its extreme) and beyond ``|z|`` = its
+   largest height + a quarter of its support (C1 smoothstep over as much again: room
+   for the surface to curve away from the tangent plane), so it does not reach the
+   far side of the body unless that is closer.
+5. **Gabor noise** (:mod:`~latlong.implicit.gabor`) is added near the surface.
+6. **Marching cubes** (VTK flying edges) on the zero level gives a closed, outward
+   oriented triangle mesh; only its largest connected piece is kept (how much area was
+   dropped is recorded). The crater catalog lists every impulse (position on the
+   coarse surface, normal, diameter and as-added depth / rim height).
+
+For star-shaped results :meth:`ImplicitSurface.to_body` casts the mesh onto a
+:class:`~latlong.LatLongGrid` (:func:`latlong.shapes.from_shape_model`), so slopes,
+strips, boulders and exports of the lat/long toolkit apply.
+
+Modules (none imports the lat/long grid; ``surface`` meets it in ``to_body`` only)::
+
+    surface    implicit_surface, ImplicitSurface, write_mesh      (the build: steps 1-6)
+    packing    sphere_packing, SpherePacking                      (step 1)
+    metaballs  fit_metaballs, Metaballs, metaball_distance        (steps 2-3)
+    layers     LcsnLayer, parse_lcsn_spec, the crater impulses    (step 4)
+    gabor      GaborNoise, GaborPatch, fit_gabor, gabor_image ... (step 5)
+    grid       VoxelGrid: index boxes, bins, sampling, marching cubes
+    _kernels   the numba kernels (craters.kernels.lcsn_height for the LCSN formulas)
+"""
+
+from .gabor import (
+    GaborNoise,
+    GaborPatch,
+    fit_gabor,
+    gabor_image,
+    parse_gabor_spec,
+    power_spectrum,
+    read_example,
+)
+from .grid import VoxelGrid
+from .layers import LcsnLayer, parse_lcsn_spec
+from .metaballs import Metaballs, fit_metaballs
+from .packing import SpherePacking, sphere_packing
+from .surface import MESH_SUFFIXES, ImplicitSurface, implicit_surface, write_mesh
+
+__all__ = ["MESH_SUFFIXES", "GaborNoise", "GaborPatch", "ImplicitSurface", "LcsnLayer",
+           "Metaballs", "SpherePacking", "VoxelGrid", "fit_gabor", "fit_metaballs",
+           "gabor_image", "implicit_surface", "parse_gabor_spec", "parse_lcsn_spec",
+           "power_spectrum", "read_example", "sphere_packing", "write_mesh"]
