@@ -3,11 +3,10 @@
 
 Other packages reach it through :mod:`craters.kernels` (``lcsn_height``): the implicit
 backend of ``latlong`` evaluates it at the squared distance of every grid point from a
-crater's axis. :func:`craters.lcsn_kernel` evaluates the same formulas with numpy
-(``craters.lcsn.kernel.kernel_heights``); the two agree to a few ulp, not bit for bit:
-numba calls the C library's ``exp``/``log``, numpy its own SIMD ones, and numpy squares
-``r`` in another order (``-b r r`` against ``-b r2``). The tests compare both with a
-pure-numpy reference of the equations.
+crater's axis; :func:`craters.lcsn_kernel` evaluates arrays through
+:func:`_lcsn_heights_kernel`, so both get the same bits (and none of numpy's
+CPU-dependent SIMD ``exp``/``log``). The tests compare it with a pure-numpy reference of
+the equations.
 """
 
 from __future__ import annotations

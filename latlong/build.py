@@ -15,7 +15,7 @@ import dataclasses
 
 import numpy as np
 
-from craters._shared import package_version
+from craters._shared import ParameterError, ParameterTypeError, package_version
 
 from .body import Body
 from .boulders import boulder_population, place_boulders
@@ -126,10 +126,14 @@ def _build_implicit(scene: Scene, progress: bool):
     from .implicit import implicit_surface
 
     imp = scene.implicit
-    surf = implicit_surface(imp.shape, imp.layers, gabor=imp.gabor, voxel_m=imp.voxel_m,
-                            target_polygons=imp.polygons, cell_m=imp.cell_m,
-                            packing_voxels=imp.packing_voxels, min_sphere_m=imp.min_sphere_m,
-                            rng=scene.seed, progress=progress)
+    try:
+        surf = implicit_surface(imp.shape, imp.layers, gabor=imp.gabor, voxel_m=imp.voxel_m,
+                                target_polygons=imp.polygons, cell_m=imp.cell_m,
+                                packing_voxels=imp.packing_voxels,
+                                min_sphere_m=imp.min_sphere_m, rng=scene.seed,
+                                progress=progress)
+    except (ParameterError, ParameterTypeError) as exc:  # the scene's names (settings)
+        raise exc.renamed({"target_polygons": "polygons"}.get(exc.name, exc.name)) from None
     meta = {**surf.metadata, "seed": scene.seed, "version": package_version(),
             "shape_units": imp.units}
     return dataclasses.replace(surf, metadata=meta)

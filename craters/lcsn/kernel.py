@@ -17,14 +17,16 @@ Gaussian term is ``exp(-b r^2)`` in kernels 3 and 4: eq. 7, eq. 10 and Table A.1
 it (with ``exp(-b r^4)``, as the extracted eq. 6 reads, Table A.1's 300 m crater would
 have a 10 m wide bowl).
 
-The compiled form of the same formulas, for kernels of other packages, is
-``craters.kernels.lcsn_height`` (:mod:`craters._lcsn_kernels`).
+The formulas are written once, in numba (:mod:`craters._lcsn_kernels`; for kernels of
+other packages ``craters.kernels.lcsn_height``); :func:`lcsn_kernel` evaluates them
+through it.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .._lcsn_kernels import _lcsn_heights_kernel
 from .._shared import check_finite, check_positive
 
 __all__ = ["BORDER_THRESHOLD", "MORPH_KEYS", "RAW_KEYS", "check_kind", "check_raw",
@@ -73,28 +75,18 @@ def check_raw(kind: int, raw: dict) -> dict:
     return out
 
 
-def _ring(r, beta, gamma):
-    """The log-normal ring L(r) = exp(-beta (ln(gamma r^2))^2), 0 at r = 0."""
-    r = np.asarray(r, dtype=np.float64)
-    out = np.zeros_like(r)
-    pos = r > 0
-    lg = np.log(gamma * r[pos] * r[pos])
-    out[pos] = np.exp(-beta * lg * lg)
-    return out
-
-
 def kernel_heights(kind: int, r, p: dict) -> np.ndarray:
     """Heights (metres) of kernel ``kind`` at distances ``r`` (metres) for raw parameters
     ``p`` already checked by :func:`check_raw`; no validation (:func:`lcsn_kernel` is the
-    checked form). numpy's evaluation of the formulas; the compiled one
-    (``craters.kernels.lcsn_height``) agrees with it to a few ulp."""
+    checked form). Evaluated by the one definition of the formulas,
+    ``craters.kernels.lcsn_height`` (numba), so numpy callers and compiled kernels get
+    the same bits."""
     r = np.asarray(r, dtype=np.float64)
-    if kind == 1:
-        return -p["a"] * np.exp(-p["b"] * r * r)
-    if kind == 2:
-        return -p["a"] * np.exp(-p["b"] * (r * r) ** 2)
-    sign = -1.0 if kind == 3 else 1.0
-    return p["kappa"] * _ring(r, p["beta"], p["gamma"]) + sign * p["a"] * np.exp(-p["b"] * r * r)
+    flat = np.ascontiguousarray(r).reshape(-1)
+    params = np.array([p.get(k, 0.0) for k in ("kappa", "beta", "gamma", "a", "b")])
+    out = np.empty_like(flat)
+    _lcsn_heights_kernel(int(kind), flat, params, out)
+    return out.reshape(r.shape)
 
 
 # --------------------------------------------------------------------------- kernels

@@ -16,7 +16,7 @@ import math
 
 import numpy as np
 
-from craters._shared import check_int, check_positive, physical_memory_bytes
+from craters._shared import ParameterError, check_int, check_positive, physical_memory_bytes
 
 from ..shapes import ShapeModel
 from . import _kernels as _k
@@ -87,23 +87,23 @@ def sphere_packing(model: ShapeModel, *, n_voxels: int = 128, min_radius_m: floa
     origin, dims = _voxel_grid(lo, hi, h, 2)
     need = _PACK_BYTES_PER_VOXEL * float(np.prod(np.asarray(dims, dtype=float)))
     if need > 0.6 * physical_memory_bytes():
-        raise ValueError(f"`n_voxels` = {n_voxels}: the packing grid {dims[0]} x {dims[1]} x "
-                         f"{dims[2]} needs about {need / 2**30:.1f} GiB; this machine has "
-                         f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer voxels")
+        raise ParameterError("n_voxels", f"= {n_voxels}: the packing grid {dims[0]} x {dims[1]} "
+                             f"x {dims[2]} needs about {need / 2**30:.1f} GiB; this machine "
+                             f"has {physical_memory_bytes() / 2**30:.1f} GiB: use fewer voxels")
     inside = np.zeros((dims[2], dims[1], dims[0]), dtype=np.uint8)
     odd = _k._voxelize_kernel(np.ascontiguousarray(model.vertices, np.float64),
                               np.ascontiguousarray(model.faces, np.int64), origin, h, inside)
     if not inside.any():
-        raise ValueError(f"`n_voxels` = {n_voxels} is too coarse: no voxel centre lies inside "
-                         f"{model.source or 'the model'}")
+        raise ParameterError("n_voxels", f"= {n_voxels} is too coarse: no voxel centre lies "
+                             f"inside {model.source or 'the model'}")
     free = distance_transform_edt(inside, sampling=h) - 0.5 * h
     free[inside == 0] = -np.inf
     centers = np.empty((max_spheres, 3))
     radii = np.empty(max_spheres)
     n = _k._pack_kernel(free, origin, h, r_min, centers, radii)
     if n == 0:
-        raise ValueError(f"`min_radius_m` = {r_min:g} m is larger than the largest ball that "
-                         "fits inside the model")
+        raise ParameterError("min_radius_m", f"= {r_min:g} m is larger than the largest ball "
+                             "that fits inside the model")
     centers, radii = centers[:n].copy(), radii[:n].copy()
     coverage = float((4.0 / 3.0) * math.pi * (radii**3).sum() / model.volume_m3)
     if odd:

@@ -24,6 +24,8 @@ import numpy as np
 
 import craters as _craters
 from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
     atomic_path,
     check_int,
     check_positive,
@@ -214,7 +216,11 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
 
     bar = progress_bar(total=6, enabled=progress, desc="implicit")
     bar.set_description("packing")
-    packing = sphere_packing(model, n_voxels=packing_voxels, min_radius_m=min_sphere_m)
+    try:
+        packing = sphere_packing(model, n_voxels=packing_voxels, min_radius_m=min_sphere_m)
+    except (ParameterError, ParameterTypeError) as exc:  # name this function's parameters
+        raise exc.renamed({"n_voxels": "packing_voxels",
+                           "min_radius_m": "min_sphere_m"}.get(exc.name, exc.name)) from None
     meta = fit_metaballs(packing, model, rng=rng.integers(2**63))
     times["packing_s"] = time.perf_counter() - t0
     bar.update()

@@ -437,7 +437,7 @@ def test_layer_errors(kwargs, match):
     ({"voxel_m": -1.0}, "`voxel_m`"),
     ({"target_polygons": 5}, "`target_polygons`"),
     ({"cell_m": 10.0}, "`cell_m`"),
-    ({"packing_voxels": 2}, "`n_voxels`"),
+    ({"packing_voxels": 2}, "`packing_voxels`"),
     ({"voxel_m": 1e-3}, "`voxel_m`.*GiB"),
 ])
 def test_surface_errors(kwargs, match):
