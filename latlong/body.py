@@ -11,14 +11,12 @@ import numpy as np
 from craters import validate_catalog
 from craters._shared import atomic_path, check_int, check_positive
 
-from .export import write_mesh
+from .export import EXPORT_SUFFIXES, export_body
 from .grid import LatLongGrid
 
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
 
 FORMAT = "craterform.body/1"
-#: Mesh formats :meth:`Body.export` writes, chosen by suffix (plus ``.npz`` via save).
-EXPORT_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk")
 # a fixed zip timestamp so that the same body always gives the same bytes
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
@@ -252,12 +250,14 @@ class Body:
         return path
 
     def export(self, path, *, progress: bool = False) -> Path:
-        """Write a mesh file chosen by suffix (.ply .obj .stl .vtp .vtk), atomically.
+        """Write a mesh file chosen by suffix (.ply .obj .stl .vtp .vtk .glb), atomically.
 
-        PLY (binary, float32 x y z and ``height_m`` per vertex), OBJ and STL (binary)
-        are streamed ring band by ring band; VTP/VTK go through pyvista.
+        Streamed band by band through the shared mesh writers (float32 positions and
+        ``height_m`` per vertex, boulders merged with ``boulder_id``);
+        ``.glb`` is the patched-strip renderer export (:func:`latlong.export_glb`). See
+        :mod:`latlong.export`.
         """
-        return write_mesh(self, path, progress=progress)
+        return export_body(self, path, progress=progress)
 
     def to_pyvista(self):
         """A ``pyvista.PolyData`` with point array ``height_m`` (radius minus reference)."""

@@ -36,7 +36,6 @@ import numpy as np
 
 from craters._shared import atomic_path, check_int, package_version, progress_bar
 
-from .body import Body
 from .grid import LatLongGrid
 from .strips import join_strips, patch_tree, strip_triangles
 
@@ -60,7 +59,7 @@ def _pad4(n: int) -> int:
     return (4 - n % 4) % 4
 
 
-def export_glb(body: Body, path, *, patch_k: int = 64, lod: int = 0,
+def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
                progress: bool = False) -> dict:
     """Write ``body`` as a patched, multi-LOD glTF binary and a JSON manifest.
 
@@ -80,8 +79,8 @@ def export_glb(body: Body, path, *, patch_k: int = 64, lod: int = 0,
     The manifest (also written): per level the magnitude, triangle count and patches
     with their bounds and byte ranges.
     """
-    if not isinstance(body, Body):
-        raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
+    if not isinstance(getattr(body, "grid", None), LatLongGrid):
+        raise TypeError(f"`body` must be a latlong.Body; got {type(body).__name__}")
     path = Path(path)
     if path.suffix.lower() != ".glb":
         raise ValueError(f"`path` must end in .glb; got {str(path)!r}")
@@ -170,7 +169,7 @@ def _json_chunk(gl: dict) -> bytes:
     return js + b" " * _pad4(len(js))
 
 
-def _write_level(body: Body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
+def _write_level(body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
                  progress: bool) -> int:
     """Write one level's patches to ``binf`` (buffer = the level); returns its size."""
     offset = 0
@@ -307,7 +306,7 @@ def _boulder_nodes(cat, level: int, first: dict, gl: dict, manifest: dict) -> No
     manifest["levels"][level]["boulder_level"] = blevel
 
 
-def export_vtp_strips(body: Body, path) -> Path:
+def export_vtp_strips(body, path) -> Path:
     """VTP with native triangle strips (one per band) and point normals/heights."""
     import pyvista as pv
 

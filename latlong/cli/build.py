@@ -13,14 +13,14 @@ from pathlib import Path
 import craters
 from craters._shared import check_output_path, human_bytes, progress_bar
 from craters._shared.cli import CliError
-from latlong import Scene, build, export_glb, render_preview
+from latlong import EXPORT_SUFFIXES, Scene, build, render_preview
+from latlong.implicit import MESH_SUFFIXES
 
 from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, shown
 
 __all__ = ["add_build_parser"]
 
-MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk")
-_SUFFIXES = {"latlong": (".npz", *MESH_SUFFIXES, ".glb"), "implicit": (".npz", *MESH_SUFFIXES)}
+_SUFFIXES = {"latlong": (".npz", *EXPORT_SUFFIXES), "implicit": (".npz", *MESH_SUFFIXES)}
 
 
 def _settings(args) -> tuple[dict, dict, set]:
@@ -64,8 +64,6 @@ def _write_body(body, run: dict, progress: bool, done) -> None:
     for out in run.get("output") or []:
         if out.lower().endswith(".npz"):
             body.save(out)
-        elif out.lower().endswith(".glb"):
-            export_glb(body, out, progress=progress)
         else:
             body.export(out, progress=progress)
         done()

@@ -49,7 +49,7 @@ strips, boulders and exports of the lat/long toolkit apply.
 
 Modules (none imports the lat/long grid; ``surface`` meets it in ``to_body`` only)::
 
-    surface    implicit_surface, ImplicitSurface, write_mesh      (the build: steps 1-6)
+    surface    implicit_surface, ImplicitSurface                   (the build: steps 1-6)
     packing    sphere_packing, SpherePacking                      (step 1)
     metaballs  fit_metaballs, Metaballs, metaball_distance        (steps 2-3)
     layers     LcsnLayer, parse_lcsn_spec, the crater impulses    (step 4)
@@ -71,9 +71,9 @@ from .grid import VoxelGrid
 from .layers import LcsnLayer, parse_lcsn_spec
 from .metaballs import Metaballs, fit_metaballs
 from .packing import SpherePacking, sphere_packing
-from .surface import MESH_SUFFIXES, ImplicitSurface, implicit_surface, write_mesh
+from .surface import MESH_SUFFIXES, ImplicitSurface, implicit_surface
 
 __all__ = ["MESH_SUFFIXES", "GaborNoise", "GaborPatch", "ImplicitSurface", "LcsnLayer",
            "Metaballs", "SpherePacking", "VoxelGrid", "fit_gabor", "fit_metaballs",
            "gabor_image", "implicit_surface", "parse_gabor_spec", "parse_lcsn_spec",
-           "power_spectrum", "read_example", "sphere_packing", "write_mesh"]
+           "power_spectrum", "read_example", "sphere_packing"]

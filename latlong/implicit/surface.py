@@ -26,13 +26,13 @@ import craters as _craters
 from craters._shared import (
     ParameterError,
     ParameterTypeError,
-    atomic_path,
     check_int,
     check_positive,
     normalize_rng,
     physical_memory_bytes,
     progress_bar,
 )
+from craters._shared.meshio import MESH_SUFFIXES, MeshSource, array_source, write_mesh
 
 from ..shapes import ShapeModel, read_shape_model
 from . import _kernels as _k
@@ -42,10 +42,9 @@ from .layers import LcsnLayer, draw_impulses, largest_height, layer_levels, meas
 from .metaballs import Metaballs, fit_metaballs, metaball_distance
 from .packing import SpherePacking, sphere_packing
 
-__all__ = ["MESH_SUFFIXES", "ImplicitSurface", "implicit_surface", "write_mesh"]
+__all__ = ["MESH_SUFFIXES", "ImplicitSurface", "implicit_surface"]
 
 logger = logging.getLogger(__name__)
-MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk")
 _GROWTH_STEPS = 6  # enlargements (x 1.5 margin each) of the grid around a bulging surface
 # triangles per (constraint area / voxel^2) of the flying-edges metaball surfaces:
 # 3.07 (Itokawa q=32), 3.11 (Eros 7790), 3.30 (Bennu) measured
@@ -111,9 +110,14 @@ class ImplicitSurface:
         _, counts = np.unique(undirected, axis=0, return_counts=True)
         return bool((counts == 2).all() and np.unique(directed).size == directed.size)
 
-    def save(self, path) -> Path:
-        """Write the mesh by suffix (:func:`write_mesh`)."""
-        return write_mesh(self.vertices, self.faces, path)
+    def mesh_source(self) -> MeshSource:
+        """The mesh for the shared mesh writers."""
+        return array_source(self.vertices, self.faces, "craterform implicit body, metres")
+
+    def save(self, path, *, progress: bool = False) -> Path:
+        """Write the mesh to a file chosen by suffix (``.ply .obj .stl .vtp .vtk .glb``,
+        :mod:`craters._shared.meshio`), atomically."""
+        return write_mesh(self.mesh_source(), path, progress=progress)
 
     def to_body(self, magnitude: int, *, crossings: str = "error"):
         """Cast the mesh onto a lat/long grid of ``magnitude`` from the origin.
@@ -351,48 +355,3 @@ def _largest_piece(verts, faces):
     remap[used] = np.arange(len(used))
     dropped = float(1.0 - comp_area[keep] / comp_area.sum())
     return verts[used], remap[faces[fmask]], dropped, int((comp_area > 0).sum())
-
-
-def write_mesh(vertices, faces, path) -> Path:
-    """Write a triangle mesh by suffix: binary PLY (float32 xyz, int32 faces), OBJ
-    (9 significant digits), binary STL, VTP/VTK (pyvista). Atomic, deterministic bytes."""
-    path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in MESH_SUFFIXES:
-        raise ValueError(f"`path` {str(path)!r}: unknown mesh format {suffix!r}; allowed: "
-                         f"{' '.join(MESH_SUFFIXES)}")
-    v = np.asarray(vertices, dtype=np.float64)
-    f = np.asarray(faces, dtype=np.int64)
-    with atomic_path(path) as tmp:
-        if suffix == ".ply":
-            header = ("ply\nformat binary_little_endian 1.0\ncomment craterform implicit "
-                      f"body, metres\nelement vertex {len(v)}\nproperty float x\n"
-                      "property float y\nproperty float z\n"
-                      f"element face {len(f)}\nproperty list uchar int vertex_indices\n"
-                      "end_header\n").encode("ascii")
-            rec = np.empty(len(f), dtype=[("n", "u1"), ("v", "<i4", (3,))])
-            rec["n"], rec["v"] = 3, f
-            with open(tmp, "wb") as fh:
-                fh.write(header)
-                fh.write(v.astype("<f4").tobytes())
-                fh.write(rec.tobytes())
-        elif suffix == ".obj":
-            with open(tmp, "w", encoding="ascii", newline="\n") as fh:
-                fh.write("# craterform implicit body, metres\n")
-                fh.write(("v %.9g %.9g %.9g\n" * len(v)) % tuple(v.ravel().tolist()))
-                fh.write(("f %d %d %d\n" * len(f)) % tuple((f + 1).ravel().tolist()))
-        elif suffix == ".stl":
-            corners = v[f]
-            normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-            norm = np.linalg.norm(normal, axis=1, keepdims=True)
-            normal = np.divide(normal, norm, out=np.zeros_like(normal), where=norm > 0)
-            rec = np.zeros(len(f), dtype=[("n", "<f4", (3,)), ("v", "<f4", (3, 3)),
-                                          ("a", "<u2")])
-            rec["n"], rec["v"] = normal, corners
-            with open(tmp, "wb") as fh:
-                fh.write(b"craterform implicit body, metres".ljust(80, b" "))
-                fh.write(np.uint32(len(f)).tobytes())
-                fh.write(rec.tobytes())
-        else:
-            ShapeModel(v, f).to_pyvista().save(str(tmp), binary=True)
-    return path

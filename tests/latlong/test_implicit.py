@@ -11,6 +11,7 @@ import pyvista as pv
 from scipy import stats
 
 import craters
+from craters._shared.meshio import array_source, write_mesh
 from latlong.implicit import (
     ImplicitSurface,
     LcsnLayer,
@@ -19,7 +20,6 @@ from latlong.implicit import (
     implicit_surface,
     parse_lcsn_spec,
     sphere_packing,
-    write_mesh,
 )
 from latlong.implicit import _kernels as K
 from latlong.implicit.metaballs import Metaballs, metaball_distance
@@ -403,7 +403,7 @@ def test_projection_onto_a_latlong_body():
         ito.to_body(60)
 
 
-@pytest.mark.parametrize("suffix", [".ply", ".obj", ".stl", ".vtp"])
+@pytest.mark.parametrize("suffix", [".ply", ".obj", ".stl", ".vtp", ".vtk"])
 def test_mesh_writers(tmp_path, suffix):
     model = sphere_model(10.0, 24)
     surf = ImplicitSurface(model.vertices, model.faces, craters.make_catalog(
@@ -411,7 +411,8 @@ def test_mesh_writers(tmp_path, suffix):
     path = surf.save(tmp_path / f"m{suffix}")
     back = read_shape_model(path, units="m")
     assert back.volume_m3 == pytest.approx(model.volume_m3, rel=1e-5)
-    again = write_mesh(model.vertices, model.faces, tmp_path / f"n{suffix}")
+    again = write_mesh(array_source(model.vertices, model.faces,
+                                    "craterform implicit body, metres"), tmp_path / f"n{suffix}")
     assert path.read_bytes() == again.read_bytes()
 
 

@@ -1,0 +1,322 @@
+"""Triangle-mesh files: one writer per format, streamed, for every kind of mesh.
+
+A :class:`MeshSource` describes a mesh as chunks (vertex positions with per-vertex
+fields, faces with global 0-based indices, triangle corners), so a writer never holds
+the whole mesh: a lat/long body generates a few latitude bands at a time, a DEM stack a
+layer at a time, boulders a chunk of rocks at a time. :data:`MESH_WRITERS` maps each
+suffix to its writer; :func:`write_mesh` picks one by suffix and writes atomically
+(temporary file in the target folder, then rename). Every writer is deterministic (no
+timestamps, no host names).
+
+Formats
+-------
+* ``.ply``: binary little-endian; float32 ``x y z`` plus the fields (as their numpy
+  types), faces ``uchar 3`` + three ``int`` (``uint`` past 2^31 vertices) indices.
+* ``.obj``: text, ``v`` with 9 significant digits, 1-based ``f``; face groups ``g``.
+* ``.stl``: binary, float32 facet normal and corners, 80-byte header.
+* ``.vtp``: VTK XML PolyData, raw appended binary (UInt64 headers): float32 points,
+  the fields, Int32 (Int64 if needed) connectivity and offsets.
+* ``.vtk``: VTK legacy binary (big-endian), POINTS float, POLYGONS, POINT_DATA fields.
+* ``.glb``: glTF 2.0 binary, one node and mesh: float32 POSITION (with bounds), uint32
+  triangle indices (fields are not written).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import struct
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .files import atomic_path
+from .progress import progress_bar
+
+__all__ = ["MESH_SUFFIXES", "MESH_WRITERS", "MeshSource", "array_source", "write_mesh"]
+
+_PLY_TYPES = {"f4": "float", "f8": "double", "i4": "int", "u1": "uchar", "u4": "uint",
+              "i2": "short", "u2": "ushort", "i1": "char"}
+_VTK_XML_TYPES = {"f4": "Float32", "f8": "Float64", "i4": "Int32", "u1": "UInt8",
+                  "u4": "UInt32", "i2": "Int16", "u2": "UInt16", "i1": "Int8"}
+_VTK_LEGACY_TYPES = {"f4": "float", "f8": "double", "i4": "int", "u1": "unsigned_char",
+                     "u4": "unsigned_int", "i2": "short", "u2": "unsigned_short", "i1": "char"}
+
+
+@dataclass(frozen=True)
+class MeshSource:
+    """A triangle mesh in chunks (module notes); positions in metres."""
+
+    n_vertices: int
+    """Number of vertices."""
+    n_faces: int
+    """Number of triangles."""
+    vertex_chunks: Callable[[], Iterable[tuple[np.ndarray, dict[str, np.ndarray]]]]
+    """Yields ``(xyz (k, 3), {field: (k,) values})`` in vertex order."""
+    face_groups: Callable[[], Iterable[tuple[str | None, Iterable[np.ndarray]]]]
+    """Yields ``(group name or None, chunks of (k, 3) global 0-based indices)`` in face
+    order; groups name the parts of a mesh (OBJ ``g``), None for a mesh of one part."""
+    facet_chunks: Callable[[], Iterable[np.ndarray]]
+    """Yields ``(k, 3, 3)`` triangle corners in face order (for STL)."""
+    fields: tuple[tuple[str, str], ...] = ()
+    """Per-vertex fields: ``(name, numpy dtype)``, e.g. ``("height_m", "<f4")``; the first
+    is the active scalar of VTK files."""
+    title: str = "craterform mesh, metres"
+    """What the mesh is: the first comment of every format (the STL header)."""
+    comments: tuple[str, ...] = ()
+    """More PLY header comments."""
+    obj_title: str | None = None
+    """The OBJ comment line when it differs from ``title``."""
+    progress_label: str = ""
+    """Label of the progress bar over the face chunks."""
+
+    def faces(self) -> Iterator[np.ndarray]:
+        """Every face chunk, groups in order."""
+        for _, chunks in self.face_groups():
+            yield from chunks
+
+
+def array_source(vertices, faces, title: str, **fields) -> MeshSource:
+    """A mesh held in memory: ``vertices`` (n, 3) metres, ``faces`` (m, 3) 0-based, and
+    per-vertex ``fields`` (name=array; written with the arrays' dtypes).
+
+    Examples
+    --------
+    >>> src = array_source(np.eye(3), [[0, 1, 2]], "one triangle")
+    >>> src.n_vertices, src.n_faces, next(iter(src.faces())).tolist()
+    (3, 1, [[0, 1, 2]])
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    if v.ndim != 2 or v.shape[1:] != (3,) or f.ndim != 2 or f.shape[1:] != (3,):
+        raise ValueError(f"`vertices` and `faces` must be (n, 3) and (m, 3); got {v.shape} "
+                         f"and {f.shape}")
+    values = {k: np.asarray(a) for k, a in fields.items()}
+    return MeshSource(len(v), len(f), lambda: [(v, values)], lambda: [(None, [f])],
+                      lambda: [v[f]], tuple((k, a.dtype.str) for k, a in values.items()),
+                      title)
+
+
+def _dtype(code: str) -> np.dtype:
+    return np.dtype(code).newbyteorder("<")
+
+
+def _index_type(n_vertices: int) -> tuple[str, str]:
+    return ("int", "<i4") if n_vertices < 2**31 else ("uint", "<u4")
+
+
+def write_ply(src: MeshSource, fh, progress: bool = False) -> None:
+    """Binary little-endian PLY (module notes)."""
+    idx, idx_dt = _index_type(src.n_vertices)
+    header = ["ply", "format binary_little_endian 1.0", f"comment {src.title}",
+              *(f"comment {c}" for c in src.comments), f"element vertex {src.n_vertices}",
+              "property float x", "property float y", "property float z",
+              *(f"property {_PLY_TYPES[_dtype(t).str[1:]]} {n}" for n, t in src.fields),
+              f"element face {src.n_faces}", f"property list uchar {idx} vertex_indices",
+              "end_header"]
+    fh.write(("\n".join(header) + "\n").encode("ascii"))
+    vdt = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+                    *((n, _dtype(t)) for n, t in src.fields)])
+    for xyz, values in src.vertex_chunks():
+        rec = np.empty(len(xyz), dtype=vdt)
+        rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+        for name, _ in src.fields:
+            rec[name] = values[name]
+        fh.write(rec.tobytes())
+    fdt = np.dtype([("n", "u1"), ("v", idx_dt, (3,))])
+    for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "PLY"):
+        rec = np.empty(len(tri), dtype=fdt)
+        rec["n"] = 3
+        rec["v"] = tri
+        fh.write(rec.tobytes())
+
+
+def _text_blocks(rows: np.ndarray, fmt: str, step: int = 1 << 18):
+    for s in range(0, len(rows), step):
+        block = rows[s:s + step]
+        yield (fmt * len(block)) % tuple(block.ravel().tolist())
+
+
+def write_obj(src: MeshSource, fh, progress: bool = False) -> None:
+    """Wavefront OBJ text (module notes)."""
+    out = io.TextIOWrapper(fh, encoding="ascii", newline="\n")
+    out.write(f"# {src.obj_title or src.title}\n")
+    for xyz, _ in src.vertex_chunks():
+        for text in _text_blocks(np.asarray(xyz), "v %.9g %.9g %.9g\n"):
+            out.write(text)
+    bar = progress_bar(total=None, enabled=progress, desc=src.progress_label or "OBJ")
+    for group, chunks in src.face_groups():
+        if group is not None:
+            out.write(f"g {group}\n")
+        for tri in chunks:
+            for text in _text_blocks(np.asarray(tri) + 1, "f %d %d %d\n"):
+                out.write(text)
+            bar.update()
+    bar.close()
+    out.flush()
+    out.detach()
+
+
+def write_stl(src: MeshSource, fh, progress: bool = False) -> None:
+    """Binary STL (module notes)."""
+    tdt = np.dtype([("n", "<f4", (3,)), ("v", "<f4", (3, 3)), ("a", "<u2")])
+    fh.write(src.title.encode("ascii")[:80].ljust(80, b" "))
+    fh.write(np.uint32(src.n_faces).tobytes())
+    for corners in progress_bar(src.facet_chunks(), enabled=progress,
+                                desc=src.progress_label or "STL"):
+        normal = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+        norm = np.linalg.norm(normal, axis=1, keepdims=True)
+        normal = np.divide(normal, norm, out=np.zeros_like(normal), where=norm > 0)
+        rec = np.zeros(len(corners), dtype=tdt)
+        rec["n"] = normal
+        rec["v"] = corners
+        fh.write(rec.tobytes())
+
+
+def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
+    """VTK XML PolyData, raw appended (module notes). Data order: points, the first
+    field, connectivity, offsets, the other fields."""
+    n_v, n_f = src.n_vertices, src.n_faces
+    itype, idt = ("Int32", "<i4") if 3 * n_f < 2**31 - 1 else ("Int64", "<i8")
+    isize = np.dtype(idt).itemsize
+    fields = [(n, _dtype(t)) for n, t in src.fields]
+    sizes = [12 * n_v, *([n_v * fields[0][1].itemsize] if fields else []),
+             3 * n_f * isize, n_f * isize, *(n_v * t.itemsize for _, t in fields[1:])]
+    offs = np.concatenate([[0], np.cumsum([8 + s for s in sizes])])
+    first = 1 if fields else 0  # blocks: points, [field 0], connectivity, offsets, fields...
+    arrays = []
+    for k, (name, t) in enumerate(fields):
+        block = 1 if k == 0 else 3 + k
+        arrays.append(f'<DataArray type="{_VTK_XML_TYPES[t.str[1:]]}" Name="{name}" '
+                      f'format="appended" offset="{offs[block]}"/>\n')
+    scalars = f' Scalars="{fields[0][0]}"' if fields else ""
+    xml = (
+        '<?xml version="1.0"?>\n'
+        '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+        'header_type="UInt64">\n'
+        f"<!-- {src.title} -->\n"
+        "<PolyData>\n"
+        f'<Piece NumberOfPoints="{n_v}" NumberOfVerts="0" NumberOfLines="0" '
+        f'NumberOfStrips="0" NumberOfPolys="{n_f}">\n'
+        f"<PointData{scalars}>\n" + "".join(arrays) + "</PointData>\n<Points>\n"
+        f'<DataArray type="Float32" Name="Points" NumberOfComponents="3" format="appended" '
+        f'offset="{offs[0]}"/>\n'
+        "</Points>\n<Polys>\n"
+        f'<DataArray type="{itype}" Name="connectivity" format="appended" '
+        f'offset="{offs[first + 1]}"/>\n'
+        f'<DataArray type="{itype}" Name="offsets" format="appended" '
+        f'offset="{offs[first + 2]}"/>\n'
+        "</Polys>\n</Piece>\n</PolyData>\n"
+        '<AppendedData encoding="raw">\n_')
+    fh.write(xml.encode("ascii"))
+    bar = progress_bar(total=None, enabled=progress, desc=src.progress_label or "VTP")
+
+    def field_block(k: int) -> None:
+        name, t = fields[k]
+        fh.write(np.uint64(n_v * t.itemsize).tobytes())
+        for _, values in src.vertex_chunks():
+            fh.write(np.asarray(values[name]).astype(t).tobytes())
+
+    fh.write(np.uint64(sizes[0]).tobytes())
+    for xyz, _ in src.vertex_chunks():
+        fh.write(np.asarray(xyz).astype("<f4").tobytes())
+    if fields:
+        field_block(0)
+    fh.write(np.uint64(3 * n_f * isize).tobytes())
+    for tri in src.faces():
+        fh.write(np.asarray(tri).astype(idt).tobytes())
+        bar.update()
+    fh.write(np.uint64(n_f * isize).tobytes())
+    done = 0
+    for tri in src.faces():
+        m = len(tri)
+        fh.write((3 * np.arange(done + 1, done + m + 1, dtype=np.int64)).astype(idt).tobytes())
+        done += m
+    for k in range(1, len(fields)):
+        field_block(k)
+    bar.close()
+    fh.write(b"\n</AppendedData>\n</VTKFile>\n")
+
+
+def write_vtk(src: MeshSource, fh, progress: bool = False) -> None:
+    """VTK legacy binary PolyData, big-endian (module notes)."""
+    fh.write(f"# vtk DataFile Version 4.2\n{src.title[:255]}\nBINARY\nDATASET POLYDATA\n"
+             f"POINTS {src.n_vertices} float\n".encode("ascii"))
+    for xyz, _ in src.vertex_chunks():
+        fh.write(np.asarray(xyz).astype(">f4").tobytes())
+    fh.write(f"\nPOLYGONS {src.n_faces} {4 * src.n_faces}\n".encode("ascii"))
+    for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "VTK"):
+        rec = np.empty((len(tri), 4), dtype=">i4")
+        rec[:, 0] = 3
+        rec[:, 1:] = tri
+        fh.write(rec.tobytes())
+    if src.fields:
+        fh.write(f"\nPOINT_DATA {src.n_vertices}\n".encode("ascii"))
+    for name, t in src.fields:
+        t = _dtype(t)
+        fh.write(f"SCALARS {name} {_VTK_LEGACY_TYPES[t.str[1:]]} 1\nLOOKUP_TABLE default\n"
+                 .encode("ascii"))
+        for _, values in src.vertex_chunks():
+            fh.write(np.asarray(values[name]).astype(t.newbyteorder(">")).tobytes())
+        fh.write(b"\n")
+
+
+def write_glb(src: MeshSource, fh, progress: bool = False) -> None:
+    """glTF 2.0 binary with one triangle mesh (module notes); below 4 GiB."""
+    n_v, n_f = src.n_vertices, src.n_faces
+    pos_bytes, idx_bytes = 12 * n_v, 12 * n_f
+    if pos_bytes + idx_bytes > 2**32 - 4096:
+        raise ValueError(f"the mesh ({n_v} vertices, {n_f} triangles) is beyond a GLB's 4 GiB")
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for xyz, _ in src.vertex_chunks():
+        p = np.asarray(xyz).astype(np.float32)
+        lo, hi = np.minimum(lo, p.min(axis=0)), np.maximum(hi, p.max(axis=0))
+    gl = {"asset": {"version": "2.0", "generator": "craterform"},
+          "extras": {"title": src.title}, "scene": 0, "scenes": [{"nodes": [0]}],
+          "nodes": [{"mesh": 0}],
+          "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
+                                      "mode": 4}]}],
+          "buffers": [{"byteLength": pos_bytes + idx_bytes}],
+          "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": pos_bytes,
+                           "target": 34962},
+                          {"buffer": 0, "byteOffset": pos_bytes, "byteLength": idx_bytes,
+                           "target": 34963}],
+          "accessors": [{"bufferView": 0, "componentType": 5126, "count": n_v,
+                         "type": "VEC3", "min": [float(v) for v in lo],
+                         "max": [float(v) for v in hi]},
+                        {"bufferView": 1, "componentType": 5125, "count": 3 * n_f,
+                         "type": "SCALAR"}]}
+    text = json.dumps(gl, separators=(",", ":")).encode("utf-8")
+    text += b" " * ((4 - len(text) % 4) % 4)
+    total = 12 + 8 + len(text) + 8 + pos_bytes + idx_bytes
+    fh.write(struct.pack("<4sII", b"glTF", 2, total))
+    fh.write(struct.pack("<I4s", len(text), b"JSON") + text)
+    fh.write(struct.pack("<I4s", pos_bytes + idx_bytes, b"BIN\x00"))
+    for xyz, _ in src.vertex_chunks():
+        fh.write(np.asarray(xyz).astype("<f4").tobytes())
+    for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "GLB"):
+        fh.write(np.asarray(tri).astype("<u4").tobytes())
+
+
+#: Suffix -> writer(source, binary file, progress).
+MESH_WRITERS: dict[str, Callable] = {".ply": write_ply, ".obj": write_obj, ".stl": write_stl,
+                                     ".vtp": write_vtp, ".vtk": write_vtk, ".glb": write_glb}
+MESH_SUFFIXES = tuple(MESH_WRITERS)
+
+
+def write_mesh(src: MeshSource, path, *, progress: bool = False) -> Path:
+    """Write ``src`` to ``path`` in the format of its suffix (:data:`MESH_WRITERS`),
+    atomically; returns the path."""
+    path = Path(path)
+    writer = MESH_WRITERS.get(path.suffix.lower())
+    if writer is None:
+        raise ValueError(f"`path` {str(path)!r}: unknown mesh format {path.suffix or '(none)'!r}; "
+                         f"allowed: {' '.join(MESH_SUFFIXES)}")
+    with atomic_path(path) as tmp, open(tmp, "wb") as raw:
+        fh = io.BufferedWriter(raw, buffer_size=1 << 22)
+        writer(src, fh, progress)
+        fh.flush()
+        fh.detach()
+    return path
