@@ -95,7 +95,7 @@ def _cmd_profile(args) -> int:
 def _cmd_population(args) -> int:
     specs = args.layer or []
     if not specs:
-        raise CliError("give at least one --layer c=...,k=...,dmin=...,dmax=...")
+        raise CliError("give at least one --layer c=...,k=...,d_min_m=...,d_max_m=...")
     layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
     where = [args.radius_m is not None, args.area_m2 is not None,
              args.x_range_m is not None or args.y_range_m is not None]
@@ -172,7 +172,7 @@ def build_parser() -> OneLineParser:
     p.set_defaults(func=_cmd_profile)
     q = sub.add_parser("population", help="a power-law crater catalog (CSV)")
     q.add_argument("--layer", action="append", metavar="SPEC",
-                   help="c=0.5,k=-2,dmin=5,dmax=800[,amin=0,amax=3.5,deg=0.2,kind=simple]"
+                   help="c=0.5,k=-2,d_min_m=5,d_max_m=800[,age_min_gyr=0,age_max_gyr=3.5,degradation=0.2,kind=simple]"
                         " (metres, Gyr; repeatable for piecewise laws)")
     q.add_argument("--radius-m", type=float, help="sphere radius (positions lat/lon)")
     q.add_argument("--area-m2", type=float, help="area for the count (positions lat/lon)")

@@ -151,22 +151,25 @@ class CraterLayer:
             raise ValueError(f"`kind` must be a short name (1-16 characters); got {self.kind!r}")
 
 
-_SPEC_KEYS = {"c": "c", "k": "k", "dmin": "d_min_m", "dmax": "d_max_m", "amin": "age_min_gyr",
-              "amax": "age_max_gyr", "deg": "degradation", "kind": "kind"}
+_SPEC = {f.name: (str if f.name == "kind" else float)
+         for f in dataclasses.fields(CraterLayer)}
+_OLD_KEYS = {"dmin": "d_min_m", "dmax": "d_max_m", "amin": "age_min_gyr",
+             "amax": "age_max_gyr", "deg": "degradation"}
 
 
 def parse_layer_spec(spec: str, *, age_max_gyr: float = 3.5) -> CraterLayer:
-    """Parse ``c=0.5,k=-2,dmin=2,dmax=50[,amin=0,amax=3.5,deg=0.2,kind=simple]``.
+    """Parse ``c=0.5,k=-2,d_min_m=2,d_max_m=50[,age_min_gyr=0,age_max_gyr=3.5,
+    degradation=0.2,kind=simple]``: the fields of :class:`CraterLayer`.
 
-    Diameters in metres, ages in Gyr; ``amax`` defaults to ``age_max_gyr``.
+    Diameters in metres, ages in Gyr; ``age_max_gyr`` defaults to the argument.
 
     Examples
     --------
-    >>> parse_layer_spec("c=0.5,k=-2,dmin=2,dmax=50").d_max_m
+    >>> parse_layer_spec("c=0.5,k=-2,d_min_m=2,d_max_m=50").d_max_m
     50.0
     """
-    items = {key: (field, str if key == "kind" else float) for key, field in _SPEC_KEYS.items()}
-    values = parse_spec(spec, items, ("c", "k", "dmin", "dmax"), "crater layer")
+    values = parse_spec(spec, _SPEC, ("c", "k", "d_min_m", "d_max_m"), "crater layer",
+                        renamed=_OLD_KEYS)
     values.setdefault("age_max_gyr", age_max_gyr)
     try:
         return CraterLayer(**values)

@@ -28,10 +28,10 @@ m_eros, m_small = (80, 60) if small else (700, 500)
 scenes = [
     ("Eros-like, young surface: N_cum = 0.03 D^-2, ages < 0.5 Gyr",
      {"preset": "eros-like", "magnitude": m_eros,
-      "craters": ["c=0.03,k=-2,dmin=40,dmax=1500,amax=0.5"]}),
+      "craters": ["c=0.03,k=-2,d_min_m=40,d_max_m=1500,age_max_gyr=0.5"]}),
     ("Eros-like, old surface: N_cum = 0.15 D^-2, ages < 3.5 Gyr",
      {"preset": "eros-like", "magnitude": m_eros,
-      "craters": ["c=0.15,k=-2,dmin=40,dmax=1500,amax=3.5"]}),
+      "craters": ["c=0.15,k=-2,d_min_m=40,d_max_m=1500,age_max_gyr=3.5"]}),
     ("Perlin base + N_cum = 0.5 D^-2 (fbm-cratered)",
      {"preset": "fbm-cratered", "magnitude": m_small}),
     ("two-phase faulting + N_cum = 0.1 D^-2 (faulted-cratered)",

@@ -64,8 +64,8 @@ plt.close(fig)
 # 2. a boulder field on a small cratered asteroid, seen from close by
 body = build(Scene.from_settings({
     "preset": "fig5a", "magnitude": 60 if small else 500, "radius_m": 250.0,
-    "craters": ["c=0.1,k=-2,dmin=4,dmax=60"],
-    "boulders": ["c=0.02,k=-3,dmin=1.5,dmax=25,near=0.3"], "seed": 3}))
+    "craters": ["c=0.1,k=-2,d_min_m=4,d_max_m=60"],
+    "boulders": ["c=0.02,k=-3,d_min_m=1.5,d_max_m=25,near=0.3"], "seed": 3}))
 print(f"body: M = {body.magnitude}, {len(body.craters)} craters, {len(body.boulders)} "
       f"boulders")
 render_preview(body, out / "boulder_body.png", sun_elevation_deg=12.0,

@@ -56,7 +56,7 @@ panels = [
 ]
 bennu = build(Scene.from_settings({
     "base": f"shape:{data / 'bennu_radar_sbgat.obj'}", "shape_units": "km",
-    "magnitude": 2 * magnitude, "craters": ["c=0.9,k=-3,dmin=4,dmax=40"], "amplitude_m": 0.5,
+    "magnitude": 2 * magnitude, "craters": ["c=0.9,k=-3,d_min_m=4,d_max_m=40"], "amplitude_m": 0.5,
     "seed": 1}))
 title = f"Bennu radar model + {len(bennu.craters):,} craters 4-40 m, M = {2 * magnitude}"
 panels.append((title, bennu))

@@ -32,7 +32,7 @@ out.mkdir(parents=True, exist_ok=True)
 magnitude = 40 if small else 300
 radius_m = 100.0
 d_min = 2.5 * np.pi * radius_m / (2 * magnitude)  # craters from 2.5 vertex spacings
-craters = [f"c=0.5,k=-2,dmin={d_min:.3f},dmax=15"]
+craters = [f"c=0.5,k=-2,d_min_m={d_min:.3f},d_max_m=15"]
 
 cases = [("two-phase faulting", {"preset": "paper"})]
 cases += [(f"Perlin {name}", {"preset": name}) for name in ("fig5a", "fig5b", "fig5c")]

@@ -64,19 +64,19 @@ PRESETS: dict[str, Preset] = {
     "fbm-cratered": Preset(
         "Martin 2014 Fig. 8: Perlin base (fig5a) on a 100 m body with N_cum = 0.5 D^-2 "
         "craters, 1-15 m (resolved from magnitude ~400)", "fbm",
-        {**_fbm("fig5a"), "radius_m": 100.0, "craters": ["c=0.5,k=-2,dmin=1,dmax=15"]},
+        {**_fbm("fig5a"), "radius_m": 100.0, "craters": ["c=0.5,k=-2,d_min_m=1,d_max_m=15"]},
         _FIG5A),
     "faulted-cratered": Preset(
         "Martin 2014 Fig. 8: two-phase faulting (paper), stretch 2 on x, with N_cum = "
         "0.1 D^-2 craters, 1-20 m", "faulting",
-        {**_faulting("paper"), "radius_m": 100.0, "craters": ["c=0.1,k=-2,dmin=1,dmax=20"]}),
+        {**_faulting("paper"), "radius_m": 100.0, "craters": ["c=0.1,k=-2,d_min_m=1,d_max_m=20"]}),
     "eros-like": Preset(
         "433 Eros-like: 8 km radius stretched to ~34 x 11 x 11 km, lumpy fBm base, a "
         "saturated crater population near equilibrium (N_cum = 0.1 D^-2, 40 m-1.5 km), "
         "asteroid d/D = 0.2 (magnitude >= 700 resolves it)", "fbm",
         {"radius_m": 8000.0, "stretch": (2.15, 0.7, 0.7), "frequency": 1.2, "octaves": 8,
          "persistence": 0.45, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
-         "craters": ["c=0.1,k=-2,dmin=40,dmax=1500"]}, 0.12),
+         "craters": ["c=0.1,k=-2,d_min_m=40,d_max_m=1500"]}, 0.12),
     "itokawa-like": Preset(
         "25143 Itokawa-like rubble pile: 165 m radius, elongated (535 x 294 x 209 m), "
         "rough low-frequency fBm, few and degraded craters (N_cum = 0.005 D^-2, 2-20 m)",
@@ -84,13 +84,13 @@ PRESETS: dict[str, Preset] = {
         {"radius_m": 165.0, "stretch": (1.6, 0.9, 0.65), "frequency": 1.0, "octaves": 10,
          "persistence": 0.55, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
          "crater_lifetime_gyr": 0.5,
-         "craters": ["c=0.005,k=-2,dmin=2,dmax=20,amin=0.5,amax=3"]}, 0.15),
+         "craters": ["c=0.005,k=-2,d_min_m=2,d_max_m=20,age_min_gyr=0.5,age_max_gyr=3"]}, 0.15),
     "bennu-like": Preset(
         "101955 Bennu-like: 245 m radius, slightly flattened, gentle fBm, craters as Li "
         "et al. 2022 Fig. A.3 (B = 3, ~19 % saturation: N_cum = 0.9 D^-3, 10-70 m)", "fbm",
         {"radius_m": 245.0, "stretch": (1.0, 1.0, 0.92), "frequency": 2.0, "octaves": 8,
          "persistence": 0.5, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
-         "crater_lifetime_gyr": 1.0, "craters": ["c=0.9,k=-3,dmin=10,dmax=70"]}, 0.05),
+         "crater_lifetime_gyr": 1.0, "craters": ["c=0.9,k=-3,d_min_m=10,d_max_m=70"]}, 0.05),
 }
 
 #: The preset a base gets when none is named (its parameter set).

@@ -303,12 +303,12 @@ class CraterSettings:
             span = math.degrees(3.0 * la.d_max_m * 1.02 / smallest_radius_m)
             if span > self.max_extent_deg:
                 raise ParameterError(
-                    "layers", f"dmax={la.d_max_m:g} m: the crater (ejecta {3 * la.d_max_m:g} m "
+                    "layers", f"d_max_m={la.d_max_m:g} m: the crater (ejecta {3 * la.d_max_m:g} m "
                     f"across) is larger than the body allows (radius {smallest_radius_m:g} m, "
                     f"limit {self.max_extent_deg:g} deg)")
             if resolution_m is not None and la.d_max_m > 2.0 * resolution_m:
                 raise ParameterError(
-                    "layers", f"dmax={la.d_max_m:g} m is above the shape model's resolution "
+                    "layers", f"d_max_m={la.d_max_m:g} m is above the shape model's resolution "
                     f"(mean edge {resolution_m:.3g} m): the model already holds craters that "
                     f"large; keep crater layers below {2 * resolution_m:.3g} m")
 
@@ -333,7 +333,7 @@ class BoulderSettings:
         """Refuse boulders larger than a fifth of the body's smallest semi-axis."""
         for la in self.layers:
             if la.d_max_m > 0.2 * smallest_radius_m:
-                raise ParameterError("layers", f"dmax={la.d_max_m:g} m: boulders larger than "
+                raise ParameterError("layers", f"d_max_m={la.d_max_m:g} m: boulders larger than "
                                      "a fifth of the body's radius are not boulders")
 
 
@@ -394,4 +394,4 @@ class ImplicitSettings:
             biggest = max(la.d_max_m for la in self.layers)
             if self.cell_m < biggest:
                 raise ParameterError("cell_m", f"{self.cell_m:g} is smaller than the largest "
-                                     f"crater (dmax {biggest:g} m): level-0 cells must hold it")
+                                     f"crater (d_max_m {biggest:g} m): level-0 cells must hold it")

@@ -44,8 +44,9 @@ STEPS: list[tuple[str, str, bool]] = [
      "--amplitude-m 4 -o fb.npz -o fb.ply -q"), False),
     ("build_sphere_craters",
      ("latlong build --magnitude 40 --base sphere --radius-m 100 --seed 4 "
-     "--craters c=0.5,k=-2,dmin=4,dmax=20 "
-     "--craters c=0.05,k=-2,dmin=20,dmax=30,amin=1,amax=3 --no-crater-roughness "
+     "--craters c=0.5,k=-2,d_min_m=4,d_max_m=20 "
+     "--craters c=0.05,k=-2,d_min_m=20,d_max_m=30,age_min_gyr=1,age_max_gyr=3 "
+     "--no-crater-roughness "
      "--catalog sc.csv -o sc.npz -q"), False),
     ("build_preset_cratered", ("latlong build --preset fbm-cratered --magnitude 48 --seed 1 "
      "-o pc.npz --catalog pc.csv -q"), False),
@@ -54,16 +55,17 @@ STEPS: list[tuple[str, str, bool]] = [
     ("build_preset_bennu", ("latlong build --preset bennu-like --magnitude 40 --seed 2 "
      "--crater-morphometry lunar-simple -o bn.npz -q"), False),
     ("build_boulders", ("latlong build --preset fbm-cratered --magnitude 48 --seed 1 "
-     "--boulders c=0.002,k=-3,dmin=1,dmax=8,burial=0.5,near=0.3 "
+     "--boulders c=0.002,k=-3,d_min_m=1,d_max_m=8,burial_max=0.5,near=0.3 "
      "-o rk.npz -o rk.ply -o rk.obj -o rk.vtp -o rk.glb --boulder-catalog rk.csv -q"), False),
     ("build_shape", ("latlong build --base shape:eros001708.tab --shape-units km "
-     "--magnitude 40 --craters c=0.05,k=-2,dmin=300,dmax=1200 --seed 1 "
+     "--magnitude 40 --craters c=0.05,k=-2,d_min_m=300,d_max_m=1200 --seed 1 "
      "-o sh.npz -o sh.stl -q"), False),
     ("build_config", "latlong build --config scene.toml -q", False),
     ("build_implicit", ("latlong build --backend implicit --shape eros001708.tab "
-     "--shape-units km --lcsn kernel=table-a1-1km-0gyr,dmin=1000,dmax=2000 "
-     "--lcsn kernel=fig6-kernel1,dmin=500,dmax=1000,hd=0.1:0.2 "
-     "--gabor f=0.0025,bw=0.00125,amp=10 --polygons 20000 --packing-voxels 32 --seed 1 "
+     "--shape-units km --lcsn kernel=table-a1-1km-0gyr,d_min_m=1000,d_max_m=2000 "
+     "--lcsn kernel=fig6-kernel1,d_min_m=500,d_max_m=1000,depth_ratio=0.1:0.2 "
+     "--gabor frequency=0.0025,bandwidth=0.00125,amplitude_m=10 --polygons 20000 "
+     "--packing-voxels 32 --seed 1 "
      "-o im.ply -o im.obj -o im.npz --magnitude 20 --shape-crossings outermost "
      "--catalog im.csv -q"), False),
     ("export_glb", "latlong export pc.npz -o pc.glb --patch-k 8 --lod 2 -q", False),
@@ -76,7 +78,7 @@ STEPS: list[tuple[str, str, bool]] = [
     ("latlong_info", "latlong info sh.npz", True),
     ("craters_profile", "craters profile --diameter-m 1000 --age-gyr 3 --csv prof.csv -q",
      False),
-    ("craters_population", ("craters population --layer c=0.5,k=-2,dmin=50,dmax=800 "
+    ("craters_population", ("craters population --layer c=0.5,k=-2,d_min_m=50,d_max_m=800 "
      "--radius-m 2000 --seed 1 -o pop.csv -q"), False),
     ("dem_info", "dem info ldem4_crop.lbl", True),
     ("dem_fill", "dem fill gappy.tif -o filled.tif --seed 1 -q", False),
@@ -113,9 +115,9 @@ target = [180.0, -0.5]
 layers = 3
 size = 65
 body_radius_m = 1737400.0
-craters = ["c=0.05,k=-2,dmin=200,dmax=100000",
-           "c=0.005,k=-1.8,dmin=20000,dmax=200000,amin=3,amax=3.8,kind=old"]
-boulders = ["c=0.00001,k=-3,dmin=300,dmax=2000,burial=0.3"]
+craters = ["c=0.05,k=-2,d_min_m=200,d_max_m=100000",
+           "c=0.005,k=-1.8,d_min_m=20000,d_max_m=200000,age_min_gyr=3,age_max_gyr=3.8,kind=old"]
+boulders = ["c=0.00001,k=-3,d_min_m=300,d_max_m=2000,burial_max=0.3"]
 """
 
 

@@ -12,7 +12,7 @@ import dataclasses
 
 import numpy as np
 
-from .._shared import check_finite, check_positive, check_range
+from .._shared import check_finite, check_positive, check_range, parse_spec
 from ..population import sample_power_law_diameters
 from .meshes import BoulderShape
 
@@ -45,33 +45,22 @@ class BoulderLayer:
         check_range("near", self.near, 0.0, 1.0)
 
 
-_SPEC = {"c": "c", "k": "k", "dmin": "d_min_m", "dmax": "d_max_m", "burial": "burial_max",
-         "near": "near"}
+_SPEC = {"c": float, "k": float, "d_min_m": float, "d_max_m": float, "burial_max": float,
+         "near": float}
+_OLD_KEYS = {"dmin": "d_min_m", "dmax": "d_max_m", "burial": "burial_max"}
 
 
 def parse_boulder_spec(spec: str) -> BoulderLayer:
-    """Parse ``c=0.05,k=-3,dmin=0.5,dmax=10[,burial=0.5,near=0.3]`` (metres).
+    """Parse ``c=0.05,k=-3,d_min_m=0.5,d_max_m=10[,burial_max=0.5,near=0.3]``: the fields
+    of :class:`BoulderLayer` (metres).
 
     Examples
     --------
-    >>> parse_boulder_spec("c=0.05,k=-3,dmin=0.5,dmax=10").d_max_m
+    >>> parse_boulder_spec("c=0.05,k=-3,d_min_m=0.5,d_max_m=10").d_max_m
     10.0
     """
-    values = {}
-    for part in str(spec).split(","):
-        key, sep, raw = part.partition("=")
-        key = key.strip()
-        if not sep or key not in _SPEC:
-            raise ValueError(f"boulder layer {spec!r}: unknown item {part.strip()!r}; "
-                             f"allowed keys: {', '.join(_SPEC)}")
-        try:
-            values[_SPEC[key]] = float(raw)
-        except ValueError:
-            raise ValueError(f"boulder layer {spec!r}: {key} must be a number; got {raw!r}") \
-                from None
-    missing = [k for k in ("c", "k", "dmin", "dmax") if _SPEC[k] not in values]
-    if missing:
-        raise ValueError(f"boulder layer {spec!r}: missing {', '.join(missing)}")
+    values = parse_spec(str(spec), _SPEC, ("c", "k", "d_min_m", "d_max_m"), "boulder layer",
+                        renamed=_OLD_KEYS)
     try:
         return BoulderLayer(**values)
     except ValueError as exc:
@@ -93,7 +82,7 @@ def draw_boulder_layer(layer: BoulderLayer, area_m2: float, index: int, rng) -> 
     mean = area_m2 * layer.c * (layer.d_min_m**layer.k - layer.d_max_m**layer.k)
     if mean > 20_000_000:
         raise ValueError(f"boulder layer {index} asks for about {mean:.3g} boulders "
-                         "(limit 2e7); raise dmin or lower c")
+                         "(limit 2e7); raise d_min_m or lower c")
     n = int(rng.poisson(mean)) if mean > 0 else 0
     d = sample_power_law_diameters(n, layer.d_min_m, layer.d_max_m, -layer.k, rng=rng)
     return {"diameter_m": d, "kind": np.full(n, "boulder"),

@@ -115,8 +115,9 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "shape base)", "fbm"),
     # craters
     Opt(("--craters",), "craters", str,
-        "crater layer c=0.5,k=-2,dmin=2,dmax=50[,amin=0,amax=3.5,deg=0.2,kind=simple]: "
-        "N_cum = c D^k per m^2, D in metres (repeatable for piecewise laws)", "craters",
+        "crater layer c=0.5,k=-2,d_min_m=2,d_max_m=50[,age_min_gyr=0,age_max_gyr=3.5,"
+        "degradation=0.2,kind=simple] (the fields of craters.CraterLayer): N_cum = c D^k "
+        "per m^2, D in metres, ages in Gyr (repeatable for piecewise laws)", "craters",
         "append"),
     Opt(("--crater-morphometry",), "crater_morphometry", str,
         "fresh crater laws: lunar-simple (Pike 1977) or asteroid-fresh (d/D = 0.2)",
@@ -129,9 +130,10 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "largest angular size of a crater's ejecta blanket, degrees of arc", "craters"),
     # boulders
     Opt(("--boulders",), "boulders", str,
-        "boulder layer c=0.05,k=-3,dmin=0.5,dmax=10[,burial=0.5,near=0.3]: N_cum = c D^k "
-        "per m^2, D in metres; burial = largest buried fraction of the height (<= 0.9); "
-        "near = share around crater rims (repeatable)", "boulders", "append"),
+        "boulder layer c=0.05,k=-3,d_min_m=0.5,d_max_m=10[,burial_max=0.5,near=0.3] (the "
+        "fields of craters.BoulderLayer): N_cum = c D^k per m^2, D in metres; burial_max = "
+        "largest buried fraction of the height (<= 0.9); near = share around crater rims "
+        "(repeatable)", "boulders", "append"),
     Opt(("--boulder-flatten",), "boulder_flatten", float,
         "boulder up-axis scale relative to its width", "boulders"),
     Opt(("--boulder-elongation",), "boulder_elongation", float,
@@ -154,15 +156,16 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--min-sphere-m",), "min_sphere_m", float,
         "smallest packed sphere, metres (default 2 packing voxels)", "implicit"),
     Opt(("--cell-m",), "cell_m", float,
-        "cell size of grid level 0, metres (default: the largest dmax)", "implicit"),
+        "cell size of grid level 0, metres (default: the largest d_max_m)", "implicit"),
     Opt(("--lcsn",), "lcsn", str,
-        "LCSN crater layer kernel=NAME,dmin=M,dmax=M[,B=3,p=0.5,w=1,hd=LO:HI]: NAME of "
-        "craters.LCSN_PRESETS scaled to D in [dmin, dmax] (metres), N(>D) ~ D^-B, p = "
-        "impulse chance per surface cell, w = weight, hd = depth/diameter (repeatable)",
-        "implicit", "append"),
+        "LCSN crater layer kernel=NAME,d_min_m=M,d_max_m=M[,exponent=3,probability=0.5,"
+        "weight=1,depth_ratio=LO:HI] (the fields of latlong.LcsnLayer): NAME of "
+        "craters.LCSN_PRESETS scaled to D in [d_min_m, d_max_m] (metres), N(>D) ~ "
+        "D^-exponent, probability = impulse chance per surface cell, depth_ratio = "
+        "depth/diameter (repeatable)", "implicit", "append"),
     Opt(("--gabor",), "gabor", str,
-        "Gabor micro-detail f=CYCLES_PER_M,bw=PER_M,amp=RMS_M[,orient=DEG,density=N]",
-        "implicit"),
+        "Gabor micro-detail frequency=CYCLES_PER_M,bandwidth=PER_M,amplitude_m=RMS_M"
+        "[,orientation_deg=DEG,density=N]", "implicit"),
     Opt(("--gabor-example",), "gabor_example", str,
         "fit the Gabor noise to an example (.npy heights in metres, or a .png/.jpg/.tif "
         "picture)", "implicit"),

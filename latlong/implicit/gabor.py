@@ -115,17 +115,20 @@ class GaborNoise:
 
 
 def parse_gabor_spec(spec: str) -> GaborNoise:
-    """Parse ``f=0.01,bw=0.005,amp=2[,orient=30,density=4]`` (cycles/m, 1/m, m, deg).
+    """Parse ``frequency=0.01,bandwidth=0.005,amplitude_m=2[,orientation_deg=30,density=4]``
+    (cycles/m, 1/m, m, degrees): the arguments of :meth:`GaborNoise.single`.
 
     Examples
     --------
-    >>> parse_gabor_spec("f=0.02,bw=0.01,amp=1.5").patches[0].orientation_deg is None
+    >>> spec = "frequency=0.02,bandwidth=0.01,amplitude_m=1.5"
+    >>> parse_gabor_spec(spec).patches[0].orientation_deg is None
     True
     """
-    items = {"f": ("frequency", float), "bw": ("bandwidth", float),
-             "amp": ("amplitude_m", float), "orient": ("orientation_deg", float),
-             "density": ("density", float)}
-    values = parse_spec(spec, items, ("f", "bw", "amp"), "Gabor spec")
+    items = {"frequency": float, "bandwidth": float, "amplitude_m": float,
+             "orientation_deg": float, "density": float}
+    values = parse_spec(spec, items, ("frequency", "bandwidth", "amplitude_m"), "Gabor spec",
+                        renamed={"f": "frequency", "bw": "bandwidth", "amp": "amplitude_m",
+                                 "orient": "orientation_deg"})
     try:
         return GaborNoise.single(**values)
     except (TypeError, ValueError) as exc:

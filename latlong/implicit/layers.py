@@ -89,20 +89,24 @@ def _ratio_range(text: str) -> tuple[float, float]:
     return float(lo), float(hi or lo)
 
 
-_SPEC_ITEMS = {"kernel": ("kernel", str), "dmin": ("d_min_m", float), "dmax": ("d_max_m", float),
-               "B": ("exponent", float), "p": ("probability", float), "w": ("weight", float),
-               "hd": ("depth_ratio", _ratio_range)}
+_SPEC = {"kernel": str, "d_min_m": float, "d_max_m": float, "exponent": float,
+         "probability": float, "weight": float, "depth_ratio": _ratio_range}
+_OLD_KEYS = {"dmin": "d_min_m", "dmax": "d_max_m", "B": "exponent", "p": "probability",
+             "w": "weight", "hd": "depth_ratio"}
 
 
 def parse_lcsn_spec(spec: str) -> LcsnLayer:
-    """Parse ``kernel=NAME,dmin=500,dmax=1000[,B=3,p=0.5,w=1,hd=0.15:0.25]`` (metres).
+    """Parse ``kernel=NAME,d_min_m=500,d_max_m=1000[,exponent=3,probability=0.5,weight=1,
+    depth_ratio=0.15:0.25]``: the fields of :class:`LcsnLayer` (metres).
 
     Examples
     --------
-    >>> parse_lcsn_spec("kernel=table-a1-1km-0gyr,dmin=500,dmax=1000,hd=0.1:0.2").depth_ratio
+    >>> parse_lcsn_spec("kernel=table-a1-1km-0gyr,d_min_m=500,d_max_m=1000,"
+    ...                 "depth_ratio=0.1:0.2").depth_ratio
     (0.1, 0.2)
     """
-    values = parse_spec(spec, _SPEC_ITEMS, ("kernel", "dmin", "dmax"), "LCSN layer")
+    values = parse_spec(spec, _SPEC, ("kernel", "d_min_m", "d_max_m"), "LCSN layer",
+                        renamed=_OLD_KEYS)
     try:
         return LcsnLayer(**values)
     except (ValueError, TypeError) as exc:

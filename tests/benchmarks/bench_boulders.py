@@ -34,7 +34,7 @@ def main():
     args = parser.parse_args()
     body = build(Scene.from_settings({"preset": "fig5a", "magnitude": args.magnitude,
                                       "radius_m": 1000.0, "seed": 1,
-                                      "craters": ["c=0.05,k=-2,dmin=10,dmax=200"]}))
+                                      "craters": ["c=0.05,k=-2,d_min_m=10,d_max_m=200"]}))
     area = float(band_areas(body).sum())
     d_min, d_max = 1.0, 30.0
     c = args.boulders / (area * (d_min**args.k - d_max**args.k))

@@ -31,7 +31,7 @@ def main():
     glb = folder / f"body_M{args.magnitude}.glb"
     scene = Scene.from_settings({"preset": "fig5a", "magnitude": args.magnitude,
                                  "radius_m": 1000.0, "seed": 1,
-                                 "craters": ["c=0.05,k=-2,dmin=2,dmax=100"]})
+                                 "craters": ["c=0.05,k=-2,d_min_m=2,d_max_m=100"]})
     t0 = time.perf_counter()
     body = build(scene)
     t_build = time.perf_counter() - t0

@@ -131,10 +131,12 @@ def test_bad_shapes(kwargs, needle):
 
 
 @pytest.mark.parametrize("spec,needle", [
-    ("c=0,k=-3,dmin=1,dmax=2", "`c`"), ("c=1,k=3,dmin=1,dmax=2", "`k`"),
-    ("c=1,k=-3,dmin=2,dmax=1", "d_min_m"), ("c=1,k=-3,dmin=1", "missing dmax"),
-    ("c=1,k=-3,dmin=1,dmax=2,burial=0.95", "burial_max"), ("c=1,k=-3,dmin=1,dmax=2,x=1", "x=1"),
-    ("c=1,k=x,dmin=1,dmax=2", "k must be a number")])
+    ("c=0,k=-3,d_min_m=1,d_max_m=2", "`c`"), ("c=1,k=3,d_min_m=1,d_max_m=2", "`k`"),
+    ("c=1,k=-3,d_min_m=2,d_max_m=1", "d_min_m"), ("c=1,k=-3,d_min_m=1", "missing d_max_m"),
+    ("c=1,k=-3,d_min_m=1,d_max_m=2,burial_max=0.95", "burial_max"),
+    ("c=1,k=-3,d_min_m=1,d_max_m=2,x=1", "x=1"),
+    ("c=1,k=-3,dmin=1,d_max_m=2", "now d_min_m="),
+    ("c=1,k=x,d_min_m=1,d_max_m=2", "k must be a number")])
 def test_bad_layer_specs(spec, needle):
     with pytest.raises(ValueError, match=needle):
         parse_boulder_spec(spec)
@@ -415,9 +417,10 @@ def test_cli_build_with_boulders_same_bytes_any_thread_count(run_cli, tmp_path):
         d = tmp_path / tag
         d.mkdir()
         proc = run_cli("latlong", "build", "--base", "fbm", "--magnitude", "48", "--radius-m",
-                       "300", "--craters", "c=0.05,k=-2,dmin=10,dmax=60",
-                       "--boulders", "c=1e-3,k=-3,dmin=1,dmax=8,near=0.3",
-                       "--boulders", "c=5e-3,k=-2.5,dmin=8,dmax=20,burial=0.2", "--seed", "4",
+                       "300", "--craters", "c=0.05,k=-2,d_min_m=10,d_max_m=60",
+                       "--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=8,near=0.3",
+                       "--boulders", "c=5e-3,k=-2.5,d_min_m=8,d_max_m=20,burial_max=0.2",
+                       "--seed", "4",
                        "-o", str(d / "a.npz"), "-o", str(d / "a.ply"), "-o", str(d / "a.glb"),
                        "--boulder-catalog", str(d / "rocks.csv"), "-q", env=env)
         assert proc.returncode == 0, proc.stderr
@@ -453,19 +456,20 @@ def test_cli_boulders_from_config_and_export(run_cli, tmp_path):
 
 
 @pytest.mark.parametrize("args,needles", [
-    (["--boulders", "c=0,k=-3,dmin=1,dmax=5"], ["--boulders", "`c`"]),
-    (["--boulders", "c=1e-3,k=3,dmin=1,dmax=5"], ["--boulders", "`k`"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=5,dmax=1"], ["--boulders", "d_min_m"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1"], ["--boulders", "missing dmax"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1,dmax=5,size=3"], ["--boulders", "size=3"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1,dmax=5,burial=1.5"], ["--boulders", "burial_max"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1,dmax=500"], ["--boulders", "fifth"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1,dmax=5", "--boulder-flatten", "0"],
+    (["--boulders", "c=0,k=-3,d_min_m=1,d_max_m=5"], ["--boulders", "`c`"]),
+    (["--boulders", "c=1e-3,k=3,d_min_m=1,d_max_m=5"], ["--boulders", "`k`"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=5,d_max_m=1"], ["--boulders", "d_min_m"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1"], ["--boulders", "missing d_max_m"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=5,size=3"], ["--boulders", "size=3"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=5,burial_max=1.5"],
+     ["--boulders", "burial_max"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=500"], ["--boulders", "fifth"]),
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=5", "--boulder-flatten", "0"],
      ["flatten"]),
-    (["--boulders", "c=1e-3,k=-3,dmin=1,dmax=5", "--boulder-roughness", "3"],
+    (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=5", "--boulder-roughness", "3"],
      ["roughness"]),
     (["--boulder-catalog", "r.csv"], ["--boulder-catalog", "--boulders"]),
-    (["--boulders", "c=100,k=-3,dmin=0.001,dmax=5"], ["boulders", "2e7"]),
+    (["--boulders", "c=100,k=-3,d_min_m=0.001,d_max_m=5"], ["boulders", "2e7"]),
 ])
 def test_cli_bad_boulder_input(run_cli, tmp_path, args, needles, one_line_error):
     proc = run_cli("latlong", "build", "--magnitude", "20", "--radius-m", "1000", *args,

@@ -204,8 +204,9 @@ def test_cratered_preset_outputs_and_determinism(run_cli, tmp_path):
 def test_crater_layers_from_options_and_config(run_cli, tmp_path):
     out = tmp_path / "c.npz"
     proc = run_cli("latlong", "build", "--magnitude", "40", "--base", "sphere", "--radius-m",
-                   "100", "--craters", "c=0.2,k=-2,dmin=3,dmax=20", "--craters",
-                   "c=0.01,k=-3,dmin=20,dmax=30,deg=0.5", "--seed", "2", "-o", str(out), "-q")
+                   "100", "--craters", "c=0.2,k=-2,d_min_m=3,d_max_m=20", "--craters",
+                   "c=0.01,k=-3,d_min_m=20,d_max_m=30,degradation=0.5", "--seed", "2", "-o",
+                   str(out), "-q")
     assert proc.returncode == 0, proc.stderr
     cat = load(out).craters
     assert set(np.unique(cat["layer"])) <= {0, 1} and len(cat) > 10
@@ -226,12 +227,12 @@ def test_crater_layers_from_options_and_config(run_cli, tmp_path):
 
 
 @pytest.mark.parametrize("args,needles", [
-    (["--radius-m", "100", "--craters", "c=0.1,k=-2,dmin=5,dmax=150"],
+    (["--radius-m", "100", "--craters", "c=0.1,k=-2,d_min_m=5,d_max_m=150"],
      ["--craters", "larger than the body"]),
-    (["--craters", "c=0,k=-2,dmin=1,dmax=5"], ["--craters", "`c`"]),
-    (["--craters", "c=-1,k=-2,dmin=1,dmax=5"], ["--craters", "`c`"]),
-    (["--craters", "c=0.1,k=-2,dmin=-1,dmax=5"], ["--craters", "d_min_m"]),
-    (["--craters", "c=0.1,k=-2,dmin=1,dmax=-5"], ["--craters", "d_max_m"]),
+    (["--craters", "c=0,k=-2,d_min_m=1,d_max_m=5"], ["--craters", "`c`"]),
+    (["--craters", "c=-1,k=-2,d_min_m=1,d_max_m=5"], ["--craters", "`c`"]),
+    (["--craters", "c=0.1,k=-2,d_min_m=-1,d_max_m=5"], ["--craters", "d_min_m"]),
+    (["--craters", "c=0.1,k=-2,d_min_m=1,d_max_m=-5"], ["--craters", "d_max_m"]),
     (["--preset", "vesta-like"], ["--preset", "fbm-cratered"]),
     (["--catalog", "x.csv"], ["--catalog", "crater layers"]),
     (["--views", "4", "--preview", "p.png"], ["--views"]),
@@ -249,7 +250,7 @@ def test_presets_command(run_cli):
     for name in ("fbm-cratered", "faulted-cratered", "eros-like", "itokawa-like",
                  "bennu-like", "paper", "fig5c"):
         assert f"\n{name}\n" in "\n" + proc.stdout
-    assert "craters = ['c=0.5,k=-2,dmin=1,dmax=15']" in proc.stdout
+    assert "craters = ['c=0.5,k=-2,d_min_m=1,d_max_m=15']" in proc.stdout
 
 
 def test_render_command(run_cli, tmp_path):
@@ -280,7 +281,7 @@ def test_shape_model_base(run_cli, tmp_path):
     out, png = tmp_path / "b.npz", tmp_path / "b.png"
     proc = run_cli("latlong", "build", "--base", f"shape:{data / 'bennu_radar_sbgat.obj'}",
                    "--shape-units", "km", "--magnitude", "60", "--craters",
-                   "c=0.9,k=-3,dmin=10,dmax=40", "--amplitude-m", "0.5", "--seed", "2",
+                   "c=0.9,k=-3,d_min_m=10,d_max_m=40", "--amplitude-m", "0.5", "--seed", "2",
                    "-o", str(out), "--preview", str(png), "-q")
     assert proc.returncode == 0, proc.stderr
     body = load(out)
@@ -291,7 +292,7 @@ def test_shape_model_base(run_cli, tmp_path):
             ([f"shape:{itokawa}"], ["--shape-units"]),
             ([f"shape:{itokawa}", "--shape-units", "km"], ["not star-shaped", "%"]),
             ([f"shape:{itokawa}", "--shape-units", "km", "--shape-crossings", "outermost",
-              "--craters", "c=0.1,k=-2,dmin=5,dmax=40"], ["--craters", "resolution"]),
+              "--craters", "c=0.1,k=-2,d_min_m=5,d_max_m=40"], ["--craters", "resolution"]),
             ([f"shape:{itokawa}", "--shape-units", "km", "--radius-m", "5"],
              ["--radius-m", "shape"]),
             ([f"shape:{tmp_path / 'none.obj'}", "--shape-units", "km"], ["does not exist"]),

@@ -175,9 +175,10 @@ def test_noise_on_an_implicit_surface():
      "`weighting`"),
     (lambda: fit_gabor(np.zeros((32, 32)), 1.0), "no variance"),
     (lambda: gabor_image(GaborNoise.single(0.1, 0.1, 1.0), (0, 4), 1.0), "`shape`"),
-    (lambda: parse_gabor_spec("f=0.1,bw=0.1"), "missing amp"),
-    (lambda: parse_gabor_spec("f=0.1,bw=x,amp=1"), "bw must be a number"),
-    (lambda: parse_gabor_spec("f=0.1,bw=0.1,amp=1,q=2"), "unknown item"),
+    (lambda: parse_gabor_spec("frequency=0.1,bandwidth=0.1"), "missing amplitude_m"),
+    (lambda: parse_gabor_spec("frequency=0.1,bandwidth=x,amplitude_m=1"),
+     "bandwidth must be a number"),
+    (lambda: parse_gabor_spec("frequency=0.1,bandwidth=0.1,amplitude_m=1,q=2"), "unknown item"),
 ])
 def test_bad_input(call, match):
     with pytest.raises(ValueError, match=match):

@@ -450,11 +450,11 @@ def test_surface_errors(kwargs, match):
 
 def test_spec_errors():
     with pytest.raises(ValueError, match="unknown item"):
-        parse_lcsn_spec("kernel=fig6-kernel1,dmin=1,dmax=2,q=3")
-    with pytest.raises(ValueError, match="missing dmax"):
-        parse_lcsn_spec("kernel=fig6-kernel1,dmin=1")
+        parse_lcsn_spec("kernel=fig6-kernel1,d_min_m=1,d_max_m=2,q=3")
+    with pytest.raises(ValueError, match="missing d_max_m"):
+        parse_lcsn_spec("kernel=fig6-kernel1,d_min_m=1")
     with pytest.raises(ValueError, match="`d_min_m`"):
-        parse_lcsn_spec("kernel=fig6-kernel1,dmin=3,dmax=2")
+        parse_lcsn_spec("kernel=fig6-kernel1,d_min_m=3,d_max_m=2")
 
 
 def test_small_seed_free_grid_and_rimless_presets():

@@ -16,8 +16,8 @@ ITOKAWA = ["--backend", "implicit", "--shape", str(DATA / "itokawa_8.obj"), "--s
            "km", "--polygons", "20000"]
 BENNU = ["--backend", "implicit", "--shape", str(DATA / "bennu_radar_sbgat.obj"),
          "--shape-units", "km", "--polygons", "20000"]
-LAYERS = ["--lcsn", "kernel=table-a1-300m-0gyr,dmin=40,dmax=80",
-          "--lcsn", "kernel=fig6-kernel1,dmin=20,dmax=40,hd=0.1:0.2,p=0.7"]
+LAYERS = ["--lcsn", "kernel=table-a1-300m-0gyr,d_min_m=40,d_max_m=80",
+          "--lcsn", "kernel=fig6-kernel1,d_min_m=20,d_max_m=40,depth_ratio=0.1:0.2,probability=0.7"]
 
 
 def assert_one_line_error(proc, *needles):
@@ -33,7 +33,7 @@ def test_build_meshes_catalog_preview(run_cli, tmp_path):
     proc = run_cli("latlong", "build", *ITOKAWA, *LAYERS, "--seed", "4",
                    *sum((["-o", str(p)] for p in outs), []), "--catalog",
                    str(tmp_path / "a.csv"), "--preview", str(tmp_path / "a.png"),
-                   "--gabor", "f=0.1,bw=0.05,amp=0.3")
+                   "--gabor", "frequency=0.1,bandwidth=0.05,amplitude_m=0.3")
     assert proc.returncode == 0, proc.stderr
     assert "implicit body:" in proc.stdout and proc.stdout.count("wrote") == 6
     meshes = [read_shape_model(p, units="m") for p in outs]
@@ -72,7 +72,7 @@ def test_same_seed_same_bytes_any_thread_count(run_cli, tmp_path):
         outs = [d / n for n in names]
         proc = run_cli("latlong", "build", *BENNU, *LAYERS, "--seed", "9", "-q",
                        "--shape-crossings", "outermost", "--magnitude", "30",
-                       "--gabor", "f=0.05,bw=0.025,amp=0.4",
+                       "--gabor", "frequency=0.05,bandwidth=0.025,amplitude_m=0.4",
                        *sum((["-o", str(p)] for p in outs[:-1]), []), "--catalog", str(outs[-1]),
                        env={"NUMBA_NUM_THREADS": threads})
         assert proc.returncode == 0, proc.stderr
@@ -85,7 +85,7 @@ def test_config_file(run_cli, tmp_path):
     cfg = tmp_path / "scene.toml"
     cfg.write_text(f'backend = "implicit"\nshape = "{DATA / "bennu_radar_sbgat.obj"}"\n'
                    'shape_units = "km"\npolygons = 20000\nseed = 3\n'
-                   'lcsn = ["kernel=fig6-kernel2,dmin=20,dmax=40,hd=0.1:0.1"]\n'
+                   'lcsn = ["kernel=fig6-kernel2,d_min_m=20,d_max_m=40,depth_ratio=0.1:0.1"]\n'
                    f'output = ["{tmp_path / "c.ply"}"]\ncatalog = "{tmp_path / "c.csv"}"\n')
     proc = run_cli("latlong", "build", "--config", str(cfg), "-q")
     assert proc.returncode == 0, proc.stderr
@@ -100,20 +100,23 @@ def test_config_file(run_cli, tmp_path):
     (["--shape", "x.obj"], ["--shape", "--backend implicit"]),
     ([*BENNU[:4]], ["--shape-units"]),
     ([*BENNU, "--radius-m", "100"], ["--radius-m", "does not apply"]),
-    ([*BENNU, "--craters", "c=0.5,k=-2,dmin=2,dmax=5"], ["--craters", "does not apply"]),
+    ([*BENNU, "--craters", "c=0.5,k=-2,d_min_m=2,d_max_m=5"], ["--craters", "does not apply"]),
     (["--backend", "implicit", "--shape", "missing.obj", "--shape-units", "km"],
      ["--shape", "does not exist"]),
-    ([*BENNU, "--lcsn", "kernel=nope,dmin=1,dmax=2"], ["--lcsn", "`kernel`"]),
-    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=5,dmax=2"], ["--lcsn", "d_min_m"]),
-    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=5,dmax=20,p=0"], ["--lcsn", "probability"]),
-    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=5,dmax=20", "--cell-m", "10"],
+    ([*BENNU, "--lcsn", "kernel=nope,d_min_m=1,d_max_m=2"], ["--lcsn", "`kernel`"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,d_min_m=5,d_max_m=2"], ["--lcsn", "d_min_m"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,d_min_m=5,d_max_m=20,probability=0"],
+     ["--lcsn", "probability"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,d_min_m=5,d_max_m=20", "--cell-m", "10"],
      ["--cell-m"]),
     ([*BENNU, "--polygons", "5"], ["--polygons"]),
     ([*BENNU, "--voxel-m", "-1"], ["--voxel-m"]),
     ([*BENNU, "--packing-voxels", "3"], ["--packing-voxels"]),
     ([*BENNU, "--packing-voxels", "1024"], ["--packing-voxels = 1024", "GiB"]),
-    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=10,dmax=20,B=-300"], ["--lcsn", "exponent"]),
-    ([*BENNU, "--gabor", "f=1,bw=1"], ["--gabor", "missing amp"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,d_min_m=10,d_max_m=20,exponent=-300"],
+     ["--lcsn", "exponent"]),
+    ([*BENNU, "--lcsn", "kernel=fig6-kernel1,dmin=10,d_max_m=20"], ["--lcsn", "now d_min_m="]),
+    ([*BENNU, "--gabor", "frequency=1,bandwidth=1"], ["--gabor", "missing amplitude_m"]),
     ([*BENNU, "--gabor-example", "x.npy"], ["--gabor-pixel-m"]),
     ([*BENNU, "--gabor-pixel-m", "2"], ["--gabor-pixel-m", "--gabor-example"]),
     ([*BENNU, "--shape-crossings", "all"], ["--shape-crossings"]),
@@ -128,8 +131,8 @@ def test_bad_input_one_line_nothing_written(run_cli, tmp_path, args, needles):
 
 
 def test_bad_outputs(run_cli, tmp_path):
-    proc = run_cli("latlong", "build", *BENNU, "-o", str(tmp_path / "x.glb"))
-    assert_one_line_error(proc, "unknown format", ".npz")
+    proc = run_cli("latlong", "build", *BENNU, "-o", str(tmp_path / "x.xyz"))
+    assert_one_line_error(proc, "unknown format", ".npz", ".glb")
     proc = run_cli("latlong", "build", *BENNU)
     assert_one_line_error(proc, "nothing to write")
     (tmp_path / "y.ply").write_text("keep")

@@ -30,7 +30,7 @@ def test_build_returns_a_body_and_writes_nothing(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     scene = Scene(BodySettings(magnitude=24, radius_m=100.0), SphereBase(),
                   CraterSettings([craters.CraterLayer(0.5, -2.0, 4.0, 20.0)]),
-                  BoulderSettings(["c=0.002,k=-3,dmin=1,dmax=8"]), seed=4)
+                  BoulderSettings(["c=0.002,k=-3,d_min_m=1,d_max_m=8"]), seed=4)
     body = build(scene)
     assert isinstance(body, latlong.Body) and body.magnitude == 24
     assert len(body.craters) > 10 and len(body.boulders) > 0
@@ -89,7 +89,7 @@ def test_shape_base_reads_the_model_once_and_sets_the_body():
     ({"radius_m": -1}, "radius_m", "> 0"),
     ({"base": "fbm", "faults_1": 10}, "faults_1", "faulting"),
     ({"preset": "paper", "base": "fbm"}, "preset", "faulting"),
-    ({"craters": ["c=0.1,k=-2,dmin=5,dmax=150"], "radius_m": 100}, "craters",
+    ({"craters": ["c=0.1,k=-2,d_min_m=5,d_max_m=150"], "radius_m": 100}, "craters",
      "larger than the body"),
     ({"boulder_flatten": 9}, "boulder_flatten", "[0.1, 2]"),
     ({"sun_elevation_deg": 95}, "sun_elevation_deg", "[-90, 90]"),
