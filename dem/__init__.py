@@ -12,9 +12,10 @@ import logging
 
 from .analysis import band_power, laplacian
 from .boulders import boulder_population, stamp_boulders
+from .config import EnhanceConfig
 from .core import Dem
 from .craterfill import fill_crater_gaps, replace_crater
-from .enhance import EnhanceConfig, enhance
+from .enhance import enhance
 from .expansion import displacement_scales, expand, expansion_sizes
 from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
 from .frame import LocalFrame, local_frame

@@ -33,7 +33,7 @@ from .fractal import fractal_fit
 from .gaps import fill_gaps
 from .io import GEOTIFF_SUFFIXES, read, write
 from .mesh import MESH_SUFFIXES, to_mesh
-from .stack import read_stack
+from .stack import check_stack_folder, read_stack
 
 
 # --------------------------------------------------------------------------- parsing
@@ -332,7 +332,8 @@ def _cmd_enhance(args: argparse.Namespace) -> int:
         value = getattr(args, key, None)
         if value is not None and value is not False:
             s[key] = list(value) if opt.many else value
-    if not s.get("output"):
+    output, force, quiet = s.pop("output", None), s.pop("force", False), s.pop("quiet", False)
+    if not output:
         raise CliError("nothing to write: give -o/--output (or the scene key 'output')")
     unknown = sorted(set(s) - set(EnhanceConfig.keys()))
     if unknown:
@@ -341,8 +342,10 @@ def _cmd_enhance(args: argparse.Namespace) -> int:
     cfg = EnhanceConfig.from_mapping(s)
     if cfg.input is None:
         raise CliError("`dem enhance` needs a base DEM (--input or the scene key 'input')")
-    stack = enhance(cfg, progress=not cfg.quiet)
-    if not cfg.quiet:
+    folder = check_stack_folder(output, force=force)
+    stack = enhance(cfg, progress=not quiet)
+    stack.write(folder, force=force, progress=not quiet)
+    if not quiet:
         info = stack.info
         c = info["craters"]
         sizes = stack.pixel_sizes_m()
@@ -355,7 +358,7 @@ def _cmd_enhance(args: argparse.Namespace) -> int:
             print(f"boulders stamped {sum(b['stamped'])}, rejected {b['rejected']} of "
                   f"{b['drawn']} (below {cfg.min_boulder_px:g} px of the finest layer or "
                   f"crossing a layer's border)")
-        print(f"wrote {Path(cfg.output) / 'manifest.json'}")
+        print(f"wrote {Path(output) / 'manifest.json'}")
     return 0
 
 

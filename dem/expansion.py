@@ -87,7 +87,7 @@ from craters._shared import (
 from ._expand_kernels import _expand_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .fractal import _local_msd, fractal_fit
+from .fractal import fractal_fit, local_msd
 
 __all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]
 
@@ -277,7 +277,7 @@ def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
     b_r, b_c = min(r0 + width + m, rows), min(c0 + width + m, cols)
     e_r, e_c = max(a_r - 1, 0), max(a_c - 1, 0)
     z = dem.heights[e_r:min(b_r + 1, rows), e_c:min(b_c + 1, cols)]
-    msd = _local_msd(z)[a_r - e_r:a_r - e_r + b_r - a_r, a_c - e_c:a_c - e_c + b_c - a_c]
+    msd = local_msd(z)[a_r - e_r:a_r - e_r + b_r - a_r, a_c - e_c:a_c - e_c + b_c - a_c]
     amp = np.sqrt(msd)
     amp[~np.isfinite(amp)] = fallback
     return (np.ascontiguousarray(amp), dem.origin[0] + a_r, dem.origin[1] + a_c)

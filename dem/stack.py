@@ -34,7 +34,7 @@ from .core import Dem, crs_label
 from .frame import LocalFrame, grid_pixel_size, pixel_affine
 from .io import read, write
 
-__all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "read_stack"]
+__all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "propagate_up", "read_stack"]
 
 STACK_FORMAT = "craterform layer stack v1"
 #: File name of the manifest inside a stack folder.
@@ -298,6 +298,14 @@ class Stack:
         crs = self._layers[0].crs
         write_geojson(cat, folder / geojson_name, to_world=self._frame.to_world,
                       crs=None if crs is None else crs_label(crs))
+
+
+def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
+    """Make layers k-1 .. 0 agree with layer k in place: each coarser footprint takes the
+    finer layer's even pixels (``arrays[j][footprint] = arrays[j + 1][::2, ::2]``)."""
+    for j in range(k - 1, -1, -1):
+        r0, c0, w = windows[j]
+        arrays[j][r0:r0 + w, c0:c0 + w] = arrays[j + 1][::2, ::2]
 
 
 def check_stack_folder(folder, *, force: bool) -> Path:

@@ -394,6 +394,6 @@ def test_every_enhance_and_mesh_option_has_a_config_key():
     parser = build_parser()
     subs = parser._subparsers._group_actions[0].choices
     dests = {a.dest for a in subs["enhance"]._actions} - {"help", "config"}
-    assert dests == set(_options("enhance")) == set(dem.EnhanceConfig.keys())
+    assert dests == set(_options("enhance")) == {*dem.EnhanceConfig.keys(), "output", "force", "quiet"}
     dests = {a.dest for a in subs["mesh"]._actions} - {"help", "config", "input"}
     assert dests == set(_options("mesh"))

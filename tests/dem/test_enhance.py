@@ -11,7 +11,7 @@ from affine import Affine
 
 import craters
 import dem
-from dem.enhance import _geometry, _windows, plan_craters
+from dem.planning import layer_windows, plan_craters, stack_geometry
 
 REACH = craters.DEFAULT_EJECTA_EDGE * 1.02  # ejecta edge with the default rim irregularity
 
@@ -135,9 +135,9 @@ def test_band_split_has_the_law_of_one_catalog_split_afterwards():
     """Per-layer counts and mean diameters of the banded draw equal those of one catalog
     for layer 0's area, split crater by crater (independent reimplementation)."""
     size, n_layers, p0, min_px = 33, 3, 10.0, 2.0
-    _, windows, _, _ = _windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None, size,
-                                n_layers)
-    geom = _geometry(size, windows, p0)
+    _, windows, _, _ = layer_windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None,
+                                     size, n_layers)
+    geom = stack_geometry(size, windows, p0)
     spec = craters.parse_layer_spec("c=0.2,k=-2,dmin=5,dmax=300")
     half = (size - 1) / 2
     runs = 300
