@@ -16,9 +16,9 @@ __all__ = ["about", "parameter_of"]
 
 
 @contextlib.contextmanager
-def about(parameter: str) -> Iterator[None]:
+def about(parameter: str | None) -> Iterator[None]:
     """Tag a ``TypeError`` / ``ValueError`` raised inside with ``parameter`` (the innermost
-    tag wins).
+    tag wins; None tags nothing).
 
     Examples
     --------
@@ -32,7 +32,7 @@ def about(parameter: str) -> Iterator[None]:
     try:
         yield
     except (TypeError, ValueError) as exc:
-        if parameter_of(exc) is None:
+        if parameter is not None and parameter_of(exc) is None:
             exc.parameter = parameter
         raise
 
