@@ -67,7 +67,7 @@ from .planning import (
 )
 from .stack import Stack, propagate_up
 
-__all__ = ["EnhanceConfig", "enhance", "plan_boulders", "plan_craters"]
+__all__ = ["enhance"]
 
 logger = logging.getLogger(__name__)
 

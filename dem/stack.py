@@ -279,7 +279,6 @@ class Stack:
         return make_catalog(**cols, world_x=wx, world_y=wy)
 
 
-
 def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
     """Make layers k-1 .. 0 agree with layer k in place: each coarser footprint takes the
     finer layer's even pixels (``arrays[j][footprint] = arrays[j + 1][::2, ::2]``)."""

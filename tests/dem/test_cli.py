@@ -410,3 +410,42 @@ def test_enhance_options_are_the_config_plus_the_run_options():
 
     assert set(options_for("enhance")) == {*dem.EnhanceConfig.keys(), "output", "force",
                                            "quiet"}
+
+
+def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_path, lola_tif,
+                                                                 monkeypatch):
+    import collections
+
+    import dem.cli.stack
+    import dem.config
+
+    calls = collections.Counter()
+
+    def counted(module, name, only=None):
+        real = getattr(module, name)
+
+        def call(*args, **kwargs):
+            if only is None or only(*args):
+                calls[name] += 1
+            return real(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, call)
+
+    counted(dem.config, "parse_layer_spec")
+    counted(dem.config, "parse_boulder_spec")
+    counted(dem.config, "check_int", only=lambda name, *_: name == "seed")
+    counted(dem.cli.stack, "check_stack_folder")
+    scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
+    proc = InProcess(capsys)("dem", "enhance", "--config", str(scene), "--seed", "3", "-q",
+                             "--boulders", "c=0.00001,k=-3,dmin=300,dmax=2000")
+    assert proc.returncode == 0, proc.stderr
+    assert calls == {"parse_layer_spec": 2, "parse_boulder_spec": 1, "check_int": 1,
+                     "check_stack_folder": 1}
+    # the input as the argument overrides the file's, the other options come from the file
+    copy = tmp_path / "copy.tif"
+    copy.write_bytes(lola_tif.read_bytes())
+    proc = InProcess(capsys)("dem", "enhance", str(copy), "--config", str(scene), "-o",
+                             str(tmp_path / "other"), "--seed", "3", "-q")
+    assert proc.returncode == 0, proc.stderr
+    info = dem.read_stack(tmp_path / "other").info
+    assert info["parameters"]["input"] == str(copy) and info["parameters"]["layers"] == 2

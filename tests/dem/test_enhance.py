@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -271,3 +272,26 @@ def test_unknown_pixels_in_layer0_are_refused(base):
     z[60, 60] = np.nan
     with pytest.raises(ValueError, match="unknown \\(NaN\\) pixels"):
         dem.enhance({"layers": 2, "size": 65}, dem=base.replace(heights=z))
+
+
+def test_config_is_typed_frozen_and_checked_where_made(base, tmp_path, monkeypatch):
+    layer = craters.CraterLayer(c=0.05, k=-2.0, d_min_m=100.0, d_max_m=3000.0)
+    cfg = dem.EnhanceConfig(layers=2, size=33, seed=1, craters=[layer, SPECS[0]])
+    assert cfg.crater_layers == (layer, craters.parse_layer_spec(SPECS[0]))
+    assert cfg.boulder_layers == () and "output" not in cfg.keys()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cfg.layers = 3
+    monkeypatch.chdir(tmp_path)
+    s = dem.enhance(cfg, dem=base)
+    assert list(tmp_path.iterdir()) == []  # enhance writes nothing; Stack.write does
+    assert s.info["parameters"]["craters"] == [dataclasses.asdict(layer), SPECS[0]]
+    # run options are not part of a stack's description
+    with pytest.raises(ValueError, match="unknown config key.*'output'.*Stack.write"):
+        dem.enhance({"layers": 2, "size": 33, "output": "st"}, dem=base)
+    # errors name the field and carry it (the command line maps it to its option)
+    with pytest.raises(ValueError, match="`size` must be 2\\^n \\+ 1") as info:
+        dem.EnhanceConfig(size=100)
+    assert dem.errors.parameter_of(info.value) == "size"
+    with pytest.raises(TypeError, match="craters.BoulderLayer") as info:
+        dem.EnhanceConfig(boulders=[layer])
+    assert dem.errors.parameter_of(info.value) == "boulders"
