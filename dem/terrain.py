@@ -71,7 +71,8 @@ def slope(dem: Dem, method: str = "horn") -> np.ndarray:
     30.0
     """
     dem = _check(dem)
-    check_choice("method", method, ("horn", "central"))
+    with about("method"):
+        check_choice("method", method, ("horn", "central"))
     z = dem.heights
     out = np.full(z.shape, np.nan)
     if min(z.shape) < 3:

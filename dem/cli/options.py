@@ -22,9 +22,10 @@ import contextlib
 import dataclasses
 import math
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
-from craters._shared import load_toml
+from craters._shared import check_output_path, load_toml
 from craters._shared.cli import CliError
 
 from ..config import EnhanceConfig
@@ -32,7 +33,8 @@ from ..core import parse_region
 from ..errors import parameter_of
 from ..io import read
 
-__all__ = ["OPTIONS", "Opt", "Settings", "add_command", "options_for", "read_input"]
+__all__ = ["OPTIONS", "Opt", "Settings", "add_command", "check_output", "options_for",
+           "read_input"]
 
 
 # --------------------------------------------------------------------------- text -> value
@@ -277,6 +279,17 @@ def settings(args: argparse.Namespace, command: str) -> Settings:
     if values["input"] is None:
         raise CliError(f"`dem {command}` needs an input (argument or config key 'input')")
     return Settings(command, values, args.config, from_config)
+
+
+def check_output(s: Settings, suffixes) -> Path:
+    """The output file: given, not the input, a known suffix, overwritten only with
+    ``--force``; checked before any work."""
+    if not s["output"]:
+        raise CliError("nothing to write: give -o/--output")
+    out = Path(s["output"])
+    if Path(s["input"]).resolve() == out.resolve():
+        raise CliError(f"output {str(out)!r} is the input; inputs are never modified")
+    return check_output_path(out, force=s["force"], suffixes=suffixes)
 
 
 def read_input(s: Settings, path=None):

@@ -2,12 +2,9 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 
-from craters._shared import check_output_path, normalize_rng, progress_bar
-from craters._shared.cli import CliError
+from craters._shared import normalize_rng, progress_bar
 
 from ..core import crs_label
 from ..errors import about
@@ -15,18 +12,7 @@ from ..expansion import expand
 from ..fractal import fractal_fit
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
-from .options import Settings, add_command, read_input
-
-
-def check_output(s: Settings, suffixes) -> Path:
-    """The output file: given, not the input, a known suffix, overwritten only with
-    ``--force``; checked before any work."""
-    if not s["output"]:
-        raise CliError("nothing to write: give -o/--output")
-    out = Path(s["output"])
-    if Path(s["input"]).resolve() == out.resolve():
-        raise CliError(f"output {str(out)!r} is the input; inputs are never modified")
-    return check_output_path(out, force=s["force"], suffixes=suffixes)
+from .options import Settings, add_command, check_output, read_input
 
 
 def _seed(s: Settings) -> int:

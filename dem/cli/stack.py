@@ -10,8 +10,7 @@ from ..config import EnhanceConfig
 from ..enhance import enhance
 from ..mesh import MESH_SUFFIXES, to_mesh
 from ..stack import check_stack_folder, read_stack, write_stack
-from .options import Settings, add_command, read_input
-from .raster import check_output
+from .options import Settings, add_command, check_output, read_input
 
 
 def _enhance(s: Settings) -> int:
