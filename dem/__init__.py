@@ -1,20 +1,33 @@
 """dem: digital elevation models: I/O, RMD expansion, gap filling, layer stacks, meshes.
 
+::
+
+    GeoTIFF, PDS3 --io.read--> Dem (core: heights, NaN = unknown, transform, CRS, metres)
+      -> fill_gaps (gaps), fill_crater_gaps / replace_crater (craterfill)  -> Dem
+      -> expand (expansion: RMD, 2x per level)                              -> Dem
+      -> enhance (EnhanceConfig in config, the plan in planning)            -> Stack
+    Stack (stack: consistent layers + catalogs; write, read_stack)
+      -> to_mesh (mesh: PLY/VTP) | slope, power_spectrum (terrain), fractal_fit (fractal)
+
+Beside them: ``frame`` (local metric frames), ``boulders`` (boulders on rasters),
+``errors`` (errors that name their parameter), ``_*kernels`` (numba) and ``cli/`` (the
+``dem`` command line, which imports the library, never the reverse; ``dem --help``).
+
 Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement
 expansion of real DEMs, outside-in fractal gap filling, crater gap filling and crater
 replacement, boulders (:func:`stamp_boulders`), multi-resolution layer stacks with
-craters and boulders per layer (:func:`enhance`) and
-their stitched meshes (:func:`to_mesh`), on a :class:`Dem` that keeps the
-georeferencing. See ``dem --help`` for the command line.
+craters and boulders per layer (:func:`enhance`) and their stitched meshes
+(:func:`to_mesh`), on a :class:`Dem` that keeps the georeferencing.
 """
 
 import logging
 
 from .analysis import band_power, laplacian
 from .boulders import boulder_population, stamp_boulders
+from .config import EnhanceConfig
 from .core import Dem
 from .craterfill import fill_crater_gaps, replace_crater
-from .enhance import EnhanceConfig, enhance
+from .enhance import enhance
 from .expansion import displacement_scales, expand, expansion_sizes
 from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
 from .frame import LocalFrame, local_frame

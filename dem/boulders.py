@@ -42,14 +42,14 @@ from ._boulder_kernels import (
     _window_gradient_kernel,
 )
 from .core import Dem
-from .craterfill import _check_common
-from .frame import LocalFrame, grid_pixel_size, pixel_affine
+from .frame import LocalFrame, grid_pixel_size, pixel_affine, resolve_frame
 
-__all__ = ["boulder_population", "stamp_boulders"]
+__all__ = ["BOULDER_REACH", "boulder_population", "draw_boulders", "place_boulders",
+           "stamp_boulders"]
 
 #: Largest horizontal reach of a boulder from its centre, in diameters (unit longest
 #: extent, centred on its bounding box: at most half the box diagonal).
-_REACH = 0.87
+BOULDER_REACH = 0.87
 
 
 def _layers(layers) -> list[BoulderLayer]:
@@ -94,7 +94,7 @@ def boulder_population(dem: Dem, layers, *, frame: LocalFrame | None = None,
     rng
         Seed or Generator.
     """
-    frame = _check_common(dem, frame)
+    frame = resolve_frame(dem, frame)
     a = pixel_affine(dem, frame)
     p = grid_pixel_size(a, "the DEM")
     rows, cols = dem.shape
@@ -130,8 +130,8 @@ def _ground_normals(z, nan, p: float, m: np.ndarray, xs, ys, ds) -> np.ndarray:
     return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
 
-def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShape,
-           max_iterations: int = 12):
+def place_boulders(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShape,
+                   max_iterations: int = 12):
     """Place and stamp boulders on a height grid; positions ``x_m, y_m`` in a local frame
     where ``(x, y) = p m (col, row) + t`` (``m`` orthogonal 2 x 2, pixel side ``p``).
 
@@ -149,7 +149,7 @@ def _place(z, p: float, m: np.ndarray, t: np.ndarray, cat, *, shape: BoulderShap
 
     d = np.asarray(cat["diameter_m"], dtype=np.float64)
     cx, cy = to_pixels(np.asarray(cat["x_m"], float), np.asarray(cat["y_m"], float))
-    reach = _REACH * d / p + 1.0
+    reach = BOULDER_REACH * d / p + 1.0
     keep = (cx - reach >= 0) & (cx + reach <= cols - 1) & (cy - reach >= 0) & \
         (cy + reach <= rows - 1)
     # no unknown pixel under the footprint: integral image of the NaN mask
@@ -235,7 +235,7 @@ def stamp_boulders(dem: Dem, catalog, *, frame: LocalFrame | None = None,
         too small for the pixels, off the raster or on unknown pixels) and, with
         ``return_catalog``, the catalog of the stamped boulders.
     """
-    frame = _check_common(dem, frame)
+    frame = resolve_frame(dem, frame)
     shape = BoulderShape() if shape is None else shape
     if not isinstance(shape, BoulderShape):
         raise TypeError(f"`shape` must be a BoulderShape; got {type(shape).__name__}")
@@ -248,8 +248,8 @@ def stamp_boulders(dem: Dem, catalog, *, frame: LocalFrame | None = None,
     p = grid_pixel_size(a, "the DEM")
     m = np.array([[a.a, a.b], [a.d, a.e]]) / p
     resolved = np.nonzero(cat["diameter_m"] >= min_px * p)[0]
-    z, keep, placed = _place(dem.heights, p, m, np.array([a.c, a.f]), cat[resolved],
-                             shape=shape)
+    z, keep, placed = place_boulders(dem.heights, p, m, np.array([a.c, a.f]), cat[resolved],
+                                     shape=shape)
     rows_placed = resolved[keep]
     out = dem.with_step(z, "dem.stamp_boulders", None,
                         {"boulders": int(len(rows_placed)), "given": int(len(cat)),

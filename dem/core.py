@@ -17,7 +17,9 @@ from rasterio.windows import Window
 
 from craters._shared import check_int, check_positive, package_version
 
-__all__ = ["Dem", "HISTORY_TAG", "crs_label"]
+from .errors import about
+
+__all__ = ["Dem", "HISTORY_TAG", "crs_label", "parse_region"]
 
 #: GeoTIFF tag holding the JSON list of craterform steps that made a layer.
 HISTORY_TAG = "CRATERFORM_HISTORY"
@@ -57,6 +59,55 @@ def crs_label(crs: CRS | None) -> str:
         return ":".join(auth)
     m = re.match(r'\s*\w+\["([^"]*)"', crs.to_wkt())
     return m.group(1) if m else crs.to_string()
+
+
+def parse_region(region) -> Window | BoundingBox:
+    """A region of a DEM, given any way the ``dem`` package takes one (``region=`` of
+    :meth:`Dem.window`, :meth:`Dem.crop` and :func:`dem.expand`; ``--region`` and the
+    ``region`` config key of ``dem expand``):
+
+    * ``(row, col, size)`` or the text ``"ROW,COL,SIZE"``: the square of ``size`` pixels
+      whose top-left pixel is (``row``, ``col``), integers;
+    * ``(left, bottom, right, top)`` or the text ``"LEFT,BOTTOM,RIGHT,TOP"``: bounds in
+      CRS units, selecting the pixels whose centres lie inside (edges included);
+    * a ``rasterio.windows.Window`` (pixels) or a ``rasterio.coords.BoundingBox``.
+
+    Returns a Window or a BoundingBox (whether it lies inside a DEM is
+    :meth:`Dem.window`'s question).
+
+    Examples
+    --------
+    >>> parse_region("0,0,33")
+    Window(col_off=0, row_off=0, width=33, height=33)
+    >>> parse_region((10.0, 20.0, 30.0, 40.0))
+    BoundingBox(left=10.0, bottom=20.0, right=30.0, top=40.0)
+    """
+    if isinstance(region, Window | BoundingBox):
+        return region
+    if isinstance(region, str):
+        parts = [p.strip() for p in region.split(",")]
+        try:
+            if len(parts) == 3:
+                parts = [int(p) for p in parts]
+            elif len(parts) == 4:
+                parts = [float(p) for p in parts]
+        except ValueError:
+            parts = []
+    elif isinstance(region, tuple | list):
+        parts = list(region)
+    else:
+        raise TypeError(f"`region` must be (row, col, size) in pixels, (left, bottom, right, "
+                        f"top) in CRS units, the same as text, a rasterio Window or "
+                        f"BoundingBox; got {type(region).__name__}")
+    integral = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in parts)
+    if len(parts) == 3 and integral:
+        row, col, size = (int(v) for v in parts)
+        return Window(col, row, size, size)
+    if (len(parts) == 4 and all(isinstance(v, numbers.Real) and not isinstance(v, bool)
+                                and math.isfinite(v) for v in parts)):
+        return BoundingBox(*(float(v) for v in parts))
+    raise ValueError(f"`region` must be ROW,COL,SIZE (integer pixels) or "
+                     f"LEFT,BOTTOM,RIGHT,TOP (finite, CRS units); got {region!r}")
 
 
 def _crs_radius_text(crs: CRS) -> str:
@@ -147,14 +198,16 @@ class Dem:
                 crs = CRS.from_user_input(crs)
             except CRSError as exc:
                 raise ValueError(f"`crs` is not a CRS rasterio understands: {exc}") from None
-        radius = None if body_radius_m is None else check_positive("body_radius_m",
-                                                                   body_radius_m)
+        with about("body_radius_m"):
+            radius = None if body_radius_m is None else check_positive("body_radius_m",
+                                                                       body_radius_m)
         self._h = _readonly(h)
         self._transform = transform
         self._crs = crs
         self._radius = radius
-        self._own_px = None if pixel_size_m is None else _pixel_pair("pixel_size_m",
-                                                                    pixel_size_m)
+        with about("pixel_size_m"):
+            self._own_px = None if pixel_size_m is None else _pixel_pair("pixel_size_m",
+                                                                        pixel_size_m)
         self._px = self._derive_pixel_size()
         tags = {} if tags is None else dict(tags)
         for k, v in tags.items():
@@ -175,18 +228,21 @@ class Dem:
         crs = self._crs
         if crs is None:
             if self._own_px is None:
-                raise ValueError("the DEM has no CRS: give its pixel size with `pixel_size_m` "
-                                 "(--pixel-size-m), in metres")
+                with about("pixel_size_m"):
+                    raise ValueError("the DEM has no CRS: give its pixel size in metres with "
+                                     "`pixel_size_m`")
             return self._own_px
         if self._own_px is not None:
-            raise ValueError(f"`pixel_size_m` is only for DEMs without a CRS; this DEM's CRS "
-                             f"({crs_label(crs)}) gives the pixel size")
+            with about("pixel_size_m"):
+                raise ValueError(f"`pixel_size_m` is only for DEMs without a CRS; this DEM's "
+                                 f"CRS ({crs_label(crs)}) gives the pixel size")
         if crs.is_geographic:
             if self._radius is None:
-                raise ValueError(
-                    f"the DEM has a geographic CRS ({crs_label(crs)})"
-                    f"{_crs_radius_text(crs)}: give the body radius with `body_radius_m` "
-                    f"(--body-radius-m), in metres, to convert degrees to metres")
+                with about("body_radius_m"):
+                    raise ValueError(
+                        f"the DEM has a geographic CRS ({crs_label(crs)})"
+                        f"{_crs_radius_text(crs)}: give the body radius in metres with "
+                        f"`body_radius_m` to convert degrees to metres")
             rad = crs.units_factor[1]  # radians per angular unit
             rows, cols = self._h.shape
             lat_c = t.d * cols / 2.0 + t.e * rows / 2.0 + t.f
@@ -331,11 +387,14 @@ class Dem:
                         tags=tags, level=level, origin=origin)
 
     def window(self, region) -> Window:
-        """The integer pixel window of ``region`` (a Window, or a BoundingBox in CRS units).
+        """The integer pixel window of ``region`` (any form :func:`parse_region` takes).
 
-        A bounding box selects the pixels whose centres lie inside it (edges included).
         Raises ValueError if the window is empty or not entirely inside the DEM.
         """
+        with about("region"):
+            return self._window(parse_region(region))
+
+    def _window(self, region: Window | BoundingBox) -> Window:
         rows, cols = self.shape
         if isinstance(region, Window):
             vals = (region.row_off, region.col_off, region.height, region.width)
@@ -343,13 +402,8 @@ class Dem:
                 raise ValueError(f"`region` window must have integer offsets and sizes; "
                                  f"got {region!r}")
             r0, c0, h, w = (int(v) for v in vals)
-        elif isinstance(region, BoundingBox):
-            r0, c0, h, w = self._bounds_window(region)
         else:
-            raise TypeError(
-                "`region` must be a rasterio.windows.Window(col_off, row_off, width, height) "
-                "in pixels or a rasterio.coords.BoundingBox(left, bottom, right, top) in CRS "
-                f"units; got {type(region).__name__}")
+            r0, c0, h, w = self._bounds_window(region)
         if h < 1 or w < 1:
             raise ValueError(f"`region` selects no pixels (rows {r0}..{r0 + h - 1}, cols "
                              f"{c0}..{c0 + w - 1}); the DEM has {rows} x {cols} pixels")

@@ -49,18 +49,15 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import scipy.sparse
-import scipy.sparse.linalg
 from rasterio.windows import Window
 
 import craters
 from craters._shared import check_range, normalize_rng
 
 from .core import Dem
-from .enhance import _propagate_up
-from .frame import LocalFrame, grid_affine, grid_pixel_size, local_frame, pixel_affine
+from .frame import LocalFrame, grid_affine, grid_pixel_size, pixel_affine, resolve_frame
 from .gaps import fill_gaps
-from .stack import Stack
+from .stack import Stack, propagate_up
 
 __all__ = ["fill_crater_gaps", "replace_crater"]
 
@@ -137,6 +134,9 @@ def harmonic_warp(z: np.ndarray, synth: np.ndarray, region: np.ndarray) -> np.nd
     >>> harmonic_warp(z, synth, region)[1].round(6).tolist()  # linear in between
     [0.0, 1.0, 2.0, 3.0, 0.0]
     """
+    import scipy.sparse  # scipy at import time would load argparse (through unittest)
+    import scipy.sparse.linalg
+
     rows, cols = z.shape
     n = int(region.sum())
     out = np.zeros(z.shape)
@@ -169,16 +169,6 @@ def harmonic_warp(z: np.ndarray, synth: np.ndarray, region: np.ndarray) -> np.nd
     a = scipy.sparse.csc_matrix((vals, (rows_i, cols_j)), shape=(n, n))
     out[region] = scipy.sparse.linalg.spsolve(a, rhs)
     return out
-
-
-def _check_common(dem, frame):
-    if not isinstance(dem, Dem):
-        raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
-    if frame is None:
-        return local_frame(dem)
-    if not isinstance(frame, LocalFrame):
-        raise TypeError(f"`frame` must be a LocalFrame; got {type(frame).__name__}")
-    return frame
 
 
 def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
@@ -231,7 +221,7 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
     >>> round(float(truth[20, 20]), 1), round(float(f.heights[20, 20]), 1)
     (-31.5, -31.5)
     """
-    frame = _check_common(dem, frame)
+    frame = resolve_frame(dem, frame)
     cat = craters.sort_oldest_first(_as_catalog(craters_))
     extent = check_range("extent", extent, 0.1, 1.5)
     gen = normalize_rng(rng)
@@ -371,7 +361,7 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
     params = {"x_m": crater.x_m, "y_m": crater.y_m, "diameter_m": crater.diameter_m,
               "degradation": crater.degradation, "smooth_craters": smooth_craters}
     if isinstance(target, Dem):
-        frame = _check_common(target, frame)
+        frame = resolve_frame(target, frame)
         if not _contains(target, frame, crater, smooth_craters):
             raise ValueError(f"the crater (diameter {crater.diameter_m:g} m at x_m "
                              f"{crater.x_m:g}, y_m {crater.y_m:g}) with its ejecta does not "
@@ -394,7 +384,7 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
                                smooth=smooth_craters, gen=gen)
     arrays = [np.array(d.heights) for d in layers]
     arrays[home] = z
-    _propagate_up(arrays, target.windows, home)
+    propagate_up(arrays, target.windows, home)
     for j in range(home + 1, len(layers)):
         r0, c0, w = target.windows[j - 1]
         parent_new = arrays[j - 1][r0:r0 + w, c0:c0 + w]

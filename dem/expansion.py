@@ -87,7 +87,8 @@ from craters._shared import (
 from ._expand_kernels import _expand_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .fractal import _local_msd, fractal_fit
+from .errors import about
+from .fractal import fractal_fit, local_msd
 
 __all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]
 
@@ -150,15 +151,17 @@ def _region(dem: Dem, region) -> tuple[int, int, int]:
     if region is None:
         rows, cols = dem.shape
         if rows != cols or rows < 3 or (rows - 1) & (rows - 2):
-            raise ValueError(
-                f"`dem` is {rows} x {cols} pixels; expansion needs a square region of "
-                f"W = 2^n + 1 pixels ({allowed}): give `region` (--region) or crop the DEM")
+            with about("region"):
+                raise ValueError(
+                    f"`dem` is {rows} x {cols} pixels; expansion needs a square region of "
+                    f"W = 2^n + 1 pixels ({allowed}): give `region` or crop the DEM")
         return 0, 0, rows
     win = dem.window(region)
     h, w = int(win.height), int(win.width)
     if h != w or h < 3 or (h - 1) & (h - 2):
-        raise ValueError(f"`region` is {h} x {w} pixels; expansion needs a square of "
-                         f"W = 2^n + 1 pixels ({allowed})")
+        with about("region"):
+            raise ValueError(f"`region` is {h} x {w} pixels; expansion needs a square of "
+                             f"W = 2^n + 1 pixels ({allowed})")
     return int(win.row_off), int(win.col_off), h
 
 
@@ -189,9 +192,11 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     roughness : float, optional
         Uniform RMS slope between neighbouring input pixels (m/m, >= 0; 0 = smooth
         diamond-square interpolation). Default: local, from the input.
-    region : rasterio.windows.Window or rasterio.coords.BoundingBox, optional
-        The square to expand (pixels, or world bounds in CRS units selecting the pixels
-        whose centres lie inside). Default: the whole DEM, which must then be a
+    region : tuple, str, rasterio Window or BoundingBox, optional
+        The square to expand: ``(row, col, size)`` in pixels or ``(left, bottom, right,
+        top)`` in CRS units (the pixels whose centres lie inside), as a tuple or the same
+        text (``"0,0,257"``, as ``dem expand --region`` takes it; see
+        :func:`dem.core.parse_region`). Default: the whole DEM, which must then be a
         2^n + 1 square. Pixels around it are used as context for its border.
     rng : int, numpy.random.Generator or None
         Seed of the counter-based randomness. Give the same *int* to get the same pixels
@@ -212,7 +217,8 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     ((17, 17), (2.0, 2.0), True)
     """
     dem = _check_dem(dem)
-    levels = check_int("levels", levels, 1, 16)
+    with about("levels"):
+        levels = check_int("levels", levels, 1, 16)
     r0, c0, width = _region(dem, region)
     block = dem.heights[r0:r0 + width, c0:c0 + width]
     unknown = int(np.isnan(block).sum())
@@ -227,9 +233,11 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
                          f"{side} pixels and needs about {human_bytes(need)} of memory; this "
                          f"machine has {human_bytes(have)}")
     if fractal_dimension is not None:
-        fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
+        with about("fractal_dimension"):
+            fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
     if roughness is not None:
-        roughness = check_positive("roughness", roughness, allow_zero=True)
+        with about("roughness"):
+            roughness = check_positive("roughness", roughness, allow_zero=True)
     params: dict = {"levels": levels, "region": [r0, c0, width],
                     "input_resolution_m": dem.resolution_m}
     fit = None
@@ -249,7 +257,8 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
         amp = np.full((1, 1), roughness * resolution)
         amp_r0, amp_c0 = dem.origin[0] + r0, dem.origin[1] + c0
         params["roughness"] = roughness
-    key, seed = key_from_rng(rng)
+    with about("rng"):
+        key, seed = key_from_rng(rng)
     params["key"] = key
     heights = _expand_region(dem.heights, (r0, c0, width), dem.origin, dem.level, levels,
                              key, fractal_dimension, amp, (amp_r0, amp_c0), progress=progress)
@@ -277,7 +286,7 @@ def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
     b_r, b_c = min(r0 + width + m, rows), min(c0 + width + m, cols)
     e_r, e_c = max(a_r - 1, 0), max(a_c - 1, 0)
     z = dem.heights[e_r:min(b_r + 1, rows), e_c:min(b_c + 1, cols)]
-    msd = _local_msd(z)[a_r - e_r:a_r - e_r + b_r - a_r, a_c - e_c:a_c - e_c + b_c - a_c]
+    msd = local_msd(z)[a_r - e_r:a_r - e_r + b_r - a_r, a_c - e_c:a_c - e_c + b_c - a_c]
     amp = np.sqrt(msd)
     amp[~np.isfinite(amp)] = fallback
     return (np.ascontiguousarray(amp), dem.origin[0] + a_r, dem.origin[1] + a_c)

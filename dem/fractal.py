@@ -42,7 +42,8 @@ from craters._shared import check_int
 
 from .core import Dem
 
-__all__ = ["FractalFit", "fractal_dimension", "fractal_fit", "local_roughness", "variogram"]
+__all__ = ["FractalFit", "fractal_dimension", "fractal_fit", "local_msd", "local_roughness",
+           "variogram"]
 
 #: Lags (pixels) of the fractal-dimension estimate: the finest scales.
 DEFAULT_MAX_LAG_PX = 4
@@ -76,7 +77,7 @@ def _axis_diffs(z: np.ndarray, k: int, axis: int) -> np.ndarray:
     return z[:, k:] - z[:, :-k] if axis == 1 else z[k:, :] - z[:-k, :]
 
 
-def _local_msd(z: np.ndarray) -> np.ndarray:
+def local_msd(z: np.ndarray) -> np.ndarray:
     """m(p): mean squared height difference to the known axis neighbours (NaN if none)."""
     acc = np.zeros_like(z)
     cnt = np.zeros(z.shape, dtype=np.int64)
@@ -106,7 +107,7 @@ def local_roughness(dem: Dem) -> np.ndarray:
     [[0.707, 0.816, 0.707], [0.707, 0.816, 0.707]]
     """
     dem = _check_dem(dem)
-    return np.sqrt(_local_msd(dem.heights)) / dem.resolution_m
+    return np.sqrt(local_msd(dem.heights)) / dem.resolution_m
 
 
 def variogram(dem: Dem, max_lag_px: int = DEFAULT_MAX_LAG_PX):
@@ -167,7 +168,7 @@ def fractal_fit(dem: Dem, max_lag_px: int = DEFAULT_MAX_LAG_PX) -> FractalFit:
     max_lag_px = check_int("max_lag_px", max_lag_px, 1)
     z = dem.heights
     dx, dy = dem.pixel_size_m
-    msd = _local_msd(z)
+    msd = local_msd(z)
     finite = np.isfinite(msd)
     roughness = (math.sqrt(float(np.mean(msd[finite]))) / dem.resolution_m if finite.any()
                  else math.nan)

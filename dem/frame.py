@@ -38,7 +38,7 @@ from craters._shared import check_finite, check_positive
 from .core import Dem, crs_label
 
 __all__ = ["SQUARE_TOLERANCE", "LocalFrame", "grid_affine", "grid_pixel_size", "local_frame",
-           "pixel_affine"]
+           "pixel_affine", "resolve_frame"]
 
 #: Largest relative difference of the two pixel sides (and cosine of the angle between
 #: them) accepted for stamping craters into a DEM.
@@ -141,6 +141,18 @@ def local_frame(dem: Dem, origin=None) -> LocalFrame:
         return LocalFrame(ox, oy, radius * rad * coslat, radius * rad, "equirectangular")
     unit = crs.linear_units_factor[1]
     return LocalFrame(ox, oy, unit, unit, "projected")
+
+
+def resolve_frame(dem: Dem, frame: LocalFrame | None = None) -> LocalFrame:
+    """``frame``, or the default frame of ``dem`` (:func:`local_frame`) if None; checks
+    that ``dem`` is a Dem and ``frame`` a LocalFrame."""
+    if not isinstance(dem, Dem):
+        raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
+    if frame is None:
+        return local_frame(dem)
+    if not isinstance(frame, LocalFrame):
+        raise TypeError(f"`frame` must be a LocalFrame; got {type(frame).__name__}")
+    return frame
 
 
 def pixel_affine(dem: Dem, frame: LocalFrame) -> Affine:

@@ -11,6 +11,7 @@ from craters._shared import check_positive
 from ._fill_kernels import _fill_gaps_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
+from .errors import about
 from .expansion import midpoint_factor
 from .fractal import fractal_fit
 
@@ -81,8 +82,10 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *, rng=None) -> Dem:
     estimated = roughness is None
     if roughness is None:
         roughness = _known_roughness(dem)
-    roughness = check_positive("roughness", roughness, allow_zero=True)
-    key, seed = key_from_rng(rng)
+    with about("roughness"):
+        roughness = check_positive("roughness", roughness, allow_zero=True)
+    with about("rng"):
+        key, seed = key_from_rng(rng)
     z, _, n_waves = _fill(dem, roughness * dem.resolution_m, key)
     params = {"roughness": roughness, "estimated": estimated, "key": key,
               "filled_pixels": int((~dem.known).sum()), "waves": n_waves}

@@ -22,6 +22,7 @@ from craters._shared import atomic_path, check_int
 
 from ._pds import Quantity, find_object, parse_label
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
+from .errors import about, parameter_of
 
 __all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "read", "write"]
 
@@ -91,7 +92,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"DEM file {str(path)!r} does not exist")
-    band = check_int("band", band, 1)
+    with about("band"):
+        band = check_int("band", band, 1)
     if path.suffix.lower() in PDS_SUFFIXES:
         heights, transform, crs, tags, label_radius = _read_pds(path, band)
         if body_radius_m is None:
@@ -122,7 +124,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         return Dem._own(heights, transform, crs, pixel_size_m=pixel_size_m,
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
     except (ValueError, TypeError) as exc:
-        raise type(exc)(f"{str(path)!r}: {exc}") from None
+        with about(parameter_of(exc)):  # the file named, the parameter kept
+            raise type(exc)(f"{str(path)!r}: {exc}") from None
 
 
 def _read_gdal(path: Path, band: int):
@@ -131,8 +134,9 @@ def _read_gdal(path: Path, band: int):
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as ds:
                 if band > ds.count:
-                    raise ValueError(f"`band` must be in [1, {ds.count}] for {str(path)!r}; "
-                                     f"got {band}")
+                    with about("band"):
+                        raise ValueError(f"`band` must be in [1, {ds.count}] for "
+                                         f"{str(path)!r}; got {band}")
                 data = ds.read(band, masked=True)
                 scale, offset = ds.scales[band - 1], ds.offsets[band - 1]
                 transform, crs = ds.transform, ds.crs
@@ -232,7 +236,8 @@ def _read_pds(path: Path, band: int):
     nbytes = bits // 8
     dtype = np.dtype(f"{order if nbytes > 1 else '|'}{kind}{nbytes}")
     if band > bands:
-        raise ValueError(f"`band` must be in [1, {bands}] for {where!r}; got {band}")
+        with about("band"):
+            raise ValueError(f"`band` must be in [1, {bands}] for {where!r}; got {band}")
     if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
             "BAND_SEQUENTIAL":
         raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")

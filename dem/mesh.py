@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import atomic_path, progress_bar
+from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes, mesh_chunk
 
 from .core import Dem
 from .frame import local_frame, pixel_affine
@@ -184,8 +185,6 @@ class _Rocks:
     """The boulders of a stack, meshed a chunk at a time after the terrain."""
 
     def __init__(self, stack: Stack):
-        from craters.boulders import catalog_shape, mesh_chunk
-
         parts, layers = [], []
         for k, cat in enumerate(stack.boulders):
             if cat is not None and len(cat):
@@ -195,8 +194,8 @@ class _Rocks:
         self.layer = np.concatenate(layers) if layers else np.zeros(0, np.uint8)
         n = 0 if self.cat is None else len(self.cat)
         if n:
-            shape = catalog_shape(self.cat)
-            self.level, self.chunk = shape.levels[-1], mesh_chunk(shape)
+            self.shape = catalog_shape(self.cat)
+            self.level, self.chunk = self.shape.levels[-1], mesh_chunk(self.shape)
             self.ids = (self.cat["index"].astype(np.int32) if "index" in self.cat.dtype.names
                         else np.arange(n, dtype=np.int32))
         else:
@@ -210,16 +209,12 @@ class _Rocks:
 
     def vertex_chunks(self):
         """(xyz (m, 3), layer (m,), boulder_id (m,)) per chunk."""
-        from craters.boulders import iter_boulder_meshes
-
         for s0, world, _ in iter_boulder_meshes(self.cat, self.level, chunk=self.chunk):
             k = len(world)
             yield (world.reshape(-1, 3), np.repeat(self.layer[s0:s0 + k], self.nv),
                    np.repeat(self.ids[s0:s0 + k], self.nv))
 
     def face_chunks(self, base: int):
-        from craters.boulders import boulder_faces
-
         faces = boulder_faces(self.level)
         n = len(self.cat)
         for s0 in range(0, n, self.chunk):

@@ -31,10 +31,12 @@ from craters import make_catalog, read_catalog, validate_catalog, write_catalog,
 from craters._shared import check_int, check_parent_folder, package_version, progress_bar
 
 from .core import Dem, crs_label
+from .errors import about
 from .frame import LocalFrame, grid_pixel_size, pixel_affine
 from .io import read, write
 
-__all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "read_stack"]
+__all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "propagate_up", "read_stack",
+           "write_stack"]
 
 STACK_FORMAT = "craterform layer stack v1"
 #: File name of the manifest inside a stack folder.
@@ -266,22 +268,7 @@ class Stack:
         at the end, so an error leaves nothing behind. An existing ``folder`` is replaced
         only with ``force`` and only if it is empty or a stack folder (has a manifest).
         """
-        folder = check_stack_folder(folder, force=force)
-        with _atomic_folder(folder) as tmp:
-            steps = [("layer", k) for k in range(len(self))]
-            steps += [("craters", k) for k in range(len(self)) if self._catalogs[k] is not None]
-            steps += [("boulders", k) for k in range(len(self))
-                      if self._boulders[k] is not None]
-            for what, k in progress_bar(steps, enabled=progress, desc="write"):
-                if what == "layer":
-                    write(self._layers[k], tmp / _layer_file(k))
-                elif what == "craters":
-                    self._write_catalog(k, tmp)
-                else:
-                    self._write_catalog(k, tmp, boulders=True)
-            text = json.dumps(self.manifest(), indent=1, sort_keys=True, allow_nan=False)
-            (tmp / MANIFEST).write_text(text + "\n", encoding="utf-8")
-        return folder / MANIFEST
+        return write_stack(self, check_stack_folder(folder, force=force), progress=progress)
 
     def world_catalog(self, k: int, *, boulders: bool = False) -> np.ndarray:
         """Layer ``k``'s crater (or boulder) catalog with ``world_x, world_y`` columns (CRS
@@ -291,13 +278,13 @@ class Stack:
         cols = {n: cat[n] for n in cat.dtype.names if n not in ("world_x", "world_y")}
         return make_catalog(**cols, world_x=wx, world_y=wy)
 
-    def _write_catalog(self, k: int, folder: Path, *, boulders: bool = False) -> None:
-        csv_name, geojson_name = (_boulder_files if boulders else _catalog_files)(k)
-        cat = self.world_catalog(k, boulders=boulders)
-        write_catalog(cat, folder / csv_name)
-        crs = self._layers[0].crs
-        write_geojson(cat, folder / geojson_name, to_world=self._frame.to_world,
-                      crs=None if crs is None else crs_label(crs))
+
+def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
+    """Make layers k-1 .. 0 agree with layer k in place: each coarser footprint takes the
+    finer layer's even pixels (``arrays[j][footprint] = arrays[j + 1][::2, ::2]``)."""
+    for j in range(k - 1, -1, -1):
+        r0, c0, w = windows[j]
+        arrays[j][r0:r0 + w, c0:c0 + w] = arrays[j + 1][::2, ::2]
 
 
 def check_stack_folder(folder, *, force: bool) -> Path:
@@ -309,11 +296,41 @@ def check_stack_folder(folder, *, force: bool) -> Path:
             raise ValueError(f"output {str(folder)!r} exists and is not a folder")
         if any(folder.iterdir()):
             if not force:
-                raise ValueError(f"output {str(folder)!r} exists; use --force to overwrite")
+                with about("force"):
+                    raise ValueError(f"output {str(folder)!r} exists; replace it with `force`")
             if not (folder / MANIFEST).is_file():
                 raise ValueError(f"output {str(folder)!r} is not a stack folder (no {MANIFEST}); "
                                  f"refusing to replace it")
     return folder
+
+
+def write_stack(stack: Stack, folder: Path, *, progress: bool = False) -> Path:
+    """Write ``stack`` into ``folder``, already checked by :func:`check_stack_folder`
+    (:meth:`Stack.write` does both; the command line checks before the work); return the
+    manifest's path. The files go to a temporary folder next to ``folder`` that is renamed
+    into place at the end, so an error leaves nothing behind."""
+    n = len(stack)
+    with _atomic_folder(Path(folder)) as tmp:
+        steps = [("layer", k) for k in range(n)]
+        steps += [("craters", k) for k in range(n) if stack.catalogs[k] is not None]
+        steps += [("boulders", k) for k in range(n) if stack.boulders[k] is not None]
+        for what, k in progress_bar(steps, enabled=progress, desc="write"):
+            if what == "layer":
+                write(stack.layers[k], tmp / _layer_file(k))
+            else:
+                _write_catalog(stack, k, tmp, boulders=what == "boulders")
+        text = json.dumps(stack.manifest(), indent=1, sort_keys=True, allow_nan=False)
+        (tmp / MANIFEST).write_text(text + "\n", encoding="utf-8")
+    return Path(folder) / MANIFEST
+
+
+def _write_catalog(stack: Stack, k: int, folder: Path, *, boulders: bool = False) -> None:
+    csv_name, geojson_name = (_boulder_files if boulders else _catalog_files)(k)
+    cat = stack.world_catalog(k, boulders=boulders)
+    write_catalog(cat, folder / csv_name)
+    crs = stack.layers[0].crs
+    write_geojson(cat, folder / geojson_name, to_world=stack.frame.to_world,
+                  crs=None if crs is None else crs_label(crs))
 
 
 @contextlib.contextmanager

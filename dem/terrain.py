@@ -18,9 +18,10 @@ import math
 
 import numpy as np
 
-from craters._shared import area_slope_summary, check_choice, check_int
+from craters._shared import area_slope_summary, check_choice, check_int, check_range
 
 from .core import Dem
+from .errors import about
 from .fractal import FractalFit, fractal_fit
 
 __all__ = ["pixel_sizes_by_row", "power_spectrum", "roughness", "slope",
@@ -70,7 +71,8 @@ def slope(dem: Dem, method: str = "horn") -> np.ndarray:
     30.0
     """
     dem = _check(dem)
-    check_choice("method", method, ("horn", "central"))
+    with about("method"):
+        check_choice("method", method, ("horn", "central"))
     z = dem.heights
     out = np.full(z.shape, np.nan)
     if min(z.shape) < 3:
@@ -105,6 +107,8 @@ def slope_distribution(dem: Dem, bin_deg: float = 3.0, method: str = "horn") -> 
     ``median_deg``, ``mean_deg`` and ``percent_above`` (10, 20, 30 degrees); each pixel
     counts with its ground area (rows shrink with latitude on a geographic CRS).
     """
+    with about("bin_deg"):  # before the work (area_slope_summary checks it too)
+        check_range("bin_deg", bin_deg, 0.01, 90.0)
     s = slope(dem, method)
     width, dy = pixel_sizes_by_row(dem)
     area = np.broadcast_to((width * dy)[:, None], s.shape)

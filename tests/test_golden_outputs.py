@@ -84,7 +84,7 @@ STEPS: list[tuple[str, str, bool]] = [
     ("dem_fill", "dem fill gappy.tif -o filled.tif --seed 1 -q", False),
     ("dem_expand", ("dem expand filled.tif -o fine.tif --levels 2 --seed 1 "
      "--region 0,0,33 -q"), False),
-    ("dem_enhance", "dem enhance site.toml --seed 5 -q", False),
+    ("dem_enhance", "dem enhance --config site.toml --seed 5 -q", False),
     ("dem_mesh_stack", "dem mesh site/manifest.json -o site.ply -q", False),
     ("dem_mesh_one", "dem mesh fine.tif -o fine.vtp -q", False),
     ("dem_slopes", "dem slopes site/manifest.json --csv dsl.csv -q", False),

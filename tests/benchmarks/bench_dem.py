@@ -199,8 +199,8 @@ def bench_enhance(quick):
             'craters = ["c=0.05,k=-2,dmin=0.5,dmax=60000", '
             '"c=0.01,k=-1.8,dmin=5000,dmax=200000,amin=3,amax=3.9,kind=old"]\n')
         load = os.getloadavg()[0]
-        wall, rss = timed_child(["dem", "enhance", str(scene), "-o", str(tmp / "a"), "--seed",
-                                 "2014", "-q"])
+        wall, rss = timed_child(["dem", "enhance", "--config", str(scene), "-o", str(tmp / "a"),
+                                 "--seed", "2014", "-q"])
         stack = dem.read_stack(tmp / "a")
         pairs = [np.array_equal(stack.layers[k].heights[::2, ::2],
                                 stack.layers[k - 1].heights[r0:r0 + w, c0:c0 + w])
@@ -218,8 +218,8 @@ def bench_enhance(quick):
               f"steep ground {sum(c['erased_on_steep_ground'])}, rejected {c['rejected']}, "
               f"drawn {c['drawn']}: adds up {adds_up}; catalog rows {len(ids)}, distinct ids "
               f"{len(np.unique(ids))}")
-        wall1, _ = timed_child(["dem", "enhance", str(scene), "-o", str(tmp / "b"), "--seed",
-                                "2014", "-q"], env={"NUMBA_NUM_THREADS": "1"})
+        wall1, _ = timed_child(["dem", "enhance", "--config", str(scene), "-o", str(tmp / "b"),
+                                "--seed", "2014", "-q"], env={"NUMBA_NUM_THREADS": "1"})
         same = all((tmp / "a" / f.name).read_bytes() == f.read_bytes()
                    for f in (tmp / "b").iterdir())
         print(f"  rerun with NUMBA_NUM_THREADS=1: {wall1:.1f} s, same bytes in all "

@@ -290,7 +290,7 @@ def test_cli_enhance_boulders_same_bytes_any_thread_count(run_cli, tmp_path, roc
     digests = {}
     for tag, env in (("a", {}), ("t1", {"NUMBA_NUM_THREADS": "1"})):
         out = tmp_path / tag
-        proc = run_cli("dem", "enhance", "--input", str(src), "-o", str(out), "--layers", "4",
+        proc = run_cli("dem", "enhance", str(src), "-o", str(out), "--layers", "4",
                        "--size", "33", "--boulders", "c=0.02,k=-3,dmin=0.5,dmax=8",
                        "--seed", "2", "-q", env=env)
         assert proc.returncode == 0, proc.stderr
@@ -301,10 +301,10 @@ def test_cli_enhance_boulders_same_bytes_any_thread_count(run_cli, tmp_path, roc
         digests[tag]["m.ply"] = (out / "m.ply").read_bytes()
     assert digests["a"] == digests["t1"]
     assert any(n.startswith("boulders_") for n in digests["a"])
-    bad = run_cli("dem", "enhance", "--input", str(src), "-o", str(tmp_path / "x"),
+    bad = run_cli("dem", "enhance", str(src), "-o", str(tmp_path / "x"),
                   "--boulders", "c=0.02,k=3,dmin=0.5,dmax=8", cwd=tmp_path)
     one_line_error(bad, "--boulders", "`k`")
-    bad = run_cli("dem", "enhance", "--input", str(src), "-o", str(tmp_path / "x"),
+    bad = run_cli("dem", "enhance", str(src), "-o", str(tmp_path / "x"),
                   "--boulders", "c=0.02,k=-3,dmin=0.5,dmax=8", "--min-boulder-px", "0.5",
                   cwd=tmp_path)
     one_line_error(bad, "min_boulder_px")

@@ -220,20 +220,35 @@ def test_config_file(run_cli, capsys, tmp_path, tiny_geotiff):
     cfg.write_text('levels = 2\ncolour = "red"\n')
     assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)),
                           "colour", "allowed")
-    cfg.write_text("levels = 'two'\n")
-    assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)), "levels")
+    cfg.write_text("levels = 'two'\n")  # the library checks it, the file's key is named
+    assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled), "-o",
+                              str(tmp_path / "x.tif")), "config", "key 'levels'", "integer")
     cfg.write_text("levels = \n")
     assert_one_line_error(run("dem", "expand", "--config", str(cfg), str(filled)), "TOML")
 
 
-def test_every_option_has_a_config_key():
-    from dem.cli import _options, build_parser
+COMMANDS = ("info", "fill", "expand", "enhance", "mesh", "slopes", "spectrum")
 
-    parser = build_parser()
-    for command in ("fill", "expand"):
-        sub = parser._subparsers._group_actions[0].choices[command]
-        dests = {a.dest for a in sub._actions} - {"help", "config", "input"}
-        assert dests == set(_options(command))
+
+@pytest.mark.parametrize("command", COMMANDS)
+def test_every_option_has_a_config_key_and_shows_its_default(command):
+    from dem.cli import build_parser
+    from dem.cli.options import options_for
+
+    sub = build_parser()._subparsers._group_actions[0].choices[command]
+    actions = [a for a in sub._actions if a.dest != "help"]
+    assert {a.dest for a in actions} - {"config"} == set(options_for(command))
+    assert "input" in options_for(command)  # the input is positional everywhere
+    for action in actions:
+        assert "(default: " in action.help, (command, action.dest)
+
+
+def test_quiet_means_the_same_everywhere():
+    from dem.cli.options import options_for
+
+    quiet = {options_for(c)["quiet"] for c in COMMANDS if "quiet" in options_for(c)}
+    assert len(quiet) == 1 and next(iter(quiet)).flags == ("-q", "--quiet")
+    assert {c for c in COMMANDS if "quiet" not in options_for(c)} == {"info"}
 
 
 # --------------------------------------------------------------------------- enhance, mesh
@@ -261,7 +276,7 @@ def scene_keys(tmp_path, lola_tif, **extra):
 
 def test_enhance_and_mesh_through_the_entry_point(run_cli, tmp_path, lola_tif):
     scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif))
-    proc = run_cli("dem", "enhance", str(scene), "--seed", "9")
+    proc = run_cli("dem", "enhance", "--config", str(scene), "--seed", "9")
     assert proc.returncode == 0, proc.stderr
     assert "wrote" in proc.stdout and "seed 9" in proc.stdout
     stack = dem.read_stack(tmp_path / "stack" / "manifest.json")
@@ -300,14 +315,14 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
     trees = {}
     for threads in ("1", "2"):
         out = tmp_path / f"stack{threads}"
-        proc = run_cli("dem", "enhance", str(scene), "-o", str(out), "--seed", "4", "-q",
-                       env={"NUMBA_NUM_THREADS": threads})
+        proc = run_cli("dem", "enhance", "--config", str(scene), "-o", str(out), "--seed", "4",
+                       "-q", env={"NUMBA_NUM_THREADS": threads})
         assert proc.returncode == 0 and proc.stdout == "", proc.stderr
         trees[threads] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
     assert len(trees["1"]) == 3 + 2 * 3 + 1 and trees["1"] == trees["2"]
     other = tmp_path / "other"
-    assert InProcess(capsys)("dem", "enhance", str(scene), "-o", str(other), "--seed", "5",
-                             "-q").returncode == 0
+    assert InProcess(capsys)("dem", "enhance", "--config", str(scene), "-o", str(other),
+                             "--seed", "5", "-q").returncode == 0
     assert (other / "layer_02.tif").read_bytes() != trees["2"]["layer_02.tif"]
 
 
@@ -329,7 +344,7 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
     ("too-many-craters", {"craters": ["c=1e6,k=-3,dmin=0.001,dmax=5"]}, [],
      ["craters", "dmin"]),
     ("no-output", {"output": None}, [], ["-o/--output"]),
-    ("no-input", {"input": None}, [], ["base DEM"]),
+    ("no-input", {"input": None}, [], ["needs an input"]),
     ("no-radius", {"body_radius_m": None}, [], ["geographic CRS", "--body-radius-m"]),
     ("bad-toml", None, [], ["TOML"]),
     ("missing-scene", "missing", [], ["does not exist"]),
@@ -346,7 +361,7 @@ def test_enhance_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_
     before = sorted(p.name for p in tmp_path.iterdir())
     runner = run_cli if case in ("unknown-key", "target-outside", "size-zero") else \
         InProcess(capsys)
-    proc = runner("dem", "enhance", str(scene), *argv)
+    proc = runner("dem", "enhance", "--config", str(scene), *argv)
     assert_one_line_error(proc, *needles)
     assert sorted(p.name for p in tmp_path.iterdir()) == before
 
@@ -354,11 +369,13 @@ def test_enhance_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_
 def test_enhance_existing_output(run_cli, capsys, tmp_path, lola_tif):
     scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
     run = InProcess(capsys)
-    assert run("dem", "enhance", str(scene), "-q", "--seed", "1").returncode == 0
+    assert run("dem", "enhance", "--config", str(scene), "-q", "--seed", "1").returncode == 0
     first = (tmp_path / "stack" / "layer_01.tif").read_bytes()
-    assert_one_line_error(run("dem", "enhance", str(scene), "--seed", "2"), "exists", "--force")
+    assert_one_line_error(run("dem", "enhance", "--config", str(scene), "--seed", "2"), "exists",
+                          "--force")
     assert (tmp_path / "stack" / "layer_01.tif").read_bytes() == first
-    assert run("dem", "enhance", str(scene), "-q", "--seed", "2", "--force").returncode == 0
+    assert run("dem", "enhance", "--config", str(scene), "-q", "--seed", "2",
+               "--force").returncode == 0
     assert (tmp_path / "stack" / "layer_01.tif").read_bytes() != first
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.tif", "scene.toml", "stack"]
 
@@ -388,12 +405,47 @@ def test_mesh_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, lola_c
     assert (tmp_path / "keep.ply").read_text() == "keep me"
 
 
-def test_every_enhance_and_mesh_option_has_a_config_key():
-    from dem.cli import _options, build_parser
+def test_enhance_options_are_the_config_plus_the_run_options():
+    from dem.cli.options import options_for
 
-    parser = build_parser()
-    subs = parser._subparsers._group_actions[0].choices
-    dests = {a.dest for a in subs["enhance"]._actions} - {"help", "config"}
-    assert dests == set(_options("enhance")) == set(dem.EnhanceConfig.keys())
-    dests = {a.dest for a in subs["mesh"]._actions} - {"help", "config", "input"}
-    assert dests == set(_options("mesh"))
+    assert set(options_for("enhance")) == {*dem.EnhanceConfig.keys(), "output", "force",
+                                           "quiet"}
+
+
+def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_path, lola_tif,
+                                                                 monkeypatch):
+    import collections
+
+    import dem.cli.stack
+    import dem.config
+
+    calls = collections.Counter()
+
+    def counted(module, name, only=None):
+        real = getattr(module, name)
+
+        def call(*args, **kwargs):
+            if only is None or only(*args):
+                calls[name] += 1
+            return real(*args, **kwargs)
+
+        monkeypatch.setattr(module, name, call)
+
+    counted(dem.config, "parse_layer_spec")
+    counted(dem.config, "parse_boulder_spec")
+    counted(dem.config, "check_int", only=lambda name, *_: name == "seed")
+    counted(dem.cli.stack, "check_stack_folder")
+    scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
+    proc = InProcess(capsys)("dem", "enhance", "--config", str(scene), "--seed", "3", "-q",
+                             "--boulders", "c=0.00001,k=-3,dmin=300,dmax=2000")
+    assert proc.returncode == 0, proc.stderr
+    assert calls == {"parse_layer_spec": 2, "parse_boulder_spec": 1, "check_int": 1,
+                     "check_stack_folder": 1}
+    # the input as the argument overrides the file's, the other options come from the file
+    copy = tmp_path / "copy.tif"
+    copy.write_bytes(lola_tif.read_bytes())
+    proc = InProcess(capsys)("dem", "enhance", str(copy), "--config", str(scene), "-o",
+                             str(tmp_path / "other"), "--seed", "3", "-q")
+    assert proc.returncode == 0, proc.stderr
+    info = dem.read_stack(tmp_path / "other").info
+    assert info["parameters"]["input"] == str(copy) and info["parameters"]["layers"] == 2

@@ -107,7 +107,14 @@ def test_window_crop_and_origin():
     with pytest.raises(ValueError, match="not inside the DEM"):
         d.window(BoundingBox(0, 0, 1, 1))
     with pytest.raises(TypeError, match="Window"):
-        d.window((0, 0, 2, 2))
+        d.window(5)
+    # the same regions as tuples or text (what `dem expand --region` takes)
+    assert d.window((1, 2, 3)) == d.window("1,2,3") == Window(2, 1, 3, 3)
+    assert d.window((x0, y1, x1, y0)) == d.window(f"{x0},{y1},{x1},{y0}") == Window(2, 1, 3, 3)
+    with pytest.raises(ValueError, match="ROW,COL,SIZE"):
+        d.window("1,2")
+    with pytest.raises(ValueError, match="ROW,COL,SIZE"):
+        d.window((1.5, 2, 3))
 
 
 def test_history_tags():

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -11,7 +12,7 @@ from affine import Affine
 
 import craters
 import dem
-from dem.enhance import _geometry, _windows, plan_craters
+from dem.planning import layer_windows, plan_craters, stack_geometry
 
 REACH = craters.DEFAULT_EJECTA_EDGE * 1.02  # ejecta edge with the default rim irregularity
 
@@ -135,9 +136,9 @@ def test_band_split_has_the_law_of_one_catalog_split_afterwards():
     """Per-layer counts and mean diameters of the banded draw equal those of one catalog
     for layer 0's area, split crater by crater (independent reimplementation)."""
     size, n_layers, p0, min_px = 33, 3, 10.0, 2.0
-    _, windows, _, _ = _windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None, size,
-                                n_layers)
-    geom = _geometry(size, windows, p0)
+    _, windows, _, _ = layer_windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None,
+                                     size, n_layers)
+    geom = stack_geometry(size, windows, p0)
     spec = craters.parse_layer_spec("c=0.2,k=-2,dmin=5,dmax=300")
     half = (size - 1) / 2
     runs = 300
@@ -222,7 +223,7 @@ def test_write_read_roundtrip_and_files(tmp_path, stack):
                 [float(wx[0]), float(wy[0])])
             assert gj["crs"]["properties"]["name"] == "EPSG:32633"
     # an existing stack is replaced only with force; a foreign folder never
-    with pytest.raises(ValueError, match="exists; use --force"):
+    with pytest.raises(ValueError, match="exists; replace it with `force`"):
         stack.write(out)
     stack.write(out, force=True)
     other = tmp_path / "photos"
@@ -271,3 +272,26 @@ def test_unknown_pixels_in_layer0_are_refused(base):
     z[60, 60] = np.nan
     with pytest.raises(ValueError, match="unknown \\(NaN\\) pixels"):
         dem.enhance({"layers": 2, "size": 65}, dem=base.replace(heights=z))
+
+
+def test_config_is_typed_frozen_and_checked_where_made(base, tmp_path, monkeypatch):
+    layer = craters.CraterLayer(c=0.05, k=-2.0, d_min_m=100.0, d_max_m=3000.0)
+    cfg = dem.EnhanceConfig(layers=2, size=33, seed=1, craters=[layer, SPECS[0]])
+    assert cfg.crater_layers == (layer, craters.parse_layer_spec(SPECS[0]))
+    assert cfg.boulder_layers == () and "output" not in cfg.keys()
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cfg.layers = 3
+    monkeypatch.chdir(tmp_path)
+    s = dem.enhance(cfg, dem=base)
+    assert list(tmp_path.iterdir()) == []  # enhance writes nothing; Stack.write does
+    assert s.info["parameters"]["craters"] == [dataclasses.asdict(layer), SPECS[0]]
+    # run options are not part of a stack's description
+    with pytest.raises(ValueError, match="unknown config key.*'output'.*Stack.write"):
+        dem.enhance({"layers": 2, "size": 33, "output": "st"}, dem=base)
+    # errors name the field and carry it (the command line maps it to its option)
+    with pytest.raises(ValueError, match="`size` must be 2\\^n \\+ 1") as info:
+        dem.EnhanceConfig(size=100)
+    assert dem.errors.parameter_of(info.value) == "size"
+    with pytest.raises(TypeError, match="craters.BoulderLayer") as info:
+        dem.EnhanceConfig(boulders=[layer])
+    assert dem.errors.parameter_of(info.value) == "boulders"

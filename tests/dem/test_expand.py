@@ -138,7 +138,8 @@ def test_zero_roughness_keeps_a_plane():
     ({"region": Window(0, 0, 9, 17)}, r"17 x 9"),
     ({"region": Window(250, 0, 9, 9)}, "not inside the DEM"),
     ({"region": BoundingBox(0.0, 0.0, 1.0, 1.0)}, "not inside the DEM"),
-    ({"region": (0, 0, 9, 9)}, "Window"),
+    ({"region": 9}, "Window"),
+    ({"region": "0,0"}, "ROW,COL,SIZE"),
     ({"region": Window(0, 0, 9, 9), "levels": 0}, "levels"),
     ({"region": Window(0, 0, 9, 9), "levels": 17}, "levels"),
     ({"region": Window(0, 0, 9, 9), "fractal_dimension": 3.5}, "fractal_dimension"),
@@ -173,6 +174,10 @@ def test_region_by_window_and_bounds(lola_crop):
     assert np.array_equal(a.heights, b.heights) and a.transform == b.transform
     assert np.array_equal(a.heights[::2, ::2], lola_crop.heights[32:161, 64:193])
     assert a.origin == (64, 128)
+    # as the command line gives them: (row, col, size) or bounds, a tuple or the text
+    for region in ((32, 64, 129), "32,64,129", (x0, y1, x1, y0), f"{x0},{y1},{x1},{y0}"):
+        c = dem.expand(lola_crop, 1, region=region, rng=2)
+        assert np.array_equal(a.heights, c.heights) and a.transform == c.transform
 
 
 @pytest.mark.parametrize("levels", [1, 2, 3])

@@ -74,7 +74,7 @@ def write_foreign_geographic(path, z):
 
 def test_geographic_needs_radius_unless_craterform_wrote_it(tmp_path, lola_crop):
     foreign = write_foreign_geographic(tmp_path / "f.tif", lola_crop.heights)
-    with pytest.raises(ValueError, match="geographic CRS.*radius 1737400 m.*--body-radius-m"):
+    with pytest.raises(ValueError, match="geographic CRS.*radius 1737400 m.*`body_radius_m`"):
         dem.read(foreign)
     assert dem.read(foreign, body_radius_m=1737400.0).pixel_size_m == pytest.approx(
         lola_crop.pixel_size_m)
@@ -102,7 +102,7 @@ def test_read_errors(tmp_path, tiny_geotiff):
     with rasterio.open(nocrs, "w", driver="GTiff", width=4, height=4, count=1,
                        dtype="float32", transform=Affine(2, 0, 0, 0, -2, 8)) as ds:
         ds.write(np.zeros((4, 4), np.float32), 1)
-    with pytest.raises(ValueError, match="no CRS.*--pixel-size-m"):
+    with pytest.raises(ValueError, match="no CRS.*`pixel_size_m`"):
         dem.read(nocrs)
     assert dem.read(nocrs, pixel_size_m=3.0).pixel_size_m == (3.0, 3.0)
     allnan = tmp_path / "nan.tif"

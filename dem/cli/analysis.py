@@ -8,39 +8,38 @@ legend and listed in one CSV and one summary table.
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
-from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
+from craters._shared.cli import CliError, check_report_outputs
 from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
 
-from .io import read
-from .stack import read_stack
-from .terrain import power_spectrum, slope_distribution, spectral_exponent
+from ..stack import read_stack
+from ..terrain import power_spectrum, slope_distribution, spectral_exponent
+from .options import Settings, add_command, read_input
 
 
-def _inputs(args) -> list[tuple[str, object]]:
+def _inputs(s: Settings) -> list[tuple[str, object]]:
     out = []
-    for path in [args.input, *(args.compare or [])]:
+    for path in [s["input"], *(s["compare"] or [])]:
         p = Path(path)
         if p.suffix.lower() == ".json":
             stack = read_stack(p)
             out += [(f"{p.stem} layer {k}", layer) for k, layer in enumerate(stack.layers)]
         else:
-            out.append((p.stem, read(p, pixel_size_m=args.pixel_size_m,
-                                     body_radius_m=args.body_radius_m)))
-    if args.label:
-        if len(args.label) != len(out):
-            raise CliError(f"--label: give one label per input ({len(out)}, stack layers "
-                           f"count one each); got {len(args.label)}")
-        out = [(lab, d) for lab, (_, d) in zip(args.label, out, strict=True)]
+            out.append((p.stem, read_input(s, p)))
+    if s["label"]:
+        if len(s["label"]) != len(out):
+            raise CliError(f"{s.where('label')}: give one label per input ({len(out)}, stack "
+                           f"layers count one each); got {len(s['label'])}")
+        out = [(lab, d) for lab, (_, d) in zip(s["label"], out, strict=True)]
     return out
 
 
-def cmd_slopes(args) -> int:
-    if not 0.01 <= args.bin_deg <= 90:
-        raise CliError(f"--bin-deg must be in [0.01, 90]; got {args.bin_deg}")
+def _slopes(s: Settings) -> int:
+    args = SimpleNamespace(**s)
     check_report_outputs(args)
     results = [(label, slope_distribution(d, args.bin_deg, args.method))
-               for label, d in _inputs(args)]
+               for label, d in _inputs(s)]
     if args.csv:
         slope_csv(args.csv, f"dem slopes: {args.method} slopes in degrees; pixels weighted by "
                   "ground area; area fractions sum to 1; percent of the area steeper than the "
@@ -54,10 +53,11 @@ def cmd_slopes(args) -> int:
     return 0
 
 
-def cmd_spectrum(args) -> int:
+def _spectrum(s: Settings) -> int:
+    args = SimpleNamespace(**s)
     check_report_outputs(args)
     results = []
-    for label, d in _inputs(args):
+    for label, d in _inputs(s):
         if not d.known.all():
             raise CliError(f"{label}: the DEM has unknown pixels; fill them first (dem fill)")
         wl, p = power_spectrum(d)
@@ -99,19 +99,9 @@ def cmd_spectrum(args) -> int:
     return 0
 
 
-def add_parsers(sub) -> None:
-    """Register ``slopes`` and ``spectrum`` on the dem sub-command parser."""
-    for name, func, text in (("slopes", cmd_slopes, "slope distributions"),
-                             ("spectrum", cmd_spectrum, "radially averaged power spectra")):
-        p = sub.add_parser(name, help=f"{text} of DEMs or stack layers, with comparisons")
-        p.add_argument("input", help="a DEM (GeoTIFF, PDS .lbl/.img) or a stack manifest")
-        p.add_argument("--compare", nargs="+", metavar="OTHER", help="more inputs to overlay")
-        p.add_argument("--label", nargs="+", help="legend labels, one per input (layer)")
-        p.add_argument("--pixel-size-m", type=float, help="pixel size of DEMs without CRS")
-        p.add_argument("--body-radius-m", type=float, help="body radius for geographic CRS")
-        if name == "slopes":
-            p.add_argument("--method", choices=("horn", "central"), default="horn",
-                           help="slope estimator (default horn)")
-            p.add_argument("--bin-deg", type=float, default=3.0, help="histogram bin, degrees")
-        add_report_arguments(p)
-        p.set_defaults(func=func)
+def register(sub) -> None:
+    """Add ``slopes`` and ``spectrum`` to the sub-command parser."""
+    add_command(sub, "slopes", _slopes,
+                "slope distributions of DEMs or stack layers, with comparisons")
+    add_command(sub, "spectrum", _spectrum,
+                "radially averaged power spectra of DEMs or stack layers, with comparisons")

@@ -1,0 +1,96 @@
+"""``dem info``, ``dem fill`` and ``dem expand``: one DEM in, one DEM (or a description) out."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from craters._shared import normalize_rng, progress_bar
+
+from ..core import crs_label
+from ..errors import about
+from ..expansion import expand
+from ..fractal import fractal_fit
+from ..gaps import fill_gaps
+from ..io import GEOTIFF_SUFFIXES, write
+from .options import Settings, add_command, check_output, read_input
+
+
+def _seed(s: Settings) -> int:
+    """The given seed (checked before any work) or a fresh one; recorded in the output."""
+    if s["seed"] is None:
+        return int(np.random.SeedSequence().entropy % (2**63))
+    with about("rng"):
+        normalize_rng(s["seed"])
+    return s["seed"]
+
+
+def _transform(s: Settings) -> int:
+    """``dem fill`` and ``dem expand``."""
+    command = s.command
+    check_output(s, GEOTIFF_SUFFIXES)
+    seed = _seed(s)
+    show = not s["quiet"]
+    bar = progress_bar(total=3, enabled=show, desc=command)
+    bar.set_description(f"read {s['input']}")
+    dem = read_input(s)
+    bar.update()
+    bar.set_description(command)
+    if command == "fill":
+        out = fill_gaps(dem, s["roughness"], rng=seed)
+    else:
+        out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
+                     rng=seed, progress=show)
+    bar.update()
+    bar.set_description(f"write {s['output']}")
+    write(out, s["output"])
+    bar.update()
+    bar.close()
+    if show:
+        params = out.history[-1]["parameters"]
+        detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
+                           else f"{k} {params[k]}" for k in params
+                           if k in ("levels", "fractal_dimension", "roughness",
+                                    "filled_pixels", "waves"))
+        print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {out.shape[0]} x "
+              f"{out.shape[1]} pixels, seed {seed}, {detail}")
+        print(f"wrote {s['output']}")
+    return 0
+
+
+def _info(s: Settings) -> int:
+    dem = read_input(s)
+    z = dem.heights[dem.known]
+    t = dem.transform
+    px = dem.pixel_size_m
+    rows = [
+        ("file", s["input"]),
+        ("size", f"{dem.shape[0]} x {dem.shape[1]} pixels (rows x cols)"),
+        ("crs", crs_label(dem.crs)),
+        ("pixel_m", f"{px[0]:.6g} x {px[1]:.6g} (x, y; resolution {dem.resolution_m:.6g})"),
+        ("transform", ", ".join(f"{v:.10g}" for v in tuple(t)[:6])),
+        ("body_m", "-" if dem.body_radius_m is None else f"{dem.body_radius_m:.10g}"),
+        ("unknown", f"{100 * dem.nan_fraction:.3f} % ({dem.heights.size - z.size} pixels)"),
+        ("height_m", f"min {z.min():.6g}  mean {z.mean():.6g}  max {z.max():.6g}"),
+    ]
+    try:
+        fit = fractal_fit(dem)
+        method = "locally normalised variogram, lags 1-4 px"
+        rows += [("fractal_d", f"{fit.fractal_dimension:.4f} ({method})"),
+                 ("roughness", f"{fit.roughness:.6g} (RMS neighbour slope, m/m)")]
+    except ValueError as exc:
+        rows.append(("fractal_d", f"n/a ({exc})"))
+    for step in dem.history:
+        rows.append(("history", f"{step['op']} seed {step['seed']}"))
+    for key, value in rows:
+        print(f"{key:<10} {value}")
+    return 0
+
+
+def register(sub) -> None:
+    """Add ``info``, ``fill`` and ``expand`` to the sub-command parser."""
+    add_command(sub, "info", _info,
+                "describe a DEM (size, CRS, pixel size, heights, fractal dimension)")
+    add_command(sub, "fill", _transform,
+                "fill the unknown pixels of a DEM with fractal terrain, outside in")
+    add_command(sub, "expand", _transform,
+                "double the resolution of a DEM (region) by random midpoint displacement")

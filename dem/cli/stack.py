@@ -1,0 +1,63 @@
+"""``dem enhance`` and ``dem mesh``: layer stacks around a site and their meshes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from craters._shared.cli import CliError
+
+from ..config import EnhanceConfig
+from ..enhance import enhance
+from ..mesh import MESH_SUFFIXES, to_mesh
+from ..stack import check_stack_folder, read_stack, write_stack
+from .options import Settings, add_command, check_output, read_input
+
+
+def _enhance(s: Settings) -> int:
+    # the stack's description is validated once, here (every spec parsed once), and the
+    # output folder checked once, before any work
+    if not s["output"]:
+        raise CliError("nothing to write: give -o/--output")
+    cfg = EnhanceConfig.from_mapping({key: s[key] for key in EnhanceConfig.keys()})
+    folder = check_stack_folder(s["output"], force=s["force"])
+    show = not s["quiet"]
+    stack = enhance(cfg, progress=show)
+    manifest = write_stack(stack, folder, progress=show)
+    if show:
+        info = stack.info
+        c = info["craters"]
+        sizes = stack.pixel_sizes_m()
+        print(f"dem enhance: {len(stack)} layers of {cfg.size} x {cfg.size} pixels, "
+              f"{sizes[0]:.4g} m -> {sizes[-1]:.4g} m per pixel, seed {info['seed']}; craters "
+              f"stamped {sum(c['stamped'])}, erased on steep ground "
+              f"{sum(c['erased_on_steep_ground'])}, rejected {c['rejected']} of {c['drawn']}")
+        b = info.get("boulders")
+        if b:
+            print(f"boulders stamped {sum(b['stamped'])}, rejected {b['rejected']} of "
+                  f"{b['drawn']} (below {cfg.min_boulder_px:g} px of the finest layer or "
+                  f"crossing a layer's border)")
+        print(f"wrote {manifest}")
+    return 0
+
+
+def _mesh(s: Settings) -> int:
+    check_output(s, MESH_SUFFIXES)
+    show = not s["quiet"]
+    if Path(s["input"]).suffix.lower() == ".json":
+        src = read_stack(s["input"], progress=show)
+    else:
+        src = read_input(s)
+    path = to_mesh(src, s["output"], progress=show, boulders=not s["no_boulders"])
+    if show:
+        n = len(src) if hasattr(src, "layers") else 1
+        print(f"dem mesh: {n} layer(s), {path.stat().st_size / 2**20:.1f} MiB")
+        print(f"wrote {path}")
+    return 0
+
+
+def register(sub) -> None:
+    """Add ``enhance`` and ``mesh`` to the sub-command parser."""
+    add_command(sub, "enhance", _enhance,
+                "build a stack of layers around a site, each 2x finer, with craters per layer")
+    add_command(sub, "mesh", _mesh,
+                "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP")

@@ -1,0 +1,180 @@
+"""The typed description of a layer stack: :class:`EnhanceConfig` (what :func:`dem.enhance`
+builds; the keys of a ``dem enhance`` TOML scene but the run options ``output``,
+``force`` and ``quiet``, which are the command line's or :meth:`dem.Stack.write`'s).
+
+It is validated once, where it is made (from command-line options, a TOML file or
+Python): every field is checked, every crater and boulder spec parsed (the parsed layers
+are :attr:`EnhanceConfig.crater_layers` and :attr:`EnhanceConfig.boulder_layers`). An
+error names the field (``exc.parameter``, see :mod:`dem.errors`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+
+from craters import BoulderLayer, CraterLayer, parse_boulder_spec, parse_layer_spec
+from craters._shared import check_int, check_positive, check_range
+
+from .errors import about
+
+__all__ = ["EnhanceConfig"]
+
+# keys of ``dem enhance`` that are not part of a stack's description
+_RUN_KEYS = ("output", "force", "quiet")
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class EnhanceConfig:
+    """Everything that defines a layer stack; validated when made (module notes).
+
+    Examples
+    --------
+    >>> cfg = EnhanceConfig(layers=3, size=17, craters=["c=0.05,k=-2,dmin=20,dmax=800"])
+    >>> cfg.crater_layers[0].d_max_m, cfg.to_dict()["craters"]
+    (800.0, ['c=0.05,k=-2,dmin=20,dmax=800'])
+    >>> EnhanceConfig(size=100)
+    Traceback (most recent call last):
+    ...
+    ValueError: `size` must be 2^n + 1 pixels, 5..16385 (5, 9, 17, ..., 1025, 2049, ...); got 100
+    """
+
+    input: str | None = None
+    """Base DEM file (GeoTIFF or PDS3 .lbl/.img); or pass the Dem to :func:`dem.enhance`."""
+    target: tuple[float, float] | None = None
+    """Site in world coordinates (CRS units, X then Y); default: the base DEM's centre."""
+    layers: int = 11
+    """Number of layers, 1..24 (layer k has pixels 2^k finer than the base)."""
+    size: int = 1025
+    """Pixels per side of every layer: 2^n + 1, 5..16385."""
+    craters: tuple[str | CraterLayer, ...] = ()
+    """Crater layers: specs ``c=..,k=..,dmin=..,dmax=..[,amin,amax,deg,kind]`` (metres,
+    Gyr) or :class:`craters.CraterLayer` objects."""
+    min_crater_px: float = 2.0
+    """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
+    boulders: tuple[str | BoulderLayer, ...] = ()
+    """Boulder layers: specs ``c=..,k=..,dmin=..,dmax=..[,burial,near]`` (metres; ``near``
+    is ignored on DEMs) or :class:`craters.BoulderLayer` objects."""
+    min_boulder_px: float = 2.0
+    """Smallest boulder a layer takes, in its pixels (>= 1)."""
+    smooth_craters: bool = False
+    """Ideal craters: no fractal overlay, circular rims."""
+    fractal_dimension: float | None = None
+    """F in [2, 3] of the expansion; default: estimated on layer 0."""
+    roughness: float | None = None
+    """Uniform RMS neighbour slope (m/m) of the expansion; default: local relief."""
+    seed: int | None = None
+    """Seed of everything random, in [0, 2^63) (a fresh one is drawn and recorded if
+    None)."""
+    band: int = 1
+    """Band of the input file (1-based)."""
+    pixel_size_m: float | None = None
+    """Pixel size in metres, for inputs without a CRS."""
+    body_radius_m: float | None = None
+    """Body radius in metres, for inputs with a geographic CRS."""
+    crater_layers: tuple[CraterLayer, ...] = dataclasses.field(init=False, repr=False,
+                                                                compare=False)
+    """The parsed :attr:`craters` (set when the config is made)."""
+    boulder_layers: tuple[BoulderLayer, ...] = dataclasses.field(init=False, repr=False,
+                                                                  compare=False)
+    """The parsed :attr:`boulders` (set when the config is made)."""
+
+    def __post_init__(self):
+        def put(name, value):
+            object.__setattr__(self, name, value)
+
+        with about("input"):
+            if self.input is not None and (not isinstance(self.input, str) or not self.input):
+                raise TypeError(f"`input` must be a file name; got {self.input!r}")
+        with about("target"):
+            t = self.target
+            if t is not None:
+                if (isinstance(t, str) or not hasattr(t, "__len__") or len(t) != 2
+                        or not all(isinstance(v, numbers.Real) and not isinstance(v, bool)
+                                   for v in t)):
+                    raise TypeError(f"`target` must be [x, y] in world coordinates (CRS "
+                                    f"units); got {t!r}")
+                if not all(math.isfinite(v) for v in t):
+                    raise ValueError(f"`target` must be finite; got {t!r}")
+                put("target", (float(t[0]), float(t[1])))
+        with about("layers"):
+            put("layers", check_int("layers", self.layers, 1, 24))
+        with about("size"):
+            size = check_int("size", self.size)
+            if size < 5 or size > 16385 or (size - 1) & (size - 2):
+                raise ValueError(f"`size` must be 2^n + 1 pixels, 5..16385 (5, 9, 17, ..., "
+                                 f"1025, 2049, ...); got {size}")
+            put("size", size)
+        for name, parse, kind, example in (
+                ("craters", parse_layer_spec, CraterLayer, "c=0.05,k=-2,dmin=1,dmax=500"),
+                ("boulders", parse_boulder_spec, BoulderLayer, "c=0.01,k=-3,dmin=0.5,dmax=5")):
+            with about(name):
+                specs = getattr(self, name)
+                if isinstance(specs, str) or not isinstance(specs, list | tuple):
+                    raise TypeError(f"`{name}` must be a list of {name[:-1]} layer specs like "
+                                    f"'{example}'; got {specs!r}")
+                parsed = []
+                for spec in specs:
+                    if not isinstance(spec, str | kind):
+                        raise TypeError(f"`{name}` must hold {name[:-1]} layer specs like "
+                                        f"'{example}' or craters.{kind.__name__}; got "
+                                        f"{spec!r}")
+                    parsed.append(spec if isinstance(spec, kind) else parse(spec))
+                put(name, tuple(specs))
+                put(f"{name[:-1]}_layers", tuple(parsed))
+        for name in ("min_crater_px", "min_boulder_px"):
+            with about(name):
+                put(name, check_range(name, getattr(self, name), 1.0, 1e6))
+        with about("smooth_craters"):
+            if not isinstance(self.smooth_craters, bool):
+                raise TypeError(f"`smooth_craters` must be true or false; got "
+                                f"{self.smooth_craters!r}")
+        if self.fractal_dimension is not None:
+            with about("fractal_dimension"):
+                check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)
+        if self.roughness is not None:
+            with about("roughness"):
+                check_positive("roughness", self.roughness, allow_zero=True)
+        if self.seed is not None:
+            with about("seed"):
+                check_int("seed", self.seed, 0, 2**63 - 1)
+        with about("band"):
+            check_int("band", self.band, 1)
+        for name in ("pixel_size_m", "body_radius_m"):
+            if getattr(self, name) is not None:
+                with about(name):
+                    check_positive(name, getattr(self, name))
+
+    @classmethod
+    def keys(cls) -> tuple[str, ...]:
+        """The config keys, in order."""
+        return tuple(f.name for f in dataclasses.fields(cls) if f.init)
+
+    @classmethod
+    def from_mapping(cls, config) -> EnhanceConfig:
+        """Validate a dict (e.g. parsed TOML); unknown keys are errors."""
+        if isinstance(config, cls):
+            return config
+        if not isinstance(config, dict):
+            raise TypeError(f"`config` must be a dict of scene keys; got "
+                            f"{type(config).__name__}")
+        unknown = sorted(set(config) - set(cls.keys()))
+        if unknown:
+            run = [k for k in unknown if k in _RUN_KEYS]
+            hint = (f" ({', '.join(run)}: how to write a stack, not what it is; use "
+                    f"Stack.write(folder, force=...) and enhance(..., progress=...))"
+                    if run else "")
+            raise ValueError(f"unknown config key(s) {', '.join(map(repr, unknown))}; "
+                             f"allowed: {', '.join(cls.keys())}{hint}")
+        return cls(**config)
+
+    def to_dict(self) -> dict:
+        """JSON-ready values that define the stack (for the manifest): the specs as given
+        (a layer object as a dict of its fields)."""
+        d = {name: getattr(self, name) for name in self.keys()}
+        for name in ("craters", "boulders"):
+            d[name] = [s if isinstance(s, str) else dataclasses.asdict(s)
+                       for s in getattr(self, name)]
+        d["target"] = None if self.target is None else list(self.target)
+        return d
