@@ -93,9 +93,9 @@ def _cmd_profile(args) -> int:
 
 # --------------------------------------------------------------------------- population
 def _cmd_population(args) -> int:
-    specs = args.layer or []
+    specs = args.craters or []
     if not specs:
-        raise CliError("give at least one --layer c=...,k=...,d_min_m=...,d_max_m=...")
+        raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=...")
     layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
     where = [args.radius_m is not None, args.area_m2 is not None,
              args.x_range_m is not None or args.y_range_m is not None]
@@ -160,30 +160,45 @@ def build_parser() -> OneLineParser:
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     p = sub.add_parser("profile", help="a crater's radial profile as CSV and/or a plot")
-    p.add_argument("--diameter-m", type=float, required=True, help="rim diameter, metres")
-    p.add_argument("--degradation", type=float, help="0 (fresh) to 1 (fully degraded)")
-    p.add_argument("--age-gyr", type=float, help="age in Gyr (degradation from age)")
+    p.add_argument("--diameter-m", type=float, required=True,
+                   help="rim diameter, metres (required)")
+    p.add_argument("--degradation", type=float,
+                   help="0 (fresh) to 1 (fully degraded) (default: from --age-gyr, else 0)")
+    p.add_argument("--age-gyr", type=float,
+                   help="age in Gyr (degradation from age) (default: none)")
     p.add_argument("--morphometry", default="lunar-simple",
-                   choices=("lunar-simple", "asteroid-fresh"), help="fresh d/D laws")
-    p.add_argument("--csv", help="write x, r_m, height_m")
-    p.add_argument("--plot", help="PNG with profiles at several ages (like Martin Fig. 3)")
-    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("-q", "--quiet", action="store_true", help="no summary line")
+                   choices=("lunar-simple", "asteroid-fresh"),
+                   help="fresh d/D laws (default: lunar-simple)")
+    p.add_argument("--csv", help="write x, r_m, height_m (default: none)")
+    p.add_argument("--plot", help="PNG with profiles at several ages (like Martin Fig. 3) "
+                   "(default: none)")
+    p.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")
+    p.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bars or messages (default: off)")
     p.set_defaults(func=_cmd_profile)
     q = sub.add_parser("population", help="a power-law crater catalog (CSV)")
-    q.add_argument("--layer", action="append", metavar="SPEC",
-                   help="c=0.5,k=-2,d_min_m=5,d_max_m=800[,age_min_gyr=0,age_max_gyr=3.5,degradation=0.2,kind=simple]"
-                        " (metres, Gyr; repeatable for piecewise laws)")
-    q.add_argument("--radius-m", type=float, help="sphere radius (positions lat/lon)")
-    q.add_argument("--area-m2", type=float, help="area for the count (positions lat/lon)")
-    q.add_argument("--x-range-m", type=_pair, help="LOW,HIGH: a rectangle (positions x/y)")
-    q.add_argument("--y-range-m", type=_pair, help="LOW,HIGH")
-    q.add_argument("--age-max-gyr", type=float, default=3.5, help="default oldest age")
-    q.add_argument("--seed", type=parse_seed, help="random seed")
-    q.add_argument("-o", "--output", required=True, help="catalog CSV")
-    q.add_argument("--plot", help="PNG of the cumulative SFD against the requested law")
-    q.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    q.add_argument("-q", "--quiet", action="store_true", help="no summary line")
+    q.add_argument("--craters", action="append", metavar="SPEC",
+                   help="crater layer c=0.5,k=-2,d_min_m=5,d_max_m=800[,age_min_gyr=0,"
+                        "age_max_gyr=3.5,degradation=0.2,kind=simple] (the fields of "
+                        "craters.CraterLayer; metres, Gyr; repeatable for piecewise laws; "
+                        "required)")
+    q.add_argument("--radius-m", type=float,
+                   help="sphere radius (positions lat/lon) (default: none)")
+    q.add_argument("--area-m2", type=float,
+                   help="area for the count (positions lat/lon) (default: none)")
+    q.add_argument("--x-range-m", type=_pair,
+                   help="LOW,HIGH: a rectangle (positions x/y) (default: none)")
+    q.add_argument("--y-range-m", type=_pair, help="LOW,HIGH (default: none)")
+    q.add_argument("--age-max-gyr", type=float, default=3.5,
+                   help="oldest age of layers that do not give age_max_gyr (default: 3.5)")
+    q.add_argument("--seed", type=parse_seed,
+                   help="random seed (default: a fresh one)")
+    q.add_argument("-o", "--output", required=True, help="catalog CSV (required)")
+    q.add_argument("--plot", help="PNG of the cumulative SFD against the requested law "
+                   "(default: none)")
+    q.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")
+    q.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bars or messages (default: off)")
     q.set_defaults(func=_cmd_population)
     return parser
 

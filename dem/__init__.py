@@ -10,7 +10,7 @@
       -> to_mesh (mesh: PLY/VTP) | slope, power_spectrum (terrain), fractal_fit (fractal)
 
 Beside them: ``frame`` (local metric frames), ``boulders`` (boulders on rasters),
-``errors`` (errors that name their parameter), ``_*kernels`` (numba) and ``cli/`` (the
+``_*kernels`` (numba) and ``cli/`` (the
 ``dem`` command line, which imports the library, never the reverse; ``dem --help``).
 
 Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement

@@ -58,7 +58,7 @@ def _layers(layers) -> list[BoulderLayer]:
     out = [craters.parse_boulder_spec(la) if isinstance(la, str) else la for la in layers]
     if not out or not all(isinstance(la, BoulderLayer) for la in out):
         raise TypeError("`layers` must be BoulderLayer(s) or specs like "
-                        "'c=0.01,k=-3,dmin=0.5,dmax=5'")
+                        "'c=0.01,k=-3,d_min_m=0.5,d_max_m=5'")
     return out
 
 

@@ -15,9 +15,7 @@ import math
 import numbers
 
 from craters import BoulderLayer, CraterLayer, parse_boulder_spec, parse_layer_spec
-from craters._shared import check_int, check_positive, check_range
-
-from .errors import about
+from craters._shared import about, check_int, check_positive, check_range
 
 __all__ = ["EnhanceConfig"]
 
@@ -31,9 +29,9 @@ class EnhanceConfig:
 
     Examples
     --------
-    >>> cfg = EnhanceConfig(layers=3, size=17, craters=["c=0.05,k=-2,dmin=20,dmax=800"])
+    >>> cfg = EnhanceConfig(layers=3, size=17, craters=["c=0.05,k=-2,d_min_m=20,d_max_m=800"])
     >>> cfg.crater_layers[0].d_max_m, cfg.to_dict()["craters"]
-    (800.0, ['c=0.05,k=-2,dmin=20,dmax=800'])
+    (800.0, ['c=0.05,k=-2,d_min_m=20,d_max_m=800'])
     >>> EnhanceConfig(size=100)
     Traceback (most recent call last):
     ...
@@ -49,12 +47,12 @@ class EnhanceConfig:
     size: int = 1025
     """Pixels per side of every layer: 2^n + 1, 5..16385."""
     craters: tuple[str | CraterLayer, ...] = ()
-    """Crater layers: specs ``c=..,k=..,dmin=..,dmax=..[,amin,amax,deg,kind]`` (metres,
+    """Crater layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,amin,amax,deg,kind]`` (metres,
     Gyr) or :class:`craters.CraterLayer` objects."""
     min_crater_px: float = 2.0
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
     boulders: tuple[str | BoulderLayer, ...] = ()
-    """Boulder layers: specs ``c=..,k=..,dmin=..,dmax=..[,burial,near]`` (metres; ``near``
+    """Boulder layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,burial,near]`` (metres; ``near``
     is ignored on DEMs) or :class:`craters.BoulderLayer` objects."""
     min_boulder_px: float = 2.0
     """Smallest boulder a layer takes, in its pixels (>= 1)."""
@@ -107,8 +105,9 @@ class EnhanceConfig:
                                  f"1025, 2049, ...); got {size}")
             put("size", size)
         for name, parse, kind, example in (
-                ("craters", parse_layer_spec, CraterLayer, "c=0.05,k=-2,dmin=1,dmax=500"),
-                ("boulders", parse_boulder_spec, BoulderLayer, "c=0.01,k=-3,dmin=0.5,dmax=5")):
+                ("craters", parse_layer_spec, CraterLayer, "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
+                ("boulders", parse_boulder_spec, BoulderLayer,
+                 "c=0.01,k=-3,d_min_m=0.5,d_max_m=5")):
             with about(name):
                 specs = getattr(self, name)
                 if isinstance(specs, str) or not isinstance(specs, list | tuple):

@@ -15,9 +15,7 @@ from rasterio.crs import CRS
 from rasterio.errors import CRSError
 from rasterio.windows import Window
 
-from craters._shared import check_int, check_positive, package_version
-
-from .errors import about
+from craters._shared import about, check_int, check_positive, package_version
 
 __all__ = ["Dem", "HISTORY_TAG", "crs_label", "parse_region"]
 

@@ -149,7 +149,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     --------
     >>> base = Dem(np.random.default_rng(0).normal(0, 5, (33, 33)), pixel_size_m=100.0)
     >>> s = enhance({"layers": 3, "size": 17, "seed": 1,
-    ...              "craters": ["c=0.05,k=-2,dmin=20,dmax=800"]}, dem=base)
+    ...              "craters": ["c=0.05,k=-2,d_min_m=20,d_max_m=800"]}, dem=base)
     >>> s.shapes, s.pixel_sizes_m(), s.is_consistent()
     ([(17, 17), (17, 17), (17, 17)], [100.0, 50.0, 25.0], True)
     >>> c = s.info["craters"]

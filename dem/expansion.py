@@ -76,6 +76,7 @@ import numpy as np
 from affine import Affine
 
 from craters._shared import (
+    about,
     check_int,
     check_positive,
     check_range,
@@ -87,7 +88,6 @@ from craters._shared import (
 from ._expand_kernels import _expand_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .errors import about
 from .fractal import fractal_fit, local_msd
 
 __all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]

@@ -6,12 +6,11 @@ import math
 
 import numpy as np
 
-from craters._shared import check_positive
+from craters._shared import about, check_positive
 
 from ._fill_kernels import _fill_gaps_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .errors import about
 from .expansion import midpoint_factor
 from .fractal import fractal_fit
 

@@ -18,11 +18,10 @@ from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.profiles import DefaultGTiffProfile
 
-from craters._shared import atomic_path, check_int
+from craters._shared import about, atomic_path, check_int, parameter_of
 
 from ._pds import Quantity, find_object, parse_label
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
-from .errors import about, parameter_of
 
 __all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "read", "write"]
 

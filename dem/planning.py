@@ -170,7 +170,7 @@ class _Drawn:
 def _poisson(rng: np.random.Generator, mean: float, what: str, noun: str) -> int:
     if mean > _MAX_COUNT_MEAN:
         raise ValueError(f"{what}: about {mean:.3g} {noun}s; the {noun} layers ask for an "
-                         f"absurd number of small {noun}s (raise dmin or lower c)")
+                         f"absurd number of small {noun}s (raise d_min_m or lower c)")
     return int(rng.poisson(mean)) if mean > 0 else 0
 
 
@@ -224,7 +224,7 @@ def _plan_banded(specs, geometry: StackGeometry, drawn: _Drawn, *, min_px: float
                    for b in range(n) for _, s in bands[b])
     if expected > MAX_STAMPED:
         raise ValueError(f"the {noun} layers put about {expected:.3g} {noun}s into the stack "
-                         f"(limit {MAX_STAMPED:.0e}); raise dmin or lower c")
+                         f"(limit {MAX_STAMPED:.0e}); raise d_min_m or lower c")
     tag_band, tag_outside, tag_small = drawn.streams
     per_layer: list[list[np.ndarray]] = [[] for _ in range(n)]
     band_rows = []

@@ -28,10 +28,9 @@ from pathlib import Path
 import numpy as np
 
 from craters import make_catalog, read_catalog, validate_catalog, write_catalog, write_geojson
-from craters._shared import check_int, check_parent_folder, package_version, progress_bar
+from craters._shared import about, check_int, check_parent_folder, package_version, progress_bar
 
 from .core import Dem, crs_label
-from .errors import about
 from .frame import LocalFrame, grid_pixel_size, pixel_affine
 from .io import read, write
 

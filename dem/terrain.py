@@ -18,10 +18,9 @@ import math
 
 import numpy as np
 
-from craters._shared import area_slope_summary, check_choice, check_int, check_range
+from craters._shared import about, area_slope_summary, check_choice, check_int, check_range
 
 from .core import Dem
-from .errors import about
 from .fractal import FractalFit, fractal_fit
 
 __all__ = ["pixel_sizes_by_row", "power_spectrum", "roughness", "slope",

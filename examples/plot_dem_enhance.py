@@ -36,8 +36,8 @@ scene = {
     "size": 65 if small else 129,
     "target": [180.0, 0.0],  # lon, lat in degrees (the CRS's units)
     "seed": 2014,
-    "craters": ["c=0.05,k=-2,dmin=20,dmax=150000",
-                "c=0.005,k=-1.8,dmin=20000,dmax=300000,amin=3,amax=3.9,kind=old"],
+    "craters": ["c=0.05,k=-2,d_min_m=20,d_max_m=150000",
+                "c=0.005,k=-1.8,d_min_m=20000,d_max_m=300000,age_min_gyr=3,age_max_gyr=3.9,kind=old"],
 }
 stack = dem.enhance(scene, dem=base)
 assert stack.is_consistent()  # finer even pixels == coarser footprint, every pair

@@ -35,9 +35,10 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import atomic_path, check_int, package_version, progress_bar
+from craters.boulders import boulder_meshes, boulder_normals, catalog_shape, mesh_chunk
 
 from .grid import LatLongGrid
-from .strips import join_strips, patch_tree, strip_triangles
+from .strips import join_strips, patch_tree, strip_triangles, triangle_strips
 
 __all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
 
@@ -235,10 +236,6 @@ def _write_level(body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
 def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
     """Every level's unit boulder meshes into ``binf`` (buffer 0); returns the new offset
     and {level: first mesh index} (boulder i's mesh at level l = first[l] + i)."""
-    from craters.boulders import boulder_meshes, boulder_normals
-
-    from .boulders import catalog_shape, mesh_chunk
-
     shape = catalog_shape(cat)
     chunk = mesh_chunk(shape)
     first = {}
@@ -310,7 +307,6 @@ def export_vtp_strips(body, path) -> Path:
     """VTP with native triangle strips (one per band) and point normals/heights."""
     import pyvista as pv
 
-    from .strips import triangle_strips
 
     path = Path(path)
     strips = triangle_strips(body.grid)

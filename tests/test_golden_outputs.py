@@ -78,7 +78,7 @@ STEPS: list[tuple[str, str, bool]] = [
     ("latlong_info", "latlong info sh.npz", True),
     ("craters_profile", "craters profile --diameter-m 1000 --age-gyr 3 --csv prof.csv -q",
      False),
-    ("craters_population", ("craters population --layer c=0.5,k=-2,d_min_m=50,d_max_m=800 "
+    ("craters_population", ("craters population --craters c=0.5,k=-2,d_min_m=50,d_max_m=800 "
      "--radius-m 2000 --seed 1 -o pop.csv -q"), False),
     ("dem_info", "dem info ldem4_crop.lbl", True),
     ("dem_fill", "dem fill gappy.tif -o filled.tif --seed 1 -q", False),

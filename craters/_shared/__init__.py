@@ -17,16 +17,19 @@ from .validation import (
     ParameterError,
     ParameterTypeError,
     RngLike,
+    about,
     check_choice,
     check_finite,
     check_int,
     check_positive,
     check_range,
     normalize_rng,
+    parameter_of,
 )
 
-__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "area_slope_summary",
+__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "area_slope_summary",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_parent_folder", "check_positive", "check_range", "human_bytes", "load_toml",
-           "normalize_rng", "package_version", "parse_spec", "physical_memory_bytes",
+           "normalize_rng", "package_version", "parameter_of", "parse_spec",
+           "physical_memory_bytes",
            "progress_bar"]

@@ -68,10 +68,14 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
 
 def add_report_arguments(parser) -> None:
     """The output options every analysis command has: --csv, --plot, --force, --quiet."""
-    parser.add_argument("--csv", help="write the table (CSV, units in the header)")
-    parser.add_argument("--plot", help="write the plot (PNG)")
-    parser.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    parser.add_argument("-q", "--quiet", action="store_true", help="no summary table")
+    parser.add_argument("--csv", help="write the table (CSV, units in the header) "
+                        "(default: none)")
+    parser.add_argument("--plot", help="write the plot (PNG) (default: none)")
+    parser.add_argument("--force", action="store_true",
+                        help="overwrite existing outputs (default: off)")
+    parser.add_argument("-q", "--quiet", action="store_true",
+                        help="no progress bars or messages, the summary table included "
+                        "(default: off)")
 
 
 def check_report_outputs(args) -> None:

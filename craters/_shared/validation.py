@@ -6,14 +6,16 @@ Every check returns the cleaned value or raises ``TypeError`` (wrong kind of obj
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 
 import numpy as np
 
-__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "check_choice", "check_finite",
-           "check_int", "check_positive", "check_range", "normalize_rng"]
+__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "check_choice",
+           "check_finite", "check_int", "check_positive", "check_range", "normalize_rng",
+           "parameter_of"]
 
 RngLike = int | np.random.Generator | None
 
@@ -56,6 +58,38 @@ class ParameterError(_Named, ValueError):
 
 class ParameterTypeError(_Named, TypeError):
     """The wrong kind of object for one named parameter (a ``TypeError``)."""
+
+
+@contextlib.contextmanager
+def about(parameter: str | None) -> Iterator[None]:
+    """Tag a ``TypeError`` / ``ValueError`` raised inside with the library ``parameter`` it
+    is about (its ``parameter`` attribute; message and type unchanged; the innermost tag
+    wins; None tags nothing), for errors raised by deeper code under another name.
+
+    Examples
+    --------
+    >>> try:
+    ...     with about("levels"):
+    ...         raise ValueError("`levels` must be >= 1; got 0")
+    ... except ValueError as exc:
+    ...     print(parameter_of(exc), "|", exc)
+    levels | `levels` must be >= 1; got 0
+    """
+    try:
+        yield
+    except (TypeError, ValueError) as exc:
+        if parameter is not None and getattr(exc, "parameter", None) is None:
+            exc.parameter = parameter
+        raise
+
+
+def parameter_of(exc: BaseException) -> str | None:
+    """The parameter an error is about: its :func:`about` tag, else the name of a
+    :class:`ParameterError`, else None."""
+    tag = getattr(exc, "parameter", None)
+    if tag is None and isinstance(exc, _Named):
+        return exc.name
+    return tag
 
 
 def normalize_rng(rng: RngLike) -> np.random.Generator:

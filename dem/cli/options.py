@@ -5,9 +5,8 @@ Every option has a config key of the same name (dashes -> underscores, ``input``
 the positional argument) in the TOML file given with ``--config``; an option on the
 command line overrides the file, the file overrides the default. A row's key is also
 the name of the library parameter it sets (plus ``also``, e.g. ``rng`` for ``seed``): a
-library error about that parameter (:func:`dem.errors.parameter_of`) is reported with
-the flag, or the config key when the value came from the file, in front of the
-library's own message.
+library error about that parameter (``craters._shared.parameter_of``) is reported under
+the flag, or the config key when the value came from the file.
 
 The command line converts its text to values (syntax only: ``--levels two`` is an
 argparse error); the library checks the values, once. The values of a TOML file are
@@ -25,12 +24,17 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-from craters._shared import check_output_path, load_toml
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    check_output_path,
+    load_toml,
+    parameter_of,
+)
 from craters._shared.cli import CliError
 
 from ..config import EnhanceConfig
 from ..core import parse_region
-from ..errors import parameter_of
 from ..io import read
 
 __all__ = ["OPTIONS", "Opt", "Settings", "add_command", "check_output", "options_for",
@@ -147,8 +151,9 @@ OPTIONS: tuple[Opt, ...] = (
     Opt(("--size",), "size", _integer, _E["size"], "pixels per side of every layer, 2^n + 1",
         (_ENHANCE,), metavar="W"),
     Opt(("--craters",), "craters", str, _E["craters"],
-        "crater layer c=..,k=..,dmin=..,dmax=..[,amin=..,amax=..,deg=..,kind=..] (N_cum = "
-        "c D^k per m^2, D in metres, ages in Gyr); repeat for several", (_ENHANCE,),
+        "crater layer c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr=..,age_max_gyr=..,"
+        "degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = c D^k per "
+        "m^2, D in metres, ages in Gyr); repeat for several", (_ENHANCE,),
         "none", kind="append", metavar="SPEC"),
     Opt(("--min-crater-px",), "min_crater_px", _number, _E["min_crater_px"],
         "smallest crater diameter a layer takes, in its pixels (>= 1)", (_ENHANCE,),
@@ -156,8 +161,9 @@ OPTIONS: tuple[Opt, ...] = (
     Opt(("--smooth-craters",), "smooth_craters", bool, _E["smooth_craters"],
         "ideal craters: no fractal overlay, circular rims", (_ENHANCE,), kind="switch"),
     Opt(("--boulders",), "boulders", str, _E["boulders"],
-        "boulder layer c=..,k=..,dmin=..,dmax=..[,burial=..] (N_cum = c D^k per m^2, D in "
-        "metres; burial = largest buried fraction of the height); stamped as a heightfield "
+        "boulder layer c=..,k=..,d_min_m=..,d_max_m=..[,burial_max=..] (N_cum = c D^k per "
+        "m^2, D in metres; burial_max = largest buried fraction of the height); stamped as "
+        "a heightfield "
         "maximum in the finest layer holding each; repeat for several", (_ENHANCE,), "none",
         kind="append", metavar="SPEC"),
     Opt(("--min-boulder-px",), "min_boulder_px", _number, _E["min_boulder_px"],
@@ -237,9 +243,12 @@ class Settings(dict):
         try:
             yield
         except (TypeError, ValueError) as exc:
-            where = self.where(parameter_of(exc))
+            name = parameter_of(exc)
+            where = self.where(name)
             if where is None:
                 raise
+            if isinstance(exc, ParameterError | ParameterTypeError) and exc.name == name:
+                raise CliError(exc.shown_as(where, lambda k: self.where(k) or f"`{k}`")) from None
             raise CliError(f"{where}: {exc}") from None
 
 

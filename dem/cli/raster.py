@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from craters._shared import normalize_rng, progress_bar
+from craters._shared import about, normalize_rng, progress_bar
 
 from ..core import crs_label
-from ..errors import about
 from ..expansion import expand
 from ..fractal import fractal_fit
 from ..gaps import fill_gaps

@@ -152,17 +152,20 @@ def add_parsers(sub) -> None:
                              ("spectrum", cmd_spectrum, "radius power spectra")):
         p = sub.add_parser(name, help=f"{text} of bodies and shape models, with comparisons")
         p.add_argument("input", help="a body (.npz) or a closed mesh file")
-        p.add_argument("--compare", nargs="+", metavar="OTHER", help="more inputs to overlay")
-        p.add_argument("--label", nargs="+", help="legend labels, one per input")
-        p.add_argument("--shape-units", choices=("km", "m"), help="units of mesh inputs")
+        p.add_argument("--compare", nargs="+", metavar="OTHER",
+                       help="more inputs to overlay (default: none)")
+        p.add_argument("--label", nargs="+",
+                       help="legend labels, one per input (default: the file names)")
+        p.add_argument("--shape-units", choices=("km", "m"),
+                       help="units of mesh inputs (default: none; required for meshes)")
         if name == "slopes":
             p.add_argument("--radius-deg", type=float, default=3.0,
-                           help="averaging cap radius, degrees of arc (default 3)")
+                           help="averaging cap radius, degrees of arc (default: 3)")
             p.add_argument("--unweighted", action="store_true",
                            help="plain mean of vertex normals (default: area-weighted)")
         else:
             p.add_argument("--magnitude", type=int, default=200,
-                           help="grid magnitude for mesh inputs (default 200)")
-            p.add_argument("--l-max", type=int, help="largest degree (default 2M/3)")
+                           help="grid magnitude for mesh inputs (default: 200)")
+            p.add_argument("--l-max", type=int, help="largest degree (default: 2M/3)")
         add_report_arguments(p)
         p.set_defaults(func=func)

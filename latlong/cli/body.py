@@ -97,8 +97,10 @@ def add_body_parsers(sub, add_groups) -> None:
     r = sub.add_parser("render", help="render a saved body to a PNG (off-screen)")
     r.add_argument("model", help="a .npz written by latlong build")
     r.add_argument("-o", "--output", required=True, help="PNG to write")
-    r.add_argument("--force", action="store_true", help="overwrite an existing picture")
-    r.add_argument("-q", "--quiet", action="store_true", help="no progress or messages")
+    r.add_argument("--force", action="store_true",
+                   help="overwrite an existing picture (default: off)")
+    r.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bars or messages (default: off)")
     add_groups(r, RENDER_OPTIONS)
     r.set_defaults(func=cmd_render)
     e = sub.add_parser("export", help="renderer export: patched triangle strips (.glb, with "
@@ -109,6 +111,7 @@ def add_body_parsers(sub, add_groups) -> None:
                    help="patch tree parameter K (default: 64)")
     e.add_argument("--lod", type=int, default=0,
                    help="coarsest level of detail (M / 2^lod), 0 = the body only (default: 0)")
-    e.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    e.add_argument("-q", "--quiet", action="store_true", help="no progress or messages")
+    e.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")
+    e.add_argument("-q", "--quiet", action="store_true",
+                   help="no progress bars or messages (default: off)")
     e.set_defaults(func=cmd_export)

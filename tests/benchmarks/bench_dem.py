@@ -196,8 +196,8 @@ def bench_enhance(quick):
         scene = tmp / "scene.toml"
         scene.write_text(
             f'input = "{tmp / "base.tif"}"\nlayers = {levels}\nsize = {size}\n'
-            'craters = ["c=0.05,k=-2,dmin=0.5,dmax=60000", '
-            '"c=0.01,k=-1.8,dmin=5000,dmax=200000,amin=3,amax=3.9,kind=old"]\n')
+            'craters = ["c=0.05,k=-2,d_min_m=0.5,d_max_m=60000", '
+            '"c=0.01,k=-1.8,d_min_m=5000,d_max_m=200000,age_min_gyr=3,age_max_gyr=3.9,kind=old"]\n')
         load = os.getloadavg()[0]
         wall, rss = timed_child(["dem", "enhance", "--config", str(scene), "-o", str(tmp / "a"),
                                  "--seed", "2014", "-q"])

@@ -30,7 +30,7 @@ def test_profile_csv_and_plot(run_cli, tmp_path):
 
 def test_population_csv_and_plot(run_cli, tmp_path):
     out, png = tmp_path / "c.csv", tmp_path / "sfd.png"
-    proc = run_cli("craters", "population", "--layer", "c=0.5,k=-2,d_min_m=5,d_max_m=100",
+    proc = run_cli("craters", "population", "--craters", "c=0.5,k=-2,d_min_m=5,d_max_m=100",
                    "--radius-m", "200", "--seed", "3", "-o", str(out), "--plot", str(png))
     assert proc.returncode == 0, proc.stderr
     cat = craters.read_catalog(out)
@@ -46,16 +46,17 @@ def test_population_csv_and_plot(run_cli, tmp_path):
     (["profile", "--diameter-m", "10", "--degradation", "1.5", "--csv", "x.csv"],
      ["--degradation"]),
     (["profile", "--diameter-m", "10"], ["nothing to write"]),
-    (["population", "--layer", "c=0,k=-2,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
+    (["population", "--craters", "c=0,k=-2,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
      ["`c`"]),
-    (["population", "--layer", "c=1,k=1,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
+    (["population", "--craters", "c=1,k=1,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
      ["`k`"]),
-    (["population", "--layer", "c=1,k=-2,d_min_m=50,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
+    (["population", "--craters", "c=1,k=-2,d_min_m=50,d_max_m=10", "--radius-m", "9", "-o",
+      "x.csv"],
      ["d_min_m"]),
-    (["population", "--layer", "c=1,k=-2,d_min_m=5,d_max_m=10", "-o", "x.csv"], ["exactly one"]),
-    (["population", "--layer", "c=1,k=-2,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.txt"],
+    (["population", "--craters", "c=1,k=-2,d_min_m=5,d_max_m=10", "-o", "x.csv"], ["exactly one"]),
+    (["population", "--craters", "c=1,k=-2,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.txt"],
      ["unknown format"]),
-    (["population", "--layer", "c=1,k=-2", "--radius-m", "9", "-o", "x.csv"], ["missing"]),
+    (["population", "--craters", "c=1,k=-2", "--radius-m", "9", "-o", "x.csv"], ["missing"]),
     (["population", "--radius-m", "9", "-o", "x.csv", "--seed", "x"], ["--seed"]),
 ])
 def test_bad_input(run_cli, tmp_path, args, needles):

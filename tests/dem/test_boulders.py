@@ -81,7 +81,8 @@ def slope_dem():
 
 @pytest.fixture(scope="module")
 def stamped(slope_dem):
-    cat = dem.boulder_population(slope_dem, "c=0.02,k=-3,dmin=0.6,dmax=6,burial=0.5", rng=4)
+    cat = dem.boulder_population(slope_dem, "c=0.02,k=-3,d_min_m=0.6,d_max_m=6,burial_max=0.5",
+                                 rng=4)
     before = slope_dem.heights.copy()
     out, placed = dem.stamp_boulders(slope_dem, cat, return_catalog=True)
     assert np.array_equal(slope_dem.heights, before)  # input untouched
@@ -196,8 +197,8 @@ def rocky_stack():
     e = dem.expand(seed, 2, fractal_dimension=2.3, roughness=0.05, rng=1)
     base = dem.Dem(e.heights, Affine(4.0, 0, 400000.0, 0, -4.0, 3000000.0), "EPSG:32633")
     return dem.enhance({"layers": 5, "size": 65, "seed": 3,
-                        "craters": ["c=0.05,k=-2,dmin=1,dmax=60"],
-                        "boulders": ["c=0.02,k=-3,dmin=0.3,dmax=12"]}, dem=base)
+                        "craters": ["c=0.05,k=-2,d_min_m=1,d_max_m=60"],
+                        "boulders": ["c=0.02,k=-3,d_min_m=0.3,d_max_m=12"]}, dem=base)
 
 
 def test_enhance_with_boulders(rocky_stack, tmp_path):
@@ -247,7 +248,7 @@ def test_every_boulder_shows_in_its_layer(rocky_stack):
     e = dem.expand(seed, 2, fractal_dimension=2.3, roughness=0.05, rng=1)
     base = dem.Dem(e.heights, Affine(4.0, 0, 400000.0, 0, -4.0, 3000000.0), "EPSG:32633")
     bare = dem.enhance({"layers": 5, "size": 65, "seed": 3,
-                        "boulders": ["c=0.02,k=-3,dmin=0.3,dmax=12"]}, dem=base)
+                        "boulders": ["c=0.02,k=-3,d_min_m=0.3,d_max_m=12"]}, dem=base)
     checked = 0
     for stack, layers in ((bare, range(5)), (rocky_stack, [4])):
         for k in layers:
@@ -291,7 +292,7 @@ def test_cli_enhance_boulders_same_bytes_any_thread_count(run_cli, tmp_path, roc
     for tag, env in (("a", {}), ("t1", {"NUMBA_NUM_THREADS": "1"})):
         out = tmp_path / tag
         proc = run_cli("dem", "enhance", str(src), "-o", str(out), "--layers", "4",
-                       "--size", "33", "--boulders", "c=0.02,k=-3,dmin=0.5,dmax=8",
+                       "--size", "33", "--boulders", "c=0.02,k=-3,d_min_m=0.5,d_max_m=8",
                        "--seed", "2", "-q", env=env)
         assert proc.returncode == 0, proc.stderr
         digests[tag] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
@@ -302,12 +303,12 @@ def test_cli_enhance_boulders_same_bytes_any_thread_count(run_cli, tmp_path, roc
     assert digests["a"] == digests["t1"]
     assert any(n.startswith("boulders_") for n in digests["a"])
     bad = run_cli("dem", "enhance", str(src), "-o", str(tmp_path / "x"),
-                  "--boulders", "c=0.02,k=3,dmin=0.5,dmax=8", cwd=tmp_path)
+                  "--boulders", "c=0.02,k=3,d_min_m=0.5,d_max_m=8", cwd=tmp_path)
     one_line_error(bad, "--boulders", "`k`")
     bad = run_cli("dem", "enhance", str(src), "-o", str(tmp_path / "x"),
-                  "--boulders", "c=0.02,k=-3,dmin=0.5,dmax=8", "--min-boulder-px", "0.5",
+                  "--boulders", "c=0.02,k=-3,d_min_m=0.5,d_max_m=8", "--min-boulder-px", "0.5",
                   cwd=tmp_path)
-    one_line_error(bad, "min_boulder_px")
+    one_line_error(bad, "--min-boulder-px", "[1,")
     assert not (tmp_path / "x").exists()
 
 
@@ -347,7 +348,7 @@ def test_extremely_rough_ground_settles_or_is_left_out(amp):
     whose points leave the raster while settling are left out and counted."""
     z = np.random.default_rng(5).normal(0, amp, (201, 201))
     d0 = dem.Dem(z, Affine(0.25, 0, 500000.0, 0, -0.25, 4000000.0), "EPSG:32633")
-    cat = dem.boulder_population(d0, "c=0.05,k=-2.5,dmin=0.5,dmax=8,burial=0.5", rng=2)
+    cat = dem.boulder_population(d0, "c=0.05,k=-2.5,d_min_m=0.5,d_max_m=8,burial_max=0.5", rng=2)
     out, placed = dem.stamp_boulders(d0, cat, return_catalog=True)
     verts, _ = boulder_world_meshes(placed)
     verts = verts.reshape(len(placed), -1, 3)

@@ -268,8 +268,8 @@ def write_scene(path, **keys):
 def scene_keys(tmp_path, lola_tif, **extra):
     keys = dict(input=str(lola_tif), output=str(tmp_path / "stack"), layers=4, size=65,
                 target=[180.0, -0.5], body_radius_m=1737400.0,
-                craters=["c=0.05,k=-2,dmin=200,dmax=100000",
-                         "c=0.005,k=-1.8,dmin=20000,dmax=200000,amin=3,amax=3.8,kind=old"])
+                craters=["c=0.05,k=-2,d_min_m=200,d_max_m=100000",
+                         "c=0.005,k=-1.8,d_min_m=20000,d_max_m=200000,age_min_gyr=3,age_max_gyr=3.8,kind=old"])
     keys.update(extra)
     return keys
 
@@ -336,13 +336,13 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
     ("size-too-big", {"size": 513}, [], ["at least 513 x 513"]),
     ("layers-zero", {"layers": 0}, [], ["layers"]),
     ("layers-text", {"layers": "many"}, [], ["layers"]),
-    ("crater-spec", {"craters": ["c=0.5,k=2,dmin=1,dmax=5"]}, [], ["k", "< 0"]),
-    ("crater-spec-key", {"craters": ["c=0.5,k=-2,dmin=1,dmax=5,colour=1"]}, [],
+    ("crater-spec", {"craters": ["c=0.5,k=2,d_min_m=1,d_max_m=5"]}, [], ["k", "< 0"]),
+    ("crater-spec-key", {"craters": ["c=0.5,k=-2,d_min_m=1,d_max_m=5,colour=1"]}, [],
      ["unknown item"]),
-    ("crater-flag", {}, ["--craters", "c=0.5,k=-2,dmin=9,dmax=5"], ["--craters", "d_min_m"]),
-    ("craters-not-list", {"craters": "c=0.5,k=-2,dmin=1,dmax=5"}, [], ["list"]),
-    ("too-many-craters", {"craters": ["c=1e6,k=-3,dmin=0.001,dmax=5"]}, [],
-     ["craters", "dmin"]),
+    ("crater-flag", {}, ["--craters", "c=0.5,k=-2,d_min_m=9,d_max_m=5"], ["--craters", "d_min_m"]),
+    ("craters-not-list", {"craters": "c=0.5,k=-2,d_min_m=1,d_max_m=5"}, [], ["list"]),
+    ("too-many-craters", {"craters": ["c=1e6,k=-3,d_min_m=0.001,d_max_m=5"]}, [],
+     ["craters", "d_min_m"]),
     ("no-output", {"output": None}, [], ["-o/--output"]),
     ("no-input", {"input": None}, [], ["needs an input"]),
     ("no-radius", {"body_radius_m": None}, [], ["geographic CRS", "--body-radius-m"]),
@@ -437,7 +437,7 @@ def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_pa
     counted(dem.cli.stack, "check_stack_folder")
     scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
     proc = InProcess(capsys)("dem", "enhance", "--config", str(scene), "--seed", "3", "-q",
-                             "--boulders", "c=0.00001,k=-3,dmin=300,dmax=2000")
+                             "--boulders", "c=0.00001,k=-3,d_min_m=300,d_max_m=2000")
     assert proc.returncode == 0, proc.stderr
     assert calls == {"parse_layer_spec": 2, "parse_boulder_spec": 1, "check_int": 1,
                      "check_stack_folder": 1}

@@ -171,7 +171,7 @@ def test_replace_crater_in_a_stack_keeps_layers_matching():
     e = dem.expand(seed, 3, fractal_dimension=2.3, roughness=0.05, rng=1)
     base = dem.Dem(e.heights, Affine(50.0, 0, 0, 0, -50.0, 0), "EPSG:32633")
     s = dem.enhance({"layers": 4, "size": 65, "seed": 3,
-                     "craters": ["c=0.05,k=-2,dmin=5,dmax=400"]}, dem=base)
+                     "craters": ["c=0.05,k=-2,d_min_m=5,d_max_m=400"]}, dem=base)
     # layer 1 spans +-800 m, layer 2 +-400 m: this crater's reach (+-480 m) fits layer 1 only
     # and overlaps layers 2 and 3
     crater = craters.Crater(100.0, -50.0, 300.0)

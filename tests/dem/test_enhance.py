@@ -11,6 +11,7 @@ import pytest
 from affine import Affine
 
 import craters
+from craters._shared import parameter_of
 import dem
 from dem.planning import layer_windows, plan_craters, stack_geometry
 
@@ -25,8 +26,8 @@ def base():
     return dem.Dem(e.heights, Affine(50.0, 0, 400000.0, 0, -50.0, 3000000.0), "EPSG:32633")
 
 
-SPECS = ["c=0.05,k=-2,dmin=0.5,dmax=3000",
-         "c=0.002,k=-1.8,dmin=100,dmax=3000,amin=3,amax=3.8,kind=old"]
+SPECS = ["c=0.05,k=-2,d_min_m=0.5,d_max_m=3000",
+         "c=0.002,k=-1.8,d_min_m=100,d_max_m=3000,age_min_gyr=3,age_max_gyr=3.8,kind=old"]
 
 
 @pytest.fixture(scope="module")
@@ -70,7 +71,7 @@ def test_crater_accounting_adds_up_and_nothing_is_listed_twice(stack):
     assert c["drawn"] == sum(b["drawn"] for b in c["bands"]) + c["rejected_below_finest"]
     for b in c["bands"]:
         assert b["drawn"] == b["assigned"] + b["rejected"]
-    assert c["rejected_below_finest"] > 0  # dmin = 0.5 m < 2 pixels of the finest layer
+    assert c["rejected_below_finest"] > 0  # d_min_m = 0.5 m < 2 pixels of the finest layer
     ids = np.concatenate([cat["index"] for cat in stack.catalogs])
     assert len(ids) == len(np.unique(ids)) == sum(c["stamped"])
     assert [len(cat) for cat in stack.catalogs] == c["stamped"]
@@ -104,7 +105,7 @@ def test_catalog_positions_are_where_the_craters_are():
     distance from the catalog position -- catalog frame, pixel sizes and propagation agree."""
     flat = dem.Dem(np.zeros((65, 65)), Affine(20.0, 0, 0, 0, -20.0, 0), "EPSG:32633")
     s = dem.enhance({"layers": 3, "size": 65, "seed": 2, "smooth_craters": True,
-                     "craters": ["c=0.01,k=-2,dmin=10,dmax=200"]}, dem=flat)
+                     "craters": ["c=0.01,k=-2,d_min_m=10,d_max_m=200"]}, dem=flat)
     sizes = s.pixel_sizes_m()
     every = np.concatenate([np.stack([c["x_m"], c["y_m"], c["diameter_m"]], 1)
                             for c in s.catalogs])
@@ -139,7 +140,7 @@ def test_band_split_has_the_law_of_one_catalog_split_afterwards():
     _, windows, _, _ = layer_windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None,
                                      size, n_layers)
     geom = stack_geometry(size, windows, p0)
-    spec = craters.parse_layer_spec("c=0.2,k=-2,dmin=5,dmax=300")
+    spec = craters.parse_layer_spec("c=0.2,k=-2,d_min_m=5,d_max_m=300")
     half = (size - 1) / 2
     runs = 300
     banded = np.zeros((runs, n_layers))
@@ -236,7 +237,7 @@ def test_write_read_roundtrip_and_files(tmp_path, stack):
 
 def test_geographic_base_from_lola(lola_crop):
     s = dem.enhance({"layers": 3, "size": 65, "seed": 1,
-                     "craters": ["c=0.05,k=-2,dmin=1000,dmax=100000"]}, dem=lola_crop)
+                     "craters": ["c=0.05,k=-2,d_min_m=1000,d_max_m=100000"]}, dem=lola_crop)
     assert s.frame.kind == "equirectangular" and s.is_consistent()
     assert s.pixel_sizes_m()[0] == pytest.approx(7580.8, rel=1e-4)
     assert sum(s.info["craters"]["stamped"]) > 0
@@ -254,10 +255,10 @@ def test_geographic_base_from_lola(lola_crop):
     ({"layers": 2.5}, TypeError, "layers"),
     ({"target": [1.0, 2.0]}, ValueError, "outside the base DEM"),
     ({"target": "centre"}, TypeError, "target"),
-    ({"craters": ["c=0.5,k=-2,dmin=50,dmax=10"]}, ValueError, "d_min_m"),
-    ({"craters": ["c=0.5,k=-2"]}, ValueError, "missing dmin"),
-    ({"craters": "c=0.5,k=-2,dmin=1,dmax=10"}, TypeError, "list of crater layer specs"),
-    ({"craters": ["c=1e9,k=-3,dmin=1e-6,dmax=10"]}, ValueError, "absurd|limit"),
+    ({"craters": ["c=0.5,k=-2,d_min_m=50,d_max_m=10"]}, ValueError, "d_min_m"),
+    ({"craters": ["c=0.5,k=-2"]}, ValueError, "missing d_min_m"),
+    ({"craters": "c=0.5,k=-2,d_min_m=1,d_max_m=10"}, TypeError, "list of crater layer specs"),
+    ({"craters": ["c=1e9,k=-3,d_min_m=1e-6,d_max_m=10"]}, ValueError, "absurd|limit"),
     ({"min_crater_px": 0.5}, ValueError, "min_crater_px"),
     ({"fractal_dimension": 3.5}, ValueError, "fractal_dimension"),
     ({"smooth_craters": "yes"}, TypeError, "smooth_craters"),
@@ -291,7 +292,7 @@ def test_config_is_typed_frozen_and_checked_where_made(base, tmp_path, monkeypat
     # errors name the field and carry it (the command line maps it to its option)
     with pytest.raises(ValueError, match="`size` must be 2\\^n \\+ 1") as info:
         dem.EnhanceConfig(size=100)
-    assert dem.errors.parameter_of(info.value) == "size"
+    assert parameter_of(info.value) == "size"
     with pytest.raises(TypeError, match="craters.BoulderLayer") as info:
         dem.EnhanceConfig(boulders=[layer])
     assert dem.errors.parameter_of(info.value) == "boulders"

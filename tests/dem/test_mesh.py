@@ -22,7 +22,7 @@ def stack():
     base = dem.Dem(e.heights, Affine(100.0, 0, 1000.0, 0, -100.0, 9000.0), "EPSG:32633")
     x, y = base.xy(6, 26)  # off centre: the footprints shift to stay inside
     return dem.enhance({"layers": 4, "size": 17, "seed": 1, "target": [float(x), float(y)],
-                        "craters": ["c=0.05,k=-2,dmin=20,dmax=800"]}, dem=base)
+                        "craters": ["c=0.05,k=-2,d_min_m=20,d_max_m=800"]}, dem=base)
 
 
 def test_mesh_is_one_closed_sheet_without_cracks(stack):
