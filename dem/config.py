@@ -5,7 +5,7 @@ builds; the keys of a ``dem enhance`` TOML scene but the run options ``output``,
 It is validated once, where it is made (from command-line options, a TOML file or
 Python): every field is checked, every crater and boulder spec parsed (the parsed layers
 are :attr:`EnhanceConfig.crater_layers` and :attr:`EnhanceConfig.boulder_layers`). An
-error names the field (``exc.parameter``, see :mod:`dem.errors`).
+error names the field (``exc.parameter``, see ``craters._shared.parameter_of``).
 """
 
 from __future__ import annotations

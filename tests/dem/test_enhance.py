@@ -11,8 +11,8 @@ import pytest
 from affine import Affine
 
 import craters
-from craters._shared import parameter_of
 import dem
+from craters._shared import parameter_of
 from dem.planning import layer_windows, plan_craters, stack_geometry
 
 REACH = craters.DEFAULT_EJECTA_EDGE * 1.02  # ejecta edge with the default rim irregularity
@@ -295,4 +295,4 @@ def test_config_is_typed_frozen_and_checked_where_made(base, tmp_path, monkeypat
     assert parameter_of(info.value) == "size"
     with pytest.raises(TypeError, match="craters.BoulderLayer") as info:
         dem.EnhanceConfig(boulders=[layer])
-    assert dem.errors.parameter_of(info.value) == "boulders"
+    assert parameter_of(info.value) == "boulders"
