@@ -1,4 +1,4 @@
-r"""Multi-resolution triangle meshes of a layer stack (or one DEM): PLY and VTP, streamed.
+r"""Multi-resolution triangle meshes of a layer stack (or one DEM), streamed to any mesh file.
 
 Geometry
 --------
@@ -18,13 +18,9 @@ outline. Needs footprints one pixel clear of their layer's border (what
 
 Formats
 -------
-* PLY: ``binary_little_endian``; vertex ``x, y, z`` (float32) and ``layer`` (uchar);
-  faces as ``uchar 3`` + three int32 indices.
-* VTP (VTK XML PolyData): raw appended binary (UInt64 headers), float32 points, a
-  UInt8 point array ``layer``, int32 (int64 if needed) connectivity and offsets.
-
-Both are written layer by layer (memory ~ a few arrays of one layer) to a temporary
-file renamed into place at the end.
+The shared mesh writers (:mod:`craters._shared.meshio`: PLY, OBJ, STL, VTP, VTK, GLB)
+with a per-vertex ``layer`` (uchar); PLY and VTP are written layer by layer (memory ~ a
+few arrays of one layer), STL gathers the vertices first.
 
 Boulders
 --------
@@ -37,22 +33,18 @@ terrain), which the files then have as an extra vertex property / point array.
 
 from __future__ import annotations
 
-import io
 from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, progress_bar
+from craters._shared.meshio import MESH_SUFFIXES, MeshSource, write_mesh
 from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes, mesh_chunk
 
 from .core import Dem
 from .frame import local_frame, pixel_affine
 from .stack import Stack
 
-__all__ = ["MESH_SUFFIXES", "mesh_arrays", "to_mesh"]
-
-#: Suffixes :func:`to_mesh` writes.
-MESH_SUFFIXES = (".ply", ".vtp")
+__all__ = ["MESH_SUFFIXES", "mesh_arrays", "mesh_source", "to_mesh"]
 
 
 class _Layout:
@@ -243,8 +235,56 @@ def mesh_arrays(source) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return verts, faces, layer
 
 
+def mesh_source(source, *, boulders: bool = True) -> MeshSource:
+    """The multi-resolution mesh of a stack (or one DEM) as a streamed mesh for the shared
+    writers (:mod:`craters._shared.meshio`): layer by layer, then the boulders."""
+    stack = _as_stack(source)
+    lay = _Layout(stack)
+    rocks = _Rocks(stack if boulders else stack.replace(boulders=[None] * len(stack)))
+    if lay.n_vertices + rocks.n_vertices >= 2**31 - 1:
+        raise ValueError(f"the mesh would have {lay.n_vertices} vertices; mesh indices are "
+                         f"limited to 2^31 - 1 here")
+    n = len(lay.counts)
+
+    def vertex_chunks():
+        for k in range(n):
+            xyz = np.stack(lay.vertices(k), 1)
+            values = {"layer": np.full(len(xyz), k, dtype=np.uint8)}
+            if rocks:
+                values["boulder_id"] = np.full(len(xyz), -1, dtype=np.int32)
+            yield xyz, values
+        if rocks:
+            for xyz, layer, ids in rocks.vertex_chunks():
+                yield xyz, {"layer": layer, "boulder_id": ids}
+
+    def face_groups():
+        terrain = (lay.faces(k) for k in range(n))
+        if not rocks:
+            yield None, terrain
+            return
+        yield "terrain", terrain
+        yield "boulders", rocks.face_chunks(lay.n_vertices)
+
+    def facet_chunks():
+        verts = np.concatenate([xyz for xyz, _ in vertex_chunks()])
+        for _, chunks in face_groups():
+            for tri in chunks:
+                yield verts[tri]
+
+    frame = stack.frame
+    title = ("craterform multi-resolution mesh; metres in a local frame: x = "
+             f"(X - {frame.origin_x!r}) * {frame.scale_x!r}, y = (Y - {frame.origin_y!r}) * "
+             f"{frame.scale_y!r} ({frame.kind}), z = height")
+    comments = ("boulders after the terrain; boulder_id -1 = terrain",) if rocks else ()
+    fields = (("layer", "u1"), *((("boulder_id", "<i4"),) if rocks else ()))
+    return MeshSource(lay.n_vertices + rocks.n_vertices, lay.n_faces + rocks.n_faces,
+                      vertex_chunks, face_groups, facet_chunks, fields, title, comments,
+                      progress_label="mesh")
+
+
 def to_mesh(source, path, *, progress: bool = False, boulders: bool = True) -> Path:
-    """Write the multi-resolution mesh of a stack (or one DEM) as PLY or VTP.
+    """Write the multi-resolution mesh of a stack (or one DEM) to a mesh file chosen by
+    suffix (``.ply .obj .stl .vtp .vtk .glb``, :mod:`craters._shared.meshio`), atomically.
 
     See the module notes for the geometry, the frame and the formats.
 
@@ -253,9 +293,9 @@ def to_mesh(source, path, *, progress: bool = False, boulders: bool = True) -> P
     source : Stack or Dem
         A DEM is meshed in its own local frame (origin at its centre pixel).
     path : str or Path
-        ``.ply`` or ``.vtp``; written atomically.
+        The output file.
     progress : bool
-        Show a progress bar over the layers.
+        Show a progress bar over the faces.
     boulders : bool
         Append the stack's boulders (if it has any) as their own meshes.
 
@@ -273,144 +313,8 @@ def to_mesh(source, path, *, progress: bool = False, boulders: bool = True) -> P
     (12, 12, (-4.0, 2.0, -2.0, 2.0))
     """
     path = Path(path)
-    suffix = path.suffix.lower()
-    if suffix not in MESH_SUFFIXES:
-        raise ValueError(f"output {str(path)!r}: unknown mesh format {suffix or '(none)'!r}; "
-                         f"allowed: {' '.join(MESH_SUFFIXES)}")
-    stack = _as_stack(source)
-    lay = _Layout(stack)
-    lay.rocks = _Rocks(stack) if boulders else _Rocks(stack.replace(
-        boulders=[None] * len(stack)))
-    if lay.n_vertices + lay.rocks.n_vertices >= 2**31 - 1:
-        raise ValueError(f"the mesh would have {lay.n_vertices} vertices; PLY/VTP indices are "
-                         f"limited to 2^31 - 1 here")
-    with atomic_path(path) as tmp, open(tmp, "wb") as fh:
-        out = io.BufferedWriter(fh, buffer_size=1 << 22)
-        (_write_ply if suffix == ".ply" else _write_vtp)(lay, out, progress)
-        out.flush()
-        out.detach()
-    return path
-
-
-_PLY_VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer", "u1")])
-_PLY_FACE = np.dtype([("n", "u1"), ("v", "<i4", (3,))])
-
-
-_PLY_VERTEX_ROCKS = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("layer", "u1"),
-                              ("boulder_id", "<i4")])
-
-
-def _write_ply(lay: _Layout, fh, progress: bool) -> None:
-    frame = lay.stack.frame
-    rocks = lay.rocks
-    header = ("ply\nformat binary_little_endian 1.0\n"
-              "comment craterform multi-resolution mesh; metres in a local frame: x = "
-              f"(X - {frame.origin_x!r}) * {frame.scale_x!r}, y = (Y - {frame.origin_y!r}) * "
-              f"{frame.scale_y!r} ({frame.kind}), z = height\n"
-              + ("comment boulders after the terrain; boulder_id -1 = terrain\n"
-                 if rocks else "")
-              + f"element vertex {lay.n_vertices + rocks.n_vertices}\nproperty float x\n"
-              "property float y\nproperty float z\nproperty uchar layer\n"
-              + ("property int boulder_id\n" if rocks else "")
-              + f"element face {lay.n_faces + rocks.n_faces}\n"
-              "property list uchar int vertex_indices\nend_header\n")
-    fh.write(header.encode("ascii"))
-    vdt = _PLY_VERTEX_ROCKS if rocks else _PLY_VERTEX
-    n = len(lay.counts)
-    for k in progress_bar(range(n), enabled=progress, desc="mesh vertices"):
-        x, y, z = lay.vertices(k)
-        rec = np.empty(x.size, dtype=vdt)
-        rec["x"], rec["y"], rec["z"], rec["layer"] = x, y, z, k
-        if rocks:
-            rec["boulder_id"] = -1
-        fh.write(rec.tobytes())
-    if rocks:
-        for xyz, layer, ids in rocks.vertex_chunks():
-            rec = np.empty(len(xyz), dtype=vdt)
-            rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
-            rec["layer"], rec["boulder_id"] = layer, ids
-            fh.write(rec.tobytes())
-    for k in progress_bar(range(n), enabled=progress, desc="mesh faces"):
-        tri = lay.faces(k)
-        rec = np.empty(len(tri), dtype=_PLY_FACE)
-        rec["n"] = 3
-        rec["v"] = tri
-        fh.write(rec.tobytes())
-    if rocks:
-        for tri in rocks.face_chunks(lay.n_vertices):
-            rec = np.empty(len(tri), dtype=_PLY_FACE)
-            rec["n"] = 3
-            rec["v"] = tri
-            fh.write(rec.tobytes())
-
-
-def _write_vtp(lay: _Layout, fh, progress: bool) -> None:
-    rocks = lay.rocks
-    n_v, n_f = lay.n_vertices + rocks.n_vertices, lay.n_faces + rocks.n_faces
-    itype, idt = ("Int32", "<i4") if 3 * n_f < 2**31 - 1 else ("Int64", "<i8")
-    isize = np.dtype(idt).itemsize
-    sizes = [12 * n_v, n_v, 3 * n_f * isize, n_f * isize] + ([4 * n_v] if rocks else [])
-    offs = np.concatenate([[0], np.cumsum([8 + s for s in sizes])])
-    frame = lay.stack.frame
-    rock_array = (f'<DataArray type="Int32" Name="boulder_id" format="appended" '
-                  f'offset="{offs[4]}"/>\n' if rocks else "")
-    xml = (
-        '<?xml version="1.0"?>\n'
-        '<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
-        'header_type="UInt64">\n'
-        f"<!-- craterform multi-resolution mesh; metres in a local frame: x = "
-        f"(X - {frame.origin_x!r}) * {frame.scale_x!r}, y = (Y - {frame.origin_y!r}) * "
-        f"{frame.scale_y!r} ({frame.kind}), z = height -->\n"
-        "<PolyData>\n"
-        f'<Piece NumberOfPoints="{n_v}" NumberOfVerts="0" NumberOfLines="0" '
-        f'NumberOfStrips="0" NumberOfPolys="{n_f}">\n'
-        '<PointData Scalars="layer">\n'
-        f'<DataArray type="UInt8" Name="layer" format="appended" offset="{offs[1]}"/>\n'
-        + rock_array +
-        "</PointData>\n<Points>\n"
-        f'<DataArray type="Float32" Name="Points" NumberOfComponents="3" format="appended" '
-        f'offset="{offs[0]}"/>\n'
-        "</Points>\n<Polys>\n"
-        f'<DataArray type="{itype}" Name="connectivity" format="appended" '
-        f'offset="{offs[2]}"/>\n'
-        f'<DataArray type="{itype}" Name="offsets" format="appended" offset="{offs[3]}"/>\n'
-        "</Polys>\n</Piece>\n</PolyData>\n"
-        '<AppendedData encoding="raw">\n_')
-    fh.write(xml.encode("ascii"))
-    n = len(lay.counts)
-    bar = progress_bar(total=3 * n, enabled=progress, desc="mesh")
-    fh.write(np.uint64(sizes[0]).tobytes())
-    for k in range(n):
-        fh.write(np.stack(lay.vertices(k), 1).astype("<f4").tobytes())
-        bar.update()
-    if rocks:
-        for xyz, _, _ in rocks.vertex_chunks():
-            fh.write(xyz.astype("<f4").tobytes())
-    fh.write(np.uint64(sizes[1]).tobytes())
-    for k in range(n):
-        fh.write(np.full(lay.counts[k], k, dtype="u1").tobytes())
-    if rocks:
-        fh.write(np.repeat(rocks.layer, rocks.nv).tobytes())
-    fh.write(np.uint64(sizes[2]).tobytes())
-    for k in range(n):
-        fh.write(lay.faces(k).astype(idt).tobytes())
-        bar.update()
-    if rocks:
-        for tri in rocks.face_chunks(lay.n_vertices):
-            fh.write(tri.astype(idt).tobytes())
-    fh.write(np.uint64(sizes[3]).tobytes())
-    done = 0
-    for k in range(n):
-        m = lay.face_counts[k]
-        fh.write((3 * np.arange(done + 1, done + m + 1, dtype=np.int64)).astype(idt).tobytes())
-        done += m
-        bar.update()
-    if rocks:
-        fh.write((3 * np.arange(done + 1, done + rocks.n_faces + 1, dtype=np.int64))
-                 .astype(idt).tobytes())
-    if rocks:
-        fh.write(np.uint64(sizes[4]).tobytes())
-        fh.write(np.full(lay.n_vertices, -1, dtype="<i4").tobytes())
-        fh.write(np.repeat(rocks.ids, rocks.nv).astype("<i4").tobytes())
-    bar.close()
-    fh.write(b"\n</AppendedData>\n</VTKFile>\n")
+    if path.suffix.lower() not in MESH_SUFFIXES:
+        raise ValueError(f"output {str(path)!r}: unknown mesh format "
+                         f"{path.suffix.lower() or '(none)'!r}; allowed: "
+                         f"{' '.join(MESH_SUFFIXES)}")
+    return write_mesh(mesh_source(source, boulders=boulders), path, progress=progress)

@@ -381,7 +381,7 @@ def test_enhance_existing_output(run_cli, capsys, tmp_path, lola_tif):
 
 
 @pytest.mark.parametrize("case,args,needles", [
-    ("suffix", ["{manifest}", "-o", "{tmp}/m.obj"], ["unknown format", ".ply"]),
+    ("suffix", ["{manifest}", "-o", "{tmp}/m.xyz"], ["unknown format", ".ply"]),
     ("no-output", ["{manifest}"], ["-o/--output"]),
     ("not-a-manifest", ["{json}", "-o", "{tmp}/m.ply"], ["not a craterform stack manifest"]),
     ("nan-dem", ["{nan}", "-o", "{tmp}/m.ply"], ["NaN"]),

@@ -99,7 +99,7 @@ def test_single_dem_mesh_and_errors(tmp_path, lola_crop):
     with pytest.raises(ValueError, match="NaN"):
         to_mesh(small.replace(heights=z), tmp_path / "x.ply")
     with pytest.raises(ValueError, match="unknown mesh format"):
-        to_mesh(small, tmp_path / "x.obj")
+        to_mesh(small, tmp_path / "x.xyz")
     with pytest.raises(TypeError, match="Stack or a Dem"):
         to_mesh(np.zeros((3, 3)), tmp_path / "x.ply")
     assert list(tmp_path.iterdir()) == []

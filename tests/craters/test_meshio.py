@@ -1,0 +1,75 @@
+"""The shared mesh writers (craters._shared.meshio): every format reads back as written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from craters._shared.meshio import MESH_SUFFIXES, MeshSource, array_source, write_mesh
+
+
+def _tetra(fields: bool):
+    v = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 3.0, 0.0], [0.0, 0.0, 4.5]])
+    f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    extra = {"height_m": np.array([0.5, 1.5, 2.5, 3.5], np.float32),
+             "layer": np.array([0, 1, 1, 2], np.uint8)} if fields else {}
+    return v, f, array_source(v, f, "a tetrahedron, metres", **extra)
+
+
+@pytest.mark.parametrize("fields", [False, True])
+@pytest.mark.parametrize("suffix", [s for s in MESH_SUFFIXES if s != ".glb"])
+def test_formats_read_back(tmp_path, suffix, fields):
+    import pyvista as pv
+
+    v, f, src = _tetra(fields)
+    mesh = pv.read(write_mesh(src, tmp_path / f"t{suffix}"))
+    if suffix == ".stl":  # STL repeats the corners of every facet
+        assert mesh.n_cells == 4 and np.allclose(np.sort(np.unique(mesh.points, axis=0), 0),
+                                                 np.sort(v, 0))
+        return
+    assert np.array_equal(mesh.points, v.astype(np.float32))
+    assert np.array_equal(mesh.faces.reshape(-1, 4)[:, 1:], f)
+    if fields and suffix == ".ply":  # VTK's PLY reader skips extra properties: parse them
+        raw = (tmp_path / "t.ply").read_bytes()
+        body = raw[raw.index(b"end_header\n") + 11:]
+        rec = np.frombuffer(body, np.dtype([("xyz", "<f4", 3), ("height_m", "<f4"),
+                                            ("layer", "u1")]), count=4)
+        assert np.array_equal(rec["height_m"], [0.5, 1.5, 2.5, 3.5])
+        assert np.array_equal(rec["layer"], [0, 1, 1, 2])
+    elif fields and suffix != ".obj":
+        assert np.array_equal(mesh.point_data["height_m"], [0.5, 1.5, 2.5, 3.5])
+        assert np.array_equal(mesh.point_data["layer"], [0, 1, 1, 2])
+
+
+def test_glb_reads_back(tmp_path):
+    import trimesh
+
+    v, f, src = _tetra(False)
+    scene = trimesh.load(write_mesh(src, tmp_path / "t.glb"))
+    (geom,) = scene.geometry.values()
+    assert np.allclose(geom.vertices, v) and np.array_equal(geom.faces, f)
+
+
+def test_chunks_and_groups_give_the_same_bytes_as_one_piece(tmp_path):
+    """A mesh delivered in several chunks and groups writes the bytes of one piece (OBJ
+    adds its group lines)."""
+    v, f, whole = _tetra(True)
+    values = {"height_m": np.array([0.5, 1.5, 2.5, 3.5], np.float32),
+              "layer": np.array([0, 1, 1, 2], np.uint8)}
+
+    def vertex_chunks():
+        yield v[:1], {k: a[:1] for k, a in values.items()}
+        yield v[1:], {k: a[1:] for k, a in values.items()}
+
+    split = MeshSource(4, 4, vertex_chunks, lambda: [(None, [f[:3], f[3:]])],
+                       lambda: [v[f[:2]], v[f[2:]]], whole.fields, whole.title)
+    for suffix in (".ply", ".stl", ".vtp", ".vtk", ".glb", ".obj"):
+        a = write_mesh(whole, tmp_path / f"a{suffix}").read_bytes()
+        b = write_mesh(split, tmp_path / f"b{suffix}").read_bytes()
+        assert a == b, suffix
+
+
+def test_unknown_suffix_writes_nothing(tmp_path):
+    with pytest.raises(ValueError, match="unknown mesh format.*allowed: .ply"):
+        write_mesh(_tetra(False)[2], tmp_path / "t.xyz")
+    assert list(tmp_path.iterdir()) == []
