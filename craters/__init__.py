@@ -1,9 +1,22 @@
 """craters: crater science shared by the body (latlong) and raster (dem) pipelines.
 
-Pure functions over numpy arrays: the Martin crater profile with degradation, irregular
-rims and roughness (lunar paper III), stamping into 2-D height grids, power-law crater
-populations and catalogs, and the locally controlled spot-noise (LCSN) crater kernels of
-Li et al. 2022 with their morphometry. Imports neither ``latlong`` nor ``dem``.
+Science only, pure functions over numpy arrays: the Martin crater profile with
+degradation, irregular rims and roughness (lunar paper III), stamping into 2-D height
+grids, power-law crater populations and catalogs, the locally controlled spot-noise
+(LCSN) crater kernels of Li et al. 2022 with their morphometry, procedural boulders.
+Imports neither ``latlong`` nor ``dem``.
+
+::
+
+    morphometry, degradation -> profile -> stamp (numba: _stamp_kernels)
+    population (layers, sizes, positions, ages) -> catalog (CSV, GeoJSON)
+    lcsn/ (kernel, morphometry, inverse, presets; numba: _lcsn_kernels)
+    boulders/ (meshes, placement)
+    kernels: the numba building blocks latlong and dem compile against
+
+The plumbing every package needs (checks, RNG, atomic files, progress, ``key=value``
+specs, reports, the mesh-writer registry) is the private ``craters._shared``, and the
+command line ``craters.cli``; neither is crater science.
 """
 
 import logging

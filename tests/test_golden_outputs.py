@@ -30,6 +30,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+# one worker runs every step (the steps share one folder and build on each other)
+pytestmark = pytest.mark.xdist_group("golden")
+
 DATA = Path(__file__).parent / "data"
 GOLDEN = DATA / "golden_outputs.json"
 WRITE = bool(os.environ.get("CRATERFORM_WRITE_GOLDEN"))
