@@ -1,0 +1,21 @@
+"""The distribution ships every subpackage (a wheel with only the top-level packages
+imports in the source tree and fails once installed)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+
+from setuptools import find_packages
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_package_with_an_init_is_in_the_distribution():
+    config = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    find = config["tool"]["setuptools"]["packages"]["find"]
+    shipped = set(find_packages(str(ROOT), include=find["include"]))
+    on_disk = {str(p.parent.relative_to(ROOT)).replace("/", ".")
+               for top in ("latlong", "craters", "dem") for p in (ROOT / top).rglob("__init__.py")}
+    assert on_disk <= shipped and {"craters._shared", "latlong.cli", "latlong.implicit",
+                                   "dem.cli", "craters.lcsn", "craters.boulders"} <= shipped
