@@ -197,3 +197,16 @@ def test_no_module_over_500_lines():
     long = {m: n for m, p in SOURCES.items()
             if (n := len(p.read_text().splitlines())) > MAX_LINES}
     assert not long, long
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_option_help_shows_its_default(package):
+    import argparse
+    import importlib
+
+    parser = importlib.import_module(f"{package}.cli").build_parser()
+    (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+    missing = [f"{package} {cmd} {a.option_strings[-1]}" for cmd, p in sub.choices.items()
+               for a in p._actions if a.option_strings and not isinstance(a, argparse._HelpAction)
+               and not any(w in (a.help or "") for w in ("default", "required"))]
+    assert not missing, missing

@@ -96,7 +96,7 @@ def add_body_parsers(sub, add_groups) -> None:
     p.set_defaults(func=cmd_presets)
     r = sub.add_parser("render", help="render a saved body to a PNG (off-screen)")
     r.add_argument("model", help="a .npz written by latlong build")
-    r.add_argument("-o", "--output", required=True, help="PNG to write")
+    r.add_argument("-o", "--output", required=True, help="PNG to write (required)")
     r.add_argument("--force", action="store_true",
                    help="overwrite an existing picture (default: off)")
     r.add_argument("-q", "--quiet", action="store_true",
@@ -106,7 +106,7 @@ def add_body_parsers(sub, add_groups) -> None:
     e = sub.add_parser("export", help="renderer export: patched triangle strips (.glb, with "
                        "a JSON manifest, nested LODs) or a VTP with native strips")
     e.add_argument("model", help="a .npz written by latlong build")
-    e.add_argument("-o", "--output", required=True, help="out.glb or out.vtp")
+    e.add_argument("-o", "--output", required=True, help="out.glb or out.vtp (required)")
     e.add_argument("--patch-k", type=int, default=64,
                    help="patch tree parameter K (default: 64)")
     e.add_argument("--lod", type=int, default=0,
