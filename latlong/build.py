@@ -22,9 +22,9 @@ from .boulders import boulder_population, place_boulders
 from .cratering import body_population, stamp_craters
 from .faulting import FaultingParams, two_phase_faulting
 from .grid import LatLongGrid
-from .perlin import perlin_fbm
+from .perlin import FbmParams, perlin_fbm
 from .scene import Scene
-from .settings import FaultingBase, FbmBase, ShapeBase, SphereBase
+from .settings import ShapeBase, SphereBase
 from .shapes import from_shape_model
 
 __all__ = ["build"]
@@ -38,13 +38,10 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
     base, body = scene.base, scene.body
     if isinstance(base, SphereBase):
         return np.zeros(grid.n_vertices), body.radius_m, {}
-    if isinstance(base, FaultingBase):
-        fp = FaultingParams(base.n_faults_1, base.max_fault_1_m, base.smooth_width_m,
-                            base.smooth_passes, base.n_faults_2, base.max_fault_2_m,
-                            tuple(body.stretch))
-        heights = two_phase_faulting(grid, body.radius_m, fp, rng=rng, progress=progress)
-        return heights, body.radius_m, dataclasses.asdict(fp)
-    if isinstance(base, FbmBase):
+    if isinstance(base, FaultingParams):  # its stretch is the body's (the scene made it so)
+        heights = two_phase_faulting(grid, body.radius_m, base, rng=rng, progress=progress)
+        return heights, body.radius_m, dataclasses.asdict(base)
+    if isinstance(base, FbmParams):
         params = {"frequency": base.frequency, "octaves": base.octaves,
                   "persistence": base.persistence, "lacunarity": base.lacunarity,
                   "amplitude_m": base.amplitude_m}
@@ -79,8 +76,8 @@ def build(scene: Scene, *, progress: bool = False):
 
     Examples
     --------
-    >>> from latlong import BodySettings, FbmBase, Scene
-    >>> body = build(Scene(BodySettings(magnitude=8), FbmBase(octaves=3), seed=1))
+    >>> from latlong import BodySettings, FbmParams, Scene
+    >>> body = build(Scene(BodySettings(magnitude=8), FbmParams(octaves=3), seed=1))
     >>> body.n_vertices, body.metadata["seed"]
     (386, 1)
     """

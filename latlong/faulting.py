@@ -3,11 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 
 import numpy as np
 
-from craters._shared import check_int, check_positive, normalize_rng, progress_bar
+from craters._shared import ParameterError, check_int, check_positive, normalize_rng, progress_bar
 
 from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid
@@ -170,19 +171,20 @@ class FaultingParams:
     max_fault_2_m: float = 0.03
     """Largest phase-2 fault offset, metres."""
     stretch: tuple[float, float, float] = (1.0, 1.0, 1.0)
-    """Final stretch of the body along x, y, z (applied by :class:`~latlong.Body`)."""
+    """Final stretch of the body along x, y, z (applied by :class:`~latlong.Body`; in a
+    :class:`~latlong.Scene` the body's stretch, which this one gives by default)."""
+    name = "faulting"  # the base shape's name in a scene (not a field)
 
     def __post_init__(self):
-        check_int("n_faults_1", self.n_faults_1, 0, 100_000_000)
-        check_int("n_faults_2", self.n_faults_2, 0, 100_000_000)
-        check_positive("max_fault_1_m", self.max_fault_1_m, allow_zero=True)
-        check_positive("max_fault_2_m", self.max_fault_2_m, allow_zero=True)
-        check_positive("smooth_width_m", self.smooth_width_m, allow_zero=True)
-        check_int("smooth_passes", self.smooth_passes, 0, 1000)
-        if len(self.stretch) != 3:
-            raise ValueError(f"`stretch` must have three factors; got {self.stretch!r}")
-        for v in self.stretch:
-            check_positive("stretch", v)
+        put = functools.partial(object.__setattr__, self)
+        put("n_faults_1", check_int("n_faults_1", self.n_faults_1, 0, 100_000_000))
+        put("n_faults_2", check_int("n_faults_2", self.n_faults_2, 0, 100_000_000))
+        for key in ("max_fault_1_m", "max_fault_2_m", "smooth_width_m"):
+            put(key, check_positive(key, getattr(self, key), allow_zero=True))
+        put("smooth_passes", check_int("smooth_passes", self.smooth_passes, 0, 1000))
+        if isinstance(self.stretch, str) or len(self.stretch) != 3:
+            raise ParameterError("stretch", f"must have three factors; got {self.stretch!r}")
+        put("stretch", tuple(check_positive("stretch", v) for v in self.stretch))
 
 
 #: Named parameter sets, both stretched 2x along x. ``paper``: the asteroid of Martin

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 
 import numpy as np
 
@@ -110,11 +111,22 @@ class FbmParams:
     """Frequency ratio between successive octaves."""
     amplitude: float = 0.4
     """Height scale as a fraction of the body radius: heights = amplitude * R * fbm."""
+    amplitude_m: float | None = None
+    """Height scale in metres, instead of ``amplitude`` x the radius (a
+    :class:`~latlong.Scene` sets it from ``amplitude`` when it is None)."""
+    name = "fbm"  # the base shape's name in a scene (not a field)
 
     def __post_init__(self):
-        check_positive("frequency", self.frequency)
-        _check_noise_params(self.octaves, self.persistence, self.lacunarity, 0)
-        check_positive("amplitude", self.amplitude, allow_zero=True)
+        put = functools.partial(object.__setattr__, self)
+        put("frequency", check_positive("frequency", self.frequency))
+        octaves, persistence, lacunarity, _ = _check_noise_params(
+            self.octaves, self.persistence, self.lacunarity, 0)
+        put("octaves", octaves)
+        put("persistence", persistence)
+        put("lacunarity", lacunarity)
+        put("amplitude", check_positive("amplitude", self.amplitude, allow_zero=True))
+        if self.amplitude_m is not None:
+            put("amplitude_m", check_positive("amplitude_m", self.amplitude_m, allow_zero=True))
 
 
 #: The three parameter sets of Martin 2014, Fig. 5 (10 octaves each).

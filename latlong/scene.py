@@ -2,8 +2,8 @@
 
 A :class:`Scene` holds everything that makes a body (no output paths): the body (grid
 magnitude, reference radius, stretch), the base shape (:class:`SphereBase`,
-:class:`FaultingBase`, :class:`FbmBase`, :class:`ShapeBase`), the crater and boulder
-layers, or the implicit backend (:class:`ImplicitSettings`) instead of a base and
+:class:`~latlong.FaultingParams`, :class:`~latlong.FbmParams`, :class:`ShapeBase`), the
+crater and boulder layers, or the implicit backend (:class:`ImplicitSettings`) instead of a base and
 craters, the preview picture's camera and light, and the seed. Each part validates
 itself when it is made (:mod:`latlong.settings`) and the scene checks how they fit
 together, once; :func:`latlong.build` turns a scene into a body and writes nothing.
@@ -33,14 +33,14 @@ from craters._shared import (
     load_toml,
 )
 
+from .faulting import FaultingParams
+from .perlin import FbmParams
 from .presets import DEFAULT_PRESET, PRESETS
 from .preview import PreviewSettings
 from .settings import (
     BodySettings,
     BoulderSettings,
     CraterSettings,
-    FaultingBase,
-    FbmBase,
     ImplicitSettings,
     ShapeBase,
     SphereBase,
@@ -92,7 +92,7 @@ def _field_defaults(kind, names: dict) -> dict:
 #: on the preset or base); the faulting and fBm values are the paper's / Fig. 5a's.
 SETTING_DEFAULTS: dict[str, object] = {
     **_field_defaults(BodySettings, _BODY), "radius_m": 50.0, "stretch": (1.0, 1.0, 1.0),
-    **_field_defaults(FaultingBase, _FAULTING), **_field_defaults(FbmBase, _FBM),
+    **_field_defaults(FaultingParams, _FAULTING), **_field_defaults(FbmParams, _FBM),
     **_field_defaults(ShapeBase, _SHAPE), **_field_defaults(CraterSettings, _CRATERS),
     **_field_defaults(_craters.BoulderShape, _BOULDER_SHAPE), "backend": "latlong",
     **_field_defaults(ImplicitSettings, _IMPLICIT), **_field_defaults(PreviewSettings, _PREVIEW),
@@ -105,7 +105,7 @@ class Scene:
 
     Examples
     --------
-    >>> s = Scene(BodySettings(magnitude=16, radius_m=100.0), FbmBase(octaves=4), seed=1)
+    >>> s = Scene(BodySettings(magnitude=16, radius_m=100.0), FbmParams(octaves=4), seed=1)
     >>> s.body.radius_m, s.body.stretch, s.base.amplitude_m
     (100.0, (1.0, 1.0, 1.0), 40.0)
     >>> Scene.from_settings({"preset": "paper", "magnitude": 20, "seed": 3}).base.n_faults_2
@@ -114,8 +114,8 @@ class Scene:
 
     body: BodySettings = dataclasses.field(default_factory=BodySettings)
     """Grid magnitude, reference radius and stretch."""
-    base: SphereBase | FaultingBase | FbmBase | ShapeBase | None = None
-    """Base shape; default :class:`FbmBase` (None with the implicit backend)."""
+    base: SphereBase | FaultingParams | FbmParams | ShapeBase | None = None
+    """Base shape; default :class:`FbmParams` (None with the implicit backend)."""
     craters: CraterSettings = dataclasses.field(default_factory=CraterSettings)
     """Crater layers and how they are stamped."""
     boulders: BoulderSettings = dataclasses.field(default_factory=BoulderSettings)
@@ -147,9 +147,9 @@ class Scene:
                 if getattr(self, name) != empty:
                     raise ParameterError(name, "does not apply to the implicit backend")
             return
-        base = FbmBase() if self.base is None else self.base
-        if not isinstance(base, SphereBase | FaultingBase | FbmBase | ShapeBase):
-            raise ParameterTypeError("base", "must be a SphereBase, FaultingBase, FbmBase or "
+        base = FbmParams() if self.base is None else self.base
+        if not isinstance(base, SphereBase | FaultingParams | FbmParams | ShapeBase):
+            raise ParameterTypeError("base", "must be a SphereBase, FaultingParams, FbmParams or "
                                      f"ShapeBase; got {type(base).__name__}")
         body, resolution = self.body, None
         if isinstance(base, ShapeBase):
@@ -161,12 +161,16 @@ class Scene:
             body = dataclasses.replace(body, **own)
             resolution = base.model.mean_edge_m
         else:
+            stretch = body.stretch
+            if stretch is None:  # a faulting set carries its body's stretch (the paper's 2,1,1)
+                stretch = base.stretch if isinstance(base, FaultingParams) else (1.0, 1.0, 1.0)
             body = dataclasses.replace(
                 body, radius_m=50.0 if body.radius_m is None else body.radius_m,
-                stretch=(1.0, 1.0, 1.0) if body.stretch is None else body.stretch)
-        if isinstance(base, FbmBase) and base.amplitude_m is None:
-            base = dataclasses.replace(base, amplitude_m=base.amplitude_fraction
-                                       * body.radius_m)
+                stretch=stretch)
+        if isinstance(base, FaultingParams):
+            base = dataclasses.replace(base, stretch=body.stretch)
+        if isinstance(base, FbmParams) and base.amplitude_m is None:
+            base = dataclasses.replace(base, amplitude_m=base.amplitude * body.radius_m)
         object.__setattr__(self, "base", base)
         object.__setattr__(self, "body", body)
         smallest = body.radius_m * min(body.stretch)
@@ -265,11 +269,11 @@ def _latlong_scene(cls, given: dict) -> Scene:
     merged = {**(p.settings if p else {}), **given}
     body = _part(BodySettings, _BODY, merged)
     if base == "faulting":
-        part = _part(FaultingBase, _FAULTING, merged)
+        part = _part(FaultingParams, _FAULTING, merged)
     elif base == "fbm":
         extra = {} if p is None or p.amplitude_fraction is None else {
-            "amplitude_fraction": p.amplitude_fraction}
-        part = _part(FbmBase, _FBM, merged, **extra)
+            "amplitude": p.amplitude_fraction}
+        part = _part(FbmParams, _FBM, merged, **extra)
     elif base == "sphere":
         part = SphereBase()
     else:

@@ -1,5 +1,6 @@
 """The parts of a :class:`latlong.Scene`: body, base shapes, crater and boulder layers,
-the implicit backend. Frozen, slotted records that validate themselves when made
+the implicit backend (the faulting and fBm bases are :class:`latlong.FaultingParams` and
+:class:`latlong.FbmParams`). Frozen, slotted records that validate themselves when made
 (errors name the field); :mod:`latlong.scene` checks how they fit together.
 """
 
@@ -23,12 +24,10 @@ from craters._shared import (
 )
 
 from .grid import LatLongGrid
-from .perlin import FBM_PRESETS
 from .shapes import ShapeModel, read_shape_model
 
 __all__ = ["BASES", "BYTES_PER_VERTEX", "BodySettings", "BoulderSettings", "CraterSettings",
-           "FaultingBase", "FbmBase", "ImplicitSettings", "ShapeBase", "SphereBase",
-           "check_memory"]
+           "ImplicitSettings", "ShapeBase", "SphereBase", "check_memory"]
 
 #: Names of the base shapes (``shape`` takes a model file).
 BASES = ("sphere", "faulting", "fbm", "shape")
@@ -95,36 +94,6 @@ class SphereBase:
     name = "sphere"
 
 
-@dataclass(frozen=True, slots=True)
-class FaultingBase:
-    """Two-phase Poisson faulting (Martin 2014 IV.A; :func:`latlong.two_phase_faulting`);
-    defaults: the paper's set."""
-
-    n_faults_1: int = 1000
-    """Phase-1 (large) faults."""
-    max_fault_1_m: float = 5.0
-    """Largest phase-1 fault offset, metres."""
-    smooth_width_m: float = 20.0
-    """Smoothing filter width between the phases (Gaussian FWHM), metres."""
-    smooth_passes: int = 3
-    """Smoothing passes."""
-    n_faults_2: int = 20000
-    """Phase-2 (small) faults."""
-    max_fault_2_m: float = 0.03
-    """Largest phase-2 fault offset, metres."""
-    name = "faulting"
-
-    def __post_init__(self):
-        for key in ("n_faults_1", "n_faults_2"):
-            _set(self, key, check_int(key, getattr(self, key), 0, 10**8))
-        _set(self, "smooth_passes", check_int("smooth_passes", self.smooth_passes, 0, 1000))
-        for key in ("max_fault_1_m", "max_fault_2_m", "smooth_width_m"):
-            value = check_finite(key, getattr(self, key))
-            if value < 0:
-                raise ParameterError(key, f"must be >= 0; got {value!r}")
-            _set(self, key, value)
-
-
 def _check_fbm(obj, prefix: str = "") -> None:
     """frequency > 0, octaves in [1, 30], persistence > 0, lacunarity >= 1 (the fields of
     an fBm record whose names start with ``prefix``)."""
@@ -140,35 +109,6 @@ def _check_fbm(obj, prefix: str = "") -> None:
     if lac < 1:
         raise ParameterError(key, f"must be >= 1; got {lac!r}")
     _set(obj, key, lac)
-
-
-@dataclass(frozen=True, slots=True)
-class FbmBase:
-    """Perlin fBm on the unit sphere (Martin 2014 IV.B; :func:`latlong.perlin_fbm`);
-    defaults: Fig. 5a."""
-
-    frequency: float = 1.5
-    """First-octave frequency on the unit sphere."""
-    octaves: int = 10
-    """Number of octaves."""
-    persistence: float = 0.5
-    """Amplitude ratio per octave."""
-    lacunarity: float = 1.75
-    """Frequency ratio per octave (>= 1)."""
-    amplitude_m: float | None = None
-    """Height scale, metres; default ``amplitude_fraction`` x the radius."""
-    amplitude_fraction: float = FBM_PRESETS["fig5a"].amplitude
-    """Height scale as a fraction of the radius when ``amplitude_m`` is not given."""
-    name = "fbm"
-
-    def __post_init__(self):
-        _check_fbm(self)
-        if self.amplitude_m is not None:
-            _set(self, "amplitude_m", check_positive("amplitude_m", self.amplitude_m,
-                                                     allow_zero=True))
-        _set(self, "amplitude_fraction", check_positive("amplitude_fraction",
-                                                        self.amplitude_fraction,
-                                                        allow_zero=True))
 
 
 @dataclass(frozen=True, slots=True)

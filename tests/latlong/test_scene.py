@@ -15,8 +15,8 @@ from latlong import (
     BodySettings,
     BoulderSettings,
     CraterSettings,
-    FaultingBase,
-    FbmBase,
+    FaultingParams,
+    FbmParams,
     Scene,
     ShapeBase,
     SphereBase,
@@ -39,8 +39,10 @@ def test_build_returns_a_body_and_writes_nothing(tmp_path, monkeypatch):
 
 
 def test_python_and_settings_give_the_same_body():
-    a = build(Scene(BodySettings(magnitude=20, radius_m=100.0, stretch=(2, 1, 1)),
-                    FaultingBase(n_faults_1=50, n_faults_2=80), seed=3, preset="paper"))
+    a = build(Scene(BodySettings(magnitude=20, radius_m=100.0),
+                    dataclasses.replace(latlong.FAULTING_PRESETS["paper"], n_faults_1=50,
+                                        n_faults_2=80), seed=3, preset="paper"))
+    assert np.array_equal(a.stretch, [2.0, 1.0, 1.0])  # the paper's set carries its stretch
     b = build(Scene.from_settings({"base": "faulting", "magnitude": 20, "faults_1": 50,
                                    "faults_2": 80, "seed": 3}))
     assert np.array_equal(a.radii_m, b.radii_m) and a.metadata == b.metadata
@@ -48,7 +50,9 @@ def test_python_and_settings_give_the_same_body():
 
 def test_scene_is_frozen_and_defaults_are_resolved_once():
     s = Scene(BodySettings(magnitude=8), seed=1)
-    assert isinstance(s.base, FbmBase) and s.base.amplitude_m == pytest.approx(0.4 * 50.0)
+    assert Scene(BodySettings(magnitude=8, stretch=(1, 1, 3)), FaultingParams()).base.stretch \
+        == (1.0, 1.0, 3.0)  # the body's stretch is the base's
+    assert isinstance(s.base, FbmParams) and s.base.amplitude_m == pytest.approx(0.4 * 50.0)
     assert s.body.radius_m == 50.0 and s.body.stretch == (1.0, 1.0, 1.0)
     with pytest.raises(dataclasses.FrozenInstanceError):
         s.seed = 2
