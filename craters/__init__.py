@@ -72,6 +72,7 @@ from .population import (
 )
 from .profile import DEFAULT_EJECTA_EDGE, ProfileParams, profile_params, radial_profile
 from .stamp import Crater, Roughness, rim_perturbations, stamp, stamp_many
+from .targets import TARGETS, Target, get_target, small_body
 
 __all__ = [
     "BoulderLayer",
@@ -80,6 +81,8 @@ __all__ = [
     "DEFAULT_EJECTA_EDGE",
     "LCSN_PRESETS",
     "MORPHOMETRY_PRESETS",
+    "TARGETS",
+    "Target",
     "Crater",
     "CraterLayer",
     "DegradationModel",
@@ -99,6 +102,7 @@ __all__ = [
     "fresh_depth",
     "fresh_rim_height",
     "get_morphometry",
+    "get_target",
     "lcsn_degrade",
     "lcsn_kernel",
     "lcsn_morphometry",
@@ -113,6 +117,7 @@ __all__ = [
     "rim_perturbations",
     "sample_power_law_diameters",
     "slope_erosion",
+    "small_body",
     "sort_oldest_first",
     "stamp",
     "stamp_many",
