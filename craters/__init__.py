@@ -38,12 +38,7 @@ from .catalog import (
     write_catalog,
     write_geojson,
 )
-from .degradation import (
-    DegradationModel,
-    degradation_factors,
-    degradation_from_age,
-    slope_erosion,
-)
+from .diffusion import kappa_m2_yr, profile_tables, tau_from_age, tau_from_degradation
 from .lcsn import (
     LCSN_PRESETS,
     LcsnParams,
@@ -53,13 +48,7 @@ from .lcsn import (
     lcsn_raw,
     lcsn_scaled,
 )
-from .morphometry import (
-    MORPHOMETRY_PRESETS,
-    Morphometry,
-    fresh_depth,
-    fresh_rim_height,
-    get_morphometry,
-)
+from .morphology import fresh_morphometry, fresh_profile, morphology_class
 from .population import (
     CraterLayer,
     expected_count,
@@ -70,8 +59,23 @@ from .population import (
     sample_power_law_diameters,
     uniform_sphere_directions,
 )
-from .profile import DEFAULT_EJECTA_EDGE, ProfileParams, profile_params, radial_profile
-from .stamp import Crater, Roughness, rim_perturbations, stamp, stamp_many
+from .profile import (
+    DEFAULT_EJECTA_EDGE,
+    crater_morphometry,
+    crater_tau,
+    radial_profile,
+    slope_erosion,
+)
+from .stamp import (
+    Crater,
+    Roughness,
+    StampingProfiles,
+    as_stamped,
+    rim_perturbations,
+    stamp,
+    stamp_many,
+    stamping_profiles,
+)
 from .targets import TARGETS, Target, get_target, small_body
 
 __all__ = [
@@ -80,38 +84,37 @@ __all__ = [
     "BoulderShape",
     "DEFAULT_EJECTA_EDGE",
     "LCSN_PRESETS",
-    "MORPHOMETRY_PRESETS",
     "TARGETS",
     "Target",
     "Crater",
     "CraterLayer",
-    "DegradationModel",
     "LcsnParams",
-    "Morphometry",
-    "ProfileParams",
     "Roughness",
+    "StampingProfiles",
+    "as_stamped",
     "boulder",
     "boulder_meshes",
     "boulder_normals",
-    "degradation_factors",
-    "degradation_from_age",
+    "crater_morphometry",
+    "crater_tau",
     "expected_count",
     "fit_power_law_exponent",
+    "fresh_morphometry",
+    "fresh_profile",
     "parse_boulder_spec",
     "parse_layer_spec",
-    "fresh_depth",
-    "fresh_rim_height",
-    "get_morphometry",
     "get_target",
+    "kappa_m2_yr",
     "lcsn_degrade",
     "lcsn_kernel",
     "lcsn_morphometry",
     "lcsn_raw",
     "lcsn_scaled",
     "make_catalog",
+    "morphology_class",
     "population",
     "power_law_population",
-    "profile_params",
+    "profile_tables",
     "radial_profile",
     "read_catalog",
     "rim_perturbations",
@@ -121,6 +124,9 @@ __all__ = [
     "sort_oldest_first",
     "stamp",
     "stamp_many",
+    "stamping_profiles",
+    "tau_from_age",
+    "tau_from_degradation",
     "uniform_sphere_directions",
     "validate_catalog",
     "write_catalog",

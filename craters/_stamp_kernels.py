@@ -25,83 +25,33 @@ _GRAD = np.array([[1.0, 0.0], [0.70710678118654752, 0.70710678118654752], [0.0, 
 
 
 # --------------------------------------------------------------------------- profile
-@njit(cache=True)
-def _degradation_factors(d, rim_rate, depth_rate, final_depth):
-    f_r = (np.exp(-rim_rate * d) - np.exp(-rim_rate)) / (1.0 - np.exp(-rim_rate))
-    f_h = 1.0 - (1.0 - final_depth) * (1.0 - np.exp(-depth_rate * d)) / (
-        1.0 - np.exp(-depth_rate))
-    if f_r < 0.0:
-        f_r = 0.0
-    return f_h, f_r
-
-
-@njit(cache=True)
-def _profile_params(diameter_m, d, morph, deg):
-    """(R, H, Hr, alpha, beta, E0) as ``craters.profile.profile_params``.
-
-    ``morph`` = (depth_coef, depth_exp, rim_coef, rim_exp) for D in km;
-    ``deg`` = (rim_rate, depth_rate, final_depth).
-    """
-    d_km = diameter_m / 1000.0
-    h0 = 1000.0 * morph[0] * d_km ** morph[1]
-    hr0 = 1000.0 * morph[2] * d_km ** morph[3]
-    f_h, f_r = _degradation_factors(d, deg[0], deg[1], deg[2])
-    h = f_h * h0
-    hr = f_r * hr0
-    h_ = hr0 - hr + h
-    alpha = 1.0 + (hr - hr0) / h_
-    beta = 1.0 + 1.5 * (hr0 - hr) / h_
-    radius = 0.5 * diameter_m
-    e0 = min(0.14 * radius**0.74, hr0) * f_r
-    return radius, h, hr, alpha, beta, e0
+@njit(cache=True, inline="always")
+def _table_value(tab, x, xe):
+    """A crater's profile table (heights at ``tab.shape[0]`` evenly spaced radii over
+    [0, xe], :func:`craters.diffusion.profile_tables`) at ``x`` radii, linearly; 0 at and
+    beyond ``xe``."""
+    n = tab.shape[0]
+    f = x / xe * (n - 1)
+    if f >= n - 1:
+        return 0.0
+    i = int(f)
+    return tab[i] + (f - i) * (tab[i + 1] - tab[i])
 
 
 @njit(cache=True, inline="always")
-def _inside(x, h, hr, alpha):
-    """Bowl and interior rim, 0 <= x <= 1."""
-    if x <= alpha:
-        return hr - h + (h / alpha) * x * x
-    u = 1.0 - x
-    return hr - h * u * u / (1.0 - alpha)
-
-
-@njit(cache=True, inline="always")
-def _ejecta(x, rim_value, e0, xe):
-    length = xe - 1.0
-    c0 = -e0 * xe**-3.0
-    c1 = -3.0 * e0 * xe**-4.0
-    c2 = (rim_value - e0 - c0 - c1 * length) / (length * length)
-    u = xe - x
-    h = e0 * x**-3.0 + c0 + c1 * u + c2 * u * u
-    dh = -3.0 * e0 * x**-4.0 - c1 - 2.0 * c2 * u
-    return h, dh
+def _outer_weight(x, xe):
+    """How much of the plane-to-terrain offset at the rim is carried at ``x`` outside the
+    rim: 1 at the rim, falling quadratically to 0 at the ejecta edge."""
+    u = (xe - x) / (xe - 1.0)
+    return u * u
 
 
 @njit(cache=True)
-def _outside(x, rim_value, beta, e0, xe):
-    """Exterior rim cubic and ejecta, 1 < x < xe; ``rim_value`` = Hr + delta."""
-    if x >= beta:
-        return _ejecta(x, rim_value, e0, xe)[0]
-    hb, db = _ejecta(beta, rim_value, e0, xe)
-    span = beta - 1.0
-    t = (x - 1.0) / span
-    t2 = t * t
-    t3 = t2 * t
-    return (2 * t3 - 3 * t2 + 1) * rim_value + (-2 * t3 + 3 * t2) * hb + (t3 - t2) * span * db
-
-
-@njit(cache=True)
-def _profile_kernel(x, diameter_m, d, morph, deg, xe, delta, out):
-    """Profile at many x (for testing the scalar functions against numpy)."""
-    radius, h, hr, alpha, beta, e0 = _profile_params(diameter_m, d, morph, deg)
-    for i in range(x.shape[0]):
-        xi = x[i]
-        if xi <= 1.0:
-            out[i] = _inside(xi, h, hr, alpha)
-        elif xi < xe:
-            out[i] = _outside(xi, hr + delta, beta, e0, xe)
-        else:
-            out[i] = 0.0
+def _table_kernel(tabs, x, xe, out):
+    """Profile tables at many x (for testing :func:`_table_value` against numpy)."""
+    for c in range(tabs.shape[0]):
+        for i in range(x.shape[0]):
+            out[c, i] = _table_value(tabs[c], x[i], xe)
 
 
 # --------------------------------------------------------------------------- noise
@@ -210,12 +160,11 @@ def _roughness_amp(x, xe, a_bowl, a_wall, a_ejecta):
 
 
 @njit(cache=True, inline="always")
-def _eroded_degradation(d, slope, onset_deg, full_deg):
-    """Slope erosion: degradation ``d`` raised linearly towards 1 between ``onset_deg``
-    and ``full_deg`` of ground slope (degrees; the caller erases the crater at or above
-    ``full_deg``)."""
-    frac = min(max((slope - onset_deg) / (full_deg - onset_deg), 0.0), 1.0)
-    return d + (1.0 - d) * frac
+def _slope_factor(slope, onset_deg, full_deg):
+    """Slope erosion: the share of a crater's relief kept on ground of ``slope`` degrees,
+    1 below ``onset_deg`` falling linearly to 0 at ``full_deg`` (the caller erases the
+    crater at or above ``full_deg``); degradation d becomes d + (1 - d)(1 - factor)."""
+    return 1.0 - min(max((slope - onset_deg) / (full_deg - onset_deg), 0.0), 1.0)
 
 
 @njit(cache=True, inline="always")
@@ -247,36 +196,34 @@ def _crater_box(h, cy, cx, pixel, radius, xe, rim_tab):
 
 
 @njit(cache=True, parallel=True)
-def _write_crater_parallel(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe,
-                           rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves,
-                           gain):
+def _write_crater_parallel(h, cy, cx, pixel, radius, tab, scale, depth, xe, rim_tab,
+                           delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
     """:func:`_write_rows` row by row in parallel (pixels are independent)."""
     i_lo, i_hi, j_lo, j_hi = _crater_box(h, cy, cx, pixel, radius, xe, rim_tab)
     for i in prange(i_lo, i_hi + 1):
-        _write_rows(i, i + 1, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha, beta,
-                    e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves,
-                    gain)
+        _write_rows(i, i + 1, j_lo, j_hi, h, cy, cx, pixel, radius, tab, scale, depth, xe,
+                    rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain)
 
 
 @njit(cache=True)
-def _write_crater(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab,
-                  delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
+def _write_crater(h, cy, cx, pixel, radius, tab, scale, depth, xe, rim_tab, delta_tab, p0, gx,
+                  gy, rough, seed, wavelength, octaves, gain):
     """Write one crater into ``h`` in place (in parallel when it is large)."""
     i_lo, i_hi, j_lo, j_hi = _crater_box(h, cy, cx, pixel, radius, xe, rim_tab)
     if (i_hi - i_lo + 1) * (j_hi - j_lo + 1) >= PARALLEL_MIN:
-        _write_crater_parallel(h, cy, cx, pixel, radius, depth, rim_h, alpha, beta, e0, xe,
-                               rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength,
-                               octaves, gain)
+        _write_crater_parallel(h, cy, cx, pixel, radius, tab, scale, depth, xe, rim_tab,
+                               delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain)
     else:
-        _write_rows(i_lo, i_hi + 1, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha,
-                    beta, e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength,
-                    octaves, gain)
+        _write_rows(i_lo, i_hi + 1, j_lo, j_hi, h, cy, cx, pixel, radius, tab, scale, depth,
+                    xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain)
 
 
 @njit(cache=True)
-def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, alpha, beta,
-                e0, xe, rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
-    """Write rows r_lo..r_hi-1 (columns j_lo..j_hi) of a crater into ``h`` in place."""
+def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, tab, scale, depth, xe,
+                rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
+    """Write rows r_lo..r_hi-1 (columns j_lo..j_hi) of a crater into ``h`` in place:
+    inside the rim the plane plus ``scale`` x the profile table, outside the terrain plus
+    it (and the plane-to-terrain offset at the rim, carried out to the ejecta edge)."""
     for i in range(r_lo, r_hi):
         dy = (i - cy) * pixel
         for j in range(j_lo, j_hi + 1):
@@ -288,12 +235,12 @@ def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, depth, rim_h, 
             if x >= xe:
                 continue
             if x <= 1.0:
-                v = p0 + gx * dx + gy * dy + _inside(x, depth, rim_h, alpha)
+                v = p0 + gx * dx + gy * dy + scale * _table_value(tab, x, xe)
             else:
-                delta = _table(delta_tab, theta)
-                v = h[i, j] + _outside(x, rim_h + delta, beta, e0, xe)
+                v = (h[i, j] + scale * _table_value(tab, x, xe)
+                     + _table(delta_tab, theta) * _outer_weight(x, xe))
             if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
-                amp = _roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth
+                amp = _roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
                 v += amp * _fbm2(seed, dx, dy, wavelength, octaves, gain)
             h[i, j] = v
 
@@ -312,33 +259,32 @@ def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
 
 
 @njit(cache=True)
-def _stamp_many_kernel(h, pixel, cx, cy, diam, degr, rim_tabs, seeds, morph, deg, xe,
-                       slope_erosion, onset_deg, full_deg, rough, gain, out_deg, out_depth,
-                       out_rim, out_slope, out_erased):
+def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe,
+                       slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
+                       out_erased):
     """Stamp craters in the given order (the caller sorts oldest first), in place.
 
     For each crater: fit the plane to the obliterated region of the current heights,
     erode on steep ground (ground at or above ``full_deg`` erases the crater: it is not
-    written and ``out_erased`` is set), sample the rim offsets, write. Records the
-    degradation, depth, rim height and plane slope actually used.
+    written and ``out_erased`` is set; below, the relief is scaled by
+    :func:`_slope_factor`, recorded in ``out_scale``), sample the rim offsets, write the
+    profile table ``tabs[c]`` (``depths[c]``: its depth, for the roughness amplitude).
     """
     delta = np.empty(rim_tabs.shape[1])
     for c in range(cx.shape[0]):
-        r_px = 0.5 * diam[c] / pixel
+        radius = 0.5 * diam[c]
+        r_px = radius / pixel
         p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
         slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
-        d = degr[c]
         out_slope[c] = slope
+        scale = 1.0
         if slope_erosion:
             if slope >= full_deg:
                 out_erased[c] = True
                 continue
-            d = _eroded_degradation(d, slope, onset_deg, full_deg)
-        radius, depth, rim_h, alpha, beta, e0 = _profile_params(diam[c], d, morph, deg)
+            scale = _slope_factor(slope, onset_deg, full_deg)
         _rim_offsets(h, cy[c], cx[c], pixel, radius, rim_tabs[c], p0, gx, gy, delta)
-        _write_crater(h, cy[c], cx[c], pixel, radius, depth, rim_h, alpha, beta, e0, xe,
+        _write_crater(h, cy[c], cx[c], pixel, radius, tabs[c], scale, depths[c], xe,
                       rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], radius,
                       _roughness_octaves(radius, pixel), gain)
-        out_deg[c] = d
-        out_depth[c] = depth
-        out_rim[c] = rim_h
+        out_scale[c] = scale

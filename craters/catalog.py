@@ -4,7 +4,8 @@ A catalog is the ground truth that users feed to crater-detection and navigation
 algorithms, so it must say exactly what was stamped. Columns (units in the names):
 
 * position: ``lat_deg, lon_deg`` (on a body) or ``x_m, y_m`` (on a plane / DEM)
-* ``diameter_m`` rim-crest diameter, ``age_gyr``, ``degradation`` (0 fresh .. 1)
+* ``diameter_m`` rim-crest diameter, ``age_gyr``, ``degradation`` (the share of the
+  fresh depth removed, 0 fresh .. 1 no relief; NaN before stamping = from the age)
 * ``kind`` (e.g. ``simple``)
 * optional as-stamped columns: ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
   ``slope_deg``, ``seed`` and any extra float columns.
@@ -27,7 +28,7 @@ CATALOG_FORMAT = "craterform crater catalog v1"
 _KIND_LEN = 16
 _INT_COLUMNS = {"seed": np.uint64, "layer": np.int64, "level": np.int64, "index": np.int64,
                 "n_vertices": np.int64}
-_STR_COLUMNS = {"kind"}
+_STR_COLUMNS = {"kind", "morphology"}
 _PLANE = ("x_m", "y_m")
 _SPHERE = ("lat_deg", "lon_deg")
 _CORE = ("diameter_m", "age_gyr", "degradation", "kind")
@@ -91,8 +92,9 @@ def validate_catalog(cat: np.ndarray) -> np.ndarray:
         raise ValueError("catalog `diameter_m` must be finite and > 0")
     if "degradation" in names:
         g = cat["degradation"]
-        if not np.isfinite(g).all() or (g < 0).any() or (g > 1).any():
-            raise ValueError("catalog `degradation` must be in [0, 1]")
+        known = g[~np.isnan(g)]  # NaN: the degradation follows from the age (diffusion)
+        if (known < 0).any() or (known > 1).any() or np.isinf(known).any():
+            raise ValueError("catalog `degradation` must be in [0, 1] (or NaN: from the age)")
     if "age_gyr" in names:
         a = cat["age_gyr"]
         if not np.isfinite(a).all() or (a < 0).any():

@@ -12,9 +12,9 @@ from ._shared import atomic_path, check_output_path, package_version
 from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
 from ._shared.report import save_figure
 from .catalog import write_catalog
-from .degradation import degradation_from_age
 from .population import CraterLayer, expected_count, parse_layer_spec, population
-from .profile import profile_params, radial_profile
+from .profile import crater_morphometry, radial_profile
+from .targets import TARGETS, get_target
 
 
 def _finite(flag: str, value: float, *, positive=False, lo=None, hi=None) -> float:
@@ -38,57 +38,66 @@ def _pair(text: str) -> tuple[float, float]:
 
 
 # --------------------------------------------------------------------------- profile
+def _target(args):
+    return get_target(args.body, gravity_m_s2=args.gravity_m_s2,
+                      radius_m=args.body_radius_m, density_kg_m3=args.density_kg_m3)
+
+
 def _cmd_profile(args) -> int:
     d = _finite("--diameter-m", args.diameter_m, positive=True)
-    if args.degradation is not None and args.age_gyr is not None:
-        raise CliError("give --degradation or --age-gyr, not both")
-    if args.age_gyr is not None:
-        _finite("--age-gyr", args.age_gyr, lo=0.0, hi=100.0)
-        deg = float(degradation_from_age(d, args.age_gyr))
-    else:
-        deg = 0.0 if args.degradation is None else args.degradation
-        _finite("--degradation", deg, lo=0.0, hi=1.0)
-    if args.csv is None and args.plot is None:
-        raise CliError("nothing to write: give --csv and/or --plot")
+    target = _target(args)
+    m = crater_morphometry(d, target=target, age_gyr=args.age_gyr,
+                           degradation=args.degradation)
+    if args.csv is None and args.plot is None and args.quiet:
+        raise CliError("nothing to do: give --csv, --plot or drop --quiet for the summary")
     for path, suffixes in ((args.csv, (".csv",)), (args.plot, (".png",))):
         if path is not None:
             check_output_path(path, force=args.force, suffixes=suffixes)
     x = np.linspace(0.0, 3.2, 641)
-    p = profile_params(d, deg, morphometry=args.morphometry)
-    h = radial_profile(x, d, deg, morphometry=args.morphometry)
+    h = radial_profile(x, d, target=target, age_gyr=args.age_gyr, degradation=args.degradation)
+    state = (f"age_gyr={args.age_gyr!r}" if args.age_gyr is not None
+             else f"degradation={args.degradation or 0.0!r}")
     if args.csv:
         with atomic_path(args.csv) as tmp, open(tmp, "w", encoding="utf-8") as fh:
-            fh.write(f"# craters profile: diameter_m={d!r} degradation={deg!r} "
-                     f"morphometry={args.morphometry}; depth_m={p.depth_m!r} "
-                     f"rim_height_m={p.rim_height_m!r}\n")
+            fh.write(f"# craters profile: diameter_m={d!r} body={target.name} {state} "
+                     f"morphology={m['morphology']}; depth_m={m['depth_m']!r} "
+                     f"rim_height_m={m['rim_height_m']!r} "
+                     f"floor_diameter_m={m['floor_diameter_m']!r} "
+                     f"peak_height_m={m['peak_height_m']!r} "
+                     f"degradation={m['degradation']!r}\n")
             fh.write("x,r_m,height_m\n")
             for xi, hi in zip(x.tolist(), h.tolist(), strict=True):
                 fh.write(f"{xi!r},{xi * d / 2!r},{hi!r}\n")
     if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        ages = (0.0, 1.0, 3.0, 6.0, 10.0)
-        for age in ages:
-            da = float(degradation_from_age(d, age))
-            ax.plot(x * d / 2, radial_profile(x, d, da, morphometry=args.morphometry), lw=1,
-                    label=f"{age:g} Gyr (d = {da:.2f})")
-        ax.plot(x * d / 2, h, "k--", lw=2, label=f"requested: d = {deg:.2f}")
-        ax.axhline(0, color="0.6", lw=0.5)
-        ax.set_xlabel("distance from centre (m)")
-        ax.set_ylabel("height (m)")
-        ax.set_title(f"Crater profile, D = {d:g} m ({args.morphometry}); rim at {d / 2:g} m")
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        save_figure(fig, args.plot)
-        plt.close(fig)
+        _plot_profiles(args.plot, d, target, x, h, m)
     if not args.quiet:
-        print(f"D = {d:g} m, degradation {deg:.3f}: depth {p.depth_m:.4g} m, rim height "
-              f"{p.rim_height_m:.4g} m, alpha {p.alpha:.3f}, beta {p.beta:.3f}")
+        print(f"D = {d:g} m on {target.name} ({m['morphology']}), {state}: depth "
+              f"{m['depth_m']:.4g} m (d/D {m['depth_diameter']:.3f}), rim height "
+              f"{m['rim_height_m']:.4g} m, degradation {m['degradation']:.3f}")
     return 0
+
+
+def _plot_profiles(path, d: float, target, x, h, m) -> None:
+    """The requested profile over the same crater at several ages (diffusion)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    for age in (0.0, 0.5, 1.0, 2.0, 3.5):
+        ha = radial_profile(x, d, target=target, age_gyr=age)
+        ax.plot(x * d / 2, ha, lw=1, label=f"{age:g} Gyr")
+    ax.plot(x * d / 2, h, "k--", lw=2, label=f"requested (degradation {m['degradation']:.2f})")
+    ax.axhline(0, color="0.6", lw=0.5)
+    ax.set_xlabel("distance from centre (m)")
+    ax.set_ylabel("height (m)")
+    ax.set_title(f"Crater profile, D = {d:g} m on {target.name} ({m['morphology']}); "
+                 f"topographic diffusion with age")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    save_figure(fig, path)
+    plt.close(fig)
 
 
 # --------------------------------------------------------------------------- population
@@ -155,6 +164,18 @@ def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
 
 
 # --------------------------------------------------------------------------- parser
+def _add_body_options(p) -> None:
+    p.add_argument("--body", default="moon", choices=(*TARGETS, "small-body"),
+                   help="target body: crater morphology and diffusivity (default: moon)")
+    p.add_argument("--gravity-m-s2", type=float,
+                   help="surface gravity, m/s^2: the transition diameters scale as 1/g "
+                   "(default: the body's)")
+    p.add_argument("--body-radius-m", type=float,
+                   help="radius of a small-body, metres (default: none)")
+    p.add_argument("--density-kg-m3", type=float,
+                   help="bulk density of a small-body, kg/m^3 (default: 2000)")
+
+
 def build_parser() -> OneLineParser:
     parser = OneLineParser(prog="craters", description="Crater profiles and populations.")
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
@@ -163,12 +184,11 @@ def build_parser() -> OneLineParser:
     p.add_argument("--diameter-m", type=float, required=True,
                    help="rim diameter, metres (required)")
     p.add_argument("--degradation", type=float,
-                   help="0 (fresh) to 1 (fully degraded) (default: from --age-gyr, else 0)")
+                   help="share of the fresh depth removed, 0 (fresh) to 1 (no relief) "
+                   "(default: from --age-gyr, else 0)")
     p.add_argument("--age-gyr", type=float,
-                   help="age in Gyr (degradation from age) (default: none)")
-    p.add_argument("--morphometry", default="lunar-simple",
-                   choices=("lunar-simple", "asteroid-fresh"),
-                   help="fresh d/D laws (default: lunar-simple)")
+                   help="age in Gyr: topographic diffusion for that time (default: fresh)")
+    _add_body_options(p)
     p.add_argument("--csv", help="write x, r_m, height_m (default: none)")
     p.add_argument("--plot", help="PNG with profiles at several ages (like Martin Fig. 3) "
                    "(default: none)")
@@ -205,7 +225,10 @@ def build_parser() -> OneLineParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return run_cli(lambda: args.func(args))
+    flags = {"body": "--body", "gravity_m_s2": "--gravity-m-s2", "radius_m": "--body-radius-m",
+             "density_kg_m3": "--density-kg-m3", "age_gyr": "--age-gyr",
+             "degradation": "--degradation", "diameter_m": "--diameter-m"}
+    return run_cli(lambda: args.func(args), flags=flags)
 
 
 if __name__ == "__main__":  # pragma: no cover

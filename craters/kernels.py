@@ -7,12 +7,14 @@ Gaussian. They take no validation: callers validate first.
 
 Crater profile and stamping:
 
-* ``profile_params(diameter_m, d, morph, deg)`` -> (R, H, Hr, alpha, beta, E0)
-* ``inside(x, H, Hr, alpha)`` and ``outside(x, Hr + delta, beta, E0, x_e)``: the profile
+* ``table_value(tab, x, x_e)``: a crater's profile table (heights at evenly spaced radii
+  over [0, x_e], :func:`craters.diffusion.profile_tables`) at x radii
+* ``outer_weight(x, x_e)``: the share of the plane-to-terrain offset at the rim carried
+  at x outside the rim
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane
 * ``rim_offsets(h, cy, cx, pixel, R, rim_tab, p0, gx, gy, out)``: plane - terrain at the rim
 * ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
-* ``eroded_degradation(d, slope, onset_deg, full_deg)``: slope erosion of the degradation
+* ``slope_factor(slope, onset_deg, full_deg)``: the share of the relief kept on a slope
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
   spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
 * ``lcsn_height(kind, r2, kappa, beta, gamma, a, b)``: LCSN crater kernel ``kind`` at
@@ -44,18 +46,17 @@ from ._rng_kernels import _hash_normal as hash_normal
 from ._rng_kernels import _mix64 as mix64
 from ._rng_kernels import _splitmix64 as splitmix64
 from ._stamp_kernels import N_RIM
-from ._stamp_kernels import _eroded_degradation as eroded_degradation
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
-from ._stamp_kernels import _inside as inside
-from ._stamp_kernels import _outside as outside
-from ._stamp_kernels import _profile_params as profile_params
+from ._stamp_kernels import _outer_weight as outer_weight
 from ._stamp_kernels import _rim_offsets as rim_offsets
 from ._stamp_kernels import _roughness_amp as roughness_amp
 from ._stamp_kernels import _roughness_octaves as roughness_octaves
+from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
+from ._stamp_kernels import _table_value as table_value
 
-__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "eroded_degradation",
-           "fbm2", "fit_plane", "hash_normal", "idw8", "inside", "lcsn_height", "mix64",
-           "outside", "plane_solve", "plane_sums_add", "profile_params", "rim_offsets",
-           "roughness_amp", "roughness_octaves", "splitmix64", "table"]
+__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "fbm2", "fit_plane",
+           "hash_normal", "idw8", "lcsn_height", "mix64", "outer_weight", "plane_solve",
+           "plane_sums_add", "rim_offsets", "roughness_amp", "roughness_octaves",
+           "slope_factor", "splitmix64", "table", "table_value"]

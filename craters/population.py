@@ -20,7 +20,6 @@ import numpy as np
 
 from ._shared import check_finite, check_int, check_positive, check_range, normalize_rng, parse_spec
 from .catalog import make_catalog, sort_oldest_first
-from .degradation import degradation_from_age
 
 __all__ = ["CraterLayer", "expected_count", "fit_power_law_exponent", "parse_layer_spec",
            "population",
@@ -201,15 +200,14 @@ def _area(radius_m, area_m2, x_range_m, y_range_m) -> tuple[float, str]:
 
 
 def population(layers, *, radius_m: float | None = None, area_m2: float | None = None,
-               x_range_m=None, y_range_m=None, degradation_kwargs: dict | None = None,
-               rng=None) -> np.ndarray:
+               x_range_m=None, y_range_m=None, rng=None) -> np.ndarray:
     """A crater catalog from one or more :class:`CraterLayer` s, sorted oldest first.
 
     Positions: uniform on the sphere (``lat_deg, lon_deg``) when ``radius_m`` or
     ``area_m2`` is given (``area_m2`` sets the count for a body of any shape), or
     uniform in the rectangle ``x_range_m`` x ``y_range_m`` (``x_m, y_m``).
-    Degradation comes from :func:`craters.degradation_from_age` (keyword arguments in
-    ``degradation_kwargs``) unless the layer fixes it. Adds a ``layer`` column.
+    ``degradation`` is NaN (the stamping diffuses each crater for its age) unless the
+    layer fixes it. Adds a ``layer`` column.
     """
     if isinstance(layers, CraterLayer):
         layers = [layers]
@@ -227,8 +225,8 @@ def population(layers, *, radius_m: float | None = None, area_m2: float | None =
         n = int(rng.poisson(mean))
         d = sample_power_law_diameters(n, la.d_min_m, la.d_max_m, -la.k, rng=rng)
         age = rng.uniform(la.age_min_gyr, la.age_max_gyr, n) if n else np.zeros(0)
-        if la.degradation is None:
-            deg = degradation_from_age(d, age, **(degradation_kwargs or {})) if n else age
+        if la.degradation is None:  # from the age, by diffusion when stamped
+            deg = np.full(n, np.nan)
         else:
             deg = np.full(n, la.degradation)
         if where == "sphere":

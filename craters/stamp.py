@@ -3,14 +3,20 @@
 Grid frame: pixel (row i, column j) has its centre at ``x = j * pixel_size_m``,
 ``y = i * pixel_size_m`` (metres). For each crater (oldest first):
 
-1. the plane fitted (least squares) to the terrain of the obliterated region
+1. the crater's radial profile: the fresh morphology of the target body
+   (:mod:`craters.morphology`: simple bowl to flat floor, central peak, terraces, peak
+   ring) evolved by topographic diffusion for the crater's age (:mod:`craters.diffusion`)
+   - or to a fixed ``degradation``, the share of the fresh depth removed - as a table of
+   heights over [0, ejecta edge];
+2. the plane fitted (least squares) to the terrain of the obliterated region
    (r <= R) becomes the crater's base, so craters sit correctly on slopes and on older
-   craters; its slope adds erosion on steep ground (:func:`craters.slope_erosion`);
-2. inside the (irregular) rim the terrain is replaced by plane + bowl; outside, the
+   craters; on steep ground the relief is reduced (slope erosion,
+   :func:`craters.slope_erosion`) and above ``full_deg`` the crater is erased;
+3. inside the (irregular) rim the terrain is replaced by plane + profile; outside, the
    exterior rim and ejecta are added to the terrain, starting from the plane's height
    at the rim (the offset ``plane - terrain`` is sampled at 64 azimuths) and ending on
    the terrain at the ejecta edge; beyond it nothing changes, bit for bit;
-3. with roughness, a fractal overlay (2-D gradient-noise fBm, fractal dimension 2.2 by
+4. with roughness, a fractal overlay (2-D gradient-noise fBm, fractal dimension 2.2 by
    default) is added with an amplitude that depends on x = r/R: bowl, wall, ejecta,
    fading linearly to zero at the ejecta edge; the rim radius gets a periodic 1-D
    fractal perturbation (harmonics 2-16, amplitude ~ k^-1.5) of at most
@@ -27,14 +33,14 @@ import numpy as np
 from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
 from ._stamp_kernels import N_RIM, _stamp_many_kernel
 from .catalog import make_catalog, sort_oldest_first, validate_catalog
-from .degradation import DEFAULT_DEGRADATION, DegradationModel
-from .morphometry import Morphometry, get_morphometry
-from .profile import DEFAULT_EJECTA_EDGE
+from .diffusion import profile_tables, tau_from_age, tau_from_degradation
+from .morphology import EJECTA_EDGE, fresh_morphometry, morphology_class
+from .targets import Target, get_target
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["Crater", "Roughness", "resolve_roughness", "rim_perturbations", "stamp",
-           "stamp_many"]
+__all__ = ["Crater", "Roughness", "StampingProfiles", "resolve_roughness", "rim_perturbations",
+           "stamp", "stamp_many", "stamping_profiles"]
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
@@ -51,7 +57,8 @@ class Crater:
     diameter_m: float
     """Rim-crest diameter, metres."""
     degradation: float = 0.0
-    """0 = fresh .. 1 = fully degraded (before slope erosion)."""
+    """Share of the fresh depth removed (0 = fresh .. 1 = no relief left; before slope
+    erosion)."""
     irregularity: float = 0.02
     """Largest rim-radius perturbation as a fraction of the radius (with roughness)."""
 
@@ -127,12 +134,63 @@ def resolve_roughness(roughness) -> tuple[Roughness, bool]:
     raise TypeError(f"`roughness` must be True, False or a Roughness; got {roughness!r}")
 
 
+@dataclasses.dataclass(frozen=True)
+class StampingProfiles:
+    """What the stamping kernels need per crater, and what the catalog reports."""
+
+    tables: np.ndarray
+    """(n, N_TABLE) heights (metres) over [0, ejecta edge] radii, relative to the plane."""
+    depth_m: np.ndarray
+    """Rim crest to floor of each table (before slope erosion)."""
+    rim_height_m: np.ndarray
+    """Rim crest above the surroundings of each table."""
+    fresh_depth_m: np.ndarray
+    """The fresh crater's depth."""
+    tau: np.ndarray
+    """Dimensionless diffusion time kappa t / R^2."""
+    extra: dict
+    """Catalog columns: morphology, floor_diameter_m, peak_height_m, kappa_t_m2."""
+
+
+def stamping_profiles(catalog, target: str | Target = "moon", *,
+                      ejecta_edge: float = EJECTA_EDGE) -> StampingProfiles:
+    """Profile tables of a catalog's craters on ``target`` (module notes, step 1).
+
+    A crater's degradation comes from its age by diffusion when its ``degradation`` is
+    NaN (what :func:`craters.population` writes for layers that do not fix it), else the
+    given share of the fresh depth is removed (an explicit override; 1 = no relief).
+    """
+    t = get_target(target)
+    cat = np.asarray(catalog)
+    names = cat.dtype.names
+    d = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
+    n = len(d)
+    age = cat["age_gyr"] if "age_gyr" in names else np.zeros(n)
+    deg = cat["degradation"] if "degradation" in names else np.zeros(n)
+    from_age = np.isnan(deg)
+    tau = np.zeros(n)
+    if from_age.any():
+        tau[from_age] = tau_from_age(d[from_age], age[from_age], t)
+    if (~from_age).any():
+        tau[~from_age] = tau_from_degradation(d[~from_age], deg[~from_age], t,
+                                              ejecta_edge=ejecta_edge)
+    tabs = profile_tables(d, tau, t, ejecta_edge=ejecta_edge)
+    inner = tabs[:, : int(np.ceil(1.2 / ejecta_edge * tabs.shape[1]))]
+    rim = tabs[:, : int(np.ceil(1.5 / ejecta_edge * tabs.shape[1]))].max(axis=1)
+    fresh = fresh_morphometry(d, t)
+    peak = np.where(fresh["complex"] > 0, fresh["peak_height_m"], 0.0)
+    kappa_t = tau * (0.5 * d) ** 2
+    extra = {"morphology": morphology_class(d, t), "floor_diameter_m": fresh["floor_diameter_m"],
+             "peak_height_m": peak, "kappa_t_m2": kappa_t}
+    return StampingProfiles(np.ascontiguousarray(tabs), rim - inner.min(axis=1), rim,
+                            fresh["depth_m"], tau, extra)
+
+
 def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
-               morphometry: str | Morphometry | None = None,
-               model: DegradationModel = DEFAULT_DEGRADATION,
-               ejecta_edge: float = DEFAULT_EJECTA_EDGE, irregularity: float = 0.02,
-               slope_erosion: bool = True, onset_deg: float = 20.0, full_deg: float = 45.0,
-               rng=None, progress: bool = False, return_catalog: bool = False):
+               target: str | Target = "moon", ejecta_edge: float = EJECTA_EDGE,
+               irregularity: float = 0.02, slope_erosion: bool = True,
+               onset_deg: float = 20.0, full_deg: float = 45.0, rng=None,
+               progress: bool = False, return_catalog: bool = False):
     """Stamp a catalog of craters (oldest first) into a copy of ``heights``.
 
     Parameters
@@ -142,24 +200,29 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     pixel_size_m : float
         Pixel size in metres.
     catalog : structured array
-        Columns ``x_m, y_m, diameter_m`` and optionally ``degradation`` (default 0) and
-        ``age_gyr`` (stamping order: oldest first; default 0), see :mod:`craters.catalog`.
+        Columns ``x_m, y_m, diameter_m`` and optionally ``age_gyr`` (stamping order:
+        oldest first, and the diffusion time; default 0) and ``degradation`` (NaN: from
+        the age; else the share of the fresh depth removed), see :mod:`craters.catalog`.
     roughness : bool or Roughness
         Fractal overlay and irregular rims (True: defaults; False: the ideal crater).
-    morphometry, model, ejecta_edge
-        Fresh depth / rim laws, degradation curves, ejecta edge in radii.
+    target : str or Target
+        The body (:data:`craters.TARGETS`): crater morphology and diffusivity.
+    ejecta_edge : float
+        Ejecta edge in crater radii.
     irregularity : float
         Largest rim-radius perturbation as a fraction of the radius (with roughness).
     slope_erosion, onset_deg, full_deg
-        Extra degradation on steep ground (see :func:`craters.slope_erosion`).
+        Less relief on steep ground (see :func:`craters.slope_erosion`).
     rng
         Seed or Generator for rim shapes and overlay seeds.
     return_catalog : bool
         Also return the catalog of the craters stamped (in stamping order; craters that
         fell on ground steeper than ``full_deg`` are erased by mass wasting, not stamped,
-        and left out) with columns
-        ``degradation`` (after slope erosion), ``rim_radius_m``, ``depth_m``,
-        ``rim_height_m``, ``slope_deg`` and ``seed``.
+        and left out) with the as-stamped ``degradation`` (share of the fresh depth
+        removed, slope erosion included), ``rim_radius_m``, ``depth_m``,
+        ``rim_height_m``, ``slope_deg``, ``seed``, ``morphology`` (simple, transitional,
+        complex, peak-ring), ``floor_diameter_m``, ``peak_height_m`` (fresh) and
+        ``kappa_t_m2`` (diffusivity x time).
 
     Returns
     -------
@@ -171,7 +234,6 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     if "x_m" not in cat.dtype.names:
         raise ValueError("`catalog` needs planar positions x_m, y_m for stamping on a grid")
     rough, irregular = resolve_roughness(roughness)
-    morph = get_morphometry(morphometry)
     ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
     irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
     onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
@@ -181,36 +243,42 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     rng = normalize_rng(rng)
     n = len(cat)
     names = cat.dtype.names
-    degr = np.ascontiguousarray(cat["degradation"] if "degradation" in names else np.zeros(n),
-                                dtype=np.float64)
+    prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
     irr = irregularity if irregular else 0.0
     rim_tabs = rim_perturbations(n, irr, rng=rng)
     seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
     cx = np.ascontiguousarray(cat["x_m"] / pixel, dtype=np.float64)
     cy = np.ascontiguousarray(cat["y_m"] / pixel, dtype=np.float64)
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
-    out = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope")}
+    scale, slope = np.ones(n), np.zeros(n)
     erased = np.zeros(n, dtype=np.bool_)
-    morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
-    deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
     gain = 2.0 ** (rough.fractal_dimension - 3.0)
     step = _BATCH if progress else max(n, 1)
     for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
         e = min(s + step, n)
-        _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], degr[s:e], rim_tabs[s:e],
-                           seeds[s:e], morph_arr, deg_arr, ejecta_edge, bool(slope_erosion),
-                           onset, full, rough_arr, gain, out["deg"][s:e], out["depth"][s:e],
-                           out["rim"][s:e], out["slope"][s:e], erased[s:e])
+        _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], prof.tables[s:e],
+                           prof.depth_m[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge,
+                           bool(slope_erosion), onset, full, rough_arr, gain, scale[s:e],
+                           slope[s:e], erased[s:e])
     if erased.any():
         logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
                     int(erased.sum()), n, full)
     if not return_catalog:
         return h
     cols = {k: cat[k] for k in names}
-    cols.update(degradation=out["deg"], rim_radius_m=diam / 2.0, depth_m=out["depth"],
-                rim_height_m=out["rim"], slope_deg=out["slope"], seed=seeds)
+    cols.update(as_stamped(prof, scale, diam), slope_deg=slope, seed=seeds)
     return h, make_catalog(**cols)[~erased]
+
+
+def as_stamped(prof: StampingProfiles, scale: np.ndarray, diameter_m: np.ndarray) -> dict:
+    """The catalog columns of craters stamped from ``prof`` with slope-erosion factors
+    ``scale``: degradation (share of the fresh depth removed), rim radius, depth, rim
+    height and the morphology columns."""
+    depth = prof.depth_m * scale
+    degradation = np.clip(1.0 - depth / prof.fresh_depth_m, 0.0, 1.0)
+    return {"degradation": degradation, "rim_radius_m": diameter_m / 2.0, "depth_m": depth,
+            "rim_height_m": prof.rim_height_m * scale, **prof.extra}
 
 
 def stamp(heights, pixel_size_m: float, crater: Crater, *, roughness=True, rng=None,

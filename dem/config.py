@@ -14,8 +14,8 @@ import dataclasses
 import math
 import numbers
 
-from craters import BoulderLayer, CraterLayer, parse_boulder_spec, parse_layer_spec
-from craters._shared import about, check_int, check_positive, check_range
+from craters import TARGETS, BoulderLayer, CraterLayer, parse_boulder_spec, parse_layer_spec
+from craters._shared import about, check_choice, check_int, check_positive, check_range
 
 __all__ = ["EnhanceConfig"]
 
@@ -71,6 +71,12 @@ class EnhanceConfig:
     """Pixel size in metres, for inputs without a CRS."""
     body_radius_m: float | None = None
     """Body radius in metres, for inputs with a geographic CRS."""
+    body: str | None = None
+    """The target body of the craters (:data:`craters.TARGETS`: morphology, transition
+    diameters, diffusivity); default: the body the DEM's CRS names, else the Moon."""
+    gravity_m_s2: float | None = None
+    """Surface gravity, m/s^2 (crater transition diameters scale as 1/g); default: the
+    body's."""
     crater_layers: tuple[CraterLayer, ...] = dataclasses.field(init=False, repr=False,
                                                                 compare=False)
     """The parsed :attr:`craters` (set when the config is made)."""
@@ -140,10 +146,13 @@ class EnhanceConfig:
                 check_int("seed", self.seed, 0, 2**63 - 1)
         with about("band"):
             check_int("band", self.band, 1)
-        for name in ("pixel_size_m", "body_radius_m"):
+        for name in ("pixel_size_m", "body_radius_m", "gravity_m_s2"):
             if getattr(self, name) is not None:
                 with about(name):
                     check_positive(name, getattr(self, name))
+        if self.body is not None:
+            with about("body"):
+                check_choice("body", self.body, tuple(TARGETS))
 
     @classmethod
     def keys(cls) -> tuple[str, ...]:

@@ -90,8 +90,29 @@ def _stamp_boulders_layer(z, cat, geometry: StackGeometry, k: int, a0, shape):
     return h, placed
 
 
+def crater_target(dem: Dem, body: str | None = None, gravity_m_s2: float | None = None):
+    """The craters' target body on ``dem``: ``body`` if given, else the body its CRS names
+    (Moon, Mars, Mercury ...; e.g. IAU_2015:30100 is the Moon), else the Moon.
+
+    Examples
+    --------
+    >>> crater_target(Dem(np.zeros((3, 3)), pixel_size_m=1.0)).name
+    'moon'
+    """
+    if body is None:
+        label = "" if dem.crs is None else dem.crs.to_wkt().lower()
+        iau = {"iau_2015:301": "moon", "iau_2015:499": "mars", "iau_2015:199": "mercury",
+               "iau_2015:399": "earth"}
+        body = next((name for name in craters.TARGETS if name in label), None)
+        if body is None:
+            auth = dem.crs.to_authority() if dem.crs is not None else None
+            code = ":".join(auth).lower() if auth else ""
+            body = next((v for k, v in iau.items() if code.startswith(k)), "moon")
+    return craters.get_target(body, gravity_m_s2=gravity_m_s2)
+
+
 def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: StackGeometry, k: int, *,
-                 roughness: bool, seed: int, progress: bool):
+                 roughness: bool, seed: int, progress: bool, target):
     """Stamp layer k's craters (layer-0 grid frame positions) into a copy of ``z``."""
     if len(cat) == 0:
         return z, cat
@@ -102,7 +123,7 @@ def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: StackGeometry, k: int
     cols["y_m"] = cat["y_m"] - r * p0
     grid = craters.make_catalog(**cols)
     h, stamped = craters.stamp_many(z, geometry.pixel_m(k), grid, roughness=roughness,
-                                    rng=seed_stream(seed, STREAM_STAMP, k),
+                                    target=target, rng=seed_stream(seed, STREAM_STAMP, k),
                                     progress=progress, return_catalog=True)
     # back to layer-0 grid positions, exactly as planned
     order = np.argsort(cat["index"])
@@ -184,6 +205,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     a0 = pixel_affine(layer0, frame)
     p0 = grid_pixel_size(a0, "the base DEM")
     geometry = stack_geometry(cfg.size, windows, p0)
+    target = crater_target(base, cfg.body, cfg.gravity_m_s2)
     irregularity = 0.0 if cfg.smooth_craters else 0.02  # craters.stamp_many's default
     reach_radii = craters.DEFAULT_EJECTA_EDGE * (1.0 + irregularity)
     plans, accounting = plan_craters(cfg.crater_layers, geometry, min_px=cfg.min_crater_px,
@@ -210,7 +232,8 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
             parent = metas[k - 1].replace(heights=arrays[k - 1])
             meta = expand(parent, 1, fd, cfg.roughness, Window(cc, rr, w, w), rng=seed)
         z, cat = _stamp_layer(np.array(meta.heights), plans[k], geometry, k,
-                              roughness=not cfg.smooth_craters, seed=seed, progress=False)
+                              roughness=not cfg.smooth_craters, seed=seed, progress=False,
+                              target=target)
         rock = None
         if with_rocks:
             z, rock = _stamp_boulders_layer(z, rock_plans[k], geometry, k, a0, rock_shape)

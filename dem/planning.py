@@ -261,7 +261,7 @@ def _plan_banded(specs, geometry: StackGeometry, drawn: _Drawn, *, min_px: float
 
 
 def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: float,
-                 seed: int, degradation_kwargs: dict | None = None):
+                 seed: int):
     """Split one crater population of layer 0's area into per-layer catalogs.
 
     Parameters
@@ -274,8 +274,6 @@ def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: 
     reach_radii : float
         Crater reach (ejecta edge with rim irregularity) in crater radii.
     seed : int
-    degradation_kwargs : dict, optional
-        Passed to ``craters.population``.
 
     Returns
     -------
@@ -287,8 +285,7 @@ def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: 
         and one entry per diameter band (see the module notes).
     """
     def draw(layers, x_range_m, y_range_m, rng):
-        return craters.population(layers, x_range_m=x_range_m, y_range_m=y_range_m, rng=rng,
-                                  degradation_kwargs=degradation_kwargs)
+        return craters.population(layers, x_range_m=x_range_m, y_range_m=y_range_m, rng=rng)
 
     drawn = _Drawn("crater", (STREAM_CRATER_BAND, STREAM_CRATER_OUTSIDE, STREAM_CRATER_SMALL),
                    draw, lambda cat: reach_radii * cat["diameter_m"] / 2.0)

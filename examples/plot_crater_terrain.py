@@ -36,8 +36,7 @@ base *= 2.0 / base.std()  # metres
 
 side = (n - 1) * pixel_m
 layer = craters.CraterLayer(c=0.05, k=-1.8, d_min_m=3.0, d_max_m=side / 3, age_max_gyr=3.8)
-cat = craters.population([layer], x_range_m=(0, side), y_range_m=(0, side), rng=rng,
-                         degradation_kwargs={"baseline_lifetime_gyr": 1.0})
+cat = craters.population([layer], x_range_m=(0, side), y_range_m=(0, side), rng=rng)
 heights, stamped = craters.stamp_many(base, pixel_m, cat, rng=rng, return_catalog=True)
 craters.write_catalog(stamped, out / "crater_terrain.csv")
 

@@ -9,18 +9,17 @@ from craters.kernels import (
     DC8,
     DR8,
     PLANE_SUMS0,
-    eroded_degradation,
     fbm2,
     idw8,
-    inside,
-    outside,
+    outer_weight,
     plane_solve,
     plane_sums_add,
-    profile_params,
     rim_offsets,
     roughness_amp,
     roughness_octaves,
+    slope_factor,
     table,
+    table_value,
 )
 
 from ._grid_kernels import _interpolate_one, _ring_size, _unit_of
@@ -195,21 +194,22 @@ PARALLEL_MIN = 20_000
 
 
 @njit(cache=True)
-def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h, alpha,
-                 beta, e0, xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength,
-                 octaves, gain, dh_out):
+def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
+                 rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves, gain,
+                 dh_out):
     """New radii for gathered vertices lo..hi-1 (each vertex written once)."""
     for q in range(lo, hi):
         x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
         dh = 0.0
         if x < xe:
             if x <= 1.0:
-                new = _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q]) + inside(x, depth, rim_h,
-                                                                              alpha)
+                new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+                       + scale * table_value(tab, x, xe))
             else:
-                new = hgt[q] + outside(x, rim_h + table(delta, az[q]), beta, e0, xe)
+                new = (hgt[q] + scale * table_value(tab, x, xe)
+                       + table(delta, az[q]) * outer_weight(x, xe))
             if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
-                amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth
+                amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
                 new += amp * fbm2(seed, xl[q], yl[q], wavelength, octaves, gain)
             dh = new - hgt[q]
             i = idx[q]
@@ -218,23 +218,23 @@ def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth,
 
 
 @njit(cache=True, parallel=True)
-def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth, rim_h, alpha, beta,
-                    e0, xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength,
-                    octaves, gain, dh_out):
+def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
+                    rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves,
+                    gain, dh_out):
     """:func:`_write_range` over blocks of vertices in parallel (blocks are disjoint)."""
     n = idx.shape[0]
     block = 4096
     for b in prange((n + block - 1) // block):
         _write_range(b * block, min(n, (b + 1) * block), radii, idx, pmag, dist, az, xl, yl,
-                     hgt, radius, depth, rim_h, alpha, beta, e0, xe, rim_tab, delta, p0, gx,
-                     gy, qa, qb, qc, rough, seed, wavelength, octaves, gain, dh_out)
+                     hgt, radius, tab, scale, depth, xe, rim_tab, delta, p0, gx, gy, qa, qb,
+                     qc, rough, seed, wavelength, octaves, gain, dh_out)
 
 
 @njit(cache=True)
-def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, degr, rim_tabs,
-                       seeds, morph, deg, xe, slope_erosion, onset_deg, full_deg, rough, gain,
-                       out_deg, out_depth, out_rim, out_slope, out_centre, out_maxdh,
-                       out_nvert, out_spacing, out_erased, naive=False, stop_after=0):
+def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
+                       rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
+                       out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
+                       out_erased, naive=False, stop_after=0):
     """Stamp craters on the body in the given order (oldest first), updating ``radii``.
 
     Per crater: centre on the current surface; gather the region's vertices through the
@@ -242,7 +242,9 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
     the centre) of each; heights radial, relative to the centre's radius; a local grid
     at the local vertex spacing (vertices binned, holes filled) for the plane fit and
     the rim offsets; the crater evaluated at every vertex with its true distance and
-    azimuth; radii rescaled by the height change.
+    azimuth (its profile table ``tabs[c]``, scaled by the slope erosion, recorded in
+    ``out_scale``; ``depths[c]`` sets the roughness amplitude); radii rescaled by the
+    height change.
 
     Vertex directions are computed from the ring structure (no whole-grid unit-vector
     array). Benchmark switches: ``naive`` gathers by scanning every vertex of ``unit``
@@ -380,7 +382,6 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         cr2 = l0 * r1 - l1 * r0
         slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
                                       l0 * r0 + l1 * r1 + l2 * r2))
-        d = degr[c]
         out_slope[c] = slope
         out_centre[c, 0] = pc0
         out_centre[c, 1] = pc1
@@ -389,27 +390,23 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, de
         if slope_erosion and slope >= full_deg:
             out_erased[c] = True  # steeper than the angle of repose: erased, not stamped
             continue
-        if slope_erosion:
-            d = eroded_degradation(d, slope, onset_deg, full_deg)
-        _, depth, rim_h, alpha, beta, e0 = profile_params(diam[c], d, morph, deg)
+        scale = slope_factor(slope, onset_deg, full_deg) if slope_erosion else 1.0
         # delta = plane - terrain at the rim = -(residual grid) there
         rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
         octaves = roughness_octaves(radius, sp)
         dh = np.empty(keep)
         if keep >= PARALLEL_MIN:
             _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
-                            yl[:keep], hgt[:keep], radius, depth, rim_h, alpha, beta, e0, xe,
+                            yl[:keep], hgt[:keep], radius, tabs[c], scale, depths[c], xe,
                             rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
                             radius, octaves, gain, dh)
         else:
-            _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, depth,
-                         rim_h, alpha, beta, e0, xe, rim_tabs[c], delta, p0, gx, gy, qa, qb,
-                         qc, rough, seeds[c], radius, octaves, gain, dh)
+            _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
+                         scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
+                         rough, seeds[c], radius, octaves, gain, dh)
         big = 0.0
         for q in range(keep):
             big = max(big, abs(dh[q]))
-        out_deg[c] = d
-        out_depth[c] = depth
-        out_rim[c] = rim_h
+        out_scale[c] = scale
         out_maxdh[c] = big
         out_nvert[c] = keep

@@ -89,6 +89,7 @@ def build(scene: Scene, *, progress: bool = False):
     rng = np.random.default_rng(scene.seed)
     heights, radius_m, params = _base_heights(scene, grid, rng, progress)
     craters, boulders = scene.craters, scene.boulders
+    target = scene.target()
     metadata = {
         "generator": GENERATOR,
         "version": package_version(),
@@ -97,8 +98,8 @@ def build(scene: Scene, *, progress: bool = False):
         "preset": scene.preset,
         "parameters": params,
         "craters": [dataclasses.asdict(la) for la in craters.layers],
-        "crater_morphometry": craters.morphometry,
-        "crater_lifetime_gyr": craters.lifetime_gyr,
+        "body": scene.body.target,
+        "gravity_m_s2": target.gravity_m_s2,
         "crater_roughness": craters.roughness,
         "boulders": [dataclasses.asdict(la) for la in boulders.layers],
         "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
@@ -106,11 +107,10 @@ def build(scene: Scene, *, progress: bool = False):
     body = Body.from_heights(grid, radius_m, heights, stretch=scene.body.stretch,
                              metadata=metadata)
     if craters.layers:
-        cat = body_population(body, craters.layers, rng=rng, degradation_kwargs={
-            "baseline_lifetime_gyr": craters.lifetime_gyr})
+        cat = body_population(body, craters.layers, rng=rng)
         body = stamp_craters(body, cat, roughness=craters.roughness, rng=rng,
                              progress=progress, max_extent_deg=craters.max_extent_deg,
-                             morphometry=craters.morphometry, too_large="skip")
+                             target=target, too_large="skip")
         body = body.replace(metadata={**body.metadata,
                                       "craters_skipped_too_large": len(cat) - len(body.craters)})
     if boulders.layers:

@@ -8,10 +8,9 @@ import numpy as np
 
 import craters as _craters
 from craters._shared import check_choice, check_range, normalize_rng, progress_bar
-from craters.degradation import DEFAULT_DEGRADATION, DegradationModel
-from craters.morphometry import Morphometry, get_morphometry
 from craters.profile import DEFAULT_EJECTA_EDGE
-from craters.stamp import resolve_roughness
+from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
+from craters.targets import Target
 
 from ._crater_kernels import _stamp_body_kernel
 from .body import Body
@@ -23,19 +22,17 @@ logger = logging.getLogger(__name__)
 _BATCH = 256  # craters per kernel call when a progress bar is shown
 
 
-def body_population(body: Body, layers, *, rng=None, degradation_kwargs=None) -> np.ndarray:
+def body_population(body: Body, layers, *, rng=None) -> np.ndarray:
     """A crater catalog for ``body``: counts from its actual surface area, positions
     uniform on its actual surface (:func:`latlong.surface_positions`), oldest first.
 
-    ``layers``: :class:`craters.CraterLayer` s; ``degradation_kwargs`` go to
-    :func:`craters.degradation_from_age`.
+    ``layers``: :class:`craters.CraterLayer` s.
     """
     if not isinstance(body, Body):
         raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
     rng = normalize_rng(rng)
     totals = band_areas(body)
-    cat = _craters.population(layers, area_m2=float(totals.sum()), rng=rng,
-                              degradation_kwargs=degradation_kwargs)
+    cat = _craters.population(layers, area_m2=float(totals.sum()), rng=rng)
     lat, lon, _ = sample_surface_points(body, totals, len(cat), rng)
     cat["lat_deg"], cat["lon_deg"] = lat, lon
     return cat
@@ -62,9 +59,8 @@ def crater_extents_deg(body: Body, catalog, *, ejecta_edge: float = DEFAULT_EJEC
 def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bool = False,
                   max_extent_deg: float = 60.0, irregularity: float = 0.02,
                   slope_erosion: bool = True, onset_deg: float = 20.0, full_deg: float = 45.0,
-                  morphometry: str | Morphometry | None = None,
-                  model: DegradationModel = DEFAULT_DEGRADATION,
-                  ejecta_edge: float = DEFAULT_EJECTA_EDGE, too_large: str = "error") -> Body:
+                  target: str | Target = "moon", ejecta_edge: float = DEFAULT_EJECTA_EDGE,
+                  too_large: str = "error") -> Body:
     """Stamp a crater catalog on a body, oldest first; returns a new :class:`Body`.
 
     For each crater (Martin 2014 V.A): the vertices of its region are gathered through
@@ -102,8 +98,9 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     too_large : {"error", "skip"}
         What to do with craters above ``max_extent_deg``: raise ValueError, or leave
         them out (logged; the returned catalog lists only stamped craters).
-    irregularity, slope_erosion, onset_deg, full_deg, morphometry, model, ejecta_edge
-        As in :func:`craters.stamp_many`.
+    irregularity, slope_erosion, onset_deg, full_deg, target, ejecta_edge
+        As in :func:`craters.stamp_many` (``target``: the body whose crater morphology
+        and diffusivity apply, e.g. :func:`craters.small_body` of this body's size).
 
     Returns
     -------
@@ -127,7 +124,6 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     full = check_range("full_deg", full_deg, 0.0, 90.0)
     if slope_erosion and full <= onset:
         raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
-    morph = get_morphometry(morphometry)
     irr = irregularity if irregular else 0.0
     check_choice("too_large", too_large, ("error", "skip"))
     if len(cat):
@@ -153,16 +149,14 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     radii = np.array(body.radii_m, dtype=np.float64, copy=True)
     grid = body.grid
     names = cat.dtype.names
-    degr = np.ascontiguousarray(cat["degradation"] if "degradation" in names else np.zeros(n),
-                                dtype=np.float64)
+    prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
     lat = np.ascontiguousarray(cat["lat_deg"], dtype=np.float64)
     lon = np.ascontiguousarray(cat["lon_deg"], dtype=np.float64)
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
-    outs = {k: np.zeros(n) for k in ("deg", "depth", "rim", "slope", "maxdh", "nvert", "sp")}
+    outs = {k: np.zeros(n) for k in ("slope", "maxdh", "nvert", "sp")}
+    scale = np.ones(n)
     centre = np.zeros((n, 3))
     erased = np.zeros(n, dtype=np.bool_)
-    morph_arr = np.array([morph.depth_coef, morph.depth_exp, morph.rim_coef, morph.rim_exp])
-    deg_arr = np.array([model.rim_rate, model.depth_rate, model.final_depth])
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
     gain = 2.0 ** (rough.fractal_dimension - 3.0)
     stretch = np.asarray(body.stretch, dtype=np.float64)
@@ -172,17 +166,16 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
         e = min(s + step, n)
         _stamp_body_kernel(grid.magnitude, offs, unit, radii, stretch, lat[s:e], lon[s:e],
-                           diam[s:e], degr[s:e], rim_tabs[s:e], seeds[s:e], morph_arr,
-                           deg_arr, ejecta_edge, bool(slope_erosion), onset, full, rough_arr,
-                           gain, outs["deg"][s:e], outs["depth"][s:e], outs["rim"][s:e],
-                           outs["slope"][s:e], centre[s:e], outs["maxdh"][s:e],
-                           outs["nvert"][s:e], outs["sp"][s:e], erased[s:e])
+                           diam[s:e], prof.tables[s:e], prof.depth_m[s:e], rim_tabs[s:e],
+                           seeds[s:e], ejecta_edge, bool(slope_erosion), onset, full,
+                           rough_arr, gain, scale[s:e], outs["slope"][s:e], centre[s:e],
+                           outs["maxdh"][s:e], outs["nvert"][s:e], outs["sp"][s:e],
+                           erased[s:e])
     if n and (radii <= 0).any():
         raise ValueError("craters pushed the surface through the body centre; lower the "
                          "largest diameter or max_extent_deg")
     cols = {k: cat[k] for k in names}
-    cols.update(degradation=outs["deg"], rim_radius_m=diam / 2.0, depth_m=outs["depth"],
-                rim_height_m=outs["rim"], slope_deg=outs["slope"], centre_x_m=centre[:, 0],
+    cols.update(as_stamped(prof, scale, diam), slope_deg=outs["slope"], centre_x_m=centre[:, 0],
                 centre_y_m=centre[:, 1], centre_z_m=centre[:, 2], seed=seeds,
                 max_change_m=outs["maxdh"], n_vertices=outs["nvert"].astype(np.int64),
                 spacing_m=outs["sp"])

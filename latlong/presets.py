@@ -75,22 +75,21 @@ PRESETS: dict[str, Preset] = {
         "saturated crater population near equilibrium (N_cum = 0.1 D^-2, 40 m-1.5 km), "
         "asteroid d/D = 0.2 (magnitude >= 700 resolves it)", "fbm",
         {"radius_m": 8000.0, "stretch": (2.15, 0.7, 0.7), "frequency": 1.2, "octaves": 8,
-         "persistence": 0.45, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
+         "persistence": 0.45, "lacunarity": 2.0,
          "craters": ["c=0.1,k=-2,d_min_m=40,d_max_m=1500"]}, 0.12),
     "itokawa-like": Preset(
         "25143 Itokawa-like rubble pile: 165 m radius, elongated (535 x 294 x 209 m), "
         "rough low-frequency fBm, few and degraded craters (N_cum = 0.005 D^-2, 2-20 m)",
         "fbm",
         {"radius_m": 165.0, "stretch": (1.6, 0.9, 0.65), "frequency": 1.0, "octaves": 10,
-         "persistence": 0.55, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
-         "crater_lifetime_gyr": 0.5,
+         "persistence": 0.55, "lacunarity": 2.0,
          "craters": ["c=0.005,k=-2,d_min_m=2,d_max_m=20,age_min_gyr=0.5,age_max_gyr=3"]}, 0.15),
     "bennu-like": Preset(
         "101955 Bennu-like: 245 m radius, slightly flattened, gentle fBm, craters as Li "
         "et al. 2022 Fig. A.3 (B = 3, ~19 % saturation: N_cum = 0.9 D^-3, 10-70 m)", "fbm",
         {"radius_m": 245.0, "stretch": (1.0, 1.0, 0.92), "frequency": 2.0, "octaves": 8,
-         "persistence": 0.5, "lacunarity": 2.0, "crater_morphometry": "asteroid-fresh",
-         "crater_lifetime_gyr": 1.0, "craters": ["c=0.9,k=-3,d_min_m=10,d_max_m=70"]}, 0.05),
+         "persistence": 0.5, "lacunarity": 2.0,
+         "craters": ["c=0.9,k=-3,d_min_m=10,d_max_m=70"]}, 0.05),
 }
 
 #: The preset a base gets when none is named (its parameter set).

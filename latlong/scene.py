@@ -49,15 +49,15 @@ from .settings import (
 __all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
 
 # flat setting -> (part, field) of the scene; a part's error is shown under the setting
-_BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch"}
+_BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch",
+         "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3"}
 _FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
              "smooth_width_m": "smooth_width_m", "smooth_passes": "smooth_passes",
              "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
 _FBM = {k: k for k in ("frequency", "octaves", "persistence", "lacunarity", "amplitude_m")}
 _SHAPE = {"shape_units": "units", "shape_center": "center", "shape_crossings": "crossings",
           "shape_smooth": "smooth", **{k: f"detail_{k}" for k in _FBM}}
-_CRATERS = {"craters": "layers", "crater_morphometry": "morphometry",
-            "crater_lifetime_gyr": "lifetime_gyr", "crater_roughness": "roughness",
+_CRATERS = {"craters": "layers", "crater_roughness": "roughness",
             "max_crater_extent_deg": "max_extent_deg"}
 _BOULDER_SHAPE = {"boulder_flatten": "flatten", "boulder_elongation": "elongation",
                   "boulder_roughness": "roughness"}
@@ -182,6 +182,16 @@ class Scene:
             self.boulders.check_fits(smallest)
         except ParameterError as exc:
             raise exc.renamed("boulders") from None
+
+    def target(self) -> _craters.Target:
+        """The craters' target (:func:`craters.get_target`): a named body, or a small body
+        of this size (volume-equivalent radius) and density."""
+        b = self.body
+        if b.target != "small-body":
+            return _craters.get_target(b.target, gravity_m_s2=b.gravity_m_s2)
+        radius = b.radius_m * float(np.prod(b.stretch)) ** (1.0 / 3.0)
+        return _craters.get_target("small-body", radius_m=radius, density_kg_m3=b.density_kg_m3,
+                                   gravity_m_s2=b.gravity_m_s2)
 
     @property
     def backend(self) -> str:

@@ -19,6 +19,7 @@ from craters._shared import (
     check_finite,
     check_int,
     check_positive,
+    check_range,
     human_bytes,
     physical_memory_bytes,
 )
@@ -76,9 +77,21 @@ class BodySettings:
     """Reference radius, metres; default 50 m (a shape base sets its own)."""
     stretch: tuple[float, float, float] | None = None
     """Scale factors along x, y, z; default 1, 1, 1 (a shape base sets its own)."""
+    target: str = "small-body"
+    """The body's kind for crater morphology and diffusivity: ``small-body`` (its gravity
+    from its size and ``density_kg_m3``) or a name of :data:`craters.TARGETS`."""
+    gravity_m_s2: float | None = None
+    """Surface gravity, m/s^2 (default: the target's; a small body's from its size)."""
+    density_kg_m3: float = 2000.0
+    """Bulk density of a small body, kg/m^3."""
 
     def __post_init__(self):
         _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
+        check_choice("target", self.target, (*_craters.TARGETS, "small-body"))
+        if self.gravity_m_s2 is not None:
+            _set(self, "gravity_m_s2", check_positive("gravity_m_s2", self.gravity_m_s2))
+        _set(self, "density_kg_m3", check_range("density_kg_m3", self.density_kg_m3,
+                                                10.0, 30_000.0))
         check_memory(self.magnitude)
         if self.radius_m is not None:
             _set(self, "radius_m", check_positive("radius_m", self.radius_m))
@@ -209,14 +222,11 @@ def _layers(value, kind, parse, name: str) -> tuple:
 
 @dataclass(frozen=True, slots=True)
 class CraterSettings:
-    """Crater layers on the body and how they are stamped (:func:`latlong.stamp_craters`)."""
+    """Crater layers on the body and how they are stamped (:func:`latlong.stamp_craters`;
+    their shapes and degradation follow the body's target, :class:`BodySettings`)."""
 
     layers: tuple[_craters.CraterLayer, ...] = ()
     """Power-law layers (:class:`craters.CraterLayer`, spec strings or tables)."""
-    morphometry: str = "lunar-simple"
-    """Fresh crater laws: a name of :data:`craters.MORPHOMETRY_PRESETS`."""
-    lifetime_gyr: float = 10.0
-    """Time for a 1 km crater to degrade fully, Gyr (ages -> degradation)."""
     roughness: bool = True
     """Fractal overlay and irregular rims (False: ideal craters)."""
     max_extent_deg: float = 60.0
@@ -225,8 +235,6 @@ class CraterSettings:
     def __post_init__(self):
         _set(self, "layers", _layers(self.layers, _craters.CraterLayer,
                                      _craters.parse_layer_spec, "layers"))
-        check_choice("morphometry", self.morphometry, tuple(_craters.MORPHOMETRY_PRESETS))
-        _set(self, "lifetime_gyr", check_positive("lifetime_gyr", self.lifetime_gyr))
         if not isinstance(self.roughness, bool):
             raise ParameterTypeError("roughness", f"must be true or false; got "
                                      f"{self.roughness!r}")

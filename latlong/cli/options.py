@@ -79,6 +79,15 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--base",), "base", str,
         "base shape: sphere, faulting, fbm or shape:PATH (a real shape model: OBJ, PDS "
         "plate .tab/.plt, PLY, STL)"),
+    Opt(("--body",), "body", str,
+        "what kind of body the craters are on (morphology, transition diameters, "
+        "diffusivity): small-body (gravity from the size and --density-kg-m3) or moon, "
+        "mars, mercury, earth, ceres, vesta"),
+    Opt(("--gravity-m-s2",), "gravity_m_s2", float,
+        "surface gravity, m/s^2: crater transition diameters scale as 1/g (default: the "
+        "body's)"),
+    Opt(("--density-kg-m3",), "density_kg_m3", float,
+        "bulk density of a small body, kg/m^3 (its gravity from its size)"),
     Opt(("--seed",), "seed", parse_seed,
         "random seed (non-negative integer); default: a fresh one, recorded in the model"),
     # two-phase faulting
@@ -119,11 +128,6 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "degradation=0.2,kind=simple] (the fields of craters.CraterLayer): N_cum = c D^k "
         "per m^2, D in metres, ages in Gyr (repeatable for piecewise laws)", "craters",
         "append"),
-    Opt(("--crater-morphometry",), "crater_morphometry", str,
-        "fresh crater laws: lunar-simple (Pike 1977) or asteroid-fresh (d/D = 0.2)",
-        "craters"),
-    Opt(("--crater-lifetime-gyr",), "crater_lifetime_gyr", float,
-        "time for a 1 km crater to degrade fully, Gyr (ages -> degradation)", "craters"),
     Opt(("--no-crater-roughness",), "crater_roughness", bool,
         "ideal craters: no fractal overlay, circular rims", "craters", "store_false"),
     Opt(("--max-crater-extent-deg",), "max_crater_extent_deg", float,

@@ -22,8 +22,10 @@ def test_profile_csv_and_plot(run_cli, tmp_path):
                    "--csv", str(csv), "--plot", str(png))
     assert proc.returncode == 0, proc.stderr
     data = np.loadtxt(csv, delimiter=",", skiprows=2)
-    want = craters.radial_profile(data[:, 0], 1000.0, craters.degradation_from_age(1000.0, 3.0))
+    want = craters.radial_profile(data[:, 0], 1000.0, age_gyr=3.0)
     assert np.allclose(data[:, 2], want)
+    header = csv.read_text().splitlines()[0]
+    assert "depth_m=" in header and "rim_height_m=" in header and "body=moon" in header
     assert png.stat().st_size > 20_000
     assert "depth" in proc.stdout
 
@@ -45,7 +47,11 @@ def test_population_csv_and_plot(run_cli, tmp_path):
     (["profile", "--diameter-m", "nan", "--csv", "x.csv"], ["--diameter-m", "finite"]),
     (["profile", "--diameter-m", "10", "--degradation", "1.5", "--csv", "x.csv"],
      ["--degradation"]),
-    (["profile", "--diameter-m", "10"], ["nothing to write"]),
+    (["profile", "--diameter-m", "10", "-q"], ["nothing to do"]),
+    (["profile", "--diameter-m", "10", "--age-gyr", "-1"], ["--age-gyr"]),
+    (["profile", "--diameter-m", "10", "--age-gyr", "1", "--degradation", "0.5"],
+     ["--age-gyr", "--degradation"]),
+    (["profile", "--diameter-m", "10", "--body", "small-body"], ["--body-radius-m"]),
     (["population", "--craters", "c=0,k=-2,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],
      ["`c`"]),
     (["population", "--craters", "c=1,k=1,d_min_m=5,d_max_m=10", "--radius-m", "9", "-o", "x.csv"],

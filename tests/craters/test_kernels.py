@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import craters
 from craters import kernels as K
 
 MASK = 2**64 - 1
@@ -145,9 +146,25 @@ def test_idw8_matches_reference(rng, frac):
 
 
 @pytest.mark.parametrize("slope", [0.0, 10.0, 20.0, 30.0, 44.9, 60.0])
-def test_eroded_degradation_is_linear_in_slope(slope):
+def test_slope_factor_is_linear_in_slope(slope):
     frac = np.clip((slope - 20.0) / 25.0, 0.0, 1.0)
-    assert K.eroded_degradation(0.2, slope, 20.0, 45.0) == pytest.approx(0.2 + 0.8 * frac)
+    assert K.slope_factor(slope, 20.0, 45.0) == pytest.approx(1.0 - frac)
+    # the relief kept: degradation d becomes d + (1 - d) frac, as craters.slope_erosion
+    kept = (1.0 - 0.2) * K.slope_factor(slope, 20.0, 45.0)
+    assert 1.0 - kept == pytest.approx(float(craters.slope_erosion(0.2, slope)))
+
+
+def test_table_value_is_linear_interpolation(rng):
+    from craters._stamp_kernels import _table_kernel
+
+    tabs = rng.normal(size=(3, 256))
+    x = np.concatenate([rng.uniform(0.0, 3.2, 500), [0.0, 3.0, 3.0 - 1e-12, 5.0]])
+    out = np.empty((3, len(x)))
+    _table_kernel(tabs, x, 3.0, out)
+    grid = np.linspace(0.0, 3.0, 256)
+    for c in range(3):
+        want = np.where(x >= 3.0, 0.0, np.interp(x, grid, tabs[c]))
+        assert np.allclose(out[c], want, rtol=0, atol=1e-12)
 
 
 @pytest.mark.parametrize(("wavelength", "spacing"), [(1.0, 1.0), (8.0, 1.0), (9.0, 1.0),

@@ -36,7 +36,8 @@ def test_same_seed_same_catalog():
     a = power_law_population(radius=300.0, c=0.5, k=-2.0, d_min=2.0, d_max=50.0, rng=7)
     b = power_law_population(radius=300.0, c=0.5, k=-2.0, d_min=2.0, d_max=50.0, rng=7)
     c = power_law_population(radius=300.0, c=0.5, k=-2.0, d_min=2.0, d_max=50.0, rng=8)
-    assert np.array_equal(a, b) and not np.array_equal(a, c)
+    assert a.tobytes() == b.tobytes() and a.tobytes() != c.tobytes()
+    assert np.isnan(a["degradation"]).all()  # from the age, by diffusion when stamped
 
 
 @pytest.mark.parametrize("B", [2.0, 3.0, 4.0])
@@ -62,8 +63,7 @@ def test_piecewise_layers_and_rectangles():
     # ages from the older layer come first
     assert (cat["layer"][: len(old)] == 1).all()
     young = cat[cat["layer"] == 0]
-    want = craters.degradation_from_age(young["diameter_m"], young["age_gyr"])
-    assert np.allclose(young["degradation"], want)
+    assert np.isnan(young["degradation"]).all()  # from the age when stamped
 
 
 @pytest.mark.parametrize("kw,match", [
@@ -96,7 +96,8 @@ def test_catalog_csv_roundtrip(tmp_path, big_population):
     back = craters.read_catalog(path)
     assert back.dtype == cat.dtype
     for name in cat.dtype.names:
-        assert np.array_equal(back[name], cat[name]), name  # lossless
+        floats = cat[name].dtype.kind == "f"
+        assert np.array_equal(back[name], cat[name], equal_nan=floats), name  # lossless
 
 
 def test_geojson(tmp_path):

@@ -1,0 +1,238 @@
+"""Crater degradation as topographic diffusion (Fassett & Thomson 2014).
+
+A crater of age T is its fresh profile (:mod:`craters.morphology`) evolved by the
+diffusion equation dh/dt = kappa lap(h) for the time T: the rim, the profile's shortest
+wavelength, goes first; the bowl shallows; an old crater is a shallow rimless dimple and
+in the limit no relief is left. Lunar diffusivity (Fassett & Thomson 2014, JGR Planets
+119, 2255; the D-scaling of Fassett & Thomson 2015): kappa = 5.5e-6 m^2/yr at D = 1 km,
+times (D / 1 km)^0.9 (:class:`~craters.Target` holds it per body).
+
+The radial problem is solved exactly (no time stepping) in Hankel space: an
+axisymmetric profile h(r) has the transform H(k) and ``h(r, t) = int H(k) exp(-kappa k^2 t)
+J0(k r) k dk``. On the quasi-discrete Hankel transform of Guizar-Sicairos & Gutierrez-Vega
+(2004, JOSA A 21, 53) - nodes at the zeros of J0 out to ``DOMAIN`` crater radii, where the
+profile is held at 0, an orthogonal symmetric matrix - the evolution is two matrix
+products with a diagonal in between, in the dimensionless time tau = kappa t / R^2.
+
+Stamping needs the profile at every pixel of thousands of craters, so profiles are made
+on a grid of (log D, log tau) nodes (3 % in D, 12 % in tau), once per target and shared
+by every crater that falls between the nodes (bilinear in log D and log tau): "cached per
+D and kappa t". A crater with tau below ``TAU_FRESH`` is evaluated fresh, exactly.
+
+``degradation`` in the catalogs is what this leaves of the fresh depth,
+``1 - depth(tau) / depth(0)`` (0 fresh ... 1 gone); a layer that fixes it (an explicit
+override) gets the tau that removes that share of its depth, and ``degradation = 1``
+leaves no relief at all.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from ._shared import ParameterError
+from .morphology import EJECTA_EDGE, fresh_morphometry, fresh_profile
+from .targets import Target, get_target
+
+__all__ = ["DOMAIN", "N_TABLE", "TAU_FRESH", "diffuse_profiles", "kappa_m2_yr",
+           "profile_tables", "tau_from_age", "tau_from_degradation"]
+
+#: Radius of the diffusion domain, in crater radii (the profile is 0 beyond).
+DOMAIN = 6.0
+#: Quasi-discrete Hankel transform nodes.
+N_NODES = 256
+#: Samples of a stamping table over [0, ejecta edge].
+N_TABLE = 256
+#: Below this tau = kappa t / R^2 a crater is stamped fresh (its rim has moved less
+#: than a hundredth of a radius).
+TAU_FRESH = 1e-5
+_TAU_MAX = 30.0
+_D_STEP = 1.03
+_TAU_STEP = 1.12
+SECONDS_PER_YEAR = 365.25 * 86400.0
+
+
+def kappa_m2_yr(diameter_m, target: str | Target = "moon") -> np.ndarray:
+    """Topographic diffusivity of craters of ``diameter_m`` on ``target``, m^2/yr.
+
+    Examples
+    --------
+    >>> float(kappa_m2_yr(1000.0))
+    5.5e-06
+    """
+    t = get_target(target)
+    d = np.asarray(diameter_m, dtype=np.float64)
+    return t.kappa_1km_m2_yr * (d / 1000.0) ** t.kappa_exponent
+
+
+def tau_from_age(diameter_m, age_gyr, target: str | Target = "moon") -> np.ndarray:
+    """Dimensionless diffusion time ``kappa(D) T / R^2`` of craters of age ``age_gyr``.
+
+    Examples
+    --------
+    >>> round(float(tau_from_age(1000.0, 1.0)), 4)
+    0.022
+    """
+    d = np.asarray(diameter_m, dtype=np.float64)
+    age = np.asarray(age_gyr, dtype=np.float64)
+    if (age < 0).any() or not np.isfinite(age).all():
+        raise ParameterError("age_gyr", "must be finite and >= 0")
+    return kappa_m2_yr(d, target) * age * 1e9 / (0.5 * d) ** 2
+
+
+@functools.lru_cache(maxsize=4)
+def _qdht(n: int, domain: float):
+    """Nodes (crater radii), wavenumbers (1/radii) and the orthogonal transform matrix."""
+    from scipy.special import j0, j1, jn_zeros  # here: importing scipy loads argparse
+
+    alpha = jn_zeros(0, n + 1)
+    s = alpha[-1]
+    a = alpha[:-1]
+    j1a = np.abs(j1(a))
+    t = 2.0 * j0(np.outer(a, a) / s) / (np.outer(j1a, j1a) * s)
+    r = a * domain / s
+    k = a / domain
+    scale = domain / j1a  # f(r_n) times this is the transform's own vector
+    return r, k, t, scale
+
+
+def diffuse_profiles(profiles: np.ndarray, tau) -> np.ndarray:
+    """Evolve axisymmetric profiles sampled at the transform's nodes by dimensionless
+    times ``tau`` (one per row; module notes). Rows are heights at
+    ``diffusion_nodes()``; the result is at the same nodes."""
+    r, k, t, scale = _qdht(N_NODES, DOMAIN)
+    tau = np.asarray(tau, dtype=np.float64).reshape(-1, 1)
+    spec = (profiles * scale) @ t.T
+    spec *= np.exp(-(k[None, :] ** 2) * tau)
+    return (spec @ t.T) / scale
+
+
+def diffusion_nodes() -> np.ndarray:
+    """Radii (in crater radii) where :func:`diffuse_profiles` samples a profile."""
+    return _qdht(N_NODES, DOMAIN)[0]
+
+
+def _taper(x, xe):
+    """1 inside, falling smoothly to 0 over the outer fifth of the ejecta span."""
+    t = np.clip((xe - x) / (0.2 * (xe - 1.0)), 0.0, 1.0)
+    return t * t * (3.0 - 2.0 * t)
+
+
+@functools.lru_cache(maxsize=4)
+def _resample(xe: float) -> np.ndarray:
+    """(N_TABLE, N_NODES) linear interpolation from the transform's nodes to the table's
+    radii (the first node's value held towards the centre), times the edge taper."""
+    r = diffusion_nodes()
+    x = np.linspace(0.0, xe, N_TABLE)
+    w = np.zeros((N_TABLE, len(r)))
+    j = np.clip(np.searchsorted(r, x) - 1, 0, len(r) - 2)
+    f = np.clip((x - r[j]) / (r[j + 1] - r[j]), 0.0, 1.0)
+    w[np.arange(N_TABLE), j] = 1.0 - f
+    w[np.arange(N_TABLE), j + 1] += f
+    return w * _taper(x, xe)[:, None]
+
+
+def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe: float):
+    """Tables (len(d), len(tau), N_TABLE) of diffused profiles divided by each node's
+    fresh depth (float32: shapes, interpolated between nodes)."""
+    r, k, t, scale = _qdht(N_NODES, DOMAIN)
+    fresh = fresh_profile(r, d_nodes, target, ejecta_edge=xe)            # (nd, N)
+    fresh /= fresh_morphometry(d_nodes, target)["depth_m"][:, None]
+    spec = (fresh * scale) @ t.T                                          # (nd, N)
+    decay = np.exp(-np.outer(tau_nodes, k**2))                            # (nt, N)
+    evolved = ((spec[:, None, :] * decay[None]) @ t.T) / scale            # (nd, nt, N)
+    return (evolved @ _resample(xe).T).astype(np.float32)
+
+
+class _Cache:
+    """Diffused shapes of one target on the (log D, log tau) node grid, made on demand."""
+
+    def __init__(self, target: Target, xe: float):
+        self.target, self.xe = target, xe
+        self.tau_nodes = np.exp(np.arange(math.log(TAU_FRESH), math.log(_TAU_MAX)
+                                          + math.log(_TAU_STEP), math.log(_TAU_STEP)))
+        self.rows: dict[int, np.ndarray] = {}  # D node index -> (n_tau, N_TABLE)
+
+    def stack(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(shapes of the nodes ``idx`` stacked, position of each idx in the stack)."""
+        need = np.unique(idx)
+        missing = [int(i) for i in need if int(i) not in self.rows]
+        if missing:
+            tabs = _node_tables(self.target, _D_STEP ** np.array(missing, dtype=np.float64),
+                                self.tau_nodes, self.xe)
+            for i, tab in zip(missing, tabs, strict=True):
+                self.rows[i] = tab
+        return np.stack([self.rows[int(i)] for i in need]), np.searchsorted(need, idx)
+
+
+@functools.lru_cache(maxsize=16)
+def _cache(target: Target, xe: float) -> _Cache:
+    return _Cache(target, xe)
+
+
+def profile_tables(diameter_m, tau, target: str | Target = "moon", *,
+                   ejecta_edge: float = EJECTA_EDGE) -> np.ndarray:
+    """Stamping tables: heights (metres, relative to the pre-impact surface) of each
+    crater at ``N_TABLE`` radii evenly over [0, ejecta_edge] (crater radii), fresh or
+    diffused by ``tau`` (module notes). Returns (n, N_TABLE) float64.
+
+    Examples
+    --------
+    >>> tab = profile_tables([1000.0, 1000.0], [0.0, 0.05])
+    >>> depth = tab.max(axis=1) - tab.min(axis=1)
+    >>> round(float(depth[0])), bool(depth[1] < depth[0])
+    (196, True)
+    """
+    t = get_target(target)
+    d = np.atleast_1d(np.asarray(diameter_m, dtype=np.float64))
+    tau = np.broadcast_to(np.asarray(tau, dtype=np.float64), d.shape)
+    if not np.isfinite(tau).all() or (tau < 0).any():
+        raise ParameterError("tau", "must be finite and >= 0")
+    x = np.linspace(0.0, ejecta_edge, N_TABLE)
+    out = np.zeros((len(d), N_TABLE))
+    fresh = tau < TAU_FRESH
+    if fresh.any():
+        out[fresh] = fresh_profile(x, d[fresh], t, ejecta_edge=ejecta_edge)
+    old = np.flatnonzero(~fresh & (tau < _TAU_MAX))  # beyond _TAU_MAX: no relief left
+    if len(old):
+        cache = _cache(t, float(ejecta_edge))
+        ld = np.log(d[old]) / math.log(_D_STEP)
+        i0 = np.floor(ld).astype(np.int64)
+        fd = (ld - i0)[:, None]
+        lt = np.log(tau[old] / TAU_FRESH) / math.log(_TAU_STEP)
+        j0 = np.clip(np.floor(lt).astype(np.int64), 0, len(cache.tau_nodes) - 2)
+        ft = np.clip(lt - j0, 0.0, 1.0)[:, None]
+        stack, pos = cache.stack(np.concatenate([i0, i0 + 1]))
+        a, b = pos[:len(old)], pos[len(old):]
+        shape = ((1 - fd) * ((1 - ft) * stack[a, j0] + ft * stack[a, j0 + 1])
+                 + fd * ((1 - ft) * stack[b, j0] + ft * stack[b, j0 + 1]))
+        out[old] = shape * fresh_morphometry(d[old], t)["depth_m"][:, None]
+    return out
+
+
+def tau_from_degradation(diameter_m, degradation, target: str | Target = "moon", *,
+                         ejecta_edge: float = EJECTA_EDGE) -> np.ndarray:
+    """The tau at which craters of ``diameter_m`` keep ``1 - degradation`` of their fresh
+    depth (``degradation = 1``: the largest tau, no relief)."""
+    t = get_target(target)
+    d = np.atleast_1d(np.asarray(diameter_m, dtype=np.float64))
+    deg = np.broadcast_to(np.asarray(degradation, dtype=np.float64), d.shape)
+    if not np.isfinite(deg).all() or (deg < 0).any() or (deg > 1).any():
+        raise ParameterError("degradation", "must be in [0, 1]")
+    taus = np.concatenate([[0.0], np.exp(np.linspace(math.log(TAU_FRESH),
+                                                       math.log(_TAU_MAX * 0.99), 160))])
+    out = np.empty(len(d))
+    for k, (dk, gk) in enumerate(zip(d.tolist(), deg.tolist(), strict=True)):
+        if gk <= 0.0:
+            out[k] = 0.0
+            continue
+        if gk >= 1.0:
+            out[k] = _TAU_MAX
+            continue
+        tabs = profile_tables(np.full(len(taus), dk), taus, t, ejecta_edge=ejecta_edge)
+        depth = tabs.max(axis=1) - tabs.min(axis=1)
+        kept = depth / depth[0]
+        out[k] = float(np.interp(1.0 - gk, kept[::-1], taus[::-1]))
+    return out
