@@ -51,6 +51,11 @@ class EnhanceConfig:
     Gyr) or :class:`craters.CraterLayer` objects."""
     min_crater_px: float = 2.0
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
+    source_crater_px: float | None = 4.0
+    """Synthetic craters stay smaller than this many pixels of the source DEM (layer 0):
+    larger craters are resolved by the source itself, whose real ones are the truth
+    (Pike-style counts on DEMs need ~4 pixels across a crater). None or 0: no limit (a
+    synthetic or smoothed base)."""
     boulders: tuple[str | BoulderLayer, ...] = ()
     """Boulder layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,burial,near]`` (metres; ``near``
     is ignored on DEMs) or :class:`craters.BoulderLayer` objects."""
@@ -131,6 +136,12 @@ class EnhanceConfig:
         for name in ("min_crater_px", "min_boulder_px"):
             with about(name):
                 put(name, check_range(name, getattr(self, name), 1.0, 1e6))
+        if self.source_crater_px == 0:
+            put("source_crater_px", None)
+        if self.source_crater_px is not None:
+            with about("source_crater_px"):
+                put("source_crater_px", check_range("source_crater_px",
+                                                    self.source_crater_px, 1.0, 1e6))
         with about("smooth_craters"):
             if not isinstance(self.smooth_craters, bool):
                 raise TypeError(f"`smooth_craters` must be true or false; got "

@@ -41,6 +41,7 @@ key, so the same seed gives the same bytes whatever the thread count.
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
@@ -88,6 +89,16 @@ def _stamp_boulders_layer(z, cat, geometry: StackGeometry, k: int, a0, shape):
     t = np.array([a0.a * c + a0.b * r + a0.c, a0.d * c + a0.e * r + a0.f])
     h, _, placed = place_boulders(z, geometry.pixel_m(k), m, t, local, shape=shape)
     return h, placed
+
+
+def below_source(layers, source_px: float | None, pixel_m: float) -> tuple:
+    """The crater layers limited to diameters below ``source_px`` source pixels (layers
+    entirely above the limit are dropped; None keeps them all)."""
+    if source_px is None:
+        return tuple(layers)
+    cap = source_px * pixel_m
+    return tuple(dataclasses.replace(la, d_max_m=min(la.d_max_m, cap)) for la in layers
+                 if la.d_min_m < cap)
 
 
 def crater_target(dem: Dem, body: str | None = None, gravity_m_s2: float | None = None):
@@ -208,7 +219,8 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     target = crater_target(base, cfg.body, cfg.gravity_m_s2)
     irregularity = 0.0 if cfg.smooth_craters else 0.02  # craters.stamp_many's default
     reach_radii = craters.DEFAULT_EJECTA_EDGE * (1.0 + irregularity)
-    plans, accounting = plan_craters(cfg.crater_layers, geometry, min_px=cfg.min_crater_px,
+    crater_layers = below_source(cfg.crater_layers, cfg.source_crater_px, p0)
+    plans, accounting = plan_craters(crater_layers, geometry, min_px=cfg.min_crater_px,
                                      reach_radii=reach_radii, seed=seed)
     with_rocks = bool(cfg.boulder_layers)
     rock_plans, rock_accounting = (plan_boulders(cfg.boulder_layers, geometry,

@@ -155,6 +155,9 @@ OPTIONS: tuple[Opt, ...] = (
         "degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = c D^k per "
         "m^2, D in metres, ages in Gyr); repeat for several", (_ENHANCE,),
         "none", kind="append", metavar="SPEC"),
+    Opt(("--source-crater-px",), "source_crater_px", _number, _E["source_crater_px"],
+        "synthetic craters stay below this many source (layer-0) pixels: the source's own "
+        "craters are the truth above (0: no limit)", (_ENHANCE,), metavar="PX"),
     Opt(("--min-crater-px",), "min_crater_px", _number, _E["min_crater_px"],
         "smallest crater diameter a layer takes, in its pixels (>= 1)", (_ENHANCE,),
         metavar="PX"),

@@ -264,12 +264,24 @@ def test_geographic_base_from_lola(lola_crop):
     ({"craters": "c=0.5,k=-2,d_min_m=1,d_max_m=10"}, TypeError, "list of crater layer specs"),
     ({"craters": ["c=1e9,k=-3,d_min_m=1e-6,d_max_m=10"]}, ValueError, "absurd|limit"),
     ({"min_crater_px": 0.5}, ValueError, "min_crater_px"),
+    ({"source_crater_px": 0.5}, ValueError, "source_crater_px"),
     ({"fractal_dimension": 3.5}, ValueError, "fractal_dimension"),
     ({"smooth_craters": "yes"}, TypeError, "smooth_craters"),
 ])
 def test_bad_config(base, config, error, match):
     with pytest.raises(error, match=match):
         dem.enhance({"layers": 2, "size": 65, "seed": 1, **config}, dem=base)
+
+
+def test_synthetic_craters_stay_below_the_source_resolution(base, stack):
+    """The source DEM resolves its own craters above ~4 pixels: none are added there
+    unless the limit is lifted (0)."""
+    cap = 4.0 * base.resolution_m
+    biggest = max(cat["diameter_m"].max() for cat in stack.catalogs if len(cat))
+    assert biggest < cap
+    free = dem.enhance({"layers": 2, "size": 65, "seed": 11, "craters": SPECS,
+                        "source_crater_px": 0}, dem=base)
+    assert free.catalogs[0]["diameter_m"].max() > cap
 
 
 def test_unknown_pixels_in_layer0_are_refused(base):
