@@ -2,14 +2,18 @@
 
 Science only, pure functions over numpy arrays: the Martin crater profile with
 degradation, irregular rims and roughness (lunar paper III), stamping into 2-D height
-grids, power-law crater populations and catalogs, the locally controlled spot-noise
-(LCSN) crater kernels of Li et al. 2022 with their morphometry, procedural boulders.
+grids, crater populations (power laws, or production functions and chronologies at a
+model age with equilibrium) and catalogs (CSV, GeoJSON, craterstats .scc), the locally
+controlled spot-noise (LCSN) crater kernels of Li et al. 2022 with their morphometry,
+procedural boulders.
 Imports neither ``latlong`` nor ``dem``.
 
 ::
 
     morphometry, degradation -> profile -> stamp (numba: _stamp_kernels)
-    population (layers, sizes, positions, ages) -> catalog (CSV, GeoJSON)
+    chronology/ (production functions, chronologies, equilibrium; model-age sampling)
+      -> layers (power-law and model-age layers) -> population (positions, ages)
+      -> catalog (CSV, GeoJSON, craterstats .scc)
     lcsn/ (kernel, morphometry, inverse, presets; numba: _lcsn_kernels)
     boulders/ (meshes, placement)
     kernels: the numba building blocks latlong and dem compile against
@@ -31,12 +35,26 @@ from .boulders import (
     parse_boulder_spec,
 )
 from .catalog import (
+    CATALOG_COLUMNS,
     make_catalog,
     read_catalog,
+    read_scc,
     sort_oldest_first,
     validate_catalog,
     write_catalog,
     write_geojson,
+    write_scc,
+)
+from .chronology import (
+    CHRONOLOGY_SYSTEMS,
+    EQUILIBRIUM_FUNCTIONS,
+    ChronologySystem,
+    cap_at_equilibrium,
+    cumulative_density,
+    formation_ages,
+    get_chronology_system,
+    sample_pf_diameters,
+    saturation_diameter_m,
 )
 from .degradation import (
     DegradationModel,
@@ -44,6 +62,7 @@ from .degradation import (
     degradation_from_age,
     slope_erosion,
 )
+from .layers import LAYER_TYPES, ModelAgeLayer, as_crater_layer
 from .lcsn import (
     LCSN_PRESETS,
     LcsnParams,
@@ -76,9 +95,14 @@ from .targets import TARGETS, Target, get_target, small_body
 
 __all__ = [
     "BoulderLayer",
+    "CATALOG_COLUMNS",
     "BoulderNode",
     "BoulderShape",
+    "CHRONOLOGY_SYSTEMS",
+    "ChronologySystem",
     "DEFAULT_EJECTA_EDGE",
+    "EQUILIBRIUM_FUNCTIONS",
+    "LAYER_TYPES",
     "LCSN_PRESETS",
     "MORPHOMETRY_PRESETS",
     "TARGETS",
@@ -87,20 +111,26 @@ __all__ = [
     "CraterLayer",
     "DegradationModel",
     "LcsnParams",
+    "ModelAgeLayer",
     "Morphometry",
     "ProfileParams",
     "Roughness",
+    "as_crater_layer",
     "boulder",
     "boulder_meshes",
     "boulder_normals",
+    "cap_at_equilibrium",
+    "cumulative_density",
     "degradation_factors",
     "degradation_from_age",
     "expected_count",
     "fit_power_law_exponent",
     "parse_boulder_spec",
     "parse_layer_spec",
+    "formation_ages",
     "fresh_depth",
     "fresh_rim_height",
+    "get_chronology_system",
     "get_morphometry",
     "get_target",
     "lcsn_degrade",
@@ -114,8 +144,11 @@ __all__ = [
     "profile_params",
     "radial_profile",
     "read_catalog",
+    "read_scc",
     "rim_perturbations",
+    "sample_pf_diameters",
     "sample_power_law_diameters",
+    "saturation_diameter_m",
     "slope_erosion",
     "small_body",
     "sort_oldest_first",
@@ -125,6 +158,7 @@ __all__ = [
     "validate_catalog",
     "write_catalog",
     "write_geojson",
+    "write_scc",
 ]
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -1,4 +1,5 @@
-"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON for planar catalogs.
+"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON for planar catalogs,
+craterstats spatial crater counts (``.scc``).
 
 A catalog is the ground truth that users feed to crater-detection and navigation
 algorithms, so it must say exactly what was stamped. Columns (units in the names):
@@ -8,6 +9,15 @@ algorithms, so it must say exactly what was stamped. Columns (units in the names
 * ``kind`` (e.g. ``simple``)
 * optional as-stamped columns: ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
   ``slope_deg``, ``seed`` and any extra float columns.
+
+CSV files use these names, or with ``columns="robbins"`` the names of the Robbins
+crater databases for the position and size (Robbins 2019, JGR Planets 124, 871, the
+lunar database: ``CRATER_ID``, ``LAT_CIRC_IMG``, ``LON_CIRC_IMG`` in degrees east 0-360,
+``DIAM_CIRC_IMG`` in km; the other columns keep their names), so tools written for
+those databases read them. ``.scc`` files (:func:`write_scc`) are what crater-counting
+tools read (craterstats, Michael & Neukum 2010; written by CraterTools, Kneissl et al.
+2011): the counted area in km^2 and one row per crater with its diameter in km and
+longitude/latitude in degrees (:mod:`craters.scc`).
 """
 
 from __future__ import annotations
@@ -18,10 +28,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ._shared import atomic_path
+from ._shared import ParameterError, atomic_path, check_choice
+from .scc import read_scc, write_scc
 
-__all__ = ["CATALOG_FORMAT", "catalog_dtype", "make_catalog", "read_catalog",
-           "sort_oldest_first", "write_catalog", "write_geojson"]
+__all__ = ["CATALOG_COLUMNS", "CATALOG_FORMAT", "catalog_dtype", "make_catalog",
+           "read_catalog", "read_scc", "sort_oldest_first", "write_catalog", "write_geojson",
+           "write_scc"]
 
 CATALOG_FORMAT = "craterform crater catalog v1"
 _KIND_LEN = 16
@@ -31,6 +43,11 @@ _STR_COLUMNS = {"kind"}
 _PLANE = ("x_m", "y_m")
 _SPHERE = ("lat_deg", "lon_deg")
 _CORE = ("diameter_m", "age_gyr", "degradation", "kind")
+#: Column-name styles of :func:`write_catalog`.
+CATALOG_COLUMNS = ("craterform", "robbins")
+# Robbins (2019) lunar database names of the position and size columns
+_ROBBINS_ID = "CRATER_ID"
+_ROBBINS = ("LAT_CIRC_IMG", "LON_CIRC_IMG", "DIAM_CIRC_IMG")
 
 
 def _column_dtype(name: str):
@@ -117,22 +134,46 @@ def _format(value) -> str:
     return str(value)
 
 
-def write_catalog(cat: np.ndarray, path) -> Path:
-    """Write a catalog as CSV (atomic). Line 1: a ``#`` comment with format and units."""
+def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path:
+    """Write a catalog as CSV (atomic).
+
+    ``columns="craterform"``: line 1 is a ``#`` comment with format and units, then the
+    column names. ``columns="robbins"`` (catalogs on a body, with ``lat_deg, lon_deg``):
+    the Robbins (2019) database names (module notes) and no comment line, so that
+    readers of that database (``pandas.read_csv``) take it as it is: ``CRATER_ID``
+    (``CF-`` and the row number), ``LAT_CIRC_IMG``, ``LON_CIRC_IMG`` (degrees east,
+    0-360), ``DIAM_CIRC_IMG`` (km), then the other columns under their own names.
+    :func:`read_catalog` reads both.
+    """
     validate_catalog(cat)
+    check_choice("columns", columns, CATALOG_COLUMNS)
     path = Path(path)
+    names = list(cat.dtype.names)
+    rows = [[_format(v) for v in row] for row in cat.tolist()]
+    if columns == "robbins":
+        if "lat_deg" not in names:
+            raise ParameterError("columns", "robbins needs a catalog on a body (lat_deg, "
+                                 "lon_deg); this one is planar (x_m, y_m)")
+        rest = [n for n in names if n not in ("lat_deg", "lon_deg", "diameter_m")]
+        lon = np.mod(cat["lon_deg"], 360.0)
+        head = [[f"CF-{i:07d}", _format(la), _format(lo), _format(d / 1000.0)]
+                for i, (la, lo, d) in enumerate(zip(cat["lat_deg"].tolist(), lon.tolist(),
+                                                    cat["diameter_m"].tolist(), strict=True))]
+        keep = [names.index(n) for n in rest]
+        rows = [h + [r[j] for j in keep] for h, r in zip(head, rows, strict=True)]
+        names = [_ROBBINS_ID, *_ROBBINS, *rest]
     units = "metres (_m), degrees (_deg), Gyr (_gyr); degradation 0 = fresh, 1 = gone"
     with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        fh.write(f"# {CATALOG_FORMAT}; units: {units}\n")
+        if columns == "craterform":
+            fh.write(f"# {CATALOG_FORMAT}; units: {units}\n")
         w = csv.writer(fh, lineterminator="\n")
-        w.writerow(cat.dtype.names)
-        for row in cat.tolist():
-            w.writerow([_format(v) for v in row])
+        w.writerow(names)
+        w.writerows(rows)
     return path
 
 
 def read_catalog(path) -> np.ndarray:
-    """Read a catalog written by :func:`write_catalog`."""
+    """Read a catalog written by :func:`write_catalog` (either column style)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"catalog {str(path)!r} does not exist")
@@ -142,6 +183,13 @@ def read_catalog(path) -> np.ndarray:
     if not rows:
         raise ValueError(f"catalog {str(path)!r} is empty")
     names, body = rows[0], rows[1:]
+    robbins = all(n in names for n in _ROBBINS)
+    if robbins:
+        drop = {names.index(n) for n in (_ROBBINS_ID,) if n in names}
+        rename = dict(zip(_ROBBINS, ("lat_deg", "lon_deg", "diameter_m"), strict=True))
+        keep = [j for j in range(len(names)) if j not in drop]
+        names = [rename.get(names[j], names[j]) for j in keep]
+        body = [[r[j] if j < len(r) else "" for j in keep] for r in body]
     cat = np.zeros(len(body), dtype=catalog_dtype(names))
     for k, name in enumerate(names):
         try:
@@ -149,6 +197,8 @@ def read_catalog(path) -> np.ndarray:
             cat[name] = np.array(col, dtype=_column_dtype(name)) if col else []
         except (IndexError, ValueError) as exc:
             raise ValueError(f"catalog {str(path)!r}: bad column {name!r}: {exc}") from None
+    if robbins:
+        cat["diameter_m"] *= 1000.0
     return validate_catalog(cat)
 
 

@@ -11,10 +11,15 @@ import numpy as np
 from ._shared import atomic_path, check_output_path, package_version
 from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
 from ._shared.report import save_figure
-from .catalog import write_catalog
+from .catalog import CATALOG_COLUMNS, write_catalog
+from .chronology import CHRONOLOGY_SYSTEMS, get_chronology_system
 from .degradation import degradation_from_age
-from .population import CraterLayer, expected_count, parse_layer_spec, population
+from .layers import ModelAgeLayer, parse_layer_spec
+from .population import population
 from .profile import profile_params, radial_profile
+from .scc import write_scc
+
+CHRONOLOGY_NAMES = tuple(CHRONOLOGY_SYSTEMS)
 
 
 def _finite(flag: str, value: float, *, positive=False, lo=None, hi=None) -> float:
@@ -95,7 +100,8 @@ def _cmd_profile(args) -> int:
 def _cmd_population(args) -> int:
     specs = args.craters or []
     if not specs:
-        raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=...")
+        raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=... or "
+                       "npf=moon,age_gyr=...,d_min_m=...,d_max_m=...")
     layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
     where = [args.radius_m is not None, args.area_m2 is not None,
              args.x_range_m is not None or args.y_range_m is not None]
@@ -105,12 +111,14 @@ def _cmd_population(args) -> int:
         _finite("--radius-m", args.radius_m, positive=True)
     if args.area_m2 is not None:
         _finite("--area-m2", args.area_m2, positive=True)
-    check_output_path(args.output, force=args.force, suffixes=(".csv",))
+    check_output_path(args.output, force=args.force, suffixes=(".csv", ".scc"))
+    scc = args.output.lower().endswith(".scc")
+    if scc and args.columns != "craterform":
+        raise CliError("--columns applies to CSV output, not .scc")
     if args.plot:
         check_output_path(args.plot, force=args.force, suffixes=(".png",))
     cat = population(layers, radius_m=args.radius_m, area_m2=args.area_m2,
                      x_range_m=args.x_range_m, y_range_m=args.y_range_m, rng=args.seed)
-    write_catalog(cat, args.output)
     if args.radius_m is not None:
         area = 4 * math.pi * args.radius_m**2
     elif args.area_m2 is not None:
@@ -118,15 +126,39 @@ def _cmd_population(args) -> int:
     else:
         (x0, x1), (y0, y1) = args.x_range_m, args.y_range_m
         area = (x1 - x0) * (y1 - y0)
+    if scc:
+        write_scc(cat, args.output, area_m2=area, body_radius_m=_body_radius(args, layers),
+                  note=f"craters population: {' '.join('--craters ' + s for s in specs)}")
+    else:
+        write_catalog(cat, args.output, columns=args.columns)
     if args.plot:
         _plot_sfd(cat, layers, area, args.plot)
     if not args.quiet:
-        want = sum(expected_count(area, la.c, la.k, la.d_min_m, la.d_max_m) for la in layers)
+        want = sum(la.expected_count(area) for la in layers)
         print(f"{len(cat)} craters (expected {want:.1f}) on {area:.6g} m^2 -> {args.output}")
+        for i, la in enumerate(layers):
+            if isinstance(la, ModelAgeLayer) and la.equilibrium is not None:
+                ds = la.saturation_diameter_m
+                state = ("never saturated in its range" if ds is None
+                         else f"saturated below D = {ds:.4g} m")
+                print(f"layer {i}: {la.npf} at {la.age_gyr:g} Gyr, {la.equilibrium} "
+                      f"equilibrium: {state}")
     return 0
 
 
-def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
+def _body_radius(args, layers) -> float | None:
+    """The radius of the .scc's ellipsoid: --radius-m, else the body of the layers'
+    chronology system if they share one, else none."""
+    if args.radius_m is not None:
+        return args.radius_m
+    bodies = {get_chronology_system(la.npf).body_radius_m for la in layers
+              if isinstance(la, ModelAgeLayer)}
+    if len(bodies) == 1 and all(isinstance(la, ModelAgeLayer) for la in layers):
+        return bodies.pop()
+    return None
+
+
+def _plot_sfd(cat, layers, area: float, path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -142,7 +174,7 @@ def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
     want = np.zeros_like(grid)
     for la in layers:
         inside = np.clip(grid, la.d_min_m, la.d_max_m)
-        want += la.c * (inside**la.k - la.d_max_m**la.k)
+        want += la.cumulative_m2(inside) - la.cumulative_m2(la.d_max_m)
     ax.loglog(grid, np.where(want > 0, want, np.nan), "k-", lw=1.5, label="requested law")
     ax.set_xlabel("diameter D (m)")
     ax.set_ylabel("cumulative number per m$^2$, N(>D)")
@@ -176,12 +208,16 @@ def build_parser() -> OneLineParser:
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no progress bars or messages (default: off)")
     p.set_defaults(func=_cmd_profile)
-    q = sub.add_parser("population", help="a power-law crater catalog (CSV)")
+    q = sub.add_parser("population", help="a crater catalog (CSV or craterstats .scc) from "
+                       "power laws or production functions at a model age")
     q.add_argument("--craters", action="append", metavar="SPEC",
-                   help="crater layer c=0.5,k=-2,d_min_m=5,d_max_m=800[,age_min_gyr=0,"
-                        "age_max_gyr=3.5,degradation=0.2,kind=simple] (the fields of "
-                        "craters.CraterLayer; metres, Gyr; repeatable for piecewise laws; "
-                        "required)")
+                   help="crater layer: a power law c=0.5,k=-2,d_min_m=5,d_max_m=800"
+                        "[,age_min_gyr=0,age_max_gyr=3.5,degradation=0.2,kind=simple] (the "
+                        "fields of craters.CraterLayer: N_cum = c D^k per m^2) or a model "
+                        "age npf=moon,age_gyr=3.8,d_min_m=1000,d_max_m=20000[,equilibrium="
+                        "trask|hartmann,degradation=0.2,kind=simple] (craters.ModelAgeLayer; "
+                        "npf: " + ", ".join(CHRONOLOGY_NAMES) + "); metres, Gyr; repeatable; "
+                        "required")
     q.add_argument("--radius-m", type=float,
                    help="sphere radius (positions lat/lon) (default: none)")
     q.add_argument("--area-m2", type=float,
@@ -193,7 +229,13 @@ def build_parser() -> OneLineParser:
                    help="oldest age of layers that do not give age_max_gyr (default: 3.5)")
     q.add_argument("--seed", type=parse_seed,
                    help="random seed (default: a fresh one)")
-    q.add_argument("-o", "--output", required=True, help="catalog CSV (required)")
+    q.add_argument("-o", "--output", required=True,
+                   help="catalog: .csv, or .scc (craterstats spatial crater count: area in "
+                        "km^2, diameters in km, lon/lat) (required)")
+    q.add_argument("--columns", default="craterform", choices=CATALOG_COLUMNS,
+                   help="CSV column names: craterform (units in the names) or robbins "
+                        "(LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG in km, as the Robbins "
+                        "2019 lunar crater database) (default: craterform)")
     q.add_argument("--plot", help="PNG of the cumulative SFD against the requested law "
                    "(default: none)")
     q.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")

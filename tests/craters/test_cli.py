@@ -40,6 +40,24 @@ def test_population_csv_and_plot(run_cli, tmp_path):
     assert png.stat().st_size > 20_000
 
 
+def test_population_model_age_scc_and_robbins(run_cli, tmp_path):
+    scc, csv = tmp_path / "m.scc", tmp_path / "m.csv"
+    spec = "npf=moon,age_gyr=3.8,d_min_m=100,d_max_m=20000,equilibrium=trask"
+    proc = run_cli("craters", "population", "--craters", spec, "--area-m2", "1e9", "--seed",
+                   "2", "-o", str(scc))
+    assert proc.returncode == 0, proc.stderr
+    assert "saturated below D = 4" in proc.stdout
+    got = craters.read_scc(scc)
+    want = craters.population(craters.parse_layer_spec(spec), area_m2=1e9, rng=2)
+    np.testing.assert_allclose(got["diameter_m"], want["diameter_m"], rtol=1e-15)
+    assert got["area_m2"] == pytest.approx(1e9) and got["axes_m"] == (1737400.0,) * 3
+    proc = run_cli("craters", "population", "--craters", spec, "--area-m2", "1e9", "--seed",
+                   "2", "-o", str(csv), "--columns", "robbins", "-q")
+    assert proc.returncode == 0 and proc.stdout == "", proc.stderr
+    assert csv.read_text().startswith("CRATER_ID,LAT_CIRC_IMG,LON_CIRC_IMG,DIAM_CIRC_IMG,")
+    assert np.allclose(craters.read_catalog(csv)["diameter_m"], want["diameter_m"])
+
+
 @pytest.mark.parametrize("args,needles", [
     (["profile", "--diameter-m", "-5", "--csv", "x.csv"], ["--diameter-m", "> 0"]),
     (["profile", "--diameter-m", "nan", "--csv", "x.csv"], ["--diameter-m", "finite"]),
@@ -58,6 +76,18 @@ def test_population_csv_and_plot(run_cli, tmp_path):
      ["unknown format"]),
     (["population", "--craters", "c=1,k=-2", "--radius-m", "9", "-o", "x.csv"], ["missing"]),
     (["population", "--radius-m", "9", "-o", "x.csv", "--seed", "x"], ["--seed"]),
+    (["population", "--craters", "npf=moon,k=-2,age_gyr=3,d_min_m=1000,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc"], ["`k` does not go with npf"]),
+    (["population", "--craters", "npf=moon,age_gyr=0,d_min_m=1000,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc"], ["`age_gyr`", "(0, 4.5]"]),
+    (["population", "--craters", "npf=moon,age_gyr=5,d_min_m=1000,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc"], ["`age_gyr`", "(0, 4.5]"]),
+    (["population", "--craters", "npf=titan,age_gyr=1,d_min_m=1000,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc"], ["`npf` must be one of moon"]),
+    (["population", "--craters", "npf=moon,age_gyr=1,d_min_m=1,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc"], ["`d_min_m`", "[10, 300000] m"]),
+    (["population", "--craters", "npf=moon,age_gyr=1,d_min_m=1000,d_max_m=9000",
+      "--area-m2", "1e9", "-o", "x.scc", "--columns", "robbins"], ["--columns"]),
 ])
 def test_bad_input(run_cli, tmp_path, args, needles):
     proc = run_cli("craters", *args, cwd=tmp_path)
