@@ -12,7 +12,7 @@ from ._shared import atomic_path, check_output_path, package_version
 from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
 from ._shared.report import save_figure
 from .catalog import CATALOG_COLUMNS, write_catalog
-from .chronology import CHRONOLOGY_SYSTEMS, get_chronology_system
+from .chronology import CHRONOLOGY_SYSTEMS, equilibrium_density, get_chronology_system
 from .degradation import degradation_from_age
 from .layers import ModelAgeLayer, parse_layer_spec
 from .population import population
@@ -176,6 +176,10 @@ def _plot_sfd(cat, layers, area: float, path) -> None:
         inside = np.clip(grid, la.d_min_m, la.d_max_m)
         want += la.cumulative_m2(inside) - la.cumulative_m2(la.d_max_m)
     ax.loglog(grid, np.where(want > 0, want, np.nan), "k-", lw=1.5, label="requested law")
+    for name in sorted({la.equilibrium for la in layers
+                        if isinstance(la, ModelAgeLayer) and la.equilibrium}):
+        ax.loglog(grid, equilibrium_density(name, grid), "--", lw=1,
+                  label=f"{name} equilibrium")
     ax.set_xlabel("diameter D (m)")
     ax.set_ylabel("cumulative number per m$^2$, N(>D)")
     ax.set_title(f"Crater size-frequency distribution ({len(cat)} craters)")
