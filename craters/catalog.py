@@ -1,4 +1,5 @@
-"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON for planar catalogs.
+"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON for planar catalogs,
+craterstats spatial crater counts (``.scc``).
 
 A catalog is the ground truth that users feed to crater-detection and navigation
 algorithms, so it must say exactly what was stamped. Columns (units in the names):
@@ -6,9 +7,21 @@ algorithms, so it must say exactly what was stamped. Columns (units in the names
 * position: ``lat_deg, lon_deg`` (on a body) or ``x_m, y_m`` (on a plane / DEM)
 * ``diameter_m`` rim-crest diameter, ``age_gyr``, ``degradation`` (the share of the
   fresh depth removed, 0 fresh .. 1 no relief; NaN before stamping = from the age)
-* ``kind`` (e.g. ``simple``)
-* optional as-stamped columns: ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
-  ``slope_deg``, ``seed`` and any extra float columns.
+* ``kind``: the layer's free label (default ``crater``; e.g. ``mare``, ``old``)
+* optional as-stamped columns: ``morphology`` (``simple``, ``transitional``, ``complex``,
+  ``peak-ring``: the fresh shape class on the target body), ``rim_radius_m``, ``depth_m``,
+  ``rim_height_m``, ``floor_diameter_m``, ``peak_height_m``, ``kappa_t_m2`` (the
+  diffusion length squared it aged by), ``slope_deg``, ``seed`` and any extra float
+  columns.
+
+CSV files use these names, or with ``columns="robbins"`` the names of the Robbins
+crater databases for the position and size (Robbins 2019, JGR Planets 124, 871, the
+lunar database: ``CRATER_ID``, ``LAT_CIRC_IMG``, ``LON_CIRC_IMG`` in degrees east 0-360,
+``DIAM_CIRC_IMG`` in km; the other columns keep their names), so tools written for
+those databases read them. ``.scc`` files (:func:`write_scc`) are what crater-counting
+tools read (craterstats, Michael & Neukum 2010; written by CraterTools, Kneissl et al.
+2011): the counted area in km^2 and one row per crater with its diameter in km and
+longitude/latitude in degrees (:mod:`craters.scc`).
 """
 
 from __future__ import annotations
@@ -19,10 +32,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ._shared import atomic_path
+from ._shared import ParameterError, atomic_path, check_choice
+from .scc import read_scc, write_scc
 
-__all__ = ["CATALOG_FORMAT", "catalog_dtype", "make_catalog", "read_catalog",
-           "sort_oldest_first", "write_catalog", "write_geojson"]
+__all__ = ["CATALOG_COLUMNS", "CATALOG_FORMAT", "catalog_dtype", "make_catalog",
+           "read_catalog", "read_scc", "sort_oldest_first", "write_catalog", "write_geojson",
+           "write_scc"]
 
 CATALOG_FORMAT = "craterform crater catalog v1"
 _KIND_LEN = 16
@@ -32,6 +47,11 @@ _STR_COLUMNS = {"kind", "morphology"}
 _PLANE = ("x_m", "y_m")
 _SPHERE = ("lat_deg", "lon_deg")
 _CORE = ("diameter_m", "age_gyr", "degradation", "kind")
+#: Column-name styles of :func:`write_catalog`.
+CATALOG_COLUMNS = ("craterform", "robbins")
+# Robbins (2019) lunar database names of the position and size columns
+_ROBBINS_ID = "CRATER_ID"
+_ROBBINS = ("LAT_CIRC_IMG", "LON_CIRC_IMG", "DIAM_CIRC_IMG")
 
 
 def _column_dtype(name: str):
@@ -49,13 +69,13 @@ def make_catalog(**columns) -> np.ndarray:
     """Build and validate a catalog from equal-length columns.
 
     Needs ``x_m, y_m`` or ``lat_deg, lon_deg`` and ``diameter_m``; ``age_gyr`` (0),
-    ``degradation`` (0) and ``kind`` (``simple``) get defaults.
+    ``degradation`` (0) and ``kind`` (``crater``) get defaults.
 
     Examples
     --------
     >>> cat = make_catalog(x_m=[1.0, 2.0], y_m=[0.0, 0.0], diameter_m=[10.0, 20.0])
     >>> cat.dtype.names[:5], cat["kind"].tolist()
-    (('x_m', 'y_m', 'diameter_m', 'age_gyr', 'degradation'), ['simple', 'simple'])
+    (('x_m', 'y_m', 'diameter_m', 'age_gyr', 'degradation'), ['crater', 'crater'])
     """
     if all(k in columns for k in _PLANE):
         pos = _PLANE
@@ -68,7 +88,7 @@ def make_catalog(**columns) -> np.ndarray:
     n = len(np.atleast_1d(columns["diameter_m"]))
     columns.setdefault("age_gyr", np.zeros(n))
     columns.setdefault("degradation", np.zeros(n))
-    columns.setdefault("kind", np.full(n, "simple"))
+    columns.setdefault("kind", np.full(n, "crater"))
     names = [*pos, *_CORE] + [k for k in columns if k not in pos and k not in _CORE]
     out = np.zeros(n, dtype=catalog_dtype(names))
     for name in names:
@@ -119,22 +139,46 @@ def _format(value) -> str:
     return str(value)
 
 
-def write_catalog(cat: np.ndarray, path) -> Path:
-    """Write a catalog as CSV (atomic). Line 1: a ``#`` comment with format and units."""
+def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path:
+    """Write a catalog as CSV (atomic).
+
+    ``columns="craterform"``: line 1 is a ``#`` comment with format and units, then the
+    column names. ``columns="robbins"`` (catalogs on a body, with ``lat_deg, lon_deg``):
+    the Robbins (2019) database names (module notes) and no comment line, so that
+    readers of that database (``pandas.read_csv``) take it as it is: ``CRATER_ID``
+    (``CF-`` and the row number), ``LAT_CIRC_IMG``, ``LON_CIRC_IMG`` (degrees east,
+    0-360), ``DIAM_CIRC_IMG`` (km), then the other columns under their own names.
+    :func:`read_catalog` reads both.
+    """
     validate_catalog(cat)
+    check_choice("columns", columns, CATALOG_COLUMNS)
     path = Path(path)
+    names = list(cat.dtype.names)
+    rows = [[_format(v) for v in row] for row in cat.tolist()]
+    if columns == "robbins":
+        if "lat_deg" not in names:
+            raise ParameterError("columns", "robbins needs a catalog on a body (lat_deg, "
+                                 "lon_deg); this one is planar (x_m, y_m)")
+        rest = [n for n in names if n not in ("lat_deg", "lon_deg", "diameter_m")]
+        lon = np.mod(cat["lon_deg"], 360.0)
+        head = [[f"CF-{i:07d}", _format(la), _format(lo), _format(d / 1000.0)]
+                for i, (la, lo, d) in enumerate(zip(cat["lat_deg"].tolist(), lon.tolist(),
+                                                    cat["diameter_m"].tolist(), strict=True))]
+        keep = [names.index(n) for n in rest]
+        rows = [h + [r[j] for j in keep] for h, r in zip(head, rows, strict=True)]
+        names = [_ROBBINS_ID, *_ROBBINS, *rest]
     units = "metres (_m), degrees (_deg), Gyr (_gyr); degradation 0 = fresh, 1 = gone"
     with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        fh.write(f"# {CATALOG_FORMAT}; units: {units}\n")
+        if columns == "craterform":
+            fh.write(f"# {CATALOG_FORMAT}; units: {units}\n")
         w = csv.writer(fh, lineterminator="\n")
-        w.writerow(cat.dtype.names)
-        for row in cat.tolist():
-            w.writerow([_format(v) for v in row])
+        w.writerow(names)
+        w.writerows(rows)
     return path
 
 
 def read_catalog(path) -> np.ndarray:
-    """Read a catalog written by :func:`write_catalog`."""
+    """Read a catalog written by :func:`write_catalog` (either column style)."""
     path = Path(path)
     if not path.is_file():
         raise ValueError(f"catalog {str(path)!r} does not exist")
@@ -144,6 +188,13 @@ def read_catalog(path) -> np.ndarray:
     if not rows:
         raise ValueError(f"catalog {str(path)!r} is empty")
     names, body = rows[0], rows[1:]
+    robbins = all(n in names for n in _ROBBINS)
+    if robbins:
+        drop = {names.index(n) for n in (_ROBBINS_ID,) if n in names}
+        rename = dict(zip(_ROBBINS, ("lat_deg", "lon_deg", "diameter_m"), strict=True))
+        keep = [j for j in range(len(names)) if j not in drop]
+        names = [rename.get(names[j], names[j]) for j in keep]
+        body = [[r[j] if j < len(r) else "" for j in keep] for r in body]
     cat = np.zeros(len(body), dtype=catalog_dtype(names))
     for k, name in enumerate(names):
         try:
@@ -151,6 +202,8 @@ def read_catalog(path) -> np.ndarray:
             cat[name] = np.array(col, dtype=_column_dtype(name)) if col else []
         except (IndexError, ValueError) as exc:
             raise ValueError(f"catalog {str(path)!r}: bad column {name!r}: {exc}") from None
+    if robbins:
+        cat["diameter_m"] *= 1000.0
     return validate_catalog(cat)
 
 

@@ -11,10 +11,16 @@ import numpy as np
 from ._shared import atomic_path, check_output_path, package_version
 from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
 from ._shared.report import save_figure
-from .catalog import write_catalog
-from .population import CraterLayer, expected_count, parse_layer_spec, population
+from .catalog import CATALOG_COLUMNS, write_catalog
+from .chronology import CHRONOLOGY_SYSTEMS, equilibrium_density, get_chronology_system
+from .layers import ModelAgeLayer, parse_layer_spec
+from .morphology import morphology_class
+from .population import population
 from .profile import crater_morphometry, radial_profile
+from .scc import write_scc
 from .targets import TARGETS, get_target
+
+CHRONOLOGY_NAMES = tuple(CHRONOLOGY_SYSTEMS)
 
 
 def _finite(flag: str, value: float, *, positive=False, lo=None, hi=None) -> float:
@@ -104,22 +110,32 @@ def _plot_profiles(path, d: float, target, x, h, m) -> None:
 def _cmd_population(args) -> int:
     specs = args.craters or []
     if not specs:
-        raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=...")
+        raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=... or "
+                       "npf=moon,age_gyr=...,d_min_m=...,d_max_m=...")
     layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
+    target = _population_target(args)
     where = [args.radius_m is not None, args.area_m2 is not None,
              args.x_range_m is not None or args.y_range_m is not None]
+    if target is not None and not any(where):
+        args.radius_m = target.radius_m  # the body's whole surface
+        where[0] = True
     if sum(where) != 1:
-        raise CliError("give exactly one of --radius-m, --area-m2 or --x-range-m/--y-range-m")
+        raise CliError("give exactly one of --radius-m, --area-m2 or --x-range-m/--y-range-m"
+                       " (or --body alone: its whole surface)")
     if args.radius_m is not None:
         _finite("--radius-m", args.radius_m, positive=True)
     if args.area_m2 is not None:
         _finite("--area-m2", args.area_m2, positive=True)
-    check_output_path(args.output, force=args.force, suffixes=(".csv",))
+    check_output_path(args.output, force=args.force, suffixes=(".csv", ".scc"))
+    scc = args.output.lower().endswith(".scc")
+    if scc and args.columns != "craterform":
+        raise CliError("--columns applies to CSV output, not .scc")
     if args.plot:
         check_output_path(args.plot, force=args.force, suffixes=(".png",))
     cat = population(layers, radius_m=args.radius_m, area_m2=args.area_m2,
                      x_range_m=args.x_range_m, y_range_m=args.y_range_m, rng=args.seed)
-    write_catalog(cat, args.output)
+    if target is not None:
+        cat = _with_morphology(cat, target)
     if args.radius_m is not None:
         area = 4 * math.pi * args.radius_m**2
     elif args.area_m2 is not None:
@@ -127,15 +143,62 @@ def _cmd_population(args) -> int:
     else:
         (x0, x1), (y0, y1) = args.x_range_m, args.y_range_m
         area = (x1 - x0) * (y1 - y0)
+    if scc:
+        write_scc(cat, args.output, area_m2=area, body_radius_m=_body_radius(args, layers),
+                  note=f"craters population: {' '.join('--craters ' + s for s in specs)}")
+    else:
+        write_catalog(cat, args.output, columns=args.columns)
     if args.plot:
         _plot_sfd(cat, layers, area, args.plot)
     if not args.quiet:
-        want = sum(expected_count(area, la.c, la.k, la.d_min_m, la.d_max_m) for la in layers)
+        want = sum(la.expected_count(area) for la in layers)
         print(f"{len(cat)} craters (expected {want:.1f}) on {area:.6g} m^2 -> {args.output}")
+        for i, la in enumerate(layers):
+            if isinstance(la, ModelAgeLayer) and la.equilibrium is not None:
+                ds = la.saturation_diameter_m
+                state = ("never saturated in its range" if ds is None
+                         else f"saturated below D = {ds:.4g} m")
+                print(f"layer {i}: {la.npf} at {la.age_gyr:g} Gyr, {la.equilibrium} "
+                      f"equilibrium: {state}")
     return 0
 
 
-def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
+def _population_target(args):
+    """The --body target of ``craters population`` (None without --body)."""
+    if args.body is None:
+        for flag, value in (("--gravity-m-s2", args.gravity_m_s2),
+                            ("--density-kg-m3", args.density_kg_m3)):
+            if value is not None:
+                raise CliError(f"{flag} needs --body")
+        return None
+    if args.body == "small-body" and args.radius_m is None:
+        raise CliError("--body small-body needs --radius-m (the body's radius)")
+    radius = args.radius_m if args.body == "small-body" else None
+    return get_target(args.body, gravity_m_s2=args.gravity_m_s2, radius_m=radius,
+                      density_kg_m3=args.density_kg_m3)
+
+
+def _with_morphology(cat, target):
+    """The catalog with a ``morphology`` column: each crater's fresh class on ``target``."""
+    from numpy.lib import recfunctions
+
+    kinds = morphology_class(cat["diameter_m"], target) if len(cat) else np.zeros(0, "U12")
+    return recfunctions.append_fields(cat, "morphology", kinds, usemask=False)
+
+
+def _body_radius(args, layers) -> float | None:
+    """The radius of the .scc's ellipsoid: --radius-m, else the body of the layers'
+    chronology system if they share one, else none."""
+    if args.radius_m is not None:
+        return args.radius_m
+    bodies = {get_chronology_system(la.npf).body_radius_m for la in layers
+              if isinstance(la, ModelAgeLayer)}
+    if len(bodies) == 1 and all(isinstance(la, ModelAgeLayer) for la in layers):
+        return bodies.pop()
+    return None
+
+
+def _plot_sfd(cat, layers, area: float, path) -> None:
     import matplotlib
 
     matplotlib.use("Agg")
@@ -151,8 +214,12 @@ def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
     want = np.zeros_like(grid)
     for la in layers:
         inside = np.clip(grid, la.d_min_m, la.d_max_m)
-        want += la.c * (inside**la.k - la.d_max_m**la.k)
+        want += la.cumulative_m2(inside) - la.cumulative_m2(la.d_max_m)
     ax.loglog(grid, np.where(want > 0, want, np.nan), "k-", lw=1.5, label="requested law")
+    for name in sorted({la.equilibrium for la in layers
+                        if isinstance(la, ModelAgeLayer) and la.equilibrium}):
+        ax.loglog(grid, equilibrium_density(name, grid), "--", lw=1,
+                  label=f"{name} equilibrium")
     ax.set_xlabel("diameter D (m)")
     ax.set_ylabel("cumulative number per m$^2$, N(>D)")
     ax.set_title(f"Crater size-frequency distribution ({len(cat)} craters)")
@@ -164,14 +231,22 @@ def _plot_sfd(cat, layers: list[CraterLayer], area: float, path) -> None:
 
 
 # --------------------------------------------------------------------------- parser
-def _add_body_options(p) -> None:
-    p.add_argument("--body", default="moon", choices=(*TARGETS, "small-body"),
-                   help="target body: crater morphology and diffusivity (default: moon)")
+def _add_body_options(p, *, population: bool = False) -> None:
+    if population:
+        p.add_argument("--body", choices=(*TARGETS, "small-body"),
+                       help="target body: its whole surface is the area unless --radius-m, "
+                       "--area-m2 or a rectangle is given (a small-body's radius is "
+                       "--radius-m), and each crater's fresh morphology class is listed "
+                       "(default: none)")
+    else:
+        p.add_argument("--body", default="moon", choices=(*TARGETS, "small-body"),
+                       help="target body: crater morphology and diffusivity (default: moon)")
     p.add_argument("--gravity-m-s2", type=float,
                    help="surface gravity, m/s^2: the transition diameters scale as 1/g "
                    "(default: the body's)")
-    p.add_argument("--body-radius-m", type=float,
-                   help="radius of a small-body, metres (default: none)")
+    if not population:
+        p.add_argument("--body-radius-m", type=float,
+                       help="radius of a small-body, metres (default: none)")
     p.add_argument("--density-kg-m3", type=float,
                    help="bulk density of a small-body, kg/m^3 (default: 2000)")
 
@@ -195,13 +270,20 @@ def build_parser() -> OneLineParser:
     p.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")
     p.add_argument("-q", "--quiet", action="store_true",
                    help="no progress bars or messages (default: off)")
-    p.set_defaults(func=_cmd_profile)
-    q = sub.add_parser("population", help="a power-law crater catalog (CSV)")
+    p.set_defaults(func=_cmd_profile, flags={
+        "body": "--body", "gravity_m_s2": "--gravity-m-s2", "radius_m": "--body-radius-m",
+        "density_kg_m3": "--density-kg-m3", "age_gyr": "--age-gyr",
+        "degradation": "--degradation", "diameter_m": "--diameter-m"})
+    q = sub.add_parser("population", help="a crater catalog (CSV or craterstats .scc) from "
+                       "power laws or production functions at a model age")
     q.add_argument("--craters", action="append", metavar="SPEC",
-                   help="crater layer c=0.5,k=-2,d_min_m=5,d_max_m=800[,age_min_gyr=0,"
-                        "age_max_gyr=3.5,degradation=0.2,kind=simple] (the fields of "
-                        "craters.CraterLayer; metres, Gyr; repeatable for piecewise laws; "
-                        "required)")
+                   help="crater layer: a power law c=0.5,k=-2,d_min_m=5,d_max_m=800"
+                        "[,age_min_gyr=0,age_max_gyr=3.5,degradation=0.2,kind=mare] (the "
+                        "fields of craters.CraterLayer: N_cum = c D^k per m^2) or a model "
+                        "age npf=moon,age_gyr=3.8,d_min_m=1000,d_max_m=20000[,equilibrium="
+                        "trask|hartmann,degradation=0.2,kind=mare] (craters.ModelAgeLayer; "
+                        "npf: " + ", ".join(CHRONOLOGY_NAMES) + "); metres, Gyr; repeatable; "
+                        "required")
     q.add_argument("--radius-m", type=float,
                    help="sphere radius (positions lat/lon) (default: none)")
     q.add_argument("--area-m2", type=float,
@@ -209,26 +291,32 @@ def build_parser() -> OneLineParser:
     q.add_argument("--x-range-m", type=_pair,
                    help="LOW,HIGH: a rectangle (positions x/y) (default: none)")
     q.add_argument("--y-range-m", type=_pair, help="LOW,HIGH (default: none)")
+    _add_body_options(q, population=True)
     q.add_argument("--age-max-gyr", type=float, default=3.5,
                    help="oldest age of layers that do not give age_max_gyr (default: 3.5)")
     q.add_argument("--seed", type=parse_seed,
                    help="random seed (default: a fresh one)")
-    q.add_argument("-o", "--output", required=True, help="catalog CSV (required)")
+    q.add_argument("-o", "--output", required=True,
+                   help="catalog: .csv, or .scc (craterstats spatial crater count: area in "
+                        "km^2, diameters in km, lon/lat) (required)")
+    q.add_argument("--columns", default="craterform", choices=CATALOG_COLUMNS,
+                   help="CSV column names: craterform (units in the names) or robbins "
+                        "(LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG in km, as the Robbins "
+                        "2019 lunar crater database) (default: craterform)")
     q.add_argument("--plot", help="PNG of the cumulative SFD against the requested law "
                    "(default: none)")
     q.add_argument("--force", action="store_true", help="overwrite existing outputs (default: off)")
     q.add_argument("-q", "--quiet", action="store_true",
                    help="no progress bars or messages (default: off)")
-    q.set_defaults(func=_cmd_population)
+    q.set_defaults(func=_cmd_population, flags={
+        "body": "--body", "gravity_m_s2": "--gravity-m-s2", "radius_m": "--radius-m",
+        "density_kg_m3": "--density-kg-m3"})
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    flags = {"body": "--body", "gravity_m_s2": "--gravity-m-s2", "radius_m": "--body-radius-m",
-             "density_kg_m3": "--density-kg-m3", "age_gyr": "--age-gyr",
-             "degradation": "--degradation", "diameter_m": "--diameter-m"}
-    return run_cli(lambda: args.func(args), flags=flags)
+    return run_cli(lambda: args.func(args), flags=args.flags)
 
 
 if __name__ == "__main__":  # pragma: no cover

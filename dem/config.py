@@ -14,7 +14,15 @@ import dataclasses
 import math
 import numbers
 
-from craters import TARGETS, BoulderLayer, CraterLayer, parse_boulder_spec, parse_layer_spec
+from craters import (
+    LAYER_TYPES,
+    TARGETS,
+    BoulderLayer,
+    CraterLayer,
+    ModelAgeLayer,
+    parse_boulder_spec,
+    parse_layer_spec,
+)
 from craters._shared import about, check_choice, check_int, check_positive, check_range
 
 __all__ = ["EnhanceConfig"]
@@ -46,9 +54,11 @@ class EnhanceConfig:
     """Number of layers, 1..24 (layer k has pixels 2^k finer than the base)."""
     size: int = 1025
     """Pixels per side of every layer: 2^n + 1, 5..16385."""
-    craters: tuple[str | CraterLayer, ...] = ()
-    """Crater layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,amin,amax,deg,kind]`` (metres,
-    Gyr) or :class:`craters.CraterLayer` objects."""
+    craters: tuple[str | CraterLayer | ModelAgeLayer, ...] = ()
+    """Crater layers: power laws ``c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr,age_max_gyr,
+    degradation,kind]`` (metres, Gyr; :class:`craters.CraterLayer`) or model ages
+    ``npf=moon,age_gyr=..,d_min_m=..,d_max_m=..[,equilibrium,degradation,kind]``
+    (:class:`craters.ModelAgeLayer`), as specs or records."""
     min_crater_px: float = 2.0
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
     source_crater_px: float | None = 4.0
@@ -82,8 +92,8 @@ class EnhanceConfig:
     gravity_m_s2: float | None = None
     """Surface gravity, m/s^2 (crater transition diameters scale as 1/g); default: the
     body's."""
-    crater_layers: tuple[CraterLayer, ...] = dataclasses.field(init=False, repr=False,
-                                                                compare=False)
+    crater_layers: tuple[CraterLayer | ModelAgeLayer, ...] = dataclasses.field(
+        init=False, repr=False, compare=False)
     """The parsed :attr:`craters` (set when the config is made)."""
     boulder_layers: tuple[BoulderLayer, ...] = dataclasses.field(init=False, repr=False,
                                                                   compare=False)
@@ -116,8 +126,8 @@ class EnhanceConfig:
                                  f"1025, 2049, ...); got {size}")
             put("size", size)
         for name, parse, kind, example in (
-                ("craters", parse_layer_spec, CraterLayer, "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
-                ("boulders", parse_boulder_spec, BoulderLayer,
+                ("craters", parse_layer_spec, LAYER_TYPES, "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
+                ("boulders", parse_boulder_spec, (BoulderLayer,),
                  "c=0.01,k=-3,d_min_m=0.5,d_max_m=5")):
             with about(name):
                 specs = getattr(self, name)
@@ -126,10 +136,10 @@ class EnhanceConfig:
                                     f"'{example}'; got {specs!r}")
                 parsed = []
                 for spec in specs:
-                    if not isinstance(spec, str | kind):
+                    if not isinstance(spec, (str, *kind)):
+                        records = " or ".join(f"craters.{k.__name__}" for k in kind)
                         raise TypeError(f"`{name}` must hold {name[:-1]} layer specs like "
-                                        f"'{example}' or craters.{kind.__name__}; got "
-                                        f"{spec!r}")
+                                        f"'{example}' or {records}; got {spec!r}")
                     parsed.append(spec if isinstance(spec, kind) else parse(spec))
                 put(name, tuple(specs))
                 put(f"{name[:-1]}_layers", tuple(parsed))

@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import re
 
 import numpy as np
 from affine import Affine
@@ -37,8 +38,8 @@ from craters._shared import check_finite, check_positive
 
 from .core import Dem, crs_label
 
-__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "grid_affine", "grid_pixel_size", "local_frame",
-           "pixel_affine", "resolve_frame"]
+__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "grid_affine", "grid_pixel_size",
+           "local_frame", "pixel_affine", "resolve_frame", "world_to_lonlat"]
 
 #: Largest relative difference of the two pixel sides (and cosine of the angle between
 #: them) accepted for stamping craters into a DEM.
@@ -181,3 +182,52 @@ def grid_affine(a: Affine, pixel_m: float) -> Affine:
     """Local metres -> the stamping grid frame (``x = col p``, ``y = row p``) of a DEM
     whose pixel affine is ``a``."""
     return Affine.scale(pixel_m) @ ~a
+
+
+# the PROJ parameters that say which body (sphere or ellipsoid) a CRS lives on
+_BODY_KEYS = ("R", "a", "b", "rf", "f", "ellps", "datum", "pm", "towgs84")
+
+
+def world_to_lonlat(crs, x, y):
+    """Longitude and latitude (degrees) on the body of ``crs`` of world coordinates
+    ``(x, y)`` (CRS units), or None if ``crs`` is None or names no body (then positions
+    on the body are unknown). A geographic CRS gives them directly (in degrees); a
+    projected one is inverted onto the longitude/latitude system of its own sphere or
+    ellipsoid (``rasterio.warp.transform``)."""
+    x = np.asarray(x, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64)
+    if crs is None:
+        return None
+    if crs.is_geographic:
+        deg = math.degrees(crs.units_factor[1])
+        return x * deg, y * deg
+    from rasterio.crs import CRS
+    from rasterio.errors import CRSError
+    from rasterio.warp import transform
+
+    body = {k: v for k, v in crs.to_dict().items() if k in _BODY_KEYS}
+    if not body or not x.size:
+        return (x.copy(), y.copy()) if body else None
+    try:
+        lon, lat = transform(crs, CRS.from_dict({"proj": "longlat", **body}), x, y)
+    except CRSError:
+        return None
+    return np.asarray(lon, dtype=np.float64), np.asarray(lat, dtype=np.float64)
+
+
+def body_axes_m(crs, body_radius_m: float | None = None):
+    """The three semi-axes (metres) of the body of ``crs`` (``body_radius_m`` if given: a
+    sphere), read from its WKT ``SPHEROID``/``ELLIPSOID[name, a, inverse flattening]``
+    (0 = a sphere), or None if unknown."""
+    if body_radius_m is not None:
+        r = check_positive("body_radius_m", body_radius_m)
+        return (r, r, r)
+    if crs is None:
+        return None
+    m = re.search(r'(?:SPHEROID|ELLIPSOID)\["[^"]*",\s*([0-9.eE+-]+),\s*([0-9.eE+-]+)',
+                  crs.to_wkt())
+    if m is None:
+        return None
+    a, rf = float(m.group(1)), float(m.group(2))
+    b = a if rf == 0 else a * (1.0 - 1.0 / rf)
+    return (a, a, b)

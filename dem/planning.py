@@ -12,8 +12,9 @@ same frame shifted by its offset, so no rounding enters.
 
 Craters: one population for the whole area
 ------------------------------------------
-One power-law population (``craters.population``, N_cum = c D^k per m^2) is drawn for
-the area of layer 0 and split: each crater goes into the *finest* layer that contains it
+One population (``craters.population``: power-law layers N_cum = c D^k per m^2, or
+model-age layers from a production function and chronology) is drawn for the area of
+layer 0 and split: each crater goes into the *finest* layer that contains it
 entirely -- its ejecta edge (1.5 D, times 1 + rim irregularity) plus one pixel clear of
 the layer's border pixels -- provided that layer resolves it (D >= ``min_crater_px``
 pixels); otherwise it is rejected and counted. Drawing all of it would be impossible
@@ -165,6 +166,9 @@ class _Drawn:
     and ``layer`` (the index into ``specs``)."""
     reach: Callable
     """``reach(catalog)``: each item's horizontal reach from its centre, metres."""
+    count: Callable
+    """``count(spec, area_m2, d_min_m, d_max_m)``: the expected number of items of a
+    layer spec in a diameter range on an area (its cumulative law)."""
 
 
 def _poisson(rng: np.random.Generator, mean: float, what: str, noun: str) -> int:
@@ -217,7 +221,7 @@ def _plan_banded(specs, geometry: StackGeometry, drawn: _Drawn, *, min_px: float
         return out
 
     def count(area, s, d0, d1):
-        return craters.expected_count(area, s.c, s.k, d0, d1)
+        return drawn.count(s, area, d0, d1)
 
     bands = [truncated(b) for b in range(n)]
     expected = sum(count(geometry.area_m2(b), s, s.d_min_m, s.d_max_m)
@@ -266,7 +270,10 @@ def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: 
 
     Parameters
     ----------
-    specs : sequence of craters.CraterLayer
+    specs : sequence of crater layers
+        ``craters.CraterLayer`` (power law) or ``craters.ModelAgeLayer`` (model age);
+        each band draws the layer truncated to the band (``dataclasses.replace`` of its
+        diameter range) through its own cumulative law.
     geometry : StackGeometry
         Layer placement (:func:`stack_geometry`).
     min_px : float
@@ -288,7 +295,8 @@ def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: 
         return craters.population(layers, x_range_m=x_range_m, y_range_m=y_range_m, rng=rng)
 
     drawn = _Drawn("crater", (STREAM_CRATER_BAND, STREAM_CRATER_OUTSIDE, STREAM_CRATER_SMALL),
-                   draw, lambda cat: reach_radii * cat["diameter_m"] / 2.0)
+                   draw, lambda cat: reach_radii * cat["diameter_m"] / 2.0,
+                   lambda s, area, d0, d1: s.expected_count(area, d0, d1))
     per_layer, accounting = _plan_banded(specs, geometry, drawn, min_px=min_px, seed=seed)
     empty = craters.make_catalog(x_m=[], y_m=[], diameter_m=[], layer=np.zeros(0, np.int64),
                                  index=np.zeros(0, np.int64))
@@ -308,7 +316,8 @@ def plan_boulders(specs, geometry: StackGeometry, *, min_px: float, seed: int):
     drawn = _Drawn("boulder",
                    (STREAM_BOULDER_BAND, STREAM_BOULDER_OUTSIDE, STREAM_BOULDER_SMALL),
                    lambda layers, xr, yr, rng: draw_boulders(layers, xr, yr, rng=rng),
-                   lambda cat: BOULDER_REACH * cat["diameter_m"])
+                   lambda cat: BOULDER_REACH * cat["diameter_m"],
+                   lambda s, area, d0, d1: craters.expected_count(area, s.c, s.k, d0, d1))
     per_layer, accounting = _plan_banded(specs, geometry, drawn, min_px=min_px, seed=seed)
     catalogs = [np.concatenate(parts) if parts else None for parts in per_layer]
     accounting["min_boulder_px"] = min_px

@@ -10,7 +10,8 @@ layer, ``layers[k].heights[::2, ::2] == layers[k-1].heights[footprint]`` exactly
 
 On disk a stack is a folder: ``layer_00.tif ...`` (GeoTIFF, :func:`dem.write`),
 ``craters_00.csv`` / ``craters_00.geojson ...`` (the craters stamped in each layer, local
-frame metres + world coordinates), ``boulders_00.csv`` / ``.geojson`` (the boulders
+frame metres + world coordinates), ``craters_00.scc ...`` (each layer's crater count for
+crater-counting tools, :meth:`Stack.crater_count`), ``boulders_00.csv`` / ``.geojson`` (the boulders
 stamped in each layer, if any) and ``manifest.json`` (format, frame, layers, files,
 bounds, pixel sizes, seeds, parameters, crater counts). The folder is written as a whole
 (:meth:`Stack.write`: a temporary folder renamed into place), so it is complete or absent.
@@ -27,11 +28,18 @@ from pathlib import Path
 
 import numpy as np
 
-from craters import make_catalog, read_catalog, validate_catalog, write_catalog, write_geojson
+from craters import (
+    make_catalog,
+    read_catalog,
+    validate_catalog,
+    write_catalog,
+    write_geojson,
+    write_scc,
+)
 from craters._shared import about, check_int, check_parent_folder, package_version, progress_bar
 
 from .core import Dem, crs_label
-from .frame import LocalFrame, grid_pixel_size, pixel_affine
+from .frame import LocalFrame, body_axes_m, grid_pixel_size, pixel_affine, world_to_lonlat
 from .io import read, write
 
 __all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "propagate_up", "read_stack",
@@ -48,6 +56,10 @@ def _layer_file(k: int) -> str:
 
 def _catalog_files(k: int) -> tuple[str, str]:
     return f"craters_{k:02d}.csv", f"craters_{k:02d}.geojson"
+
+
+def _count_file(k: int) -> str:
+    return f"craters_{k:02d}.scc"
 
 
 def _boulder_files(k: int) -> tuple[str, str]:
@@ -244,7 +256,8 @@ class Stack:
             if cat is not None:
                 csv_name, geojson_name = _catalog_files(k)
                 entry["craters"] = {"csv": csv_name, "geojson": geojson_name,
-                                    "stamped": int(len(cat))}
+                                    "stamped": int(len(cat)), "scc": _count_file(k),
+                                    "counted": int(len(self.crater_count(k)[0]))}
             rocks = self._boulders[k]
             if rocks is not None:
                 csv_name, geojson_name = _boulder_files(k)
@@ -276,6 +289,47 @@ class Stack:
         wx, wy = self._frame.to_world(cat["x_m"], cat["y_m"])
         cols = {n: cat[n] for n in cat.dtype.names if n not in ("world_x", "world_y")}
         return make_catalog(**cols, world_x=wx, world_y=wy)
+
+
+    def crater_count(self, k: int, *, min_crater_px: float | None = None):
+        """What a crater counter sees in layer ``k``: (catalog, area in m^2).
+
+        Every stamped crater of the stack (the catalogs of all layers: a crater sits in
+        the finest layer that holds it, and is in every coarser layer's heights too)
+        whose centre lies in layer ``k`` and whose diameter spans at least
+        ``min_crater_px`` of its pixels (default: the stack's own, else 2), over the
+        layer's area: complete in that diameter range up to craters that reached past
+        the stack or were erased on steep ground. The catalog has ``x_m, y_m`` (local
+        frame), ``diameter_m, age_gyr, degradation, kind``, the ``layer`` it was stamped
+        in, ``world_x, world_y`` and, where the CRS names a body, ``lat_deg, lon_deg``.
+        """
+        k = check_int("k", k, 0, len(self) - 1)
+        if min_crater_px is None:
+            min_crater_px = float((self._info.get("craters") or {}).get("min_crater_px", 2.0))
+        d = self._layers[k]
+        b = d.bounds
+        xs, ys = self._frame.to_local([b.left, b.right], [b.bottom, b.top])
+        x0, x1 = sorted(xs.tolist())
+        y0, y1 = sorted(ys.tolist())
+        d_min = min_crater_px * self.pixel_sizes_m()[k]
+        parts = []
+        for j, cat in enumerate(self._catalogs):
+            if cat is None:
+                continue
+            inside = ((cat["x_m"] >= x0) & (cat["x_m"] <= x1) & (cat["y_m"] >= y0)
+                      & (cat["y_m"] <= y1) & (cat["diameter_m"] >= d_min))
+            cols = {n: cat[n][inside] for n in ("x_m", "y_m", "diameter_m", "age_gyr",
+                                                "degradation", "kind")}
+            parts.append(make_catalog(**cols, layer=np.full(int(inside.sum()), j)))
+        cat = (np.concatenate(parts) if parts else
+               make_catalog(x_m=[], y_m=[], diameter_m=[], layer=np.zeros(0, np.int64)))
+        wx, wy = self._frame.to_world(cat["x_m"], cat["y_m"])
+        extra = {"world_x": wx, "world_y": wy}
+        lonlat = world_to_lonlat(d.crs, wx, wy)
+        if lonlat is not None:
+            extra.update(lat_deg=lonlat[1], lon_deg=lonlat[0])
+        cols = {n: cat[n] for n in cat.dtype.names}
+        return make_catalog(**cols, **extra), (x1 - x0) * (y1 - y0)
 
 
 def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
@@ -330,6 +384,24 @@ def _write_catalog(stack: Stack, k: int, folder: Path, *, boulders: bool = False
     crs = stack.layers[0].crs
     write_geojson(cat, folder / geojson_name, to_world=stack.frame.to_world,
                   crs=None if crs is None else crs_label(crs))
+    if not boulders:
+        _write_count(stack, k, folder)
+
+
+def _write_count(stack: Stack, k: int, folder: Path) -> None:
+    """Layer ``k``'s crater count as a craterstats ``.scc`` (:meth:`Stack.crater_count`)."""
+    count, area = stack.crater_count(k)
+    d = stack.layers[k]
+    b = d.bounds
+    corners = world_to_lonlat(d.crs, [b.left, b.right, b.right, b.left],
+                              [b.bottom, b.bottom, b.top, b.top])
+    crs = d.crs
+    write_scc(count, folder / _count_file(k), area_m2=area,
+              axes_m=body_axes_m(crs, d.body_radius_m),
+              coordinate_system=None if crs is None else crs_label(crs),
+              boundary_lonlat_deg=None if corners is None else np.column_stack(corners),
+              note=f"dem enhance layer {k}: the stack's craters centred in this layer and "
+                   f"resolved by it (dem.Stack.crater_count)")
 
 
 @contextlib.contextmanager

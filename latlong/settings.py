@@ -192,12 +192,15 @@ def _center(value):
 
 
 # --------------------------------------------------------------------------- layers
-def _layers(value, kind, parse, name: str) -> tuple:
-    """A tuple of ``kind`` records from records, spec strings or TOML tables."""
-    items = [value] if isinstance(value, str | dict | kind) else list(value)
+def _layers(value, kind, parse, name: str, *, table=None) -> tuple:
+    """A tuple of layer records (``kind``: a record type or a tuple of them) from
+    records, spec strings (``parse``) or TOML tables (``table(dict)``, default the
+    record ``kind(**table)`` with unknown keys refused)."""
+    kinds = kind if isinstance(kind, tuple) else (kind,)
+    items = [value] if isinstance(value, (str, dict, *kinds)) else list(value)
     out = []
     for item in items:
-        if isinstance(item, kind):
+        if isinstance(item, kinds):
             out.append(item)
         elif isinstance(item, str):
             try:
@@ -205,17 +208,19 @@ def _layers(value, kind, parse, name: str) -> tuple:
             except ValueError as exc:
                 raise ParameterError(name, f": {exc}") from None
         elif isinstance(item, dict):
-            allowed = {f.name for f in dataclasses.fields(kind)}
-            unknown = set(item) - allowed
-            if unknown:
-                raise ParameterError(name, f": unknown key(s) {', '.join(sorted(unknown))}; "
-                                     f"allowed: {', '.join(sorted(allowed))}")
+            if table is None:
+                allowed = {f.name for f in dataclasses.fields(kinds[0])}
+                unknown = set(item) - allowed
+                if unknown:
+                    raise ParameterError(name, f": unknown key(s) {', '.join(sorted(unknown))}; "
+                                         f"allowed: {', '.join(sorted(allowed))}")
             try:
-                out.append(kind(**item))
+                out.append(kinds[0](**item) if table is None else table(item))
             except (TypeError, ValueError) as exc:
                 raise ParameterError(name, f": {exc}") from None
         else:
-            raise ParameterTypeError(name, f"must be {kind.__name__}s, spec strings or "
+            names = " or ".join(k.__name__ for k in kinds)
+            raise ParameterTypeError(name, f"must be {names}s, spec strings or "
                                      f"tables; got {item!r}")
     return tuple(out)
 
@@ -225,16 +230,18 @@ class CraterSettings:
     """Crater layers on the body and how they are stamped (:func:`latlong.stamp_craters`;
     their shapes and degradation follow the body's target, :class:`BodySettings`)."""
 
-    layers: tuple[_craters.CraterLayer, ...] = ()
-    """Power-law layers (:class:`craters.CraterLayer`, spec strings or tables)."""
+    layers: tuple[_craters.CraterLayer | _craters.ModelAgeLayer, ...] = ()
+    """Crater layers: power laws (:class:`craters.CraterLayer`) or model ages
+    (:class:`craters.ModelAgeLayer`), as records, spec strings or tables."""
     roughness: bool = True
     """Fractal overlay and irregular rims (False: ideal craters)."""
     max_extent_deg: float = 60.0
     """Largest angular size of a crater's ejecta blanket, degrees of arc, (0, 180]."""
 
     def __post_init__(self):
-        _set(self, "layers", _layers(self.layers, _craters.CraterLayer,
-                                     _craters.parse_layer_spec, "layers"))
+        _set(self, "layers", _layers(self.layers, _craters.LAYER_TYPES,
+                                     _craters.parse_layer_spec, "layers",
+                                     table=_craters.as_crater_layer))
         if not isinstance(self.roughness, bool):
             raise ParameterTypeError("roughness", f"must be true or false; got "
                                      f"{self.roughness!r}")

@@ -83,6 +83,15 @@ STEPS: list[tuple[str, str, bool]] = [
      False),
     ("craters_population", ("craters population --craters c=0.5,k=-2,d_min_m=50,d_max_m=800 "
      "--radius-m 2000 --seed 1 -o pop.csv -q"), False),
+    ("craters_population_model_age", ("craters population --craters npf=moon,age_gyr=3.8,"
+     "d_min_m=100,d_max_m=20000,equilibrium=trask --area-m2 1e9 --seed 1 -o popm.scc -q"),
+     False),
+    ("craters_population_robbins", ("craters population --craters npf=mars,age_gyr=3.5,"
+     "d_min_m=1000,d_max_m=20000 --area-m2 1e10 --seed 1 -o popr.csv --columns robbins -q"),
+     False),
+    ("build_model_age_scc", ("latlong build --magnitude 24 --base sphere --radius-m 20000 "
+     "--craters npf=moon,age_gyr=3.8,d_min_m=300,d_max_m=3000 --seed 2 --catalog bn.scc -q"),
+     False),
     ("dem_info", "dem info ldem4_crop.lbl", True),
     ("dem_fill", "dem fill gappy.tif -o filled.tif --seed 1 -q", False),
     ("dem_expand", ("dem expand filled.tif -o fine.tif --levels 2 --seed 1 "

@@ -151,9 +151,13 @@ OPTIONS: tuple[Opt, ...] = (
     Opt(("--size",), "size", _integer, _E["size"], "pixels per side of every layer, 2^n + 1",
         (_ENHANCE,), metavar="W"),
     Opt(("--craters",), "craters", str, _E["craters"],
-        "crater layer c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr=..,age_max_gyr=..,"
-        "degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = c D^k per "
-        "m^2, D in metres, ages in Gyr); repeat for several", (_ENHANCE,),
+        "crater layer: a power law c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr=..,"
+        "age_max_gyr=..,degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = "
+        "c D^k per m^2, D in metres, ages in Gyr) or a model age npf=moon,age_gyr=..,"
+        "d_min_m=..,d_max_m=..[,equilibrium=trask|hartmann,degradation=..,kind=..] "
+        "(craters.ModelAgeLayer: the body's production function and chronology); repeat "
+        "for several. Each layer's crater count is also written as craters_NN.scc "
+        "(craterstats)", (_ENHANCE,),
         "none", kind="append", metavar="SPEC"),
     Opt(("--source-crater-px",), "source_crater_px", _number, _E["source_crater_px"],
         "synthetic craters stay below this many source (layer-0) pixels: the source's own "

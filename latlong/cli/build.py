@@ -15,6 +15,7 @@ from craters._shared import check_output_path, human_bytes, progress_bar
 from craters._shared.cli import CliError
 from latlong import EXPORT_SUFFIXES, Scene, build, render_preview
 from latlong.implicit import MESH_SUFFIXES
+from latlong.surface import band_areas
 
 from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, shown
 
@@ -55,9 +56,26 @@ def _check_outputs(scene: Scene, run: dict) -> list[str]:
     force = bool(run.get("force"))
     for x in outputs:
         check_output_path(x, force=force, suffixes=_SUFFIXES[scene.backend])
+    suffixes = {"preview": (".png",), "catalog": (".csv", ".scc")}
     for k, x in extras.items():
-        check_output_path(x, force=force, suffixes=(".png",) if k == "preview" else (".csv",))
+        check_output_path(x, force=force, suffixes=suffixes.get(k, (".csv",)))
+    columns = run.get("catalog_columns", "craterform")
+    if columns not in craters.CATALOG_COLUMNS:
+        raise CliError(f"--catalog-columns must be one of {', '.join(craters.CATALOG_COLUMNS)}; "
+                       f"got {columns!r}")
+    if columns != "craterform" and not str(extras.get("catalog", "")).lower().endswith(".csv"):
+        raise CliError("--catalog-columns applies to a CSV --catalog")
     return [*outputs, *extras.values()]
+
+
+def _write_craters(catalog, run: dict, *, area_m2: float, axes_m) -> None:
+    """The crater catalog as CSV (in the chosen column names) or craterstats .scc."""
+    path = run["catalog"]
+    if str(path).lower().endswith(".scc"):
+        craters.write_scc(catalog, path, area_m2=area_m2, axes_m=axes_m,
+                          note="latlong build: the craters as stamped on the whole body")
+    else:
+        craters.write_catalog(catalog, path, columns=run.get("catalog_columns", "craterform"))
 
 
 def _write_body(body, run: dict, progress: bool, done) -> None:
@@ -68,7 +86,8 @@ def _write_body(body, run: dict, progress: bool, done) -> None:
             body.export(out, progress=progress)
         done()
     if run.get("catalog"):
-        craters.write_catalog(body.craters, run["catalog"])
+        area = float(band_areas(body).sum()) if run["catalog"].lower().endswith(".scc") else 0.0
+        _write_craters(body.craters, run, area_m2=area, axes_m=body.radius_m * body.stretch)
         done()
     if run.get("boulder_catalog"):
         craters.write_catalog(body.boulders, run["boulder_catalog"])
@@ -87,7 +106,7 @@ def _write_implicit(surf, scene: Scene, run: dict, done) -> None:
         (body.save if out.lower().endswith(".npz") else surf.save)(out)
         done()
     if run.get("catalog"):
-        craters.write_catalog(surf.catalog, run["catalog"])
+        _write_craters(surf.catalog, run, area_m2=surf.area_m2, axes_m=None)
         done()
 
 

@@ -124,10 +124,12 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "shape base)", "fbm"),
     # craters
     Opt(("--craters",), "craters", str,
-        "crater layer c=0.5,k=-2,d_min_m=2,d_max_m=50[,age_min_gyr=0,age_max_gyr=3.5,"
-        "degradation=0.2,kind=simple] (the fields of craters.CraterLayer): N_cum = c D^k "
-        "per m^2, D in metres, ages in Gyr (repeatable for piecewise laws)", "craters",
-        "append"),
+        "crater layer: a power law c=0.5,k=-2,d_min_m=2,d_max_m=50[,age_min_gyr=0,"
+        "age_max_gyr=3.5,degradation=0.2,kind=mare] (the fields of craters.CraterLayer): "
+        "N_cum = c D^k per m^2, D in metres, ages in Gyr; or a model age npf=moon,age_gyr="
+        "3.8,d_min_m=100,d_max_m=5000[,equilibrium=trask|hartmann,degradation,kind] "
+        "(craters.ModelAgeLayer: the body's production function and chronology, npf one "
+        "of craters.CHRONOLOGY_SYSTEMS) (repeatable)", "craters", "append"),
     Opt(("--no-crater-roughness",), "crater_roughness", bool,
         "ideal craters: no fractal overlay, circular rims", "craters", "store_false"),
     Opt(("--max-crater-extent-deg",), "max_crater_extent_deg", float,
@@ -184,7 +186,12 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "`latlong export` adds levels of detail)",
         "output", "append"),
     Opt(("--catalog",), "catalog", str,
-        "write the ground-truth crater catalog as stamped (CSV)", "output"),
+        "write the ground-truth crater catalog as stamped: .csv, or .scc (craterstats "
+        "spatial crater count: the body's area in km^2, diameters in km, lon/lat)", "output"),
+    Opt(("--catalog-columns",), "catalog_columns", str,
+        "column names of a CSV --catalog: craterform (units in the names) or robbins "
+        "(LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG in km, as the Robbins 2019 lunar "
+        "crater database)", "output"),
     Opt(("--boulder-catalog",), "boulder_catalog", str,
         "write the boulder catalog as placed (CSV)", "output"),
     Opt(("--preview",), "preview", str, "write a preview picture (PNG)", "output"),
@@ -194,7 +201,8 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--force",), "force", bool, "overwrite existing outputs", "output", "store_true"),
 )
 #: Run options of ``latlong build``: what to write and how, not what to make.
-OUTPUT_KEYS = ("output", "catalog", "boulder_catalog", "preview", "quiet", "force")
+OUTPUT_KEYS = ("output", "catalog", "boulder_catalog", "preview", "quiet", "force",
+               "catalog_columns")
 _BY_KEY = {o.key: o for o in BUILD_OPTIONS}
 
 
@@ -210,7 +218,8 @@ def _default_text(opt: Opt) -> str:
     if opt.action == "store_false":
         return "on"
     if opt.key in OUTPUT_KEYS or opt.key in ("seed", "preset", "base"):
-        return {"base": "fbm (preset fig5a)"}.get(opt.key, "none")
+        return {"base": "fbm (preset fig5a)", "catalog_columns": "craterform"}.get(opt.key,
+                                                                                  "none")
     value = SETTING_DEFAULTS.get(opt.key)
     if value is None:
         return "the preset's / base's" if opt.group in ("faulting", "fbm", "body") else "none"
@@ -263,7 +272,7 @@ def read_config(path) -> dict:
                 raise CliError(f"{where}: key 'output' must be a file name or a list of "
                                f"them; got {value!r}")
             raw[key] = value
-        elif key in OUTPUT_KEYS[1:4] and not isinstance(value, str):
+        elif key in (*OUTPUT_KEYS[1:4], "catalog_columns") and not isinstance(value, str):
             raise CliError(f"{where}: key {key!r} must be a file name; got {value!r}")
     return raw
 

@@ -319,7 +319,7 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
                        "-q", env={"NUMBA_NUM_THREADS": threads})
         assert proc.returncode == 0 and proc.stdout == "", proc.stderr
         trees[threads] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
-    assert len(trees["1"]) == 3 + 2 * 3 + 1 and trees["1"] == trees["2"]
+    assert len(trees["1"]) == 3 + 3 * 3 + 1 and trees["1"] == trees["2"]  # tif, csv geojson scc
     other = tmp_path / "other"
     assert InProcess(capsys)("dem", "enhance", "--config", str(scene), "-o", str(other),
                              "--seed", "5", "-q").returncode == 0

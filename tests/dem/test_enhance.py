@@ -95,7 +95,7 @@ def test_each_crater_is_in_the_finest_layer_containing_and_resolving_it(stack):
         assert (cat["diameter_m"] >= 2 * sizes[k] * (1 - 1e-12)).all()
         if k + 1 < len(stack):
             assert not contained(cat, k + 1).any()  # a finer layer would have taken it
-        assert set(cat["kind"]) <= {"simple", "old"}
+        assert set(cat["kind"]) <= {"crater", "old"}
         assert (np.diff(cat["age_gyr"]) <= 0).all()  # stamped oldest first
 
 
@@ -137,16 +137,18 @@ def test_catalog_positions_are_where_the_craters_are():
     assert len({k for k, _ in checked}) >= 2 and any(j < k for k, j in checked), checked
 
 
-def test_band_split_has_the_law_of_one_catalog_split_afterwards():
+@pytest.mark.parametrize(("text", "runs"), [("c=0.2,k=-2,d_min_m=5,d_max_m=300", 300),
+                                           ("npf=moon,age_gyr=3.8,d_min_m=10,d_max_m=300", 120)])
+def test_band_split_has_the_law_of_one_catalog_split_afterwards(text, runs):
     """Per-layer counts and mean diameters of the banded draw equal those of one catalog
-    for layer 0's area, split crater by crater (independent reimplementation)."""
+    for layer 0's area, split crater by crater (independent reimplementation); for a
+    power law and a model-age layer (each band drawn through the layer's own law)."""
     size, n_layers, p0, min_px = 33, 3, 10.0, 2.0
     _, windows, _, _ = layer_windows(dem.Dem(np.zeros((size, size)), pixel_size_m=p0), None,
                                      size, n_layers)
     geom = stack_geometry(size, windows, p0)
-    spec = craters.parse_layer_spec("c=0.2,k=-2,d_min_m=5,d_max_m=300")
+    spec = craters.parse_layer_spec(text)
     half = (size - 1) / 2
-    runs = 300
     banded = np.zeros((runs, n_layers))
     direct = np.zeros((runs, n_layers))
     d_banded = [[] for _ in range(n_layers)]
@@ -237,6 +239,54 @@ def test_write_read_roundtrip_and_files(tmp_path, stack):
     with pytest.raises(ValueError, match="not a stack folder"):
         stack.write(other, force=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["photos", "st"]
+
+
+def test_crater_counts_per_layer(tmp_path, stack):
+    """Each layer's crater count (and its .scc): every stamped crater of the stack centred
+    in the layer and at least 2 of its pixels wide, over the layer's area."""
+    every = np.concatenate([c for c in stack.catalogs])
+    out = tmp_path / "st"
+    doc = json.loads(stack.write(out).read_text())
+    for k, d in enumerate(stack.layers):
+        count, area = stack.crater_count(k)
+        p = stack.pixel_sizes_m()[k]
+        assert area == pytest.approx((65 * p) ** 2)
+        b = d.bounds
+        wx, wy = stack.frame.to_world(every["x_m"], every["y_m"])
+        inside = ((wx >= b.left) & (wx <= b.right) & (wy >= b.bottom) & (wy <= b.top)
+                  & (every["diameter_m"] >= 2 * p))
+        assert len(count) == int(inside.sum())
+        assert np.array_equal(np.sort(count["diameter_m"]), np.sort(every["diameter_m"][inside]))
+        # EPSG:32633 (UTM 33 N, WGS84): positions on the Earth's ellipsoid
+        assert (np.abs(count["lon_deg"] - 13.96) < 0.1).all()
+        assert (np.abs(count["lat_deg"] - 27.1) < 0.1).all()
+        entry = doc["layers"][k]["craters"]
+        got = craters.read_scc(out / entry["scc"])
+        assert entry["counted"] == len(count) == len(got["diameter_m"])
+        assert got["area_m2"] == pytest.approx(area, rel=1e-12)
+        np.testing.assert_allclose(got["diameter_m"], count["diameter_m"], rtol=1e-15)
+        assert got["axes_m"] == pytest.approx((6378137.0, 6378137.0, 6356752.314), rel=1e-9)
+    assert len(stack.crater_count(5)[0]) > len(stack.catalogs[5])   # coarser craters too
+    with pytest.raises(ValueError, match="`k`"):
+        stack.crater_count(6)
+
+
+def test_model_age_craters_in_a_stack(lola_crop, tmp_path):
+    """npf layers (with equilibrium) through the whole enhance: accounting and the .scc on
+    the Moon (geographic CRS: lon/lat are the world coordinates, axes the body radius)."""
+    specs = ["npf=moon,age_gyr=3.8,d_min_m=500,d_max_m=200000,equilibrium=trask"]
+    s = dem.enhance({"layers": 4, "size": 65, "seed": 3, "craters": specs}, dem=lola_crop)
+    c = s.info["craters"]
+    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    assert sum(c["stamped"]) > 5
+    s.write(tmp_path / "st")
+    got = craters.read_scc(tmp_path / "st" / "craters_01.scc")
+    count, area = s.crater_count(1)
+    wx, wy = s.frame.to_world(count["x_m"], count["y_m"])
+    lon = np.where(wx > 180, wx - 360, wx)
+    np.testing.assert_allclose(got["lon_deg"], lon)
+    np.testing.assert_allclose(got["lat_deg"], wy)
+    assert got["axes_m"] == (1737400.0,) * 3
 
 
 def test_geographic_base_from_lola(lola_crop):

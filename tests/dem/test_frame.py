@@ -77,3 +77,29 @@ def test_frame_dict_roundtrip_and_validation():
         LocalFrame(0.0, 0.0, 1.0, 1.0, "polar")
     with pytest.raises(ValueError, match="bad local frame"):
         LocalFrame.from_dict({"origin_world": [0, 0]})
+
+
+def test_world_to_lonlat_and_body_axes():
+    """Positions on the body for .scc catalogs: geographic CRSs directly, projected ones
+    inverted on their own sphere or ellipsoid; axes from the CRS's SPHEROID."""
+    from rasterio.crs import CRS
+
+    from dem.frame import body_axes_m, world_to_lonlat
+
+    polar = CRS.from_proj4("+proj=stere +lat_0=-90 +lon_0=0 +k=1 +x_0=0 +y_0=0 +R=1737400 "
+                           "+units=m +no_defs")
+    lon, lat = world_to_lonlat(polar, [0.0, 0.0], [0.0, 10000.0])
+    assert lat[0] == pytest.approx(-90.0)
+    # polar stereographic: a point 10 km from the pole lies 2 R atan(r / 2R) of arc away
+    arc = 2 * 1737400.0 * np.arctan(10000.0 / (2 * 1737400.0))
+    assert lat[1] == pytest.approx(-90.0 + np.degrees(arc / 1737400.0), abs=1e-9)
+    assert body_axes_m(polar) == pytest.approx((1737400.0,) * 3)
+    utm = CRS.from_epsg(32633)
+    lon, lat = world_to_lonlat(utm, [500000.0], [0.0])
+    assert lon[0] == pytest.approx(15.0) and lat[0] == pytest.approx(0.0, abs=1e-9)
+    assert body_axes_m(utm) == pytest.approx((6378137.0, 6378137.0, 6356752.314245), rel=1e-12)
+    geo = CRS.from_wkt('GEOGCS["Moon",DATUM["D_Moon",SPHEROID["Moon",1737400,0]],'
+                       'PRIMEM["Reference_Meridian",0],UNIT["degree",0.0174532925199433]]')
+    assert world_to_lonlat(geo, [181.0], [2.0]) == ([181.0], [2.0])
+    assert world_to_lonlat(None, [1.0], [2.0]) is None and body_axes_m(None) is None
+    assert body_axes_m(utm, 1000.0) == (1000.0,) * 3

@@ -226,7 +226,46 @@ def test_crater_layers_from_options_and_config(run_cli, tmp_path):
                                   str(tmp_path / "x.npz")), "shape")
 
 
+def test_model_age_craters_scc_and_robbins(run_cli, tmp_path):
+    """npf layers from an option and a [[craters]] table; the catalog as .scc (the body's
+    area, its axes) and with Robbins column names."""
+    import craters
+
+    scc, csv, out = tmp_path / "c.scc", tmp_path / "c.csv", tmp_path / "c.npz"
+    base = ["--magnitude", "40", "--base", "sphere", "--radius-m", "20000", "--seed", "4",
+            "--stretch", "1.2,1,1"]
+    spec = "npf=moon,age_gyr=3.8,d_min_m=300,d_max_m=3000,equilibrium=hartmann"
+    proc = run_cli("latlong", "build", *base, "--craters", spec, "--catalog", str(scc),
+                   "-o", str(out), "-q")
+    assert proc.returncode == 0, proc.stderr
+    body = load(out)
+    got = craters.read_scc(scc)
+    assert len(got["diameter_m"]) == len(body.craters) > 50
+    np.testing.assert_allclose(got["diameter_m"], body.craters["diameter_m"])
+    assert got["axes_m"] == pytest.approx((24000.0, 20000.0, 20000.0))
+    from latlong.surface import band_areas
+    assert got["area_m2"] == pytest.approx(float(band_areas(body).sum()), rel=1e-12)
+    cfg = tmp_path / "scene.toml"
+    cfg.write_text('magnitude = 40\nbase = "sphere"\nradius_m = 20000\nseed = 4\n'
+                   'stretch = [1.2, 1, 1]\ncatalog_columns = "robbins"\n'
+                   f'catalog = "{csv}"\nquiet = true\n'
+                   '[[craters]]\nnpf = "moon"\nage_gyr = 3.8\nd_min_m = 300\n'
+                   'd_max_m = 3000\nequilibrium = "hartmann"\n')
+    proc = run_cli("latlong", "build", "--config", str(cfg))
+    assert proc.returncode == 0, proc.stderr
+    assert csv.read_text().startswith("CRATER_ID,LAT_CIRC_IMG,LON_CIRC_IMG,DIAM_CIRC_IMG,")
+    np.testing.assert_allclose(craters.read_catalog(csv)["diameter_m"],
+                               body.craters["diameter_m"])
+
+
 @pytest.mark.parametrize("args,needles", [
+    (["--craters", "npf=moon,c=1,age_gyr=3,d_min_m=10,d_max_m=20"],
+     ["--craters", "`c` does not go with npf"]),
+    (["--craters", "npf=moon,age_gyr=9,d_min_m=10,d_max_m=20"], ["--craters", "(0, 4.5]"]),
+    (["--craters", "c=1,k=-2,d_min_m=1,d_max_m=5", "--catalog", "c.scc",
+      "--catalog-columns", "robbins"], ["--catalog-columns", "CSV"]),
+    (["--craters", "c=1,k=-2,d_min_m=1,d_max_m=5", "--catalog", "c.csv",
+      "--catalog-columns", "nasa"], ["--catalog-columns", "craterform, robbins"]),
     (["--radius-m", "100", "--craters", "c=0.1,k=-2,d_min_m=5,d_max_m=150"],
      ["--craters", "larger than the body"]),
     (["--craters", "c=0,k=-2,d_min_m=1,d_max_m=5"], ["--craters", "`c`"]),
