@@ -134,6 +134,14 @@ def _resample(xe: float) -> np.ndarray:
     return w * _taper(x, xe)[:, None]
 
 
+@functools.lru_cache(maxsize=4)
+def _to_table(xe: float) -> np.ndarray:
+    """(N_NODES, N_TABLE): a spectrum (transform's own vector) to the table's heights:
+    the inverse transform, the node scaling and the resampling in one matrix."""
+    r, k, t, scale = _qdht(N_NODES, DOMAIN)
+    return np.ascontiguousarray((t.T / scale[None, :]) @ _resample(xe).T)
+
+
 def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe: float):
     """Tables (len(d), len(tau), N_TABLE) of diffused profiles divided by each node's
     fresh depth (float32: shapes, interpolated between nodes)."""
@@ -142,8 +150,9 @@ def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe:
     fresh /= fresh_morphometry(d_nodes, target)["depth_m"][:, None]
     spec = (fresh * scale) @ t.T                                          # (nd, N)
     decay = np.exp(-np.outer(tau_nodes, k**2))                            # (nt, N)
-    evolved = ((spec[:, None, :] * decay[None]) @ t.T) / scale            # (nd, nt, N)
-    return (evolved @ _resample(xe).T).astype(np.float32)
+    nd, nt = len(d_nodes), len(tau_nodes)
+    evolved = (spec[:, None, :] * decay[None]).reshape(nd * nt, -1) @ _to_table(xe)
+    return evolved.reshape(nd, nt, -1).astype(np.float32)
 
 
 class _Cache:

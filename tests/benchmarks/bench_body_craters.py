@@ -1,10 +1,12 @@
 """Benchmark: stamping 50 000 craters on a magnitude-1000 body (plain script).
 
-R = 10 km body (6 M vertices), N_cum ~ D^-2 between 20 m and 2 km, roughness on.
-Reports craters/s, the share of time per stage (population, setup, gather + local
+R = 10 km body (6 M vertices), N_cum ~ D^-2 between 20 m and 2 km, roughness on, each
+crater diffused for its age on a small body of that size (craters.small_body).
+Reports craters/s, the share of time per stage (population, profile tables, gather + local
 coordinates, local grid + plane fit, crater evaluation + write-back) and, in the same
 run, craters/s of a naive stamp that scans every vertex per crater.
-Usage: ``python tests/benchmarks/bench_body_craters.py [--quick]``.
+Usage: ``python tests/benchmarks/bench_body_craters.py [--quick]`` (quick: M = 300, R = 3
+km, D 20-600 m).
 """
 
 from __future__ import annotations
@@ -20,22 +22,22 @@ from latlong._crater_kernels import _stamp_body_kernel
 from latlong.cratering import stamp_craters
 
 
-def run_kernel(body, cat, rng, **switches):
+def run_kernel(body, cat, prof, rng, **switches):
+    """Call the kernel directly (same arguments as stamp_craters) with benchmark switches;
+    ``prof`` = :func:`craters.stamping_profiles` of ``cat``."""
     unit = body.grid.unit_vectors() if switches.get("naive") else np.empty((0, 3))
-    """Call the kernel directly (same arguments as stamp_craters) with benchmark switches."""
     n = len(cat)
     rim = craters.rim_perturbations(n, 0.02, rng=rng)
     seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
     radii = np.array(body.radii_m)
-    outs = [np.zeros(n) for _ in range(4)] + [np.zeros((n, 3))] + [np.zeros(n) for _ in range(3)]
-    outs.append(np.zeros(n, dtype=np.bool_))
+    outs = [np.zeros(n), np.zeros(n), np.zeros((n, 3)), np.zeros(n), np.zeros(n), np.zeros(n),
+            np.zeros(n, dtype=np.bool_)]
     g = body.grid
     t0 = time.perf_counter()
     _stamp_body_kernel(g.magnitude, g.ring_offsets(), unit, radii,
                        np.asarray(body.stretch), cat["lat_deg"].copy(), cat["lon_deg"].copy(),
-                       cat["diameter_m"].copy(), cat["degradation"].copy(), rim, seeds,
-                       np.array([0.196, 1.010, 0.036, 1.014]), np.array([3.0, 1.5, 0.25]), 3.0,
-                       True, 20.0, 45.0, np.array([0.03, 0.06, 0.05]), 2.0**-0.8, *outs,
+                       cat["diameter_m"].copy(), prof.tables[:n], prof.depth_m[:n], rim, seeds,
+                       3.0, True, 20.0, 45.0, np.array([0.03, 0.06, 0.05]), 2.0**-0.8, *outs,
                        **switches)
     return time.perf_counter() - t0
 
@@ -44,41 +46,48 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
     args = parser.parse_args()
-    m, radius, n_target = (300, 3000.0, 5000) if args.quick else (1000, 10_000.0, 50_000)
+    m, radius, n_target, d_max = ((300, 3000.0, 5000, 600.0) if args.quick
+                                  else (1000, 10_000.0, 50_000, 2000.0))
     grid = LatLongGrid(m)
     t0 = time.perf_counter()
     grid.unit_vectors()
     body = Body.sphere(grid, radius)
     t_setup = time.perf_counter() - t0
     area = 4 * np.pi * radius**2
-    c = n_target / (area * (20.0**-2 - 2000.0**-2))
+    c = n_target / (area * (20.0**-2 - d_max**-2))
     t0 = time.perf_counter()
-    cat = craters.power_law_population(radius=radius, c=c, k=-2.0, d_min=20.0, d_max=2000.0,
+    cat = craters.power_law_population(radius=radius, c=c, k=-2.0, d_min=20.0, d_max=d_max,
                                        rng=1)
     t_pop = time.perf_counter() - t0
-    stamp_craters(Body.sphere(LatLongGrid(8), radius), cat[:2])  # compile
+    target = craters.small_body(radius)
+    stamp_craters(Body.sphere(LatLongGrid(8), radius), cat[:2], target=target)  # compile
     t0 = time.perf_counter()
-    out = stamp_craters(body, cat, rng=2)
+    out = stamp_craters(body, cat, rng=2, target=target)
     t_total = time.perf_counter() - t0
     print(f"M={m} ({grid.n_vertices:,} vertices), R={radius:g} m, {len(cat)} craters "
-          f"(D 20-2000 m, N_cum ~ D^-2), roughness on: {t_total:.1f} s = "
+          f"(D 20-{d_max:g} m, N_cum ~ D^-2), roughness on: {t_total:.1f} s = "
           f"{len(cat) / t_total:.0f} craters/s; {out.craters['n_vertices'].sum():.3g} "
           "vertex updates")
     rng = np.random.default_rng(3)
     small = Body.sphere(LatLongGrid(8), radius)
+    t0 = time.perf_counter()
+    prof = craters.stamping_profiles(cat, target)
+    t_prof = time.perf_counter() - t0
     for sw in ({"stop_after": 1}, {"stop_after": 2}, {}, {"naive": True}):
-        run_kernel(small, cat[:2], rng, **sw)  # compile each variant
-    t1 = run_kernel(body, cat, rng, stop_after=1)
-    t2 = run_kernel(body, cat, rng, stop_after=2)
-    t3 = run_kernel(body, cat, rng)
-    total = t_pop + t3
+        run_kernel(small, cat[:2], prof, rng, **sw)  # compile each variant
+    t1 = run_kernel(body, cat, prof, rng, stop_after=1)
+    t2 = run_kernel(body, cat, prof, rng, stop_after=2)
+    t3 = run_kernel(body, cat, prof, rng)
+    total = t_pop + t_prof + t3
     print(f"(grid unit vectors, once per body: {t_setup:.2f} s) share of the cratering time: "
-          f"population {t_pop / total:.1%}, gather + local coordinates {t1 / total:.1%}, "
+          f"population {t_pop / total:.1%}, profile tables (morphology + diffusion) "
+          f"{t_prof / total:.1%}, gather + local coordinates {t1 / total:.1%}, "
           f"local grid + plane fit {(t2 - t1) / total:.1%}, "
           f"evaluate + write back {(t3 - t2) / total:.1%}")
     sub = cat[:: max(1, len(cat) // 200)]
-    t_fast = run_kernel(body, sub, rng)
-    t_naive = run_kernel(body, sub, rng, naive=True)
+    sprof = craters.stamping_profiles(sub, target)
+    t_fast = run_kernel(body, sub, sprof, rng)
+    t_naive = run_kernel(body, sub, sprof, rng, naive=True)
     print(f"naive stamp scanning every vertex, same {len(sub)} craters: "
           f"{len(sub) / t_naive:.0f} craters/s vs ring gather {len(sub) / t_fast:.0f} "
           f"craters/s (x{t_naive / t_fast:.0f})")
