@@ -112,7 +112,10 @@ def _cmd_population(args) -> int:
     if not specs:
         raise CliError("give at least one --craters c=...,k=...,d_min_m=...,d_max_m=... or "
                        "npf=moon,age_gyr=...,d_min_m=...,d_max_m=...")
-    layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
+    try:
+        layers = [parse_layer_spec(s, age_max_gyr=args.age_max_gyr) for s in specs]
+    except (TypeError, ValueError) as exc:
+        raise CliError(f"--craters: {exc}") from None
     target = _population_target(args)
     where = [args.radius_m is not None, args.area_m2 is not None,
              args.x_range_m is not None or args.y_range_m is not None]

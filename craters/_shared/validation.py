@@ -38,7 +38,7 @@ class _Named:
         ``name_of(other)`` in place of each other parameter it names."""
         name_of = name_of or (lambda other: f"`{other}`")
         rule = self.rule.format(*map(name_of, self.see)) if self.see else self.rule
-        return f"{label} {rule}"
+        return f"{label}{rule}" if rule.startswith(":") else f"{label} {rule}"
 
     def renamed(self, name: str):
         """The same error for the parameter ``name`` (the caller's name for the value)."""
