@@ -1,7 +1,7 @@
 """Numba kernels for stamping Martin craters into a 2-D height grid.
 
-Scalar versions of the profile (``craters.profile``) and degradation curves
-(``craters.degradation``) - the tests compare them with the numpy versions - plus a
+Per-crater profile tables (``craters.diffusion.profile_tables``: fresh morphology and
+diffusion) read linearly - the tests compare them with the numpy versions - plus a
 counter-based 2-D gradient noise for the roughness overlay (a pure function of the
 crater's seed and the position, so results never depend on threads or tiling). The
 plane fit, bilinear sampling and hash come from ``_raster_kernels`` and ``_rng_kernels``.

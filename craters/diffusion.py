@@ -32,6 +32,7 @@ import math
 
 import numpy as np
 
+from ._diffusion_kernels import _blend_tables
 from ._shared import ParameterError
 from .morphology import EJECTA_EDGE, fresh_morphometry, fresh_profile
 from .targets import Target, get_target
@@ -142,37 +143,59 @@ def _to_table(xe: float) -> np.ndarray:
     return np.ascontiguousarray((t.T / scale[None, :]) @ _resample(xe).T)
 
 
-def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe: float):
-    """Tables (len(d), len(tau), N_TABLE) of diffused profiles divided by each node's
-    fresh depth (float32: shapes, interpolated between nodes)."""
+def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe: float,
+                 rows_d: np.ndarray | None = None, rows_tau: np.ndarray | None = None):
+    """Diffused profiles divided by each node's fresh depth, as float32 shapes that the
+    stamping interpolates between nodes: (len(d), len(tau), N_TABLE) for every pair, or,
+    given ``rows_d`` / ``rows_tau`` (indices into ``d_nodes`` / ``tau_nodes``), only those
+    pairs, (len(rows_d), N_TABLE)."""
     r, k, t, scale = _qdht(N_NODES, DOMAIN)
     fresh = fresh_profile(r, d_nodes, target, ejecta_edge=xe)            # (nd, N)
     fresh /= fresh_morphometry(d_nodes, target)["depth_m"][:, None]
     spec = (fresh * scale) @ t.T                                          # (nd, N)
     decay = np.exp(-np.outer(tau_nodes, k**2))                            # (nt, N)
-    nd, nt = len(d_nodes), len(tau_nodes)
-    evolved = (spec[:, None, :] * decay[None]).reshape(nd * nt, -1) @ _to_table(xe)
-    return evolved.reshape(nd, nt, -1).astype(np.float32)
+    if rows_d is None:
+        nd, nt = len(d_nodes), len(tau_nodes)
+        evolved = (spec[:, None, :] * decay[None]).reshape(nd * nt, -1) @ _to_table(xe)
+        return evolved.reshape(nd, nt, -1).astype(np.float32)
+    return ((spec[rows_d] * decay[rows_tau]) @ _to_table(xe)).astype(np.float32)
 
 
 class _Cache:
-    """Diffused shapes of one target on the (log D, log tau) node grid, made on demand."""
+    """Diffused shapes of one target on the (log D, log tau) node grid, made on demand:
+    per D node, the tau nodes up to the largest one a crater has needed."""
 
     def __init__(self, target: Target, xe: float):
         self.target, self.xe = target, xe
         self.tau_nodes = np.exp(np.arange(math.log(TAU_FRESH), math.log(_TAU_MAX)
                                           + math.log(_TAU_STEP), math.log(_TAU_STEP)))
         self.rows: dict[int, np.ndarray] = {}  # D node index -> (n_tau, N_TABLE)
+        self.done: dict[int, int] = {}  # D node index -> tau nodes made so far
 
-    def stack(self, idx: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(shapes of the nodes ``idx`` stacked, position of each idx in the stack)."""
+    def stack(self, idx: np.ndarray, upto: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(shapes of the D nodes ``idx`` stacked, position of each idx in the stack),
+        each with at least its tau nodes below ``upto`` (same length as idx) made."""
         need = np.unique(idx)
-        missing = [int(i) for i in need if int(i) not in self.rows]
-        if missing:
-            tabs = _node_tables(self.target, _D_STEP ** np.array(missing, dtype=np.float64),
-                                self.tau_nodes, self.xe)
-            for i, tab in zip(missing, tabs, strict=True):
-                self.rows[i] = tab
+        top = np.zeros(len(need), dtype=np.int64)
+        np.maximum.at(top, np.searchsorted(need, idx), upto)
+        rows_d, rows_tau, owners = [], [], []
+        for slot, (i, hi) in enumerate(zip(need.tolist(), top.tolist(), strict=True)):
+            lo = self.done.get(i, 0)
+            if hi > lo:
+                rows_d.append(np.full(hi - lo, slot))
+                rows_tau.append(np.arange(lo, hi))
+                owners.append((i, lo, hi))
+        if owners:
+            made = _node_tables(self.target, _D_STEP ** need.astype(np.float64),
+                                self.tau_nodes, self.xe, np.concatenate(rows_d),
+                                np.concatenate(rows_tau))
+            at = 0
+            for i, lo, hi in owners:
+                if i not in self.rows:
+                    self.rows[i] = np.zeros((len(self.tau_nodes), N_TABLE), np.float32)
+                self.rows[i][lo:hi] = made[at:at + hi - lo]
+                self.done[i] = hi
+                at += hi - lo
         return np.stack([self.rows[int(i)] for i in need]), np.searchsorted(need, idx)
 
 
@@ -209,15 +232,17 @@ def profile_tables(diameter_m, tau, target: str | Target = "moon", *,
         cache = _cache(t, float(ejecta_edge))
         ld = np.log(d[old]) / math.log(_D_STEP)
         i0 = np.floor(ld).astype(np.int64)
-        fd = (ld - i0)[:, None]
+        fd = ld - i0
         lt = np.log(tau[old] / TAU_FRESH) / math.log(_TAU_STEP)
         j0 = np.clip(np.floor(lt).astype(np.int64), 0, len(cache.tau_nodes) - 2)
-        ft = np.clip(lt - j0, 0.0, 1.0)[:, None]
-        stack, pos = cache.stack(np.concatenate([i0, i0 + 1]))
+        ft = np.clip(lt - j0, 0.0, 1.0)
+        upto = np.minimum(j0 + 2, len(cache.tau_nodes))
+        stack, pos = cache.stack(np.concatenate([i0, i0 + 1]), np.concatenate([upto, upto]))
         a, b = pos[:len(old)], pos[len(old):]
-        shape = ((1 - fd) * ((1 - ft) * stack[a, j0] + ft * stack[a, j0 + 1])
-                 + fd * ((1 - ft) * stack[b, j0] + ft * stack[b, j0 + 1]))
-        out[old] = shape * fresh_morphometry(d[old], t)["depth_m"][:, None]
+        blended = np.empty((len(old), N_TABLE))
+        _blend_tables(stack, a, b, j0, fd, ft,
+                      fresh_morphometry(d[old], t)["depth_m"], blended)
+        out[old] = blended
     return out
 
 
