@@ -29,7 +29,16 @@ from .core import Dem
 from .craterfill import fill_crater_gaps, replace_crater
 from .enhance import enhance
 from .expansion import displacement_scales, expand, expansion_sizes
-from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
+from .fractal import (
+    FractalFit,
+    SpectralFit,
+    dimension_warning,
+    expansion_fit,
+    fractal_dimension,
+    fractal_fit,
+    local_roughness,
+    variogram,
+)
 from .frame import LocalFrame, local_frame
 from .gaps import fill_gaps
 from .io import read, write
@@ -42,6 +51,7 @@ from .terrain import (
     slope,
     slope_distribution,
     spectral_exponent,
+    spectral_fit,
 )
 
 __all__ = [
@@ -49,12 +59,15 @@ __all__ = [
     "EnhanceConfig",
     "FractalFit",
     "LocalFrame",
+    "SpectralFit",
     "Stack",
     "band_power",
     "boulder_population",
+    "dimension_warning",
     "displacement_scales",
     "enhance",
     "expand",
+    "expansion_fit",
     "expansion_sizes",
     "fill_crater_gaps",
     "fill_gaps",
@@ -72,6 +85,7 @@ __all__ = [
     "slope",
     "slope_distribution",
     "spectral_exponent",
+    "spectral_fit",
     "stamp_boulders",
     "to_mesh",
     "variogram",

@@ -12,7 +12,7 @@ from ._fill_kernels import _fill_gaps_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
 from .expansion import midpoint_factor
-from .fractal import fractal_fit
+from .fractal import expansion_fit
 
 __all__ = ["fill_gaps"]
 
@@ -54,7 +54,7 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *, rng=None) -> Dem:
     roughness : float, optional
         Noise scale (m/m, >= 0): the Gaussian's standard deviation is
         ``roughness * resolution_m``. Default: from the known terrain's fBm fit, the
-        RMS neighbour slope ``rho`` and Hurst exponent ``H`` (:func:`dem.fractal_fit`):
+        RMS neighbour slope ``rho`` and Hurst exponent ``H`` (:func:`dem.expansion_fit`):
         ``rho * sqrt(k(H))``, the displacement a midpoint one pixel from its neighbours
         needs to get the known terrain's one-pixel increments (the derivation in
         :mod:`dem.expansion`, ``k(H) = 1 - 2^(H-2) - 2^(2H-3)``).
@@ -94,7 +94,7 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *, rng=None) -> Dem:
 def _known_roughness(dem: Dem) -> float:
     """Default noise scale: ``rho sqrt(k(H))`` of the known terrain (0 if not estimable)."""
     try:
-        fit = fractal_fit(dem)
+        fit = expansion_fit(dem)
     except ValueError:
         return 0.0
     if not math.isfinite(fit.roughness):

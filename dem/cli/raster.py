@@ -11,6 +11,7 @@ from ..expansion import expand
 from ..fractal import fractal_fit
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
+from ..terrain import MATCHED_BAND_PX, spectral_fit
 from .options import Settings, add_command, check_output, read_input
 
 
@@ -71,18 +72,45 @@ def _info(s: Settings) -> int:
         ("unknown", f"{100 * dem.nan_fraction:.3f} % ({dem.heights.size - z.size} pixels)"),
         ("height_m", f"min {z.min():.6g}  mean {z.mean():.6g}  max {z.max():.6g}"),
     ]
-    try:
-        fit = fractal_fit(dem)
-        method = "locally normalised variogram, lags 1-4 px"
-        rows += [("fractal_d", f"{fit.fractal_dimension:.4f} ({method})"),
-                 ("roughness", f"{fit.roughness:.6g} (RMS neighbour slope, m/m)")]
-    except ValueError as exc:
-        rows.append(("fractal_d", f"n/a ({exc})"))
+    rows += _dimension_rows(dem)
     for step in dem.history:
         rows.append(("history", f"{step['op']} seed {step['seed']}"))
     for key, value in rows:
         print(f"{key:<10} {value}")
     return 0
+
+
+def _dimension(fit, method: str) -> str:
+    """F with its method, or the sentence that says it is no surface dimension."""
+    if fit.warning:
+        return f"n/a: {fit.warning} ({method})"
+    return f"{fit.fractal_dimension:.4f} ({method})"
+
+
+def _dimension_rows(dem) -> list[tuple[str, str]]:
+    """``fractal_d`` (variogram), ``spectral_d`` (same scales) and ``roughness`` rows."""
+    rows = []
+    try:
+        fit = fractal_fit(dem)
+        lo_lag, hi_lag = fit.lag_range_px
+        rows.append(("fractal_d", _dimension(
+            fit, f"locally normalised variogram, lags {lo_lag}-{hi_lag} px")))
+        rough = fit.roughness
+    except ValueError as exc:
+        rows.append(("fractal_d", f"n/a ({exc})"))
+        rough = None
+    lo, hi = MATCHED_BAND_PX
+    band = f"power-spectrum slope, wavelengths {lo:g}-{hi:g} px"
+    if not dem.known.all():
+        rows.append(("spectral_d", f"n/a (unknown pixels; fill them first) ({band})"))
+    else:
+        try:
+            rows.append(("spectral_d", _dimension(spectral_fit(dem, lo, hi), band)))
+        except ValueError as exc:
+            rows.append(("spectral_d", f"n/a ({exc})"))
+    if rough is not None:
+        rows.append(("roughness", f"{rough:.6g} (RMS neighbour slope, m/m)"))
+    return rows
 
 
 def register(sub) -> None:

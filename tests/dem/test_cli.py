@@ -128,7 +128,9 @@ def test_info(run_cli, capsys, lola_tif, tiny_geotiff):
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout
     for needle in ("257 x 257 pixels", "Moon 2015", "7580.8", "0.25, 0, 148, 0, -0.25, 32",
-                   "unknown    0.000 %", "fractal_d  2.2", "height_m   min -6059.5"):
+                   "unknown    0.000 %", "height_m   min -6059.5",
+                   "fractal_d  2.5975 (locally normalised variogram, lags 2-8 px)",
+                   "spectral_d 2.5249 (power-spectrum slope, wavelengths 4-16 px)"):
         assert needle in out, out
     proc = InProcess(capsys)("dem", "info", str(tiny_geotiff))
     assert "EPSG:32633" in proc.stdout and "(1 pixels)" in proc.stdout
