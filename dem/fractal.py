@@ -283,15 +283,13 @@ def window_mean(values: np.ndarray, window_px: int) -> np.ndarray:
     v = np.asarray(values, dtype=np.float64)
     ok = np.isfinite(v)
     h = window_px // 2
+    # shifted sums in a fixed order (rows, then columns): every pixel adds the same
+    # neighbours in the same order, so a crop gives the same bits as the whole array
     out = []
     for a in (np.where(ok, v, 0.0), ok.astype(np.float64)):
-        c = np.zeros((a.shape[0] + 1, a.shape[1] + 1))
-        c[1:, 1:] = a.cumsum(0).cumsum(1)
-        r = np.arange(a.shape[0])
-        q = np.arange(a.shape[1])
-        r0, r1 = np.maximum(r - h, 0), np.minimum(r + h + 1, a.shape[0])
-        c0, c1 = np.maximum(q - h, 0), np.minimum(q + h + 1, a.shape[1])
-        out.append(c[r1][:, c1] - c[r0][:, c1] - c[r1][:, c0] + c[r0][:, c0])
+        p = np.pad(a, h)
+        rows = sum(p[k:k + a.shape[0], :] for k in range(2 * h + 1))
+        out.append(sum(rows[:, k:k + a.shape[1]] for k in range(2 * h + 1)))
     total, count = out
     with np.errstate(invalid="ignore", divide="ignore"):
         return np.where(count > 0.5, total / count, np.nan)

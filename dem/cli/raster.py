@@ -50,7 +50,7 @@ def _transform(s: Settings) -> int:
         detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
                            else f"{k} {params[k]}" for k in params
                            if k in ("levels", "fractal_dimension", "roughness",
-                                    "filled_pixels", "waves"))
+                                    "filled_pixels", "holes", "craters"))
         print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {out.shape[0]} x "
               f"{out.shape[1]} pixels, seed {seed}, {detail}")
         print(f"wrote {s['output']}")
