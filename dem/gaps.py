@@ -57,11 +57,14 @@ from ._fill_kernels import (
 from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import NORMALISER_WINDOW_PX, fractal_fit, local_msd, window_mean
+from .gapcraters import gap_crater_layer, stamp_gap_craters
 
 __all__ = ["fbm_noise", "fill_gaps", "harmonic_fill"]
 
 #: Noise box: the hole's bounding box plus this fraction of its longer side on each side.
 NOISE_MARGIN = 0.25
+#: Most craters listed one by one in the history tags (more: the count only).
+_MAX_RECORDED = 2000
 #: F used when the known terrain is too small to estimate it (and no value is given).
 DEFAULT_FRACTAL_DIMENSION = 2.5
 # Laplace solve (multigrid-preconditioned conjugate gradients): stop when a step changes
@@ -79,12 +82,14 @@ _COARSEST_SWEEPS = 10
 
 
 def fill_gaps(dem: Dem, roughness: float | None = None, *,
-              fractal_dimension: float | None = None, rng=None) -> Dem:
+              fractal_dimension: float | None = None, craters="auto", rng=None,
+              return_catalog: bool = False):
     """Fill the unknown (NaN) pixels of ``dem`` with fractal terrain that meets the rims.
 
     See the module docstring: each hole gets ``sigma N + L[z - sigma N]`` (fBm noise
-    plus the harmonic interpolation of the rim mismatch). Known pixels are returned bit
-    for bit; the input is not modified.
+    plus the harmonic interpolation of the rim mismatch); holes large enough to hold
+    craters of 5 pixels and their ejecta get craters (:mod:`dem.gapcraters`). Known
+    pixels are returned bit for bit; the input is not modified.
 
     Parameters
     ----------
@@ -98,13 +103,22 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     fractal_dimension : float, optional
         F in [2, 3] of the fill's noise. Default: :func:`dem.fractal_fit` of the known
         terrain, clipped to [2, 3] (2.5 when the DEM is too small to estimate it).
+    craters : "auto", None, str or craters.CraterLayer
+        Craters in large holes: ``"auto"`` at the density the crater detector measures
+        around each hole, a crater layer (``c=..,k=..,d_min_m=..,d_max_m=..``) for a
+        given density, None for none (see :mod:`dem.gapcraters`).
     rng : int, numpy.random.Generator or None
-        Seed of the counter-based noise.
+        Seed of the counter-based noise and of the craters.
+    return_catalog : bool
+        Also return the catalog of the craters stamped (``x_m, y_m`` from the centre of
+        pixel (0, 0) along columns and rows, and ``craters.stamp_many``'s columns).
 
     Returns
     -------
     Dem
-        Without NaN; its history tags record the step (F, roughness, holes, key).
+        Without NaN; its history tags record the step (F, roughness, holes, key, the
+        crater density used per hole and the craters stamped as [row, col, diameter_m,
+        degradation]). With ``return_catalog``, ``(Dem, catalog)``.
 
     Examples
     --------
@@ -124,6 +138,7 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     if fractal_dimension is not None:
         with about("fractal_dimension"):
             fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
+    layer = gap_crater_layer(craters)
     with about("rng"):
         key, seed = key_from_rng(rng)
     unknown = ~dem.known
@@ -138,12 +153,35 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     z = np.array(dem.heights, dtype=np.float64, copy=True)
     holes = _holes(unknown)
     params["holes"] = len(holes)
+    catalogs, notes = [], []
     if holes:
         amp = (None if roughness is not None
                else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
         for sl, hole in holes:
             _fill_hole(z, dem, sl, hole, amp, roughness, fractal_dimension, key)
-    return dem.with_step(z, "dem.fill_gaps", seed, params)
+            if layer is not None:
+                cat, note = stamp_gap_craters(z, dem, sl, hole, layer, key)
+                if note is not None:
+                    notes.append(note)
+                if cat is not None:
+                    catalogs.append(cat)
+    catalog = (np.concatenate(catalogs) if catalogs else None)
+    params["craters"] = 0 if catalog is None else len(catalog)
+    params["crater_density"] = "none" if layer is None else notes
+    if catalog is not None and len(catalog) <= _MAX_RECORDED:
+        params["crater_catalog"] = [
+            [round(float(r["y_m"] / dem.pixel_size_m[1]), 3),
+             round(float(r["x_m"] / dem.pixel_size_m[0]), 3),
+             round(float(r["diameter_m"]), 3), round(float(r["degradation"]), 4)]
+            for r in catalog]
+    out = dem.with_step(z, "dem.fill_gaps", seed, params)
+    if not return_catalog:
+        return out
+    if catalog is None:
+        import craters as _craters_pkg
+
+        catalog = _craters_pkg.make_catalog(x_m=[], y_m=[], diameter_m=[])
+    return out, catalog
 
 
 def _known_dimension(dem: Dem) -> float:

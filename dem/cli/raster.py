@@ -7,12 +7,16 @@ import numpy as np
 from craters._shared import about, normalize_rng, progress_bar
 
 from ..core import crs_label
+from ..craterdensity import RESOLVED_CRATER_PX, crater_density, detect_craters, resolved_diameter_m
 from ..expansion import expand
 from ..fractal import fractal_fit
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
 from ..terrain import MATCHED_BAND_PX, spectral_fit
 from .options import Settings, add_command, check_output, read_input
+
+#: ``dem info`` counts craters on DEMs up to this many pixels (a few seconds).
+_CRATER_COUNT_MAX_PX = 4_000_000
 
 
 def _seed(s: Settings) -> int:
@@ -36,7 +40,8 @@ def _transform(s: Settings) -> int:
     bar.update()
     bar.set_description(command)
     if command == "fill":
-        out = fill_gaps(dem, s["roughness"], rng=seed)
+        out = fill_gaps(dem, s["roughness"], fractal_dimension=s["fractal_dimension"],
+                        craters=s["craters"], rng=seed)
     else:
         out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
                      rng=seed, progress=show)
@@ -73,6 +78,7 @@ def _info(s: Settings) -> int:
         ("height_m", f"min {z.min():.6g}  mean {z.mean():.6g}  max {z.max():.6g}"),
     ]
     rows += _dimension_rows(dem)
+    rows += _crater_rows(dem)
     for step in dem.history:
         rows.append(("history", f"{step['op']} seed {step['seed']}"))
     for key, value in rows:
@@ -113,10 +119,28 @@ def _dimension_rows(dem) -> list[tuple[str, str]]:
     return rows
 
 
+def _crater_rows(dem) -> list[tuple[str, str]]:
+    """``resolves`` (the crater resolution limit) and ``craters`` (the detector's count
+    and density), skipped on DEMs over :data:`_CRATER_COUNT_MAX_PX` pixels."""
+    limit = resolved_diameter_m(dem)
+    rows = [("resolves", f"craters from {limit:.6g} m ({RESOLVED_CRATER_PX:g} px)")]
+    if dem.heights.size > _CRATER_COUNT_MAX_PX:
+        note = f"n/a (over {_CRATER_COUNT_MAX_PX / 1e6:g} Mpx: use dem.crater_density)"
+        return [*rows, ("craters", note)]
+    found = detect_craters(dem)
+    density = crater_density(dem)
+    text = f"{len(found)} found of {RESOLVED_CRATER_PX:g} px and up (rim-over-floor detector)"
+    if density is not None:
+        text += (f"; from {density.d_lo_m:.6g} m: {density.count}, N(>D) = {density.c:.4g} "
+                 f"D^{density.k:g} (D in m, per m^2), N(>{density.d_lo_m / 1e3:.4g} km) = "
+                 f"{density.count / density.area_m2 * 1e6:.4g} per km^2")
+    return [*rows, ("craters", text)]
+
+
 def register(sub) -> None:
     """Add ``info``, ``fill`` and ``expand`` to the sub-command parser."""
     add_command(sub, "info", _info,
-                "describe a DEM (size, CRS, pixel size, heights, fractal dimension)")
+                "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)")
     add_command(sub, "fill", _transform,
                 "fill the unknown pixels of a DEM with fractal terrain, outside in")
     add_command(sub, "expand", _transform,

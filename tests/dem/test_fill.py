@@ -135,15 +135,19 @@ def test_known_pixels_kept_no_nan_deterministic(lola_crop):
 
 
 def test_a_hole_is_filled_the_same_in_a_crop(lola_crop):
-    """A hole's fill depends on the known pixels near it and the seed, not on the crop."""
-    z = lola_crop.heights.copy()
-    z[100:130, 90:140] = np.nan
-    whole = dem.fill_gaps(lola_crop.replace(heights=z), fractal_dimension=2.4, rng=3)
+    """A hole's fill depends on the known pixels near it and the seed, not on the crop;
+    so do its craters at a given density (measured ones depend on the window around)."""
     from rasterio.windows import Window
 
-    crop = lola_crop.replace(heights=z).crop(Window(80, 90, 75, 50))
-    part = dem.fill_gaps(crop, fractal_dimension=2.4, rng=3)
-    assert np.array_equal(part.heights, whole.heights[90:140, 80:155])
+    z = lola_crop.heights.copy()
+    z[100:130, 90:140] = np.nan
+    d = Dem(0.02 * z, pixel_size_m=100.0)  # projected: one pixel size in every crop
+    for craters in (None, "c=0.2,k=-2,d_min_m=300,d_max_m=3000"):
+        whole = dem.fill_gaps(d, fractal_dimension=2.4, craters=craters, rng=3)
+        part = dem.fill_gaps(d.crop(Window(80, 90, 75, 50)), fractal_dimension=2.4,
+                             craters=craters, rng=3)
+        assert np.array_equal(part.heights, whole.heights[90:140, 80:155])
+    assert whole.history[-1]["parameters"]["craters"] > 0
 
 
 def test_holes_on_the_border_and_no_holes(rng):
