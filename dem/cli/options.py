@@ -155,11 +155,6 @@ OPTIONS: tuple[Opt, ...] = (
         "degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = c D^k per "
         "m^2, D in metres, ages in Gyr); repeat for several", (_ENHANCE,),
         "none", kind="append", metavar="SPEC"),
-    Opt(("--craters",), "craters", str, "auto",
-        "craters in gaps large enough to hold them (4 px and their ejecta): auto (at the "
-        "density the crater detector finds around each gap), none, or a crater layer "
-        "c=..,k=..,d_min_m=..,d_max_m=.. (N_cum = c D^k per m^2, D in metres)", (_FILL,),
-        metavar="SPEC"),
     Opt(("--min-crater-px",), "min_crater_px", _number, _E["min_crater_px"],
         "smallest crater diameter a layer takes, in its pixels (>= 1)", (_ENHANCE,),
         metavar="PX"),
@@ -175,6 +170,11 @@ OPTIONS: tuple[Opt, ...] = (
         "smallest boulder a layer takes, in its pixels (>= 1)", (_ENHANCE,), metavar="PX"),
     Opt(("--no-boulders",), "no_boulders", bool, False,
         "leave the stack's boulders out of the mesh", (_MESH,), kind="switch", toml=bool),
+    Opt(("--craters",), "craters", str, "auto",
+        "craters in gaps large enough to hold them (4 px and their ejecta): auto (at the "
+        "density the crater detector finds around each gap), none, or a crater layer "
+        "c=..,k=..,d_min_m=..,d_max_m=.. (N_cum = c D^k per m^2, D in metres)", (_FILL,),
+        metavar="SPEC"),
     Opt(("--levels",), "levels", _integer, 1, "number of 2x expansions (1..16)", (_EXPAND,),
         metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
