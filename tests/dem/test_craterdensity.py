@@ -46,11 +46,13 @@ def matches(found, truth, px):
 
 
 def test_detector_finds_stamped_craters(fbm_surface):
-    d, truth, terrain = cratered_scene(1, fbm_surface)
+    d, truth, terrain = cratered_scene(1, fbm_surface, degradation=(0.0, 0.3))
     found = dem.detect_craters(d)
     hit = matches(found, truth, 100.0)
     big = truth["diameter_m"] >= 600.0
-    assert hit[big].mean() >= 0.95  # measured 1.0 (5 scenes: 97-100 % from 6 px)
+    # measured 0.97-1.0 from 6 px (bench_craterdensity.py), with the simple-crater shapes
+    # and with the diffusion-degraded ones
+    assert hit[big].mean() >= 0.9
     assert found["diameter_m"].min() >= 400.0 - 1e-6  # 4 px and up
     assert len(dem.detect_craters(terrain)) <= 10  # the fBm alone: measured 1-7
     # a trough is not a crater
