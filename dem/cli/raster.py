@@ -15,8 +15,10 @@ from ..io import GEOTIFF_SUFFIXES, write
 from ..terrain import MATCHED_BAND_PX, spectral_fit
 from .options import Settings, add_command, check_output, read_input
 
-#: ``dem info`` counts craters on DEMs up to this many pixels (a few seconds).
-_CRATER_COUNT_MAX_PX = 4_000_000
+#: ``dem info`` counts craters of up to this many pixels on DEMs up to this many pixels
+#: (a 257^2 crop: 1 s; LOLA LDEM_4, 1.04 Mpx, would take 12 s).
+_CRATER_COUNT_MAX_D_PX = 64.0
+_CRATER_COUNT_MAX_PX = 1_000_000
 
 
 def _seed(s: Settings) -> int:
@@ -127,9 +129,13 @@ def _crater_rows(dem) -> list[tuple[str, str]]:
     if dem.heights.size > _CRATER_COUNT_MAX_PX:
         note = f"n/a (over {_CRATER_COUNT_MAX_PX / 1e6:g} Mpx: use dem.crater_density)"
         return [*rows, ("craters", note)]
-    found = detect_craters(dem)
-    density = crater_density(dem)
-    text = f"{len(found)} found of {RESOLVED_CRATER_PX:g} px and up (rim-over-floor detector)"
+    top = min(_CRATER_COUNT_MAX_D_PX, min(dem.shape) / 4.0)
+    if top <= RESOLVED_CRATER_PX * 1.5:
+        return [*rows, ("craters", "n/a (the DEM is too small to count craters)")]
+    found = detect_craters(dem, max_diameter_px=top)
+    density = crater_density(dem, max_diameter_px=top)
+    text = (f"{len(found)} found of {RESOLVED_CRATER_PX:g}-{top:g} px (rim-over-floor "
+            f"detector)")
     if density is not None:
         text += (f"; from {density.d_lo_m:.6g} m: {density.count}, N(>D) = {density.c:.4g} "
                  f"D^{density.k:g} (D in m, per m^2), N(>{density.d_lo_m / 1e3:.4g} km) = "

@@ -131,7 +131,7 @@ def test_info(run_cli, capsys, lola_tif, tiny_geotiff):
                    "unknown    0.000 %", "height_m   min -6059.5",
                    "fractal_d  2.5975 (locally normalised variogram, lags 2-8 px)",
                    "spectral_d 2.5249 (power-spectrum slope, wavelengths 4-16 px)",
-                   "resolves   craters from 30323.3 m (4 px)", "craters    147 found of 4 px"):
+                   "resolves   craters from 30323.3 m (4 px)", "craters    147 found of 4-64 px"):
         assert needle in out, out
     proc = InProcess(capsys)("dem", "info", str(tiny_geotiff))
     assert "EPSG:32633" in proc.stdout and "(1 pixels)" in proc.stdout
