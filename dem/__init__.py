@@ -3,7 +3,8 @@
 ::
 
     GeoTIFF, PDS3 --io.read--> Dem (core: heights, NaN = unknown, transform, CRS, metres)
-      -> fill_gaps (gaps), fill_crater_gaps / replace_crater (craterfill)  -> Dem
+      -> fill_gaps (gaps, gapcraters), fill_crater_gaps / replace_crater (craterfill)
+      -> detect_craters, crater_density, resolved_diameter_m (craterdensity)
       -> expand (expansion: RMD, 2x per level)                              -> Dem
       -> enhance (EnhanceConfig in config, the plan in planning)            -> Stack
     Stack (stack: consistent layers + catalogs; write, read_stack)
@@ -14,7 +15,8 @@ Beside them: ``frame`` (local metric frames), ``boulders`` (boulders on rasters)
 ``dem`` command line, which imports the library, never the reverse; ``dem --help``).
 
 Martin et al. (lunar crater model and DEM enhancement, IV): random-midpoint-displacement
-expansion of real DEMs, outside-in fractal gap filling, crater gap filling and crater
+expansion of real DEMs, fractal gap filling (conditioned on the gaps' rims, with craters
+at the density around large gaps), crater gap filling and crater
 replacement, boulders (:func:`stamp_boulders`), multi-resolution layer stacks with
 craters and boulders per layer (:func:`enhance`) and their stitched meshes
 (:func:`to_mesh`), on a :class:`Dem` that keeps the georeferencing.
@@ -26,10 +28,20 @@ from .analysis import band_power, laplacian
 from .boulders import boulder_population, stamp_boulders
 from .config import EnhanceConfig
 from .core import Dem
+from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
 from .craterfill import fill_crater_gaps, replace_crater
 from .enhance import enhance
 from .expansion import displacement_scales, expand, expansion_sizes
-from .fractal import FractalFit, fractal_dimension, fractal_fit, local_roughness, variogram
+from .fractal import (
+    FractalFit,
+    SpectralFit,
+    dimension_warning,
+    expansion_fit,
+    fractal_dimension,
+    fractal_fit,
+    local_roughness,
+    variogram,
+)
 from .frame import LocalFrame, local_frame
 from .gaps import fill_gaps
 from .io import read, write
@@ -42,19 +54,26 @@ from .terrain import (
     slope,
     slope_distribution,
     spectral_exponent,
+    spectral_fit,
 )
 
 __all__ = [
+    "CraterDensity",
     "Dem",
     "EnhanceConfig",
     "FractalFit",
     "LocalFrame",
+    "SpectralFit",
     "Stack",
     "band_power",
     "boulder_population",
+    "crater_density",
+    "detect_craters",
+    "dimension_warning",
     "displacement_scales",
     "enhance",
     "expand",
+    "expansion_fit",
     "expansion_sizes",
     "fill_crater_gaps",
     "fill_gaps",
@@ -66,12 +85,14 @@ __all__ = [
     "read",
     "read_stack",
     "replace_crater",
+    "resolved_diameter_m",
     "pixel_sizes_by_row",
     "power_spectrum",
     "roughness",
     "slope",
     "slope_distribution",
     "spectral_exponent",
+    "spectral_fit",
     "stamp_boulders",
     "to_mesh",
     "variogram",

@@ -34,7 +34,7 @@ Crater replacement (:func:`replace_crater`)
 A blurred crater (e.g. after several expansions) is replaced by a sharp synthetic one:
 every pixel within the crater's reach (ejecta edge 1.5 D, times 1 + rim irregularity)
 is erased and refilled with fractal terrain continued from the surroundings
-(:func:`dem.fill_gaps`, outside in), then the crater is stamped on it (plane fit,
+(:func:`dem.fill_gaps`, without its gap craters), then the crater is stamped on it (plane fit,
 profile, ejecta that ends on the terrain at the ejecta edge), so it blends into the
 untouched terrain beyond the ejecta edge. In a :class:`dem.Stack` the crater goes into
 the finest layer that contains its reach (plus one pixel), and the change is
@@ -242,7 +242,7 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
     r0, r1 = min(r0, fr.min()), max(r1, fr.max() + 1)
     c0, c1 = min(c0, fc.min()), max(c1, fc.max() + 1)
     crop = dem.crop(Window(c0, r0, c1 - c0, r1 - r0))
-    base = fill_gaps(crop, roughness, rng=gen)
+    base = fill_gaps(crop, roughness, craters=None, rng=gen)
     local = {name: cat[name] for name in cat.dtype.names}
     local.update(x_m=gx - c0 * p, y_m=gy - r0 * p)
     synth, stamped = craters.stamp_many(base.heights, p, craters.make_catalog(**local),
@@ -273,7 +273,7 @@ def _replace_in_layer(d: Dem, frame: LocalFrame, crater, *, roughness, smooth, g
     crop = d.crop(Window(c0, r0, c1 - c0, r1 - r0))
     disc = _discs(crop.shape, (r0, c0), [cx], [cy], [reach])
     erased = crop.replace(heights=np.where(disc, np.nan, crop.heights))
-    base = fill_gaps(erased, roughness, rng=gen)
+    base = fill_gaps(erased, roughness, craters=None, rng=gen)
     cat = craters.make_catalog(x_m=[gx[0] - c0 * p], y_m=[gy[0] - r0 * p],
                                diameter_m=[crater.diameter_m],
                                degradation=[crater.degradation], kind=["replacement"],

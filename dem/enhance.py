@@ -54,7 +54,7 @@ from .boulders import place_boulders
 from .config import EnhanceConfig
 from .core import Dem
 from .expansion import expand
-from .fractal import fractal_fit
+from .fractal import expansion_fit
 from .frame import grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .planning import (
@@ -230,7 +230,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     fd = cfg.fractal_dimension
     fd_estimated = None
     if fd is None:
-        fd_estimated = fractal_fit(layer0).fractal_dimension
+        fd_estimated = expansion_fit(layer0).fractal_dimension
         fd = min(3.0, max(2.0, fd_estimated))
     arrays: list[np.ndarray] = []
     metas: list[Dem] = []

@@ -39,9 +39,10 @@ after ``n`` RMD iterations (eq. 16) are replaced by ``sigma``, *measured* on the
 its own resolution, so the expansion continues the input's roughness across scales. The
 independence of ``D`` is an approximation (the neighbours of a new point are not all
 model-distributed pairs: two square-phase points share corners); measured on a 17 x 17
-seed expanded 7 levels (tests, ``bench_dem.py``): F = 2.2 / 2.5 read 2.25 / 2.46 with
-:func:`dem.fractal_dimension` (2.8 reads 2.61), and the variance at the finest lag is
-0.82 / 0.98 of ``gamma``.
+seed expanded 7 levels (tests, ``bench_dem.py``): F = 2.2 / 2.5 / 2.8 read 2.29 / 2.56 /
+2.75 with :func:`dem.fractal_dimension` (lags 2-8 px) and 2.15 / 2.50 / 2.81 with the
+power-spectrum slope (:func:`dem.spectral_fit`), and the variance at the finest lag is
+0.82 / 0.98 of ``gamma`` (F = 2.2 / 2.5).
 
 Local amplitude. By default ``sigma`` is not one number but the local relief of the
 input, ``sigma(p) = rho(p) R``: the RMS height difference between input pixel ``p`` and
@@ -88,7 +89,7 @@ from craters._shared import (
 from ._expand_kernels import _expand_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .fractal import fractal_fit, local_msd
+from .fractal import expansion_fit, local_msd
 
 __all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]
 
@@ -176,8 +177,9 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     ``2^levels``. Displacements follow fBm with fractal dimension ``fractal_dimension``;
     their amplitude is the input's relief at its finest scale (see the module
     docstring). Defaults come from the input DEM itself, so the expansion continues its
-    statistics: F from :func:`dem.fractal_dimension` of the *whole* DEM (clipped to
-    [2, 3]) and, without ``roughness``, the local roughness of each input pixel
+    statistics: F from :func:`dem.expansion_fit` of the *whole* DEM (clipped to
+    [2, 3]; 0.1-0.3 below its fractal dimension, which is what reproduces real terrain
+    below the pixel, see there) and, without ``roughness``, the local roughness of each input pixel
     (:func:`dem.local_roughness`, interpolated bilinearly), so rough areas get rough
     detail and smooth areas smooth detail. A ``roughness`` value makes it uniform (the
     paper's single scale).
@@ -242,7 +244,7 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
                     "input_resolution_m": dem.resolution_m}
     fit = None
     if fractal_dimension is None or roughness is None:
-        fit = fractal_fit(dem)
+        fit = expansion_fit(dem)
     if fractal_dimension is None:
         fractal_dimension = min(3.0, max(2.0, fit.fractal_dimension))
         params["fractal_dimension_estimated"] = fit.fractal_dimension

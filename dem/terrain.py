@@ -9,6 +9,9 @@
   (plane removed, 2-D Hann window, normalised so that it integrates to the height
   variance), against wavelength in metres; a fractal surface shows a straight line of
   slope -beta on log axes (beta = 8 - 2F for a surface of fractal dimension F).
+* :func:`spectral_fit` - the fractal dimension ``F = (8 - beta) / 2`` from that slope over
+  a band of wavelengths (in pixels), flagged when it falls outside [2, 3]; over 4-16 px
+  it measures the scales of :func:`dem.fractal_fit`'s lags (see :mod:`dem.fractal`).
 * :func:`roughness` - the fractal fit used by :func:`dem.expand` (dimension and scale).
 """
 
@@ -21,10 +24,13 @@ import numpy as np
 from craters._shared import about, area_slope_summary, check_choice, check_int, check_range
 
 from .core import Dem
-from .fractal import FractalFit, fractal_fit
+from .fractal import FractalFit, SpectralFit, fractal_fit
 
-__all__ = ["pixel_sizes_by_row", "power_spectrum", "roughness", "slope",
-           "slope_distribution", "spectral_exponent"]
+__all__ = ["SpectralFit", "pixel_sizes_by_row", "power_spectrum", "roughness", "slope",
+           "slope_distribution", "spectral_exponent", "spectral_fit"]
+
+#: Wavelength band (pixels) of :func:`spectral_fit` that matches the variogram's lags 2-8.
+MATCHED_BAND_PX = (4.0, 16.0)
 
 
 def _check(dem) -> Dem:
@@ -175,6 +181,34 @@ def spectral_exponent(wavelength_m, psd, lo_m: float | None = None,
     if sel.sum() < 3:
         raise ValueError("fewer than 3 spectrum points in the wavelength range")
     return float(np.polyfit(np.log(1.0 / wl[sel]), np.log(p[sel]), 1)[0] * -1.0)
+
+
+def spectral_fit(dem: Dem, lo_px: float | None = None,
+                 hi_px: float | None = None) -> SpectralFit:
+    """Fractal dimension from the power-spectrum slope between two wavelengths (pixels).
+
+    ``beta`` is fitted by :func:`spectral_exponent` to :func:`power_spectrum` between
+    ``lo_px`` and ``hi_px`` pixels (default: :func:`spectral_exponent`'s, about 4 pixels
+    to a quarter of the longest wavelength); ``F = (8 - beta) / 2`` for an fBm surface
+    (``beta = 2 H + 2``).
+    :data:`MATCHED_BAND_PX` (4-16 px) measures the scales of :func:`dem.fractal_fit`'s
+    lags 2-8 px. The DEM must have no unknown pixel.
+
+    Examples
+    --------
+    >>> noise = np.random.default_rng(0).standard_normal((64, 64))
+    >>> fit = spectral_fit(Dem(noise, pixel_size_m=1.0))   # white noise: beta ~ 0
+    >>> fit.is_surface_dimension, fit.warning[:30]
+    (False, 'not a surface fractal dimensio')
+    """
+    wl, psd = power_spectrum(dem)
+    width, dy = pixel_sizes_by_row(dem)
+    px = math.sqrt(float(width.mean()) * dy)  # the pixel, as power_spectrum sees it
+    lo = 2.0 * float(wl.min()) if lo_px is None else check_range("lo_px", lo_px, 2.0, None) * px
+    hi = (float(wl.max()) / 4.0 if hi_px is None
+          else check_range("hi_px", hi_px, lo / px, None) * px)
+    beta = spectral_exponent(wl, psd, lo, hi)
+    return SpectralFit((8.0 - beta) / 2.0, beta, (lo, hi), (lo / px, hi / px))
 
 
 def roughness(dem: Dem) -> FractalFit:

@@ -15,6 +15,22 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(12345)
 
 
+def spectral_fbm(n: int, beta: float, rng: np.random.Generator) -> np.ndarray:
+    """An n x n periodic fBm surface by spectral synthesis: amplitude f^(-beta/2), random
+    phases (psd ~ f^-beta; F = (8 - beta) / 2). Independent of dem's RMD code."""
+    f = np.hypot(*np.meshgrid(np.fft.fftfreq(n), np.fft.fftfreq(n), indexing="ij"))
+    f[0, 0] = 1.0
+    amp = f ** (-beta / 2.0)
+    amp[0, 0] = 0.0
+    return np.fft.ifft2(amp * np.exp(2j * np.pi * rng.random((n, n)))).real
+
+
+@pytest.fixture
+def fbm_surface():
+    """``fbm_surface(n, fractal_dimension, rng)``: :func:`spectral_fbm` of beta = 8 - 2F."""
+    return lambda n, fractal_dimension, rng: spectral_fbm(n, 8.0 - 2.0 * fractal_dimension, rng)
+
+
 @pytest.fixture
 def tiny_grid():
     from latlong import LatLongGrid

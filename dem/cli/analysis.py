@@ -13,6 +13,7 @@ from types import SimpleNamespace
 from craters._shared.cli import CliError, check_report_outputs
 from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
 
+from ..fractal import dimension_warning
 from ..stack import read_stack
 from ..terrain import power_spectrum, slope_distribution, spectral_exponent
 from .options import Settings, add_command, read_input
@@ -94,8 +95,15 @@ def _spectrum(s: Settings) -> int:
         plt.close(fig)
     if not args.quiet:
         print(f"{'input':<28} {'pixel_m':>9} {'beta':>6} {'F=(8-beta)/2':>12}")
+        notes = []
         for label, _, _, beta, px in results:
-            print(f"{label[:28]:<28} {px:9.4g} {beta:6.2f} {(8 - beta) / 2:12.2f}")
+            warning = dimension_warning((8 - beta) / 2)
+            f_text = "n/a" if warning else f"{(8 - beta) / 2:.2f}"
+            print(f"{label[:28]:<28} {px:9.4g} {beta:6.2f} {f_text:>12}")
+            if warning:
+                notes.append(f"{label}: {warning}")
+        for note in notes:
+            print(note)
     return 0
 
 

@@ -177,10 +177,15 @@ OPTIONS: tuple[Opt, ...] = (
         "smallest boulder a layer takes, in its pixels (>= 1)", (_ENHANCE,), metavar="PX"),
     Opt(("--no-boulders",), "no_boulders", bool, False,
         "leave the stack's boulders out of the mesh", (_MESH,), kind="switch", toml=bool),
+    Opt(("--craters",), "craters", str, "auto",
+        "craters in gaps large enough to hold them (4 px and their ejecta): auto (at the "
+        "density the crater detector finds around each gap), none, or a crater layer "
+        "c=..,k=..,d_min_m=..,d_max_m=.. (N_cum = c D^k per m^2, D in metres)", (_FILL,),
+        metavar="SPEC"),
     Opt(("--levels",), "levels", _integer, 1, "number of 2x expansions (1..16)", (_EXPAND,),
         metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
-        "fractal dimension F in [2, 3]", (_EXPAND, _ENHANCE), "estimated from the input",
+        "fractal dimension F in [2, 3]", (_FILL, _EXPAND, _ENHANCE), "estimated from the input",
         metavar="F"),
     Opt(("--roughness",), "roughness", _number, None,
         "RMS slope between neighbouring pixels, m/m, >= 0", (_FILL, _EXPAND, _ENHANCE),

@@ -7,11 +7,18 @@ import numpy as np
 from craters._shared import about, normalize_rng, progress_bar
 
 from ..core import crs_label
+from ..craterdensity import RESOLVED_CRATER_PX, crater_density, detect_craters, resolved_diameter_m
 from ..expansion import expand
 from ..fractal import fractal_fit
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
+from ..terrain import MATCHED_BAND_PX, spectral_fit
 from .options import Settings, add_command, check_output, read_input
+
+#: ``dem info`` counts craters of up to this many pixels on DEMs up to this many pixels
+#: (a 257^2 crop: 1 s; LOLA LDEM_4, 1.04 Mpx, would take 12 s).
+_CRATER_COUNT_MAX_D_PX = 64.0
+_CRATER_COUNT_MAX_PX = 1_000_000
 
 
 def _seed(s: Settings) -> int:
@@ -35,7 +42,8 @@ def _transform(s: Settings) -> int:
     bar.update()
     bar.set_description(command)
     if command == "fill":
-        out = fill_gaps(dem, s["roughness"], rng=seed)
+        out = fill_gaps(dem, s["roughness"], fractal_dimension=s["fractal_dimension"],
+                        craters=s["craters"], rng=seed)
     else:
         out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
                      rng=seed, progress=show)
@@ -49,7 +57,7 @@ def _transform(s: Settings) -> int:
         detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
                            else f"{k} {params[k]}" for k in params
                            if k in ("levels", "fractal_dimension", "roughness",
-                                    "filled_pixels", "waves"))
+                                    "filled_pixels", "holes", "craters"))
         print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {out.shape[0]} x "
               f"{out.shape[1]} pixels, seed {seed}, {detail}")
         print(f"wrote {s['output']}")
@@ -71,13 +79,8 @@ def _info(s: Settings) -> int:
         ("unknown", f"{100 * dem.nan_fraction:.3f} % ({dem.heights.size - z.size} pixels)"),
         ("height_m", f"min {z.min():.6g}  mean {z.mean():.6g}  max {z.max():.6g}"),
     ]
-    try:
-        fit = fractal_fit(dem)
-        method = "locally normalised variogram, lags 1-4 px"
-        rows += [("fractal_d", f"{fit.fractal_dimension:.4f} ({method})"),
-                 ("roughness", f"{fit.roughness:.6g} (RMS neighbour slope, m/m)")]
-    except ValueError as exc:
-        rows.append(("fractal_d", f"n/a ({exc})"))
+    rows += _dimension_rows(dem)
+    rows += _crater_rows(dem)
     for step in dem.history:
         rows.append(("history", f"{step['op']} seed {step['seed']}"))
     for key, value in rows:
@@ -85,10 +88,65 @@ def _info(s: Settings) -> int:
     return 0
 
 
+def _dimension(fit, method: str) -> str:
+    """F with its method, or the sentence that says it is no surface dimension."""
+    if fit.warning:
+        return f"n/a: {fit.warning} ({method})"
+    return f"{fit.fractal_dimension:.4f} ({method})"
+
+
+def _dimension_rows(dem) -> list[tuple[str, str]]:
+    """``fractal_d`` (variogram), ``spectral_d`` (same scales) and ``roughness`` rows."""
+    rows = []
+    try:
+        fit = fractal_fit(dem)
+        lo_lag, hi_lag = fit.lag_range_px
+        rows.append(("fractal_d", _dimension(
+            fit, f"locally normalised variogram, lags {lo_lag}-{hi_lag} px")))
+        rough = fit.roughness
+    except ValueError as exc:
+        rows.append(("fractal_d", f"n/a ({exc})"))
+        rough = None
+    lo, hi = MATCHED_BAND_PX
+    band = f"power-spectrum slope, wavelengths {lo:g}-{hi:g} px"
+    if not dem.known.all():
+        rows.append(("spectral_d", f"n/a (unknown pixels; fill them first) ({band})"))
+    else:
+        try:
+            rows.append(("spectral_d", _dimension(spectral_fit(dem, lo, hi), band)))
+        except ValueError as exc:
+            rows.append(("spectral_d", f"n/a ({exc})"))
+    if rough is not None:
+        rows.append(("roughness", f"{rough:.6g} (RMS neighbour slope, m/m)"))
+    return rows
+
+
+def _crater_rows(dem) -> list[tuple[str, str]]:
+    """``resolves`` (the crater resolution limit) and ``craters`` (the detector's count
+    and density), skipped on DEMs over :data:`_CRATER_COUNT_MAX_PX` pixels."""
+    limit = resolved_diameter_m(dem)
+    rows = [("resolves", f"craters from {limit:.6g} m ({RESOLVED_CRATER_PX:g} px)")]
+    if dem.heights.size > _CRATER_COUNT_MAX_PX:
+        note = f"n/a (over {_CRATER_COUNT_MAX_PX / 1e6:g} Mpx: use dem.crater_density)"
+        return [*rows, ("craters", note)]
+    top = min(_CRATER_COUNT_MAX_D_PX, min(dem.shape) / 4.0)
+    if top <= RESOLVED_CRATER_PX * 1.5:
+        return [*rows, ("craters", "n/a (the DEM is too small to count craters)")]
+    found = detect_craters(dem, max_diameter_px=top)
+    density = crater_density(dem, max_diameter_px=top)
+    text = (f"{len(found)} found of {RESOLVED_CRATER_PX:g}-{top:g} px (rim-over-floor "
+            f"detector)")
+    if density is not None:
+        text += (f"; from {density.d_lo_m:.6g} m: {density.count}, N(>D) = {density.c:.4g} "
+                 f"D^{density.k:g} (D in m, per m^2), N(>{density.d_lo_m / 1e3:.4g} km) = "
+                 f"{density.count / density.area_m2 * 1e6:.4g} per km^2")
+    return [*rows, ("craters", text)]
+
+
 def register(sub) -> None:
     """Add ``info``, ``fill`` and ``expand`` to the sub-command parser."""
     add_command(sub, "info", _info,
-                "describe a DEM (size, CRS, pixel size, heights, fractal dimension)")
+                "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)")
     add_command(sub, "fill", _transform,
                 "fill the unknown pixels of a DEM with fractal terrain, outside in")
     add_command(sub, "expand", _transform,

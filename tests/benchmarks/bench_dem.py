@@ -113,6 +113,58 @@ def bench_fill(quick):
               f"Laplacian std filled/known {laplacian_ratio(f, mask):.2f}")
 
 
+def fill_spectra(quick):
+    """The fill's spectrum against the terrain's: crosshatch and mid-scale power, new fill
+    and the paper's outside-in fill (tests/dem/test_fill.py's reference), with pictures."""
+    sys.path.insert(0, str(ROOT / "tests" / "dem"))
+    sys.path.insert(0, str(ROOT / "tests"))
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from conftest import spectral_fbm
+    from matplotlib.colors import LightSource
+    from test_fill import disc_gap, paper_fill, spectrum_ratios
+
+    crop = dem.read(CROP)
+    fbm = dem.Dem(spectral_fbm(257, 8 - 2 * 2.3, np.random.default_rng(0)) * 300.0,
+                  pixel_size_m=100.0)
+    seeds = (1,) if quick else (1, 2, 3, 4, 5, 6)
+    patch = np.s_[73:183, 73:183]
+    light = LightSource(azdeg=315, altdeg=40)
+    fig, axes = plt.subplots(2, 3, figsize=(14, 9.5))
+    for row, (name, d) in enumerate((("LOLA crop", crop), ("fBm F=2.3", fbm))):
+        gappy, _ = disc_gap(d, 80)
+        new = [dem.fill_gaps(gappy, rng=s) for s in seeds]
+        r_new = np.array([spectrum_ratios(f.heights[patch], d.heights[patch]) for f in new])
+        sigma = dem.expansion_fit(d).roughness * d.resolution_m * 0.63
+        t = time.perf_counter()
+        old = paper_fill(gappy.heights, sigma, np.random.default_rng(1))
+        t_old = time.perf_counter() - t
+        r_old = spectrum_ratios(old[patch], d.heights[patch])
+        r_self = [spectrum_ratios(d.heights[q], d.heights[patch])
+                  for q in (np.s_[0:110, 0:110], np.s_[147:257, 147:257])]
+        print(f"fill of a 160-px disc in the {name}, Nyquist diagonal/axis power and 6-12 px "
+              f"power relative to the original: new {r_new[:, 0].mean():.2f} "
+              f"({r_new[:, 0].min():.2f}-{r_new[:, 0].max():.2f}, {len(seeds)} seeds) / "
+              f"{r_new[:, 1].mean():.2f}; paper's outside-in fill {r_old[0]:.2f} / "
+              f"{r_old[1]:.2f} (numpy reference, {t_old:.1f} s); two other patches of the "
+              f"original {r_self[0][0]:.2f}, {r_self[1][0]:.2f} / {r_self[0][1]:.2f}, "
+              f"{r_self[1][1]:.2f}")
+        ex = 3.0 / np.std(np.diff(d.heights, axis=1))
+        for col, (title, z) in enumerate((("original", d.heights),
+                                          ("paper's outside-in fill", old),
+                                          ("dem.fill_gaps", new[0].heights))):
+            axes[row, col].imshow(light.hillshade(z[40:216, 40:216], vert_exag=ex),
+                                  cmap="gray", interpolation="nearest")
+            axes[row, col].set_title(f"{name}: {title}")
+    fig.tight_layout()
+    path = ROOT / "out" / "bench_fill.png"
+    path.parent.mkdir(exist_ok=True)
+    fig.savefig(path, dpi=80)
+    print(f"wrote {path}")
+
+
 def figures(quick):
     seeds = (1,) if quick else (1, 2, 3)
     for f in (2.2, 2.5, 2.8):
@@ -237,14 +289,15 @@ def bench_enhance(quick):
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
-    parser.add_argument("--only", choices=["expand", "fill", "figures", "enhance"],
+    parser.add_argument("--only", choices=["expand", "fill", "fill_spectra", "figures",
+                                           "enhance"],
                         help="run one part")
     args = parser.parse_args()
     quick = args.quick
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numba threads {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
-    parts = {"expand": bench_expand, "fill": bench_fill, "figures": figures,
-             "enhance": bench_enhance}
+    parts = {"expand": bench_expand, "fill": bench_fill, "fill_spectra": fill_spectra,
+             "figures": figures, "enhance": bench_enhance}
     for name, func in parts.items():
         if args.only in (None, name):
             func(quick)

@@ -128,7 +128,10 @@ def test_info(run_cli, capsys, lola_tif, tiny_geotiff):
     assert proc.returncode == 0, proc.stderr
     out = proc.stdout
     for needle in ("257 x 257 pixels", "Moon 2015", "7580.8", "0.25, 0, 148, 0, -0.25, 32",
-                   "unknown    0.000 %", "fractal_d  2.2", "height_m   min -6059.5"):
+                   "unknown    0.000 %", "height_m   min -6059.5",
+                   "fractal_d  2.5975 (locally normalised variogram, lags 2-8 px)",
+                   "spectral_d 2.5249 (power-spectrum slope, wavelengths 4-16 px)",
+                   "resolves   craters from 30323.3 m (4 px)", "craters    147 found of 4-64 px"):
         assert needle in out, out
     proc = InProcess(capsys)("dem", "info", str(tiny_geotiff))
     assert "EPSG:32633" in proc.stdout and "(1 pixels)" in proc.stdout
@@ -163,6 +166,8 @@ ENTRY_POINT = {"nocrs", "geographic", "allnan", "outside", "not-raster", "no-com
     ("fd-nan", ["expand", "{geo}", "-o", "{out}", "--fractal-dimension", "nan"],
      ["--fractal-dimension", "finite"]),
     ("roughness", ["fill", "{geo}", "-o", "{out}", "--roughness", "-1", *MOON], ["--roughness"]),
+    ("gap-craters", ["fill", "{geo}", "-o", "{out}", "--craters", "c=1,k=2,d_min_m=1,d_max_m=5",
+                     *MOON], ["--craters", "k"]),
     ("region-syntax", ["expand", "{geo}", "-o", "{out}", "--region", "1,2"], ["--region"]),
     ("seed", ["fill", "{geo}", "-o", "{out}", "--seed", "-4"], ["--seed"]),
     ("radius", ["fill", "{geo}", "-o", "{out}", "--body-radius-m", "0"], ["--body-radius-m"]),

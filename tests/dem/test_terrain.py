@@ -78,18 +78,9 @@ def test_slope_distribution():
     assert out["area_fraction"][8] == pytest.approx(1.0)  # the 24-27 deg bin
 
 
-def fbm_surface(n, beta, rng):
-    """Spectral synthesis: amplitude ~ f^(-beta/2), random phases."""
-    f = np.hypot(*np.meshgrid(np.fft.fftfreq(n), np.fft.fftfreq(n), indexing="ij"))
-    f[0, 0] = 1.0
-    amp = f ** (-beta / 2.0)
-    amp[0, 0] = 0.0
-    return np.fft.ifft2(amp * np.exp(2j * np.pi * rng.random((n, n)))).real
-
-
 @pytest.mark.parametrize("beta", [2.0, 2.6, 3.2, 3.8])
-def test_power_spectrum_recovers_beta(beta, rng):
-    d = Dem(fbm_surface(512, beta, rng) * 50.0, pixel_size_m=5.0)
+def test_power_spectrum_recovers_beta(beta, rng, fbm_surface):
+    d = Dem(fbm_surface(512, (8.0 - beta) / 2.0, rng) * 50.0, pixel_size_m=5.0)
     wl, psd = dem.power_spectrum(d)
     assert wl[0] > wl[-1] >= 10.0
     assert abs(dem.spectral_exponent(wl, psd) - beta) <= BETA_TOL
