@@ -26,7 +26,7 @@ import logging
 
 from .analysis import band_power, laplacian
 from .boulders import boulder_population, stamp_boulders
-from .config import EnhanceConfig
+from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
 from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
 from .craterfill import fill_crater_gaps, replace_crater
@@ -61,6 +61,7 @@ __all__ = [
     "CraterDensity",
     "Dem",
     "EnhanceConfig",
+    "SourceCraterLayer",
     "FractalFit",
     "LocalFrame",
     "SpectralFit",

@@ -23,9 +23,80 @@ from craters import (
     parse_boulder_spec,
     parse_layer_spec,
 )
-from craters._shared import about, check_choice, check_int, check_positive, check_range
+from craters._shared import (
+    ParameterError,
+    about,
+    check_choice,
+    check_int,
+    check_positive,
+    check_range,
+    parse_spec,
+)
 
-__all__ = ["EnhanceConfig"]
+__all__ = ["EnhanceConfig", "SourceCraterLayer", "parse_source_spec"]
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class SourceCraterLayer:
+    """Craters at the source DEM's own density, continued below what it resolves.
+
+    :func:`dem.enhance` measures the density of the source's craters with
+    :func:`dem.crater_density` (craters of 6 source pixels and up, N_cum = c D^-2, the
+    equilibrium slope; a lower bound, as the detector misses shallow and overlapping
+    craters) and draws a power law with that ``c`` and ``k`` from ``d_min_m`` up to the
+    source's resolution (``source_crater_px``); ages uniform in [``age_min_gyr``,
+    ``age_max_gyr``]. Spec: ``source[,d_min_m=..,age_min_gyr=..,age_max_gyr=..,
+    degradation=..,kind=..]``.
+    """
+
+    d_min_m: float = 1.0
+    """Smallest diameter, metres."""
+    age_min_gyr: float = 0.0
+    """Youngest age, Gyr."""
+    age_max_gyr: float = 3.5
+    """Oldest age, Gyr (ages uniform in between)."""
+    degradation: float | None = None
+    """Fixed degradation for every crater; None = from its age."""
+    kind: str = "source"
+    """Label in the catalogs."""
+
+    def __post_init__(self):
+        check_positive("d_min_m", self.d_min_m)
+        check_range("age_min_gyr", self.age_min_gyr, 0.0, 4.6)
+        check_range("age_max_gyr", self.age_max_gyr, 0.0, 4.6)
+        if self.age_max_gyr < self.age_min_gyr:
+            raise ParameterError("age_max_gyr", f"must be >= age_min_gyr "
+                                 f"({self.age_min_gyr}); got {self.age_max_gyr}")
+        if self.degradation is not None:
+            check_range("degradation", self.degradation, 0.0, 1.0)
+
+    def layer(self, c: float, k: float, d_max_m: float) -> CraterLayer:
+        """The power-law layer at the measured ``c`` and ``k`` up to ``d_max_m``."""
+        return CraterLayer(c, k, self.d_min_m, d_max_m, self.age_min_gyr, self.age_max_gyr,
+                           self.degradation, self.kind)
+
+
+def parse_source_spec(spec: str) -> SourceCraterLayer:
+    """``source[,d_min_m=..,age_min_gyr=..,age_max_gyr=..,degradation=..,kind=..]``.
+
+    Examples
+    --------
+    >>> parse_source_spec("source,d_min_m=2").d_min_m
+    2.0
+    """
+    head, _, rest = spec.strip().partition(",")
+    if head.strip() != "source":
+        raise ValueError(f"a source crater layer spec starts with 'source'; got {spec!r}")
+    fields = {f.name: (str if f.name == "kind" else float)
+              for f in dataclasses.fields(SourceCraterLayer)}
+    values = parse_spec(rest, fields, (), "source crater layer") if rest.strip() else {}
+    return SourceCraterLayer(**values)
+
+
+def _parse_crater_spec(spec: str):
+    if spec.strip().split(",")[0].strip() == "source":
+        return parse_source_spec(spec)
+    return parse_layer_spec(spec)
 
 # keys of ``dem enhance`` that are not part of a stack's description
 _RUN_KEYS = ("output", "force", "quiet")
@@ -54,11 +125,13 @@ class EnhanceConfig:
     """Number of layers, 1..24 (layer k has pixels 2^k finer than the base)."""
     size: int = 1025
     """Pixels per side of every layer: 2^n + 1, 5..16385."""
-    craters: tuple[str | CraterLayer | ModelAgeLayer, ...] = ()
+    craters: tuple[str | CraterLayer | ModelAgeLayer | SourceCraterLayer, ...] = ()
     """Crater layers: power laws ``c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr,age_max_gyr,
-    degradation,kind]`` (metres, Gyr; :class:`craters.CraterLayer`) or model ages
+    degradation,kind]`` (metres, Gyr; :class:`craters.CraterLayer`), model ages
     ``npf=moon,age_gyr=..,d_min_m=..,d_max_m=..[,equilibrium,degradation,kind]``
-    (:class:`craters.ModelAgeLayer`), as specs or records."""
+    (:class:`craters.ModelAgeLayer`) or the source's own density continued below its
+    resolution, ``source[,d_min_m=..,...]`` (:class:`SourceCraterLayer`), as specs or
+    records."""
     min_crater_px: float = 2.0
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
     source_crater_px: float | None = 4.0
@@ -92,7 +165,7 @@ class EnhanceConfig:
     gravity_m_s2: float | None = None
     """Surface gravity, m/s^2 (crater transition diameters scale as 1/g); default: the
     body's."""
-    crater_layers: tuple[CraterLayer | ModelAgeLayer, ...] = dataclasses.field(
+    crater_layers: tuple[CraterLayer | ModelAgeLayer | SourceCraterLayer, ...] = dataclasses.field(
         init=False, repr=False, compare=False)
     """The parsed :attr:`craters` (set when the config is made)."""
     boulder_layers: tuple[BoulderLayer, ...] = dataclasses.field(init=False, repr=False,
@@ -126,7 +199,8 @@ class EnhanceConfig:
                                  f"1025, 2049, ...); got {size}")
             put("size", size)
         for name, parse, kind, example in (
-                ("craters", parse_layer_spec, LAYER_TYPES, "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
+                ("craters", _parse_crater_spec, (*LAYER_TYPES, SourceCraterLayer),
+                 "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
                 ("boulders", parse_boulder_spec, (BoulderLayer,),
                  "c=0.01,k=-3,d_min_m=0.5,d_max_m=5")):
             with about(name):
@@ -137,7 +211,8 @@ class EnhanceConfig:
                 parsed = []
                 for spec in specs:
                     if not isinstance(spec, (str, *kind)):
-                        records = " or ".join(f"craters.{k.__name__}" for k in kind)
+                        records = " or ".join(f"{k.__module__.split('.')[0]}.{k.__name__}"
+                                              for k in kind)
                         raise TypeError(f"`{name}` must hold {name[:-1]} layer specs like "
                                         f"'{example}' or {records}; got {spec!r}")
                     parsed.append(spec if isinstance(spec, kind) else parse(spec))

@@ -43,16 +43,18 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import math
 
 import numpy as np
 from rasterio.windows import Window
 
 import craters
-from craters._shared import human_bytes, physical_memory_bytes, progress_bar
+from craters._shared import ParameterError, human_bytes, physical_memory_bytes, progress_bar
 
 from .boulders import place_boulders
-from .config import EnhanceConfig
+from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
+from .craterdensity import crater_density
 from .expansion import expand
 from .fractal import expansion_fit
 from .frame import grid_pixel_size, local_frame, pixel_affine
@@ -71,6 +73,9 @@ from .stack import Stack, propagate_up
 __all__ = ["enhance"]
 
 logger = logging.getLogger(__name__)
+
+#: Largest source area (pixels) the crater density of a ``source`` layer is measured on.
+_DENSITY_MAX_PX = 1_100_000
 
 
 # --------------------------------------------------------------------------- stamping
@@ -99,6 +104,35 @@ def below_source(layers, source_px: float | None, pixel_m: float) -> tuple:
     cap = source_px * pixel_m
     return tuple(dataclasses.replace(la, d_max_m=min(la.d_max_m, cap)) for la in layers
                  if la.d_min_m < cap)
+
+
+def _with_source_density(cfg, base: Dem, win0, p0: float):
+    """The crater layers with each :class:`~dem.config.SourceCraterLayer` made a power law
+    at the source's measured crater density (the whole base when it has at most
+    ``_DENSITY_MAX_PX`` pixels, else a window of that many around layer 0); and the
+    measurement (None without such a layer)."""
+    if not any(isinstance(la, SourceCraterLayer) for la in cfg.crater_layers):
+        return cfg.crater_layers, None
+    src = base
+    if base.shape[0] * base.shape[1] > _DENSITY_MAX_PX:
+        side = int(math.isqrt(_DENSITY_MAX_PX))
+        r = max(0, min(base.shape[0] - side, int(win0.row_off) + cfg.size // 2 - side // 2))
+        c = max(0, min(base.shape[1] - side, int(win0.col_off) + cfg.size // 2 - side // 2))
+        src = base.crop(Window(c, r, min(side, base.shape[1]), min(side, base.shape[0])))
+    density = crater_density(src)
+    if density is None:
+        raise ParameterError("craters", "'source': the source DEM shows too few craters of 6 "
+                             "pixels and up (fewer than 3 found) to measure their density; "
+                             "give a crater layer (c=..,k=.. or npf=..) instead")
+    # up to what the source resolves: source_crater_px of its pixels, else (no limit
+    # asked) the smallest crater the density was measured on
+    d_max = cfg.source_crater_px * p0 if cfg.source_crater_px else density.d_lo_m
+    layers = tuple(la.layer(density.c, density.k, max(d_max, la.d_min_m * 1.0001))
+                   if isinstance(la, SourceCraterLayer) else la for la in cfg.crater_layers)
+    logger.info("source crater density: N(>D) = %.4g D^%g per m^2 from %d craters of %.4g-%.4g "
+                "m on %.4g km^2", density.c, density.k, density.count, density.d_lo_m,
+                density.d_hi_m, density.area_m2 / 1e6)
+    return layers, density
 
 
 def crater_target(dem: Dem, body: str | None = None, gravity_m_s2: float | None = None):
@@ -219,7 +253,8 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     target = crater_target(base, cfg.body, cfg.gravity_m_s2)
     irregularity = 0.0 if cfg.smooth_craters else 0.02  # craters.stamp_many's default
     reach_radii = craters.DEFAULT_EJECTA_EDGE * (1.0 + irregularity)
-    crater_layers = below_source(cfg.crater_layers, cfg.source_crater_px, p0)
+    crater_layers, source_density = _with_source_density(cfg, base, win0, p0)
+    crater_layers = below_source(crater_layers, cfg.source_crater_px, p0)
     plans, accounting = plan_craters(crater_layers, geometry, min_px=cfg.min_crater_px,
                                      reach_radii=reach_radii, seed=seed)
     with_rocks = bool(cfg.boulder_layers)
@@ -273,6 +308,10 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
                    "world_pixel_centre": [float(v) for v in layer0.xy(*t0)]},
         "layer0_window_in_base": [int(win0.row_off), int(win0.col_off), cfg.size],
         "craters": accounting,
+        "source_crater_density": None if source_density is None else {
+            "c": source_density.c, "k": source_density.k, "count": source_density.count,
+            "area_m2": source_density.area_m2, "d_lo_m": source_density.d_lo_m,
+            "d_hi_m": source_density.d_hi_m},
         "boulders": rock_accounting,
         "randomness": "numpy SeedSequence(seed, spawn_key=(1, band)) for the population of "
                       "each diameter band, (2, band) and (3,) for the rejected counts, "

@@ -155,9 +155,10 @@ OPTIONS: tuple[Opt, ...] = (
         "age_max_gyr=..,degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = "
         "c D^k per m^2, D in metres, ages in Gyr) or a model age npf=moon,age_gyr=..,"
         "d_min_m=..,d_max_m=..[,equilibrium=trask|hartmann,degradation=..,kind=..] "
-        "(craters.ModelAgeLayer: the body's production function and chronology); repeat "
-        "for several. Each layer's crater count is also written as craters_NN.scc "
-        "(craterstats)", (_ENHANCE,),
+        "(craters.ModelAgeLayer: the body's production function and chronology) or "
+        "source[,d_min_m=..,age_min_gyr=..,age_max_gyr=..] (the source DEM's own crater "
+        "density, measured, continued below what it resolves); repeat for several. Each "
+        "layer's crater count is also written as craters_NN.scc (craterstats)", (_ENHANCE,),
         "none", kind="append", metavar="SPEC"),
     Opt(("--source-crater-px",), "source_crater_px", _number, _E["source_crater_px"],
         "synthetic craters stay below this many source (layer-0) pixels: the source's own "

@@ -334,6 +334,36 @@ def test_synthetic_craters_stay_below_the_source_resolution(base, stack):
     assert free.catalogs[0]["diameter_m"].max() > cap
 
 
+def test_source_layer_continues_the_sources_own_crater_density(lola_crop):
+    """``source``: the density of the source's craters (dem.crater_density) drawn below
+    what the source resolves."""
+    st = dem.enhance({"layers": 3, "size": 65, "seed": 4, "target": [180.0, 0.0],
+                      "craters": ["source,d_min_m=5000"]}, dem=lola_crop)
+    measured = dem.crater_density(lola_crop)
+    got = st.info["source_crater_density"]
+    assert got["c"] == measured.c and got["k"] == -2.0 and got["count"] >= 30
+    cats = [c for c in st.catalogs if len(c)]
+    every = np.concatenate([c["diameter_m"] for c in cats])
+    assert every.max() < 4 * lola_crop.resolution_m and every.min() >= 5000.0
+    assert {k for c in cats for k in c["kind"]} == {"source"}
+
+
+@pytest.mark.parametrize("spec,match", [
+    ("source,k=-2", "allowed keys: d_min_m"),
+    ("source,d_min_m=-1", "d_min_m"),
+    ("sources", "unknown item|allowed keys"),
+])
+def test_bad_source_specs(base, spec, match):
+    with pytest.raises(ValueError, match=match):
+        dem.enhance({"layers": 2, "size": 65, "seed": 1, "craters": [spec]}, dem=base)
+
+
+def test_source_layer_on_a_craterless_base_says_so():
+    flat = dem.Dem(np.random.default_rng(0).normal(0, 0.01, (129, 129)), pixel_size_m=10.0)
+    with pytest.raises(ValueError, match="too few craters"):
+        dem.enhance({"layers": 2, "size": 65, "seed": 1, "craters": ["source"]}, dem=flat)
+
+
 def test_unknown_pixels_in_layer0_are_refused(base):
     z = np.array(base.heights)
     z[60, 60] = np.nan
