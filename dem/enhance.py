@@ -57,7 +57,7 @@ from .core import Dem
 from .craterdensity import crater_density
 from .expansion import expand
 from .fractal import expansion_fit
-from .frame import grid_pixel_size, local_frame, pixel_affine
+from .frame import crater_target, grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .planning import (
     STREAM_STAMP,
@@ -133,27 +133,6 @@ def _with_source_density(cfg, base: Dem, win0, p0: float):
                 "m on %.4g km^2", density.c, density.k, density.count, density.d_lo_m,
                 density.d_hi_m, density.area_m2 / 1e6)
     return layers, density
-
-
-def crater_target(dem: Dem, body: str | None = None, gravity_m_s2: float | None = None):
-    """The craters' target body on ``dem``: ``body`` if given, else the body its CRS names
-    (Moon, Mars, Mercury ...; e.g. IAU_2015:30100 is the Moon), else the Moon.
-
-    Examples
-    --------
-    >>> crater_target(Dem(np.zeros((3, 3)), pixel_size_m=1.0)).name
-    'moon'
-    """
-    if body is None:
-        label = "" if dem.crs is None else dem.crs.to_wkt().lower()
-        iau = {"iau_2015:301": "moon", "iau_2015:499": "mars", "iau_2015:199": "mercury",
-               "iau_2015:399": "earth"}
-        body = next((name for name in craters.TARGETS if name in label), None)
-        if body is None:
-            auth = dem.crs.to_authority() if dem.crs is not None else None
-            code = ":".join(auth).lower() if auth else ""
-            body = next((v for k, v in iau.items() if code.startswith(k)), "moon")
-    return craters.get_target(body, gravity_m_s2=gravity_m_s2)
 
 
 def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: StackGeometry, k: int, *,
@@ -235,7 +214,7 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
                          f"{human_bytes(physical_memory_bytes())}")
     base = dem if dem is not None else read(cfg.input, band=cfg.band,
                                             pixel_size_m=cfg.pixel_size_m,
-                                            body_radius_m=cfg.body_radius_m)
+                                            body_radius_m=cfg.body_radius_m, body=cfg.body)
     seed = cfg.seed  # checked by the config
     if seed is None:
         seed = int(np.random.SeedSequence().entropy % 2**63)

@@ -34,12 +34,13 @@ import re
 import numpy as np
 from affine import Affine
 
+import craters
 from craters._shared import check_finite, check_positive
 
 from .core import Dem, crs_label
 
-__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "grid_affine", "grid_pixel_size",
-           "local_frame", "pixel_affine", "resolve_frame", "world_to_lonlat"]
+__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "crater_target", "grid_affine",
+           "grid_pixel_size", "local_frame", "pixel_affine", "resolve_frame", "world_to_lonlat"]
 
 #: Largest relative difference of the two pixel sides (and cosine of the angle between
 #: them) accepted for stamping craters into a DEM.
@@ -231,3 +232,24 @@ def body_axes_m(crs, body_radius_m: float | None = None):
     a, rf = float(m.group(1)), float(m.group(2))
     b = a if rf == 0 else a * (1.0 - 1.0 / rf)
     return (a, a, b)
+
+
+def crater_target(dem: Dem, body: str | None = None, gravity_m_s2: float | None = None):
+    """The craters' target body on ``dem``: ``body`` if given, else the body its CRS names
+    (Moon, Mars, Mercury ...; e.g. IAU_2015:30100 is the Moon), else the Moon.
+
+    Examples
+    --------
+    >>> crater_target(Dem(np.zeros((3, 3)), pixel_size_m=1.0)).name
+    'moon'
+    """
+    if body is None:
+        label = "" if dem.crs is None else dem.crs.to_wkt().lower()
+        iau = {"iau_2015:301": "moon", "iau_2015:499": "mars", "iau_2015:199": "mercury",
+               "iau_2015:399": "earth"}
+        body = next((name for name in craters.TARGETS if name in label), None)
+        if body is None:
+            auth = dem.crs.to_authority() if dem.crs is not None else None
+            code = ":".join(auth).lower() if auth else ""
+            body = next((v for k, v in iau.items() if code.startswith(k)), "moon")
+    return craters.get_target(body, gravity_m_s2=gravity_m_s2)

@@ -31,7 +31,8 @@ on the part of the gap a crater of that size fits in and is lower near the gap's
 Ages are uniform in 0..3.5 Gyr with the craters package's degradation for their age.
 The craters are drawn from a generator keyed by (seed, level, the gap's global
 position), so a crop that holds the gap stamps the same ones. Their shape is
-``craters.stamp_many``'s (the craters package's morphology for the Moon).
+``craters.stamp_many``'s, on the body the DEM's CRS names (``dem.frame.crater_target``;
+the Moon without one) or the ``target`` given.
 
 Measured (``tests/benchmarks/bench_craterdensity.py``): a 160-px disc cut from the LOLA
 crop gets 34-42 craters (c = 0.043 from 55 craters found around it); the detector
@@ -53,6 +54,7 @@ from craters._shared import about
 
 from .core import Dem
 from .craterdensity import RESOLVED_CRATER_PX, CraterDensity, crater_density
+from .frame import crater_target
 
 __all__ = ["gap_crater_layer", "stamp_gap_craters"]
 
@@ -82,7 +84,8 @@ def gap_crater_layer(spec):
                     f"got {type(spec).__name__}")
 
 
-def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key: int):
+def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key: int,
+                      target=None):
     """Stamp craters into one filled gap of ``z`` in place; returns (catalog, note).
 
     ``sl`` is the gap's bounding box in ``z``, ``hole`` its mask there, ``layer`` "auto"
@@ -138,6 +141,7 @@ def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key:
     local.update(x_m=cat["x_m"] / dx * pixel, y_m=cat["y_m"] / dy * pixel)
     block = z[r0:r1, c0:c1]
     out, stamped = craters.stamp_many(block, pixel, craters.make_catalog(**local), rng=gen,
+                                      target=crater_target(dem) if target is None else target,
                                       return_catalog=True)
     block[hole] = out[hole]
     stamped["x_m"] = (stamped["x_m"] / pixel + c0) * dx

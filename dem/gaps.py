@@ -83,7 +83,7 @@ _COARSEST_SWEEPS = 10
 
 def fill_gaps(dem: Dem, roughness: float | None = None, *,
               fractal_dimension: float | None = None, craters="auto", rng=None,
-              return_catalog: bool = False):
+              target=None, return_catalog: bool = False):
     """Fill the unknown (NaN) pixels of ``dem`` with fractal terrain that meets the rims.
 
     See the module docstring: each hole gets ``sigma N + L[z - sigma N]`` (fBm noise
@@ -109,6 +109,9 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
         given density, None for none (see :mod:`dem.gapcraters`).
     rng : int, numpy.random.Generator or None
         Seed of the counter-based noise and of the craters.
+    target : str or craters.Target, optional
+        The craters' body (morphology, diffusivity); default: the body the DEM's CRS
+        names, else the Moon (:func:`dem.frame.crater_target`).
     return_catalog : bool
         Also return the catalog of the craters stamped (``x_m, y_m`` from the centre of
         pixel (0, 0) along columns and rows, and ``craters.stamp_many``'s columns).
@@ -160,7 +163,7 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
         for sl, hole in holes:
             _fill_hole(z, dem, sl, hole, amp, roughness, fractal_dimension, key)
             if layer is not None:
-                cat, note = stamp_gap_craters(z, dem, sl, hole, layer, key)
+                cat, note = stamp_gap_craters(z, dem, sl, hole, layer, key, target)
                 if note is not None:
                     notes.append(note)
                 if cat is not None:

@@ -18,6 +18,7 @@ from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.profiles import DefaultGTiffProfile
 
+from craters import get_target
 from craters._shared import about, atomic_path, check_int, parameter_of
 
 from ._pds import Quantity, find_object, parse_label
@@ -50,7 +51,8 @@ _SIMPLE_CYLINDRICAL = ("SIMPLE CYLINDRICAL", "SIMPLE_CYLINDRICAL", "EQUIRECTANGU
 
 
 # --------------------------------------------------------------------------- read
-def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = None) -> Dem:
+def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = None,
+         body: str | None = None) -> Dem:
     """Read a DEM: a GeoTIFF (or any raster GDAL reads) or a PDS3 ``.IMG``/``.LBL`` pair.
 
     NoData pixels become NaN; the band's scale and offset are applied; the CRS,
@@ -76,6 +78,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         Body radius in metres, required for a geographic CRS unless a PDS label or the
         ``CRATERFORM_BODY_RADIUS_M`` tag of a file craterform wrote gives it (an explicit
         value wins).
+    body : str, optional
+        A body of :data:`craters.TARGETS` (``moon``, ``mars`` ...): its mean radius when
+        neither ``body_radius_m`` nor the file gives one (a geographic CRS needs it).
 
     Returns
     -------
@@ -108,6 +113,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         except ValueError:
             logger.warning("%s: ignoring malformed %s/%s tags", path, RADIUS_TAG,
                            PIXEL_SIZE_TAG)
+    if body_radius_m is None and body is not None and crs is not None and crs.is_geographic:
+        body_radius_m = get_target(body).radius_m
     if not np.isfinite(heights).any():
         raise ValueError(f"{str(path)!r}: every pixel is NoData/NaN; there is no terrain to "
                          f"work with")

@@ -211,12 +211,13 @@ OPTIONS: tuple[Opt, ...] = (
         "body radius in metres, for inputs with a geographic CRS (e.g. 1737400 for the Moon)",
         _READ, "from the file's tags or PDS label", metavar="M"),
     Opt(("--body",), "body", str, None,
-        "target body of the craters (morphology, transition diameters, diffusivity)",
-        (_ENHANCE,), "the body the DEM's CRS names, else moon", metavar="NAME",
+        "the DEM's body: the craters' target (morphology, transition diameters, "
+        "diffusivity) and, for a geographic CRS the file gives no radius for, its mean "
+        "radius", _READ, "the body the DEM's CRS names, else moon", metavar="NAME",
         choices=("moon", "mars", "mercury", "earth", "ceres", "vesta")),
     Opt(("--gravity-m-s2",), "gravity_m_s2", _number, None,
-        "surface gravity, m/s^2: crater transition diameters scale as 1/g", (_ENHANCE,),
-        "the body's", metavar="G"),
+        "surface gravity, m/s^2: crater transition diameters scale as 1/g",
+        (_ENHANCE, _FILL), "the body's", metavar="G"),
     Opt(("--method",), "method", str, "horn", "slope estimator", (_SLOPES,),
         choices=("horn", "central")),
     Opt(("--bin-deg",), "bin_deg", _number, 3.0, "histogram bin, degrees (0.01..90)",
@@ -324,7 +325,8 @@ def check_output(s: Settings, suffixes) -> Path:
 def read_input(s: Settings, path=None):
     """Read the input DEM (or ``path``) with the band, pixel size and body radius options."""
     return read(s["input"] if path is None else path, band=s.get("band", 1),
-                pixel_size_m=s["pixel_size_m"], body_radius_m=s["body_radius_m"])
+                pixel_size_m=s["pixel_size_m"], body_radius_m=s["body_radius_m"],
+                body=s.get("body"))
 
 
 # --------------------------------------------------------------------------- parsers

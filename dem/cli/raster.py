@@ -10,6 +10,7 @@ from ..core import crs_label
 from ..craterdensity import RESOLVED_CRATER_PX, crater_density, detect_craters, resolved_diameter_m
 from ..expansion import expand
 from ..fractal import fractal_fit
+from ..frame import crater_target
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
 from ..terrain import MATCHED_BAND_PX, spectral_fit
@@ -42,8 +43,9 @@ def _transform(s: Settings) -> int:
     bar.update()
     bar.set_description(command)
     if command == "fill":
+        target = crater_target(dem, s.get("body"), s.get("gravity_m_s2"))
         out = fill_gaps(dem, s["roughness"], fractal_dimension=s["fractal_dimension"],
-                        craters=s["craters"], rng=seed)
+                        craters=s["craters"], rng=seed, target=target)
     else:
         out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
                      rng=seed, progress=show)

@@ -143,6 +143,13 @@ def test_gap_craters_options_and_determinism(lola_crop):
     note = given.history[-1]["parameters"]["crater_density"][0]
     assert note["source"] == "given" and len(cat) == note["stamped"] > 5
     assert cat["diameter_m"].min() >= 5 * r and cat["diameter_m"].max() <= 20 * r
+    # the craters take the DEM's body (the Moon here) or the one given: on Mars (g 2.3x
+    # the Moon's) the same 38-150 km craters are complex and shallower
+    assert set(cat["morphology"]) <= {"transitional", "complex", "peak-ring"}
+    _, mars = dem.fill_gaps(gappy, craters=f"c=0.05,k=-2,d_min_m={5 * r},d_max_m={20 * r}",
+                            rng=2, return_catalog=True, target="mars")
+    assert np.array_equal(mars["diameter_m"], cat["diameter_m"])
+    assert (mars["depth_m"] < cat["depth_m"]).mean() > 0.9
     none, empty = dem.fill_gaps(gappy, craters="none", rng=2, return_catalog=True)
     assert len(empty) == 0 and np.array_equal(none.heights, plain.heights)
     with pytest.raises(ValueError, match="crater layer"):

@@ -85,6 +85,11 @@ def test_geographic_needs_radius_unless_craterform_wrote_it(tmp_path, lola_crop)
     assert np.array_equal(back.heights, lola_crop.heights)
     assert back.tags["PDS_PRODUCT_ID"] == "LDEM_4_CROP"
     assert dem.read(p, body_radius_m=1.0).body_radius_m == 1.0  # explicit value wins
+    # a body name gives its mean radius where the file gives none, never over the file's
+    assert dem.read(foreign, body="mars").body_radius_m == 3_389_500.0
+    assert dem.read(p, body="mars").body_radius_m == 1737400.0
+    with pytest.raises(ValueError, match="body"):
+        dem.read(foreign, body="titan")
 
 
 def test_read_errors(tmp_path, tiny_geotiff):
