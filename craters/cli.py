@@ -77,9 +77,16 @@ def _cmd_profile(args) -> int:
     if args.plot:
         _plot_profiles(args.plot, d, target, x, h, m)
     if not args.quiet:
-        print(f"D = {d:g} m on {target.name} ({m['morphology']}), {state}: depth "
+        when = (f"{args.age_gyr:g} Gyr old" if args.age_gyr is not None
+                else "fresh" if not args.degradation else f"degradation {args.degradation:g}")
+        shape = ""
+        if m["floor_diameter_m"] > 0:
+            shape += f", floor {m['floor_diameter_m']:.4g} m wide when fresh"
+        if m["peak_height_m"] > 0:
+            shape += f", peak {m['peak_height_m']:.4g} m"
+        print(f"D = {d:g} m on {target.name} ({m['morphology']}), {when}: depth "
               f"{m['depth_m']:.4g} m (d/D {m['depth_diameter']:.3f}), rim height "
-              f"{m['rim_height_m']:.4g} m, degradation {m['degradation']:.3f}")
+              f"{m['rim_height_m']:.4g} m, degradation {m['degradation']:.3f}{shape}")
     return 0
 
 
