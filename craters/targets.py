@@ -37,7 +37,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
-from ._shared import ParameterError, check_choice, check_positive
+from ._shared import ParameterError, check_choice, check_positive, check_range
 
 __all__ = ["TARGETS", "Target", "get_target", "small_body"]
 
@@ -159,10 +159,13 @@ TARGETS: dict[str, Target] = {
 }
 
 
-def small_body(radius_m: float, density_kg_m3: float = 2000.0) -> Target:
+def small_body(radius_m: float, density_kg_m3: float = 2000.0,
+               depth_ratio: float = 0.2) -> Target:
     """A generic small body: surface gravity ``4/3 pi G rho R`` of a sphere of that size
-    and bulk density, asteroid fresh craters (d/D = 0.2, rim/depth as Pike's lunar
-    simple craters), transition and peak-ring diameters by 1/g from the Moon's.
+    and bulk density, asteroid fresh craters (d/D = ``depth_ratio``, default 0.2 (Marchi et
+    al. 2015); rim/depth as Pike's lunar simple craters), transition and peak-ring
+    diameters by 1/g from the Moon's. A measured body's own d/D goes in ``depth_ratio``,
+    e.g. Bennu 0.10 +- 0.03 for craters >= 10 m (Daly et al. 2020, GRL 47, e2020GL089672).
 
     Examples
     --------
@@ -172,16 +175,19 @@ def small_body(radius_m: float, density_kg_m3: float = 2000.0) -> Target:
     """
     r = check_positive("radius_m", radius_m)
     rho = check_positive("density_kg_m3", density_kg_m3)
+    dd = check_range("depth_ratio", depth_ratio, 0.01, 0.5)
     g = 4.0 / 3.0 * math.pi * G_NEWTON * rho * r
-    return _from_moon("small-body", r, g, "Marchi et al. 2015 d/D; 1/g scaling",
-                      simple_depth=(0.200, 1.0), simple_rim=(0.200 * 0.036 / 0.196, 1.0))
+    source = ("Marchi et al. 2015 d/D" if dd == 0.2 else f"d/D = {dd:g}") + "; 1/g scaling"
+    return _from_moon("small-body", r, g, source,
+                      simple_depth=(dd, 1.0), simple_rim=(dd * 0.036 / 0.196, 1.0))
 
 
 def get_target(body: str | Target = "moon", *, gravity_m_s2: float | None = None,
-               radius_m: float | None = None, density_kg_m3: float | None = None) -> Target:
+               radius_m: float | None = None, density_kg_m3: float | None = None,
+               depth_ratio: float | None = None) -> Target:
     """A target by name (:data:`TARGETS` or ``small-body``), optionally under another
     gravity. ``small-body`` needs ``radius_m`` (and takes ``density_kg_m3``, default
-    2000) unless ``gravity_m_s2`` is given.
+    2000, and the fresh ``depth_ratio``, default 0.2) unless ``gravity_m_s2`` is given.
 
     Examples
     --------
@@ -198,7 +204,11 @@ def get_target(body: str | Target = "moon", *, gravity_m_s2: float | None = None
                 raise ParameterError("body", "small-body needs {} (or {})",
                                      see=("radius_m", "gravity_m_s2"))
             target = small_body(radius_m if radius_m is not None else 1000.0,
-                                density_kg_m3 if density_kg_m3 is not None else 2000.0)
+                                density_kg_m3 if density_kg_m3 is not None else 2000.0,
+                                depth_ratio if depth_ratio is not None else 0.2)
+        elif depth_ratio is not None:
+            raise ParameterError("depth_ratio", f"applies to small-body only (the {body}'s "
+                                 "crater depths follow its published laws)")
         else:
             target = TARGETS[body]
     if gravity_m_s2 is not None:

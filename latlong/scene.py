@@ -50,7 +50,8 @@ __all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
 
 # flat setting -> (part, field) of the scene; a part's error is shown under the setting
 _BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch",
-         "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3"}
+         "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3",
+         "crater_depth_ratio": "crater_depth_ratio"}
 _FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
              "smooth_width_m": "smooth_width_m", "smooth_passes": "smooth_passes",
              "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
@@ -191,7 +192,8 @@ class Scene:
             return _craters.get_target(b.target, gravity_m_s2=b.gravity_m_s2)
         radius = b.radius_m * float(np.prod(b.stretch)) ** (1.0 / 3.0)
         return _craters.get_target("small-body", radius_m=radius, density_kg_m3=b.density_kg_m3,
-                                   gravity_m_s2=b.gravity_m_s2)
+                                   gravity_m_s2=b.gravity_m_s2,
+                                   depth_ratio=b.crater_depth_ratio)
 
     @property
     def backend(self) -> str:

@@ -84,6 +84,9 @@ class BodySettings:
     """Surface gravity, m/s^2 (default: the target's; a small body's from its size)."""
     density_kg_m3: float = 2000.0
     """Bulk density of a small body, kg/m^3."""
+    crater_depth_ratio: float | None = None
+    """Fresh crater depth/diameter of a small body, [0.01, 0.5]; default 0.2 (Marchi et
+    al. 2015); e.g. Bennu 0.10 (Daly et al. 2020)."""
 
     def __post_init__(self):
         _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
@@ -92,6 +95,12 @@ class BodySettings:
             _set(self, "gravity_m_s2", check_positive("gravity_m_s2", self.gravity_m_s2))
         _set(self, "density_kg_m3", check_range("density_kg_m3", self.density_kg_m3,
                                                 10.0, 30_000.0))
+        if self.crater_depth_ratio is not None:
+            if self.target != "small-body":
+                raise ParameterError("crater_depth_ratio", f"applies to small-body only (the "
+                                     f"{self.target}'s crater depths follow its published laws)")
+            _set(self, "crater_depth_ratio", check_range("crater_depth_ratio",
+                                                         self.crater_depth_ratio, 0.01, 0.5))
         check_memory(self.magnitude)
         if self.radius_m is not None:
             _set(self, "radius_m", check_positive("radius_m", self.radius_m))

@@ -88,6 +88,9 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "body's)"),
     Opt(("--density-kg-m3",), "density_kg_m3", float,
         "bulk density of a small body, kg/m^3 (its gravity from its size)"),
+    Opt(("--crater-depth-ratio",), "crater_depth_ratio", float,
+        "fresh crater depth/diameter on a small body, 0.01-0.5 (default: 0.2, Marchi et al. "
+        "2015; Bennu's measured 0.10)"),
     Opt(("--seed",), "seed", parse_seed,
         "random seed (non-negative integer); default: a fresh one, recorded in the model"),
     # two-phase faulting

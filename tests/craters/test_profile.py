@@ -86,6 +86,22 @@ def test_transition_scales_as_one_over_g():
     assert small.transition_m > 1e6 and craters.morphology_class(50e3, small) == "simple"
 
 
+def test_small_body_depth_ratio_sets_fresh_depth_and_keeps_rim_share():
+    """Bennu's measured d/D = 0.10 (Daly et al. 2020) halves the depth and the rim of the
+    default d/D = 0.2 (Marchi et al. 2015); only small bodies take it."""
+    default, bennu = craters.small_body(245.0, 1190.0), craters.small_body(245.0, 1190.0, 0.1)
+    for d in (2.0, 10.0, 60.0):
+        m0 = craters.crater_morphometry(d, target=default)
+        m1 = craters.crater_morphometry(d, target=bennu)
+        assert m0["depth_m"] / d == pytest.approx(0.2, rel=1e-12)
+        assert m1["depth_m"] / d == pytest.approx(0.1, rel=1e-12)
+        assert m1["rim_height_m"] / m0["rim_height_m"] == pytest.approx(0.5, rel=1e-12)
+    with pytest.raises(ValueError, match="depth_ratio"):
+        craters.small_body(245.0, 1190.0, 0.9)
+    with pytest.raises(ValueError, match="depth_ratio.*small-body only"):
+        craters.get_target("moon", depth_ratio=0.1)
+
+
 # --------------------------------------------------------------------------- diffusion
 def explicit_radial_diffusion(r, h, tau, n_steps=None):
     """Independent reference: explicit finite differences of dh/dt = lap h in polar
