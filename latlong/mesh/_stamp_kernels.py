@@ -106,10 +106,11 @@ def _frame(n0, n1, n2):
 
 
 @njit(cache=True)
-def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv, diam, tabs,
-                       depths, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
-                       gain, cos_tilt, mark, gdist, epoch, out_scale, out_slope, out_centre,
-                       out_normal, out_maxdh, out_nvert, out_spacing, out_state):
+def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv, vertical,
+                       diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,
+                       full_deg, rough, gain, cos_tilt, mark, gdist, epoch, out_scale,
+                       out_slope, out_centre, out_normal, out_maxdh, out_nvert, out_spacing,
+                       out_state):
     """Stamp craters in the given order (oldest first), moving ``pos`` (and adding the
     change to ``heights``).
 
@@ -120,8 +121,9 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
     in that frame (x, y in the plane, h along up); the region refused (``out_state`` 2)
     when one of its faces inside the reach turns more than the tilt limit from up (the
     surface there is no height field over the crater's plane: a fold, a thin edge);
-    then the base quadric, the local height grid, slope erosion against the radial
-    direction from the origin (``out_state`` 1 = erased on steep ground) and the
+    then the base quadric, the local height grid, slope erosion against the crater's
+    vertical ``vertical[c]`` (unit, against gravity; ``out_state`` 1 = erased on steep
+    ground) and the
     crater written as on the lat/long body (:mod:`latlong._crater_kernels`).
     ``epoch`` (one-element array) counts gathers for the ``mark`` work array.
     """
@@ -257,15 +259,18 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
                 if known[gi, gj]:
                     grid[gi, gj] /= num[gi, gj]
         local = _fill_holes(grid, known)
-        # slope: the fitted base's normal against the radial direction from the origin
+        # slope: the fitted base's normal against the crater's vertical (-gravity)
         l0 = up[0] - gx * e0 - gy * n0
         l1 = up[1] - gx * e1 - gy * n1
         l2 = up[2] - gx * e2 - gy * n2
-        cr0 = l1 * pc2 - l2 * pc1
-        cr1 = l2 * pc0 - l0 * pc2
-        cr2 = l0 * pc1 - l1 * pc0
+        v0 = vertical[c, 0]
+        v1 = vertical[c, 1]
+        v2 = vertical[c, 2]
+        cr0 = l1 * v2 - l2 * v1
+        cr1 = l2 * v0 - l0 * v2
+        cr2 = l0 * v1 - l1 * v0
         slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
-                                      l0 * pc0 + l1 * pc1 + l2 * pc2))
+                                      l0 * v0 + l1 * v1 + l2 * v2))
         out_slope[c] = slope
         out_spacing[c] = sp
         if slope_erosion and slope >= full_deg:
@@ -289,3 +294,26 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
         out_scale[c] = scale
         out_maxdh[c] = big
         out_nvert[c] = keep
+
+
+@njit(cache=True, parallel=True)
+def _point_mass_kernel(points, centres, masses, soft, out):
+    """Softened point-mass attraction sum_j m_j d_j / (|d_j|^2 + soft)^1.5 (d_j = centre j
+    - point; G = density = 1) at every point; each point's row is its own (any thread
+    count gives the same sums, added in the same order)."""
+    for p in prange(points.shape[0]):
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        for j in range(centres.shape[0]):
+            d0 = centres[j, 0] - points[p, 0]
+            d1 = centres[j, 1] - points[p, 1]
+            d2 = centres[j, 2] - points[p, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2 + soft
+            w = masses[j] / (r2 * np.sqrt(r2))
+            g0 += w * d0
+            g1 += w * d1
+            g2 += w * d2
+        out[p, 0] = g0
+        out[p, 1] = g1
+        out[p, 2] = g2

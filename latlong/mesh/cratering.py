@@ -14,11 +14,11 @@ from craters.profile import DEFAULT_EJECTA_EDGE
 from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
 from craters.targets import Target
 
-from ._stamp_kernels import _stamp_mesh_kernel
+from ._stamp_kernels import _point_mass_kernel, _stamp_mesh_kernel
 from .surface import MeshSurface, lat_lon_deg
 from .topology import TriangleGrid, adjacency, face_normals
 
-__all__ = ["mesh_crater_population", "sample_mesh_points", "stamp_mesh_craters"]
+__all__ = ["down_directions", "mesh_crater_population", "sample_mesh_points", "stamp_mesh_craters"]
 
 logger = logging.getLogger(__name__)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
@@ -41,6 +41,41 @@ def sample_mesh_points(vertices, faces, n: int, rng) -> tuple[np.ndarray, np.nda
 def _points(vertices, faces, face, uv) -> np.ndarray:
     a, b, c = (vertices[faces[face, k]] for k in range(3))
     return a + uv[:, :1] * (b - a) + uv[:, 1:] * (c - a)
+
+
+def down_directions(vertices, faces, points, *, block: int = 32) -> np.ndarray:
+    """Unit directions of the self-gravity of a constant-density closed mesh at
+    ``points`` (n, 3), for slope erosion where "downhill" is not towards the centre
+    (Itokawa's neck, the ends of an elongated body).
+
+    The body is the signed sum of the tetrahedra (origin, a, b, c) of its faces
+    (volume-integral decomposition of a polyhedron, e.g. Werner & Scheeres 1997, sect.
+    2); the tetrahedra of ``block`` consecutive faces (a compact patch of a refined
+    mesh) are lumped into two point masses, their positive and their negative parts, at
+    their volume centroids. The near field of such lumps is approximate (a few
+    degrees at a lump's own distance): enough to tell a wall from a floor, not a
+    gravity model (that is :func:`latlong.gravity`'s job).
+    """
+    v = np.asarray(vertices, dtype=np.float64)
+    f = np.asarray(faces, dtype=np.int64)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    vol = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
+    cen = (a + b + c) / 4.0
+    group = np.arange(len(f)) // block
+    masses, centres = [], []
+    for part in (vol > 0, vol < 0):
+        w = np.where(part, vol, 0.0)
+        m = np.bincount(group, weights=w)
+        mc = np.stack([np.bincount(group, weights=w * cen[:, k]) for k in range(3)], 1)
+        ok = m != 0
+        masses.append(m[ok])
+        centres.append(mc[ok] / m[ok, None])
+    m, q = np.concatenate(masses), np.ascontiguousarray(np.concatenate(centres))
+    p = np.ascontiguousarray(np.asarray(points, dtype=np.float64).reshape(-1, 3))
+    soft = float((np.abs(vol).sum() / len(f) * block) ** (2.0 / 3.0))  # a lump's size^2
+    g = np.empty_like(p)
+    _point_mass_kernel(p, q, m, soft, g)
+    return g / np.linalg.norm(g, axis=1, keepdims=True)
 
 
 def mesh_crater_population(surface: MeshSurface, layers, *, rng=None) -> np.ndarray:
@@ -80,8 +115,10 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
     plane and its height along up. Then as on the lat/long body
     (:func:`latlong.stamp_craters`, Martin 2014 V.A): a quadric base fitted to the
     obliterated region, a local height grid at the local vertex spacing for the rim
-    offsets, slope erosion (the base's normal against the radial direction from the
-    origin), the profile of :func:`craters.stamping_profiles` (fresh morphology by size
+    offsets, slope erosion (the base's normal against the vertical: the direction of
+    the body's constant-density self-gravity at the centre, :func:`down_directions`,
+    not the radial direction, which on a body that is not star-shaped can lie along the
+    surface), the profile of :func:`craters.stamping_profiles` (fresh morphology by size
     on ``target``, diffusion degradation by age), irregular rim and roughness; vertices
     move along up by their height change. A crater whose region holds a face turned
     more than ``max_tilt_deg`` from up (a fold or an edge within its reach: no height
@@ -134,6 +171,7 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
     faces = np.ascontiguousarray(surface.faces)
     centres = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
     face_of, uv, _ = TriangleGrid.build(pos, faces).closest(centres)
+    vertical = -down_directions(pos, faces, _points(pos, faces, face_of, uv))
     voff, vnbr, foff, fids = adjacency(faces, len(pos))
     prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
@@ -152,11 +190,11 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
     for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
         e = min(s + step, n)
         _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of[s:e], uv[s:e],
-                           diam[s:e], prof.tables[s:e], prof.depth_m[s:e], rim_tabs[s:e],
-                           seeds[s:e], ejecta_edge, bool(slope_erosion), onset, full, rough_arr,
-                           gain, cos_tilt, mark, gdist, epoch, scale[s:e], outs["slope"][s:e],
-                           centre[s:e], normal[s:e], outs["maxdh"][s:e], outs["nvert"][s:e],
-                           outs["sp"][s:e], state[s:e])
+                           vertical[s:e], diam[s:e], prof.tables[s:e], prof.depth_m[s:e],
+                           rim_tabs[s:e], seeds[s:e], ejecta_edge, bool(slope_erosion), onset,
+                           full, rough_arr, gain, cos_tilt, mark, gdist, epoch, scale[s:e],
+                           outs["slope"][s:e], centre[s:e], normal[s:e], outs["maxdh"][s:e],
+                           outs["nvert"][s:e], outs["sp"][s:e], state[s:e])
     cols = {k: cat[k] for k in names}
     lat, lon = lat_lon_deg(centre)
     cols.update(as_stamped(prof, scale, diam), lat_deg=lat, lon_deg=lon, slope_deg=outs["slope"],
