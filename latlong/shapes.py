@@ -305,7 +305,7 @@ def _smoothed(model: ShapeModel, smooth: str, subdivisions: int) -> ShapeModel:
 
 def _share(fraction: float) -> str:
     """A fraction in words that never rounds a non-zero share to "0.00 %"."""
-    return f"{fraction:.2%}" if fraction >= 1e-3 else f"{fraction:.2g}"
+    return f"{fraction:.2%}" if fraction >= 1e-3 else f"{100 * fraction:.2g}%"
 
 
 def from_shape_model(model, magnitude: int, *, units: str | None = None,

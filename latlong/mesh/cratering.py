@@ -147,7 +147,7 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
         raise TypeError(f"`surface` must be a MeshSurface; got {type(surface).__name__}")
     if surface.boulders is not None and len(surface.boulders):
         raise ValueError("`surface` has placed boulders: stamp the craters first, then place "
-                         "the boulders (latlong.place_mesh_boulders)")
+                         "the boulders (latlong.mesh.place_mesh_boulders)")
     cat = _craters.sort_oldest_first(_craters.validate_catalog(catalog))
     names = cat.dtype.names
     if not all(k in names for k in ("centre_x_m", "centre_y_m", "centre_z_m")):

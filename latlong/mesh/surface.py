@@ -4,8 +4,8 @@ The mesh path cratering real shape models of any topology (not star-shaped:
 Itokawa's neck, a comet's two lobes): the model is moved so that its volume centroid
 (the centre of mass at constant density) is the origin, refined to the requested
 spacing (:func:`latlong.mesh.refine_mesh`), optionally given fBm detail along its
-normals, then cratered (:func:`latlong.stamp_mesh_craters`) and strewn with boulders
-(:func:`latlong.place_mesh_boulders`). Outputs are meshes (PLY, OBJ, STL, VTP, VTK, glTF
+normals, then cratered (:func:`latlong.mesh.stamp_mesh_craters`) and strewn with boulders
+(:func:`latlong.mesh.place_mesh_boulders`). Outputs are meshes (PLY, OBJ, STL, VTP, VTK, glTF
 binary through the shared writers, boulders merged with a per-vertex ``boulder_id``),
 catalogs and pictures; slopes through :func:`latlong.mesh_slopes`.
 """
@@ -60,9 +60,9 @@ class MeshSurface:
     """(V,) metres each vertex moved along the local up axes since the refined model
     (fBm detail, craters), read-only."""
     craters: np.ndarray | None = None
-    """The crater catalog as stamped (:func:`latlong.stamp_mesh_craters`) or None."""
+    """The crater catalog as stamped (:func:`latlong.mesh.stamp_mesh_craters`) or None."""
     boulders: np.ndarray | None = None
-    """The boulders as placed (:func:`latlong.place_mesh_boulders`) or None."""
+    """The boulders as placed (:func:`latlong.mesh.place_mesh_boulders`) or None."""
     metadata: dict = dataclasses.field(default_factory=dict)
     """JSON-serialisable description: source, centre, refinement, seed, parameters."""
 
@@ -97,7 +97,7 @@ class MeshSurface:
         if ("vertices" in changes and "boulders" not in changes and self.boulders is not None
                 and len(self.boulders)):
             raise ValueError("the surface moves but it has placed boulders: pass `boulders` "
-                             "too (None, or placed again with latlong.place_mesh_boulders)")
+                             "too (None, or placed again with latlong.mesh.place_mesh_boulders)")
         return dataclasses.replace(self, **changes)
 
     # ------------------------------------------------------------------ measures
