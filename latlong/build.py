@@ -27,7 +27,7 @@ from .scene import Scene
 from .settings import ShapeBase, SphereBase
 from .shapes import from_shape_model
 
-__all__ = ["build"]
+__all__ = ["build", "mesh_spacing_m"]
 
 GENERATOR = "craterform latlong build"
 
@@ -47,8 +47,12 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
                   "amplitude_m": base.amplitude_m}
         return perlin_fbm(grid, *params.values(), rng=rng), body.radius_m, params
     assert isinstance(base, ShapeBase)
-    shaped = from_shape_model(base.model, grid.magnitude, center=base.center,
-                              crossings=base.crossings, smooth=base.smooth)
+    try:
+        shaped = from_shape_model(base.model, grid.magnitude, center=base.center,
+                                  crossings=base.crossings, smooth=base.smooth)
+    except ParameterError as exc:  # the scene's names (settings)
+        raise exc.renamed(f"shape_{exc.name}" if exc.name in ("crossings", "center")
+                          else exc.name) from None
     params = {"frequency": base.detail_frequency, "octaves": base.detail_octaves,
               "persistence": base.detail_persistence, "lacunarity": base.detail_lacunarity,
               "amplitude_m": base.detail_amplitude_m}
@@ -71,6 +75,9 @@ def build(scene: Scene, *, progress: bool = False):
     Body
         For the lat/long backend: the base, then the craters (``body.craters``, the
         catalog as stamped), then the boulders (``body.boulders``, as placed).
+    latlong.mesh.MeshSurface
+        For a shape base with ``surface="mesh"``: the model refined to the spacing
+        (:func:`mesh_spacing_m`), then fBm detail, craters and boulders on its own mesh.
     latlong.implicit.ImplicitSurface
         For the implicit backend (``.to_body(magnitude)`` casts it onto a grid).
 
@@ -85,25 +92,14 @@ def build(scene: Scene, *, progress: bool = False):
         raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
     if scene.implicit is not None:
         return _build_implicit(scene, progress)
+    if isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh":
+        return _build_mesh(scene, progress)
     grid = LatLongGrid(scene.body.magnitude)
     rng = np.random.default_rng(scene.seed)
     heights, radius_m, params = _base_heights(scene, grid, rng, progress)
     craters, boulders = scene.craters, scene.boulders
     target = scene.target()
-    metadata = {
-        "generator": GENERATOR,
-        "version": package_version(),
-        "seed": scene.seed,
-        "base": scene.base.name,
-        "preset": scene.preset,
-        "parameters": params,
-        "craters": [dataclasses.asdict(la) for la in craters.layers],
-        "body": scene.body.target,
-        "gravity_m_s2": target.gravity_m_s2,
-        "crater_roughness": craters.roughness,
-        "boulders": [dataclasses.asdict(la) for la in boulders.layers],
-        "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
-    }
+    metadata = _metadata(scene, params)
     body = Body.from_heights(grid, radius_m, heights, stretch=scene.body.stretch,
                              metadata=metadata)
     if craters.layers:
@@ -117,6 +113,71 @@ def build(scene: Scene, *, progress: bool = False):
         found = boulder_population(body, boulders.layers, rng=rng)
         body = body.replace(boulders=place_boulders(body, found, shape=boulders.shape))
     return body
+
+
+def _metadata(scene: Scene, params: dict) -> dict:
+    craters, boulders, target = scene.craters, scene.boulders, scene.target()
+    return {
+        "generator": GENERATOR,
+        "version": package_version(),
+        "seed": scene.seed,
+        "base": scene.base.name,
+        "preset": scene.preset,
+        "parameters": params,
+        "craters": [dataclasses.asdict(la) for la in craters.layers],
+        "body": scene.body.target,
+        "gravity_m_s2": target.gravity_m_s2,
+        "crater_roughness": craters.roughness,
+        "boulders": [dataclasses.asdict(la) for la in boulders.layers],
+        "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
+    }
+
+
+def mesh_spacing_m(scene: Scene) -> float:
+    """The refined mesh's mean edge of a ``surface="mesh"`` shape base: its
+    ``spacing_m``, else the lat/long grid's spacing at the scene's magnitude,
+    (pi / 2) R / M (R the model's volume-equivalent radius)."""
+    base = scene.base
+    if base.spacing_m is not None:
+        return base.spacing_m
+    return 0.5 * np.pi * base.radius_m / scene.body.magnitude
+
+
+def _build_mesh(scene: Scene, progress: bool):
+    """A shape base cratered on its own refined mesh (:mod:`latlong.mesh`)."""
+    from .mesh import (
+        mesh_boulder_population,
+        mesh_crater_population,
+        mesh_surface,
+        place_mesh_boulders,
+        stamp_mesh_craters,
+        with_detail,
+    )
+
+    base, rng = scene.base, np.random.default_rng(scene.seed)
+    params = {"frequency": base.detail_frequency, "octaves": base.detail_octaves,
+              "persistence": base.detail_persistence, "lacunarity": base.detail_lacunarity,
+              "amplitude_m": base.detail_amplitude_m}
+    try:
+        surf = mesh_surface(base.model, mesh_spacing_m(scene), center=base.center,
+                            smooth=base.smooth)
+    except ParameterError as exc:
+        raise exc.renamed({"center": "shape_center", "smooth": "shape_smooth"}.get(
+            exc.name, exc.name)) from None
+    params["shape"] = dict(surf.metadata)
+    surf = surf.replace(metadata={**surf.metadata, **_metadata(scene, params),
+                                  "surface": "mesh"})
+    if base.detail_amplitude_m:
+        surf = with_detail(surf, *list(params.values())[:5], rng=rng)
+    craters, boulders = scene.craters, scene.boulders
+    if craters.layers:
+        cat = mesh_crater_population(surf, craters.layers, rng=rng)
+        surf = stamp_mesh_craters(surf, cat, roughness=craters.roughness, rng=rng,
+                                  progress=progress, target=scene.target())
+    if boulders.layers:
+        found = mesh_boulder_population(surf, boulders.layers, rng=rng)
+        surf = surf.replace(boulders=place_mesh_boulders(surf, found, shape=boulders.shape))
+    return surf
 
 
 def _build_implicit(scene: Scene, progress: bool):

@@ -57,7 +57,8 @@ _FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
              "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
 _FBM = {k: k for k in ("frequency", "octaves", "persistence", "lacunarity", "amplitude_m")}
 _SHAPE = {"shape_units": "units", "shape_center": "center", "shape_crossings": "crossings",
-          "shape_smooth": "smooth", **{k: f"detail_{k}" for k in _FBM}}
+          "shape_smooth": "smooth", "surface": "surface", "spacing_m": "spacing_m",
+          **{k: f"detail_{k}" for k in _FBM}}
 _CRATERS = {"craters": "layers", "crater_roughness": "roughness",
             "max_crater_extent_deg": "max_extent_deg"}
 _BOULDER_SHAPE = {"boulder_flatten": "flatten", "boulder_elongation": "elongation",
@@ -241,7 +242,8 @@ def _preview(given: dict) -> PreviewSettings:
     return _part(PreviewSettings, _PREVIEW, given)
 
 
-_SHAPE_ONLY = ("shape_units", "shape_center", "shape_crossings", "shape_smooth")
+_SHAPE_ONLY = ("shape_units", "shape_center", "shape_crossings", "shape_smooth", "surface",
+               "spacing_m")
 _GROUPS = {"faulting": tuple(_FAULTING), "fbm": tuple(_FBM), "shape:PATH": _SHAPE_ONLY}
 _GROUPS_OF_BASE = {"faulting": ("faulting",), "fbm": ("fbm",), "sphere": (),
                    "shape": ("fbm", "shape:PATH")}

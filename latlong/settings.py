@@ -28,13 +28,15 @@ from .grid import LatLongGrid
 from .shapes import ShapeModel, read_shape_model
 
 __all__ = ["BASES", "BYTES_PER_VERTEX", "BodySettings", "BoulderSettings", "CraterSettings",
-           "ImplicitSettings", "ShapeBase", "SphereBase", "check_memory"]
+           "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase", "check_memory"]
 
 #: Names of the base shapes (``shape`` takes a model file).
 BASES = ("sphere", "faulting", "fbm", "shape")
 #: Memory per vertex of a build with export (radii, unit vectors, vertices, caches).
 BYTES_PER_VERTEX = 160
 CROSSINGS = ("error", "outermost", "innermost")
+#: Where a shape base is cratered: the lat/long grid or the model's own mesh.
+SURFACES = ("latlong", "mesh")
 
 
 def check_memory(magnitude: int) -> None:
@@ -158,6 +160,13 @@ class ShapeBase:
     """fBm detail frequency ratio per octave."""
     detail_amplitude_m: float = 0.0
     """fBm detail height scale, metres (0 = no detail)."""
+    surface: str = "latlong"
+    """``latlong``: ray-cast onto the lat/long grid (the body must be star-shaped from
+    the centre); ``mesh``: cratered on the model's own refined mesh (:mod:`latlong.mesh`;
+    any closed shape, e.g. Itokawa's neck)."""
+    spacing_m: float | None = None
+    """Mean edge of the refined mesh with ``surface="mesh"``, metres; default: the
+    lat/long grid's spacing at the scene's magnitude, (pi / 2) R / M."""
     name = "shape"
 
     def __post_init__(self):
@@ -171,6 +180,14 @@ class ShapeBase:
                 raise ParameterError("model", f"{self.model}: {exc}") from None
         check_choice("crossings", self.crossings, CROSSINGS)
         check_choice("smooth", self.smooth, ("butterfly", "linear", "loop", "none"))
+        check_choice("surface", self.surface, SURFACES)
+        if self.surface == "mesh" and self.smooth not in ("butterfly", "linear"):
+            raise ParameterError("smooth", f"must be butterfly or linear with {{}} mesh; got "
+                                 f"{self.smooth!r}", see=("surface",))
+        if self.spacing_m is not None:
+            if self.surface != "mesh":
+                raise ParameterError("spacing_m", "applies to {} mesh", see=("surface",))
+            _set(self, "spacing_m", check_positive("spacing_m", self.spacing_m))
         _set(self, "center", _center(self.center))
         if self.detail_frequency is None:
             _set(self, "detail_frequency", self.radius_m / self.model.mean_edge_m)

@@ -13,7 +13,7 @@ from pathlib import Path
 import craters
 from craters._shared import check_output_path, human_bytes, progress_bar
 from craters._shared.cli import CliError
-from latlong import EXPORT_SUFFIXES, Scene, build, render_preview
+from latlong import EXPORT_SUFFIXES, Scene, ShapeBase, build, render_preview
 from latlong.implicit import MESH_SUFFIXES
 from latlong.surface import band_areas
 
@@ -21,7 +21,14 @@ from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, sho
 
 __all__ = ["add_build_parser"]
 
-_SUFFIXES = {"latlong": (".npz", *EXPORT_SUFFIXES), "implicit": (".npz", *MESH_SUFFIXES)}
+_SUFFIXES = {"latlong": (".npz", *EXPORT_SUFFIXES), "implicit": (".npz", *MESH_SUFFIXES),
+             "mesh": MESH_SUFFIXES}
+
+
+def _kind(scene: Scene) -> str:
+    """latlong, implicit or mesh (a shape base cratered on its own mesh)."""
+    mesh = isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh"
+    return "mesh" if mesh else scene.backend
 
 
 def _settings(args) -> tuple[dict, dict, set]:
@@ -42,6 +49,9 @@ def _check_outputs(scene: Scene, run: dict) -> list[str]:
         raise CliError("--boulder-catalog does not apply to --backend implicit")
     if not outputs and not extras:
         raise CliError("nothing to write: give -o/--output, --catalog or --preview")
+    if _kind(scene) == "mesh" and any(str(x).lower().endswith(".npz") for x in outputs):
+        raise CliError("--surface mesh writes meshes (" + " ".join(MESH_SUFFIXES) + "), not "
+                       ".npz (a lat/long body)")
     if scene.backend == "latlong":
         if extras.get("catalog") and not scene.craters.layers:
             raise CliError("--catalog needs crater layers (--craters or a cratered --preset)")
@@ -55,7 +65,7 @@ def _check_outputs(scene: Scene, run: dict) -> list[str]:
         seen.add(key)
     force = bool(run.get("force"))
     for x in outputs:
-        check_output_path(x, force=force, suffixes=_SUFFIXES[scene.backend])
+        check_output_path(x, force=force, suffixes=_SUFFIXES[_kind(scene)])
     suffixes = {"preview": (".png",), "catalog": (".csv", ".scc")}
     for k, x in extras.items():
         check_output_path(x, force=force, suffixes=suffixes.get(k, (".csv",)))
@@ -110,6 +120,18 @@ def _write_implicit(surf, scene: Scene, run: dict, done) -> None:
         done()
 
 
+def _write_mesh(surf, run: dict, progress: bool, done) -> None:
+    for out in run.get("output") or []:
+        surf.save(out, progress=progress)
+        done()
+    if run.get("catalog"):
+        _write_craters(surf.craters, run, area_m2=surf.area_m2, axes_m=None)
+        done()
+    if run.get("boulder_catalog"):
+        craters.write_catalog(surf.boulders, run["boulder_catalog"])
+        done()
+
+
 def _summary(made, scene: Scene) -> str:
     if scene.backend == "implicit":
         meta = made.metadata
@@ -118,6 +140,14 @@ def _summary(made, scene: Scene) -> str:
                 f"{pk['spheres']} spheres (coverage {pk['coverage']:.1%}), "
                 f"{len(made.catalog)} craters, seed {scene.seed}, volume "
                 f"{made.volume_m3 / meta['constraint_volume_m3']:.3f} x the constraint's")
+    if _kind(scene) == "mesh":
+        meta = made.metadata
+        skipped = meta.get("craters_skipped_no_height_field", 0)
+        n_craters = 0 if made.craters is None else len(made.craters)
+        n_boulders = 0 if made.boulders is None else len(made.boulders)
+        return (f"mesh surface: {made.n_vertices} vertices, {len(made.faces)} triangles (mean "
+                f"edge {meta['mean_edge_m']:.3g} m), {n_craters} craters ({skipped} left out "
+                f"on folds), {n_boulders} boulders, seed {scene.seed}")
     r = made.radii_m
     n_craters = 0 if made.craters is None else len(made.craters)
     return (f"body: magnitude {made.magnitude}, {made.n_vertices} vertices, base "
@@ -139,10 +169,12 @@ def cmd_build(args) -> int:
     bar.update()
     if scene.backend == "implicit":
         _write_implicit(made, scene, run, bar.update)
+    elif _kind(scene) == "mesh":
+        _write_mesh(made, run, show, bar.update)
     else:
         _write_body(made, run, show, bar.update)
     if run.get("preview"):
-        view = made.to_pyvista() if scene.backend == "implicit" else made
+        view = made if _kind(scene) == "latlong" else made.to_pyvista()
         render_preview(view, run["preview"], scene.preview)
         bar.update()
     bar.close()

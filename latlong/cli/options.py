@@ -114,7 +114,14 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "shape"),
     Opt(("--shape-smooth",), "shape_smooth", str,
         "subdivision before casting: butterfly (interpolating), linear (keep the facets), "
-        "loop, none", "shape"),
+        "loop, none (--surface mesh: butterfly or linear)", "shape"),
+    Opt(("--surface",), "surface", str,
+        "where a shape model is cratered: latlong (ray-cast onto the lat/long grid; the "
+        "model must be star-shaped from its centre) or mesh (its own refined triangle "
+        "mesh: any closed shape, e.g. Itokawa; outputs .ply .obj .stl .vtp .vtk .glb)",
+        "shape"),
+    Opt(("--spacing-m",), "spacing_m", float,
+        "mean edge of the refined mesh with --surface mesh, metres", "shape"),
     # fBm
     Opt(("--frequency",), "frequency", float,
         "first-octave frequency on the unit sphere (with a shape base: fBm detail, "
@@ -225,6 +232,8 @@ def _default_text(opt: Opt) -> str:
                                                                                   "none")
     value = SETTING_DEFAULTS.get(opt.key)
     if value is None:
+        if opt.key == "spacing_m":
+            return "the lat/long spacing at --magnitude, (pi/2) R / M"
         return "the preset's / base's" if opt.group in ("faulting", "fbm", "body") else "none"
     if isinstance(value, tuple):
         return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value) or "none"

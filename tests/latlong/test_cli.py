@@ -329,7 +329,8 @@ def test_shape_model_base(run_cli, tmp_path):
     itokawa = data / "itokawa_32.obj"
     for args, needles in (
             ([f"shape:{itokawa}"], ["--shape-units"]),
-            ([f"shape:{itokawa}", "--shape-units", "km"], ["not star-shaped", "%"]),
+            ([f"shape:{itokawa}", "--shape-units", "km"],
+             ["--shape-crossings", "not star-shaped", "%", "--surface mesh"]),
             ([f"shape:{itokawa}", "--shape-units", "km", "--shape-crossings", "outermost",
               "--craters", "c=0.1,k=-2,d_min_m=5,d_max_m=40"], ["--craters", "resolution"]),
             ([f"shape:{itokawa}", "--shape-units", "km", "--radius-m", "5"],

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -384,7 +385,7 @@ def test_same_seed_same_surface():
     assert not np.array_equal(a.catalog["diameter_m"], c.catalog["diameter_m"][:len(a.catalog)])
 
 
-def test_projection_onto_a_latlong_body():
+def test_projection_onto_a_latlong_body(caplog):
     model = read_shape_model(DATA / "bennu_radar_sbgat.obj", units="km")
     bare = implicit_surface(model, target_polygons=30_000, rng=2)
     body = bare.to_body(60)  # the metaball Bennu is star-shaped from its centroid
@@ -392,8 +393,11 @@ def test_projection_onto_a_latlong_body():
     assert mean_surface_distance(body, bare.to_pyvista(), rng=0) < bare.metadata["voxel_m"]
     surf = implicit_surface(model, [LcsnLayer("table-a1-300m-0gyr", 30, 60, probability=0.3)],
                             target_polygons=30_000, rng=2)
-    with pytest.raises(ValueError, match="not star-shaped"):  # rims on steep lumps fold
+    # rims on steep lumps fold over 2 of 21602 directions: below 1 in 10^4, accepted
+    # with a warning that counts them (the outermost crossing kept)
+    with caplog.at_level(logging.WARNING, logger="latlong.shapes"):
         surf.to_body(60)
+    assert "2 of 21602 grid directions" in caplog.text
     body = surf.to_body(60, crossings="outermost")
     assert len(body.craters) == len(surf.catalog) > 10
     assert 0 < body.metadata["non_star_fraction"] < 0.02

@@ -1,0 +1,319 @@
+"""Numba kernels for stamping craters on a triangle mesh via local height grids.
+
+The lat/long body's method (Martin 2014 V.A; :mod:`latlong._crater_kernels`) on any
+closed mesh: the crater's region is gathered over the mesh's own edges (geodesic reach,
+so the other side of a thin part or of a neck is never touched), mapped to a local frame
+whose up axis is the surface normal averaged over the obliterated region, and the
+crater is evaluated at every vertex with its true distance in that frame. Vertices move
+along the frame's up axis, so their positions in the frame's plane stay where they are
+and no triangle of the region turns over.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from craters.kernels import (
+    fbm2,
+    outer_weight,
+    rim_offsets,
+    roughness_amp,
+    roughness_octaves,
+    slope_factor,
+    table,
+    table_value,
+)
+from latlong._crater_kernels import PARALLEL_MIN, _fill_holes, _fit_quadric_points, _quadric
+
+from ._kernels import _geodesic_gather
+
+#: Graph distance over straight-line distance allowed when gathering a region: mesh
+#: paths are up to ~15 % longer than geodesics, and the walls of older craters make the
+#: surface up to ~30 % longer than its footprint in the crater's plane.
+GATHER_FACTOR = 1.6
+
+
+@njit(cache=True)
+def _write_range(lo, hi, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tab, scale,
+                 depth, xe, rim_tab, delta, quad, rough, seed, wavelength, octaves, gain,
+                 dh_out):
+    """Move gathered vertices lo..hi-1 along ``up`` by their height change (each vertex
+    written once)."""
+    p0, gx, gy, qa, qb, qc = quad[0], quad[1], quad[2], quad[3], quad[4], quad[5]
+    for q in range(lo, hi):
+        x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
+        dh = 0.0
+        if x < xe:
+            if x <= 1.0:
+                new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+                       + scale * table_value(tab, x, xe))
+            else:
+                new = (hgt[q] + scale * table_value(tab, x, xe)
+                       + table(delta, az[q]) * outer_weight(x, xe))
+            if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
+                amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
+                new += amp * fbm2(seed, xl[q], yl[q], wavelength, octaves, gain)
+            dh = new - hgt[q]
+            i = idx[q]
+            pos[i, 0] += dh * up[0]
+            pos[i, 1] += dh * up[1]
+            pos[i, 2] += dh * up[2]
+            heights[i] += dh
+        dh_out[q] = dh
+
+
+@njit(cache=True, parallel=True)
+def _write_parallel(pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tab, scale, depth,
+                    xe, rim_tab, delta, quad, rough, seed, wavelength, octaves, gain, dh_out):
+    """:func:`_write_range` over disjoint blocks of vertices in parallel."""
+    n = idx.shape[0]
+    block = 4096
+    for b in prange((n + block - 1) // block):
+        _write_range(b * block, min(n, (b + 1) * block), pos, heights, idx, dist, az, xl, yl,
+                     hgt, up, radius, tab, scale, depth, xe, rim_tab, delta, quad, rough, seed,
+                     wavelength, octaves, gain, dh_out)
+
+
+@njit(cache=True)
+def _face_normal_sum(pos, faces, f, acc):
+    a = faces[f, 0]
+    b = faces[f, 1]
+    c = faces[f, 2]
+    u0 = pos[b, 0] - pos[a, 0]
+    u1 = pos[b, 1] - pos[a, 1]
+    u2 = pos[b, 2] - pos[a, 2]
+    v0 = pos[c, 0] - pos[a, 0]
+    v1 = pos[c, 1] - pos[a, 1]
+    v2 = pos[c, 2] - pos[a, 2]
+    acc[0] = u1 * v2 - u2 * v1
+    acc[1] = u2 * v0 - u0 * v2
+    acc[2] = u0 * v1 - u1 * v0
+
+
+@njit(cache=True)
+def _frame(n0, n1, n2):
+    """(east, north) completing the up axis n: east = z x n (x x n near the poles)."""
+    if abs(n2) < 0.9:
+        e0, e1, e2 = -n1, n0, 0.0
+    else:
+        e0, e1, e2 = 0.0, -n2, n1
+    en = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    e0 /= en
+    e1 /= en
+    e2 /= en
+    return e0, e1, e2, n1 * e2 - n2 * e1, n2 * e0 - n0 * e2, n0 * e1 - n1 * e0
+
+
+@njit(cache=True)
+def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv, vertical,
+                       diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,
+                       full_deg, rough, gain, cos_tilt, mark, gdist, epoch, out_scale,
+                       out_slope, out_centre, out_normal, out_maxdh, out_nvert, out_spacing,
+                       out_state):
+    """Stamp craters in the given order (oldest first), moving ``pos`` (and adding the
+    change to ``heights``).
+
+    Per crater: its centre on the current surface (face ``face_of[c]`` at ``uv[c]``);
+    the vertices within graph distance GATHER_FACTOR x (reach + 2 spacings) of it; the
+    local spacing from the vertex count inside the reach; the up axis = the area-
+    weighted normal of the faces around the obliterated region; every vertex's position
+    in that frame (x, y in the plane, h along up); the region refused (``out_state`` 2)
+    when one of its faces inside the reach turns more than the tilt limit from up (the
+    surface there is no height field over the crater's plane: a fold, a thin edge);
+    then the base quadric, the local height grid, slope erosion against the crater's
+    vertical ``vertical[c]`` (unit, against gravity; ``out_state`` 1 = erased on steep
+    ground) and the
+    crater written as on the lat/long body (:mod:`latlong._crater_kernels`).
+    ``epoch`` (one-element array) counts gathers for the ``mark`` work array.
+    """
+    n_rim = rim_tabs.shape[1]
+    delta = np.empty(n_rim)
+    seed_v = np.empty(3, np.int64)
+    seed_d = np.empty(3)
+    acc = np.empty(3)
+    up = np.empty(3)
+    quad = np.empty(6)
+    for c in range(diam.shape[0]):
+        f = face_of[c]
+        u = uv[c, 0]
+        v = uv[c, 1]
+        pc0 = 0.0
+        pc1 = 0.0
+        pc2 = 0.0
+        for k in range(3):
+            w = (1.0 - u - v) if k == 0 else (u if k == 1 else v)
+            vk = faces[f, k]
+            pc0 += w * pos[vk, 0]
+            pc1 += w * pos[vk, 1]
+            pc2 += w * pos[vk, 2]
+        edge = 0.0
+        for k in range(3):
+            a = faces[f, k]
+            b = faces[f, (k + 1) % 3]
+            d0 = pos[a, 0] - pos[b, 0]
+            d1 = pos[a, 1] - pos[b, 1]
+            d2 = pos[a, 2] - pos[b, 2]
+            edge += np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) / 3.0
+            seed_v[k] = a
+            d0 = pos[a, 0] - pc0
+            d1 = pos[a, 1] - pc1
+            d2 = pos[a, 2] - pc2
+            seed_d[k] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        radius = 0.5 * diam[c]
+        rho_max = 0.0
+        for k in range(n_rim):
+            rho_max = max(rho_max, rim_tabs[c, k])
+        reach = xe * radius * (1.0 + rho_max)
+        epoch[0] += 1
+        cand, gd = _geodesic_gather(pos, voff, vnbr, seed_v, seed_d,
+                                    GATHER_FACTOR * (reach + 2.0 * edge) + edge, mark, gdist,
+                                    epoch[0])
+        cnt = cand.shape[0]
+        n_in = 0
+        for q in range(cnt):
+            if gd[q] <= reach:
+                n_in += 1
+        sp = np.sqrt(np.pi * reach * reach / n_in) if n_in >= 4 else max(edge, 0.5 * reach)
+        r_fit = max(radius, 2.0 * sp)
+        # up axis: area-weighted normal of the faces around the obliterated region
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        for q in range(cnt):
+            if gd[q] > r_fit and q >= 3:
+                continue
+            i = cand[q]
+            for t in range(foff[i], foff[i + 1]):
+                _face_normal_sum(pos, faces, fids[t], acc)
+                s0 += acc[0]
+                s1 += acc[1]
+                s2 += acc[2]
+        sn = np.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+        up[0] = s0 / sn
+        up[1] = s1 / sn
+        up[2] = s2 / sn
+        e0, e1, e2, n0, n1, n2 = _frame(up[0], up[1], up[2])
+        # positions in the crater's frame
+        limit = reach + 2.0 * sp
+        idx = np.empty(cnt, np.int64)
+        dist = np.empty(cnt)
+        az = np.empty(cnt)
+        xl = np.empty(cnt)
+        yl = np.empty(cnt)
+        hgt = np.empty(cnt)
+        keep = 0
+        n_inside = 0
+        folded = False
+        for q in range(cnt):
+            i = cand[q]
+            r0 = pos[i, 0] - pc0
+            r1 = pos[i, 1] - pc1
+            r2 = pos[i, 2] - pc2
+            x = r0 * e0 + r1 * e1 + r2 * e2
+            y = r0 * n0 + r1 * n1 + r2 * n2
+            d = np.sqrt(x * x + y * y)
+            if d > limit:
+                continue
+            if d <= reach:
+                n_inside += 1
+                for t in range(foff[i], foff[i + 1]):
+                    _face_normal_sum(pos, faces, fids[t], acc)
+                    an = np.sqrt(acc[0] * acc[0] + acc[1] * acc[1] + acc[2] * acc[2])
+                    if acc[0] * up[0] + acc[1] * up[1] + acc[2] * up[2] <= cos_tilt * an:
+                        folded = True
+            idx[keep] = i
+            dist[keep] = d
+            az[keep] = np.arctan2(y, x)
+            xl[keep] = x
+            yl[keep] = y
+            hgt[keep] = r0 * up[0] + r1 * up[1] + r2 * up[2]
+            keep += 1
+        out_centre[c, 0] = pc0
+        out_centre[c, 1] = pc1
+        out_centre[c, 2] = pc2
+        out_normal[c, 0] = up[0]
+        out_normal[c, 1] = up[1]
+        out_normal[c, 2] = up[2]
+        if folded:
+            out_state[c] = 2
+            continue
+        if n_inside >= 4:
+            sp = np.sqrt(np.pi * reach * reach / n_inside)
+        r_fit = max(radius, 2.0 * sp)
+        p0, gx, gy, qa, qb, qc = _fit_quadric_points(xl, yl, hgt, dist, keep, r_fit)
+        quad[0], quad[1], quad[2], quad[3], quad[4], quad[5] = p0, gx, gy, qa, qb, qc
+        nh = int(np.ceil(limit / sp)) + 1
+        g = 2 * nh + 1
+        grid = np.zeros((g, g))
+        num = np.zeros((g, g))
+        for q in range(keep):
+            gi = int(np.round(yl[q] / sp)) + nh
+            gj = int(np.round(xl[q] / sp)) + nh
+            if 0 <= gi < g and 0 <= gj < g:
+                grid[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+                num[gi, gj] += 1.0
+        known = num > 0
+        for gi in range(g):
+            for gj in range(g):
+                if known[gi, gj]:
+                    grid[gi, gj] /= num[gi, gj]
+        local = _fill_holes(grid, known)
+        # slope: the fitted base's normal against the crater's vertical (-gravity)
+        l0 = up[0] - gx * e0 - gy * n0
+        l1 = up[1] - gx * e1 - gy * n1
+        l2 = up[2] - gx * e2 - gy * n2
+        v0 = vertical[c, 0]
+        v1 = vertical[c, 1]
+        v2 = vertical[c, 2]
+        cr0 = l1 * v2 - l2 * v1
+        cr1 = l2 * v0 - l0 * v2
+        cr2 = l0 * v1 - l1 * v0
+        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                      l0 * v0 + l1 * v1 + l2 * v2))
+        out_slope[c] = slope
+        out_spacing[c] = sp
+        if slope_erosion and slope >= full_deg:
+            out_state[c] = 1
+            continue
+        scale = slope_factor(slope, onset_deg, full_deg) if slope_erosion else 1.0
+        rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
+        octaves = roughness_octaves(radius, sp)
+        dh = np.empty(keep)
+        if keep >= PARALLEL_MIN:
+            _write_parallel(pos, heights, idx[:keep], dist[:keep], az[:keep], xl[:keep],
+                            yl[:keep], hgt[:keep], up, radius, tabs[c], scale, depths[c], xe,
+                            rim_tabs[c], delta, quad, rough, seeds[c], radius, octaves, gain, dh)
+        else:
+            _write_range(0, keep, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tabs[c],
+                         scale, depths[c], xe, rim_tabs[c], delta, quad, rough, seeds[c],
+                         radius, octaves, gain, dh)
+        big = 0.0
+        for q in range(keep):
+            big = max(big, abs(dh[q]))
+        out_scale[c] = scale
+        out_maxdh[c] = big
+        out_nvert[c] = keep
+
+
+@njit(cache=True, parallel=True)
+def _point_mass_kernel(points, centres, masses, soft, out):
+    """Softened point-mass attraction sum_j m_j d_j / (|d_j|^2 + soft)^1.5 (d_j = centre j
+    - point; G = density = 1) at every point; each point's row is its own (any thread
+    count gives the same sums, added in the same order)."""
+    for p in prange(points.shape[0]):
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        for j in range(centres.shape[0]):
+            d0 = centres[j, 0] - points[p, 0]
+            d1 = centres[j, 1] - points[p, 1]
+            d2 = centres[j, 2] - points[p, 2]
+            r2 = d0 * d0 + d1 * d1 + d2 * d2 + soft
+            w = masses[j] / (r2 * np.sqrt(r2))
+            g0 += w * d0
+            g1 += w * d1
+            g2 += w * d2
+        out[p, 0] = g0
+        out[p, 1] = g1
+        out[p, 2] = g2
