@@ -234,7 +234,7 @@ def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale,
 def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
                        rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                        out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
-                       out_erased, naive=False, stop_after=0):
+                       out_erased, up, naive=False, stop_after=0):
     """Stamp craters on the body in the given order (oldest first), updating ``radii``.
 
     Per crater: centre on the current surface; gather the region's vertices through the
@@ -244,7 +244,8 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
     the rim offsets; the crater evaluated at every vertex with its true distance and
     azimuth (its profile table ``tabs[c]``, scaled by the slope erosion, recorded in
     ``out_scale``; ``depths[c]`` sets the roughness amplitude); radii rescaled by the
-    height change.
+    height change. The slope for slope erosion is measured against ``up[c]`` when ``up``
+    has rows (one per crater), otherwise against the reference body's normal.
 
     Vertex directions are computed from the ring structure (no whole-grid unit-vector
     array). Benchmark switches: ``naive`` gathers by scanning every vertex of ``unit``
@@ -374,9 +375,14 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
         l0 = a0 - gx * e0v - gy * n0
         l1 = a1 - gx * e1v - gy * n1
         l2 = a2 - gx * e2v - gy * n2
-        r0 = pc0 / (stretch[0] * stretch[0])
-        r1 = pc1 / (stretch[1] * stretch[1])
-        r2 = pc2 / (stretch[2] * stretch[2])
+        if up.shape[0] > 0:  # the given "up" (e.g. against self-gravity on a shape model)
+            r0 = up[c, 0]
+            r1 = up[c, 1]
+            r2 = up[c, 2]
+        else:
+            r0 = pc0 / (stretch[0] * stretch[0])
+            r1 = pc1 / (stretch[1] * stretch[1])
+            r2 = pc2 / (stretch[2] * stretch[2])
         cr0 = l1 * r2 - l2 * r1
         cr1 = l2 * r0 - l0 * r2
         cr2 = l0 * r1 - l1 * r0

@@ -106,7 +106,9 @@ def build(scene: Scene, *, progress: bool = False):
         cat = body_population(body, craters.layers, rng=rng)
         body = stamp_craters(body, cat, roughness=craters.roughness, rng=rng,
                              progress=progress, max_extent_deg=craters.max_extent_deg,
-                             target=target, too_large="skip")
+                             target=target, too_large="skip",
+                             slope_reference="gravity" if isinstance(scene.base, ShapeBase)
+                             else "body")
         body = body.replace(metadata={**body.metadata,
                                       "craters_skipped_too_large": len(cat) - len(body.craters)})
     if boulders.layers:

@@ -35,7 +35,7 @@ from craters._shared import (
 
 from .faulting import FaultingParams
 from .perlin import FbmParams
-from .presets import DEFAULT_PRESET, PRESETS
+from .presets import DEFAULT_PRESET, PRESETS, RENAMED_PRESETS
 from .preview import PreviewSettings
 from .settings import (
     BodySettings,
@@ -254,6 +254,9 @@ def _latlong_scene(cls, given: dict) -> Scene:
     if stray:
         raise ParameterError(stray[0], "applies to {} implicit", see=("backend",))
     preset, base = given.get("preset"), given.get("base")
+    if preset in RENAMED_PRESETS:
+        raise ParameterError("preset", f"{preset!r} is now {RENAMED_PRESETS[preset]!r} (built "
+                             "from the real body's bundled shape model)")
     if preset is not None and preset not in PRESETS:
         raise ParameterError("preset", f"must be one of {', '.join(PRESETS)}; got {preset!r}")
     shape_path = None
@@ -275,6 +278,8 @@ def _latlong_scene(cls, given: dict) -> Scene:
         preset = DEFAULT_PRESET.get(base)
     p = PRESETS[preset] if preset else None
     base = p.base if p else base
+    if p is not None and p.model is not None:
+        shape_path = str(p.model_path)
     for group, keys in _GROUPS.items():
         for key in keys:
             if key in given and group not in _GROUPS_OF_BASE[base]:
@@ -291,7 +296,7 @@ def _latlong_scene(cls, given: dict) -> Scene:
     elif base == "sphere":
         part = SphereBase()
     else:
-        part = _part(ShapeBase, {**_SHAPE, "base": "model"}, {**given, "base": shape_path})
+        part = _part(ShapeBase, {**_SHAPE, "base": "model"}, {**merged, "base": shape_path})
     shape = _part(_craters.BoulderShape, _BOULDER_SHAPE, merged)
     return cls(body=body, base=part, craters=_part(CraterSettings, _CRATERS, merged),
                boulders=_part(BoulderSettings, {"boulders": "layers"}, merged, shape=shape),

@@ -55,8 +55,8 @@ STEPS: list[tuple[str, str, bool]] = [
      "-o pc.npz --catalog pc.csv -q"), False),
     ("build_preset_faulted", ("latlong build --preset faulted-cratered --magnitude 32 --seed 2 "
      "--faults-1 100 --faults-2 100 -o pf.npz -q"), False),
-    ("build_preset_bennu", ("latlong build --preset bennu-like --magnitude 40 --seed 2 "
-     "--density-kg-m3 1190 -o bn.npz -q"), False),
+    ("build_preset_bennu", ("latlong build --preset bennu --magnitude 40 --seed 2 "
+     "-o bn.npz -q"), False),
     ("build_boulders", ("latlong build --preset fbm-cratered --magnitude 48 --seed 1 "
      "--boulders c=0.002,k=-3,d_min_m=1,d_max_m=8,burial_max=0.5,near=0.3 "
      "-o rk.npz -o rk.ply -o rk.obj -o rk.vtp -o rk.glb --boulder-catalog rk.csv -q"), False),

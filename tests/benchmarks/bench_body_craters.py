@@ -38,7 +38,7 @@ def run_kernel(body, cat, prof, rng, **switches):
                        np.asarray(body.stretch), cat["lat_deg"].copy(), cat["lon_deg"].copy(),
                        cat["diameter_m"].copy(), prof.tables[:n], prof.depth_m[:n], rim, seeds,
                        3.0, True, 20.0, 45.0, np.array([0.03, 0.06, 0.05]), 2.0**-0.8, *outs,
-                       **switches)
+                       np.empty((0, 3)), **switches)
     return time.perf_counter() - t0
 
 

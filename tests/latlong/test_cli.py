@@ -286,8 +286,8 @@ def test_bad_crater_input(run_cli, tmp_path, args, needles):
 def test_presets_command(run_cli):
     proc = run_cli("latlong", "presets")
     assert proc.returncode == 0
-    for name in ("fbm-cratered", "faulted-cratered", "eros-like", "itokawa-like",
-                 "bennu-like", "paper", "fig5c"):
+    for name in ("fbm-cratered", "faulted-cratered", "eros", "itokawa", "bennu", "paper",
+                 "fig5c"):
         assert f"\n{name}\n" in "\n" + proc.stdout
     assert "craters = ['c=0.5,k=-2,d_min_m=1,d_max_m=15']" in proc.stdout
 
@@ -346,7 +346,7 @@ def test_shape_model_base(run_cli, tmp_path):
 def test_slopes_and_spectrum_commands(run_cli, tmp_path):
     data = Path(__file__).parents[1] / "data"
     model = tmp_path / "m.npz"
-    assert run_cli("latlong", "build", "--preset", "eros-like", "--magnitude", "40",
+    assert run_cli("latlong", "build", "--preset", "eros", "--magnitude", "40",
                    "--seed", "3", "-o", str(model), "-q").returncode == 0
     csv, png = tmp_path / "s.csv", tmp_path / "s.png"
     proc = run_cli("latlong", "slopes", str(model), "--compare", str(data / "eros001708.tab"),
