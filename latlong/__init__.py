@@ -46,6 +46,7 @@ from .faulting import (
     two_phase_faulting,
 )
 from .gltf import export_glb, export_vtp_strips
+from .gravity import GravityField, gravity
 from .grid import LatLongGrid
 from .implicit import (
     GaborNoise,
@@ -86,6 +87,7 @@ __all__ = [
     "EXPORT_SUFFIXES",
     "FAULTING_PRESETS",
     "FBM_PRESETS",
+    "GravityField",
     "PRESETS",
     "SETTINGS",
     "SETTING_DEFAULTS",
@@ -122,6 +124,7 @@ __all__ = [
     "export_glb",
     "export_vtp_strips",
     "facet_slopes",
+    "gravity",
     "fbm3",
     "fit_gabor",
     "fit_metaballs",

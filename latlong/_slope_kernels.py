@@ -169,3 +169,80 @@ def _cap_average_kernel(m, ring_offsets, prefix, ang, out):
                     jhi = n - 1
                 for c in range(k):
                     out[i, c] += _arc_sum(prefix, base, n, jlo, jhi, c)
+
+
+
+@njit(cache=True, inline="always")
+def _box_gap(p, lo, side):
+    """Smallest and largest distance (1-D) from ``p`` to the interval [lo, lo + side]."""
+    hi = lo + side
+    near = lo - p if p < lo else (p - hi if p > hi else 0.0)
+    far = max(abs(p - lo), abs(p - hi))
+    return near, far
+
+
+@njit(cache=True, parallel=True)
+def _direction_cap_sum_kernel(dirs, values, cells, keys, starts, cell_sums, nc, side, reach,
+                              chord2, out):
+    """Sum of ``values`` over every point's cap: the points whose unit direction lies
+    within the chord ``sqrt(chord2)`` of its own (``|d_j - d_i|^2 <= chord2``).
+
+    Points are sorted by cell of a cubic grid over [-1, 1]^3 (``nc`` cells a side of
+    ``side`` >= chord / ``reach``): ``cells`` (N, 3) each point's cell, ``keys`` the sorted
+    distinct cell keys ``(ix nc + iy) nc + iz``, ``starts`` their first points (plus N)
+    and ``cell_sums`` their sums of ``values``. Each point visits the cells within
+    ``reach`` of its own (one binary search per column: a column's cells are consecutive
+    keys): a cell wholly outside the cap is skipped, one wholly inside adds its sum, the
+    others are tested point by point. Memory O(N); every sum in a fixed order (thread-count
+    independent).
+    """
+    n = dirs.shape[0]
+    k = values.shape[1]
+    n_keys = keys.shape[0]
+    for i in prange(n):
+        acc = np.zeros(k)
+        px = dirs[i, 0]
+        py = dirs[i, 1]
+        pz = dirs[i, 2]
+        for dx in range(-reach, reach + 1):
+            cx = cells[i, 0] + dx
+            if cx < 0 or cx >= nc:
+                continue
+            nx, fx = _box_gap(px, cx * side - 1.0, side)
+            for dy in range(-reach, reach + 1):
+                cy = cells[i, 1] + dy
+                if cy < 0 or cy >= nc:
+                    continue
+                ny, fy = _box_gap(py, cy * side - 1.0, side)
+                if nx * nx + ny * ny > chord2:
+                    continue
+                base = (cx * nc + cy) * nc
+                z_hi = base + min(cells[i, 2] + reach, nc - 1)
+                s = np.searchsorted(keys, base + max(cells[i, 2] - reach, 0))
+                while s < n_keys and keys[s] <= z_hi:
+                    nz, fz = _box_gap(pz, (keys[s] - base) * side - 1.0, side)
+                    if nx * nx + ny * ny + nz * nz > chord2:
+                        s += 1
+                        continue
+                    if fx * fx + fy * fy + fz * fz <= chord2:
+                        for c in range(k):
+                            acc[c] += cell_sums[s, c]
+                        s += 1
+                        continue
+                    for j in range(starts[s], starts[s + 1]):
+                        ex = dirs[j, 0] - px
+                        ey = dirs[j, 1] - py
+                        ez = dirs[j, 2] - pz
+                        if ex * ex + ey * ey + ez * ez <= chord2:
+                            for c in range(k):
+                                acc[c] += values[j, c]
+                    s += 1
+        for c in range(k):
+            out[i, c] = acc[c]
+
+
+@njit(cache=True)
+def _scatter_add_kernel(index, values, out):
+    """``out[index[t]] += values[t]`` in the order of t (``np.add.at``, (N,) or (N, k))."""
+    for t in range(index.shape[0]):
+        out[index[t]] += values[t]

@@ -23,12 +23,22 @@ import numpy as np
 
 from craters._shared import area_slope_summary, check_int, check_range
 
-from ._slope_kernels import _cap_average_kernel, _ring_prefix_kernel, _vertex_normals_kernel
+from ._slope_kernels import (
+    _cap_average_kernel,
+    _direction_cap_sum_kernel,
+    _ring_prefix_kernel,
+    _scatter_add_kernel,
+    _vertex_normals_kernel,
+)
 from .body import Body
 from .shapes import ShapeModel
 
-__all__ = ["SLOPE_BIN_DEG", "facet_slopes", "mesh_slopes", "radius_spectrum", "slope_summary",
+__all__ = ["SLOPE_BIN_DEG", "direction_cap_sums", "facet_slopes", "mesh_slopes", "radius_spectrum",
+           "slope_summary",
            "slopes", "slopes_and_areas", "vertex_normals"]
+
+#: Cells a cap's chord spans in :func:`direction_cap_sums` (fewer point tests vs more cells).
+_CAP_REACH = 3
 
 #: The paper's histogram bins, degrees.
 SLOPE_BIN_DEG = 3.0
@@ -85,8 +95,24 @@ def slopes(body: Body, radius_deg: float = 3.0, *, weighted: bool = True) -> np.
     return slopes_and_areas(body, radius_deg, weighted=weighted)[0]
 
 
-def slopes_and_areas(body: Body, radius_deg: float = 3.0, *, weighted: bool = True):
-    """:func:`slopes` and the vertex areas (m^2) used to weight them in statistics."""
+def _down(gravity, pos: np.ndarray) -> np.ndarray:
+    """The reference "up" the slope is measured against: radial (geometric) or minus the
+    effective gravity of a :class:`~latlong.gravity.GravityField` (gravitational)."""
+    if gravity is None:
+        return pos
+    up = -np.asarray(gravity.effective_m_s2)
+    if up.shape != pos.shape:
+        raise ValueError(f"`gravity` has {len(up)} vertices; the surface has {len(pos)}")
+    return up
+
+
+def slopes_and_areas(body: Body, radius_deg: float = 3.0, *, weighted: bool = True,
+                     gravity=None):
+    """:func:`slopes` and the vertex areas (m^2) used to weight them in statistics.
+
+    With ``gravity`` (a :class:`~latlong.gravity.GravityField` of this body) the slope is
+    the angle between the cap-averaged normal and minus the effective gravity
+    (gravitational slope) instead of the radial direction (geometric slope)."""
     body = _check_body(body)
     radius_deg = check_range("radius_deg", radius_deg, 0.0, 90.0)
     normals, area = vertex_normals(body)
@@ -101,7 +127,7 @@ def slopes_and_areas(body: Body, radius_deg: float = 3.0, *, weighted: bool = Tr
         avg = np.empty((grid.n_vertices, 3))
         _cap_average_kernel(grid.magnitude, grid.ring_offsets(), prefix,
                             math.radians(radius_deg), avg)
-    return _angle_deg(avg, verts), area
+    return _angle_deg(avg, _down(gravity, verts)), area
 
 
 def facet_slopes(body: Body) -> tuple[np.ndarray, np.ndarray]:
@@ -122,21 +148,22 @@ def facet_slopes(body: Body) -> tuple[np.ndarray, np.ndarray]:
 
 
 def mesh_slopes(model: ShapeModel, radius_deg: float = 3.0, *, weighted: bool = True,
-                center="volume-centroid") -> tuple[np.ndarray, np.ndarray]:
+                center="volume-centroid", gravity=None) -> tuple[np.ndarray, np.ndarray]:
     """Per-vertex slopes (degrees) and vertex areas (m^2) of any closed mesh.
 
     The same measure as :func:`slopes`: vertex normals averaged over the vertices whose
-    directions from ``center`` lie within ``radius_deg`` (k-d tree), against the radial
-    direction from ``center``.
+    directions from ``center`` lie within ``radius_deg`` (:func:`direction_cap_sums`:
+    memory linear in the mesh size), against the radial direction from ``center`` or,
+    with ``gravity`` (its :class:`~latlong.gravity.GravityField`), against minus the
+    effective gravity.
     """
-    from scipy.spatial import cKDTree
-
     if not isinstance(model, ShapeModel):
         raise TypeError(f"`model` must be a ShapeModel; got {type(model).__name__}")
     radius_deg = check_range("radius_deg", radius_deg, 0.0, 90.0)
     if isinstance(center, str):
-        c = {"volume-centroid": model.volume_centroid, "area-centroid": model.area_centroid,
-             "origin": np.zeros(3)}.get(center)
+        c = {"volume-centroid": lambda: model.volume_centroid,
+             "area-centroid": lambda: model.area_centroid,
+             "origin": lambda: np.zeros(3)}.get(center, lambda: None)()
         if c is None:
             raise ValueError("`center` must be volume-centroid, area-centroid, origin or "
                              f"(x, y, z); got {center!r}")
@@ -144,24 +171,53 @@ def mesh_slopes(model: ShapeModel, radius_deg: float = 3.0, *, weighted: bool = 
         c = np.asarray(center, dtype=np.float64)
     v = model.vertices - c
     f = model.faces
-    a, b, cc = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
-    tri_n = 0.5 * np.cross(b - a, cc - a)
-    tri_a = np.linalg.norm(tri_n, axis=1)
+    tri_n = 0.5 * np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
+    third = np.linalg.norm(tri_n, axis=1) / 3.0
     normals = np.zeros_like(v)
     area = np.zeros(len(v))
-    for k in range(3):
-        np.add.at(normals, f[:, k], tri_n)
-        area += np.bincount(f[:, k], weights=tri_a / 3.0, minlength=len(v))
+    for k in range(3):  # np.add.at / np.bincount's order, column by column (same bytes)
+        col = np.ascontiguousarray(f[:, k])
+        _scatter_add_kernel(col, tri_n, normals)
+        part = np.zeros(len(v))
+        _scatter_add_kernel(col, third, part)
+        area += part
     normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    up = _down(gravity, v)
     if radius_deg == 0:
-        return _angle_deg(normals, v), area
+        return _angle_deg(normals, up), area
     dirs = v / np.linalg.norm(v, axis=1, keepdims=True)
     chord = 2.0 * math.sin(math.radians(radius_deg) / 2.0)
     w = normals * (area[:, None] if weighted else 1.0)
-    avg = np.zeros_like(v)
-    for i, nb in enumerate(cKDTree(dirs).query_ball_point(dirs, chord)):
-        avg[i] = w[nb].sum(axis=0)
-    return _angle_deg(avg, v), area
+    return _angle_deg(direction_cap_sums(dirs, w, chord), up), area
+
+
+def direction_cap_sums(dirs: np.ndarray, values: np.ndarray, chord: float) -> np.ndarray:
+    """Sum of ``values`` (N, k) over every point's cap: the points whose unit direction
+    (``dirs``, N x 3) lies within the chord ``chord`` of its own (distance <= chord).
+
+    Memory O(N) (a cell grid over the unit ball, no neighbour lists), so meshes of
+    millions of vertices fit: the cap sums the former k-d tree neighbour lists gave, in
+    a fixed order whatever the thread count.
+    """
+    dirs = np.ascontiguousarray(dirs, dtype=np.float64)
+    values = np.ascontiguousarray(values, dtype=np.float64)
+    reach = _CAP_REACH
+    side = max(chord * (1.0 + 1e-9) / reach, 2.0 ** -19)  # >= chord / reach; keys fit int64
+    nc = int(2.0 / side) + 1
+    cells = np.clip(np.floor((dirs + 1.0) / side), 0, nc - 1).astype(np.int64)
+    key = (cells[:, 0] * nc + cells[:, 1]) * nc + cells[:, 2]
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    values_sorted = values[order]
+    first = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    sums = np.empty_like(values)
+    _direction_cap_sum_kernel(dirs[order], values_sorted, cells[order], key[first],
+                              np.r_[first, len(key)].astype(np.int64),
+                              np.add.reduceat(values_sorted, first, axis=0), nc, side, reach,
+                              chord * chord, sums)
+    out = np.empty_like(values)
+    out[order] = sums
+    return out
 
 
 def slope_summary(slopes_deg, areas, *, bin_deg: float = SLOPE_BIN_DEG) -> dict:
@@ -181,6 +237,9 @@ def radius_spectrum(body: Body, l_max: int | None = None) -> tuple[np.ndarray, n
     ``a_lm`` of the radius (metres, distance of each vertex from the centre) with
     orthonormal harmonics, by an FFT along every ring and quadrature over the rings
     (each vertex weighted by its zone area); degrees up to ``l_max`` (default: 2M/3).
+    The relief r - R (R: the area-weighted mean radius) is transformed and the mean's
+    exact ``a_00 = R sqrt(4 pi)`` added back, so the quadrature error of the large
+    constant does not leak into the other degrees.
     Returns ``(l, S_l)``; the wavelength of degree l is ``2 pi R / sqrt(l (l + 1))``.
 
     Examples
@@ -196,8 +255,13 @@ def radius_spectrum(body: Body, l_max: int | None = None) -> tuple[np.ndarray, n
     grid = body.grid
     l_max = check_int("l_max", l_max if l_max is not None else (2 * grid.magnitude) // 3, 0,
                       2 * grid.magnitude)
-    r = np.linalg.norm(body.vertices(), axis=1)
     w = grid.vertex_areas()
+    r = np.linalg.norm(body.vertices(), axis=1)
+    # transform r - R, not r: the quadrature is not exact for the (large) constant, whose
+    # leakage would swamp the small relief's high degrees (issue 16: up to 61 % error in
+    # degrees 11-40 and spurious power above); the constant's a_00 is exact: R sqrt(4 pi)
+    mean_r = float(np.sum(w * r) / np.sum(w))
+    r = r - mean_r
     offs, sizes, theta = grid.ring_offsets(), grid.ring_sizes(), grid.ring_colatitudes()
     coeff = np.zeros((l_max + 1, l_max + 1), dtype=np.complex128)  # [l, m], m >= 0
     chunk = max(1, int(2e7 // ((l_max + 1) * (2 * l_max + 1))))
@@ -210,5 +274,6 @@ def radius_spectrum(body: Body, l_max: int | None = None) -> tuple[np.ndarray, n
             mmax = min(l_max, (n - 1) // 2) if n > 1 else 0
             ms = np.arange(mmax + 1)
             coeff[:, :mmax + 1] += plm[:, ms, k] * f[ms][None, :]
+    coeff[0, 0] += mean_r * math.sqrt(4.0 * math.pi)
     power = np.abs(coeff[:, 0]) ** 2 + 2.0 * (np.abs(coeff[:, 1:]) ** 2).sum(axis=1)
     return np.arange(l_max + 1), power

@@ -17,6 +17,7 @@ from latlong import (
     Body,
     ShapeModel,
     from_shape_model,
+    gravity,
     load,
     mesh_slopes,
     radius_spectrum,
@@ -47,10 +48,41 @@ def _labels(inputs, labels) -> list[str]:
 
 
 # --------------------------------------------------------------------------- slopes
-def _slopes_of(obj, radius_deg: float, weighted: bool):
+def _slopes_of(obj, radius_deg: float, weighted: bool, field=None):
     if isinstance(obj, Body):
-        return slopes_and_areas(obj, radius_deg, weighted=weighted)
-    return mesh_slopes(obj, radius_deg, weighted=weighted)
+        return slopes_and_areas(obj, radius_deg, weighted=weighted, gravity=field)
+    return mesh_slopes(obj, radius_deg, weighted=weighted, gravity=field)
+
+
+def _mean_radius_m(obj) -> float:
+    """Mean distance of the vertices from the centre the caps are taken around."""
+    if isinstance(obj, Body):
+        return float(np.linalg.norm(obj.vertices(), axis=1).mean())
+    return float(np.linalg.norm(obj.vertices - obj.volume_centroid, axis=1).mean())
+
+
+def _gravity_args(args):
+    """(density, period, spin axis) from the flags, or None for geometric slopes."""
+    if args.density_kg_m3 is None:
+        for flag, value in (("--period-h", args.period_h), ("--spin-axis", args.spin_axis)):
+            if value is not None:
+                raise CliError(f"{flag} needs --density-kg-m3 (gravitational slopes)")
+        return None
+    if not np.isfinite(args.density_kg_m3) or args.density_kg_m3 <= 0:
+        raise CliError(f"--density-kg-m3 must be finite and > 0; got {args.density_kg_m3}")
+    period = np.inf if args.period_h is None else args.period_h
+    if not period > 0 or np.isnan(period):
+        raise CliError(f"--period-h must be > 0; got {args.period_h}")
+    axis = (0.0, 0.0, 1.0)
+    if args.spin_axis is not None:
+        try:
+            axis = tuple(float(x) for x in args.spin_axis.split(","))
+        except ValueError:
+            axis = ()
+        if len(axis) != 3 or not np.all(np.isfinite(axis)) or not any(axis):
+            raise CliError(f"--spin-axis must be three numbers x,y,z, not all zero; got "
+                           f"{args.spin_axis!r}")
+    return args.density_kg_m3, period, axis
 
 
 def cmd_slopes(args) -> int:
@@ -58,21 +90,38 @@ def cmd_slopes(args) -> int:
     labels = _labels(inputs, args.label)
     if not 0 <= args.radius_deg <= 90 or not np.isfinite(args.radius_deg):
         raise CliError(f"--radius-deg must be in [0, 90]; got {args.radius_deg}")
+    grav = _gravity_args(args)
     check_report_outputs(args)
     objs = [_load_input(p, args.shape_units) for p in inputs]
-    results = []
+    results, baselines = [], []
     for label, obj in zip(labels, objs, strict=True):
-        s, a = _slopes_of(obj, args.radius_deg, not args.unweighted)
+        field = None if grav is None else gravity(obj, grav[0], grav[1], spin_axis=grav[2])
+        s, a = _slopes_of(obj, args.radius_deg, not args.unweighted, field)
         results.append((label, slope_summary(s, a, bin_deg=SLOPE_BIN_DEG)))
+        baselines.append(np.radians(args.radius_deg) * _mean_radius_m(obj))
+    if grav is None:
+        kind, against = "geometric", "radial"
+    else:
+        rot = "not rotating" if np.isinf(grav[1]) else (
+            f"period {grav[1]:g} h about ({','.join(f'{c:g}' for c in grav[2])})")
+        kind = "gravitational"
+        against = (f"minus the effective gravity (constant-density polyhedron, "
+                   f"{grav[0]:g} kg/m^3, {rot})")
     if args.csv:
-        slope_csv(args.csv, f"latlong slopes: {args.radius_deg:g} deg "
+        baseline = "" if grav is None else " (cap radius " + ", ".join(
+            f"{b:.4g} m" for b in baselines) + " at the mean radius)"
+        slope_csv(args.csv, f"latlong slopes: {args.radius_deg:g} deg{baseline} "
                   f"{'unweighted' if args.unweighted else 'area-weighted'} cap-averaged "
-                  "normals vs radial; bins in degrees; area fractions sum to 1; percent "
+                  f"normals vs {against}; bins in degrees; area fractions sum to 1; percent "
                   "of the area steeper than the bin's lower edge", results)
     if args.plot:
-        plot_slopes(args.plot, results, xlabel="slope (deg), 3 deg bins",
+        shown = [(f"{label} (cap {b:.3g} m)", r) for (label, r), b in
+                 zip(results, baselines, strict=True)]
+        plot_slopes(args.plot, shown, xlabel=f"{kind} slope (deg), 3 deg bins",
                     ylabel="share of the surface area (%)",
-                    title=f"slope-area histogram ({args.radius_deg:g} deg averaged normals)",
+                    title=(f"{kind} slopes: normals averaged over {args.radius_deg:g} deg "
+                           "caps\n(" + ("vs the radial direction" if grav is None
+                                        else f"vs {against}") + ")"),
                     full_range=True)
     if not args.quiet:
         print(slope_table(results))
@@ -163,6 +212,15 @@ def add_parsers(sub) -> None:
                            help="averaging cap radius, degrees of arc (default: 3)")
             p.add_argument("--unweighted", action="store_true",
                            help="plain mean of vertex normals (default: area-weighted)")
+            p.add_argument("--density-kg-m3", type=float,
+                           help="bulk density: slopes against the effective gravity of "
+                           "the constant-density polyhedron (default: none, geometric "
+                           "slopes against the radial direction)")
+            p.add_argument("--period-h", type=float,
+                           help="rotation period, hours, for the centrifugal part "
+                           "(default: none, not rotating)")
+            p.add_argument("--spin-axis", metavar="X,Y,Z",
+                           help="rotation axis in the body frame (default: 0,0,1)")
         else:
             p.add_argument("--magnitude", type=int, default=200,
                            help="grid magnitude for mesh inputs (default: 200)")

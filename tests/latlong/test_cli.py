@@ -375,3 +375,24 @@ def test_slopes_and_spectrum_commands(run_cli, tmp_path):
                                   "--label", "one", "--csv", str(tmp_path / "x.csv")),
                           "--label")
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_gravitational_slopes_command(run_cli, tmp_path):
+    data = Path(__file__).parents[1] / "data"
+    eros = str(data / "eros001708.tab")
+    csv = tmp_path / "g.csv"
+    proc = run_cli("latlong", "slopes", eros, "--shape-units", "km", "--density-kg-m3",
+                   "2670", "--period-h", "5.27", "--spin-axis", "0,0,1", "--csv", str(csv))
+    assert proc.returncode == 0, proc.stderr
+    median = float(proc.stdout.splitlines()[1].split()[1])
+    assert 4 < median < 15  # gravitational, not the ~40 deg geometric median
+    head = csv.read_text().splitlines()[0]
+    assert "effective gravity" in head and "2670 kg/m^3" in head and " m at the mean" in head
+    for args, flag in ((("--period-h", "5"), "--period-h"),
+                       (("--spin-axis", "0,0,1"), "--spin-axis"),
+                       (("--density-kg-m3", "-3"), "--density-kg-m3"),
+                       (("--density-kg-m3", "2670", "--period-h", "0"), "--period-h"),
+                       (("--density-kg-m3", "2670", "--spin-axis", "0,0"), "--spin-axis")):
+        assert_one_line_error(run_cli("latlong", "slopes", eros, "--shape-units", "km",
+                                      *args, "--csv", str(tmp_path / "x.csv")), flag)
+    assert not (tmp_path / "x.csv").exists()
