@@ -1,11 +1,11 @@
-"""A gallery of crater-saturated asteroids built from the scene presets.
+"""A gallery of the body presets beside the real shape models they are built from.
 
-Top row: an Eros-like body with a young (sparse, fresh) and an old (saturated,
-degraded) crater population, in the spirit of Li et al. 2022 Figs. A.1/A.2. Bottom row:
-Martin et al. 2014 Fig. 8's comparison of base shapes under the same kind of craters:
-Perlin fBm (``fbm-cratered``) and two-phase faulting (``faulted-cratered``). Writes
-``asteroid_gallery.png``. Environment: ``CRATERFORM_EXAMPLE_OUT`` (default ``out``) and
-``CRATERFORM_EXAMPLE_SMALL=1`` (small meshes, quick).
+Top row: the ``eros``, ``itokawa`` and ``bennu`` presets (bundled shape models, crater and
+boulder populations from the published counts; ``latlong presets`` lists the sources).
+Bottom row: the bundled shape models themselves, seen from the same direction, so the
+outlines can be compared. Writes ``asteroid_gallery.png``. Environment:
+``CRATERFORM_EXAMPLE_OUT`` (default ``out``) and ``CRATERFORM_EXAMPLE_SMALL=1`` (coarse,
+quick).
 """
 
 import os
@@ -16,35 +16,37 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.image as mpimg  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pyvista as pv  # noqa: E402
 
-from latlong import Scene, build, render_preview  # noqa: E402
+from latlong import Scene, build, read_shape_model, render_preview  # noqa: E402
+from latlong.presets import PRESETS  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
 out.mkdir(parents=True, exist_ok=True)
 png = out / "_gallery_panel.png"
-m_eros, m_small = (80, 60) if small else (700, 500)
+coarse = {"eros": {"magnitude": 80}, "itokawa": {"spacing_m": 10.0},
+          "bennu": {"magnitude": 50}}
+view = {"sun_azimuth_deg": 60, "sun_elevation_deg": 25, "width_px": 700, "height_px": 500}
 
-scenes = [
-    ("Eros-like, young surface: N_cum = 0.03 D^-2, ages < 0.5 Gyr",
-     {"preset": "eros-like", "magnitude": m_eros,
-      "craters": ["c=0.03,k=-2,d_min_m=40,d_max_m=1500,age_max_gyr=0.5"]}),
-    ("Eros-like, old surface: N_cum = 0.15 D^-2, ages < 3.5 Gyr",
-     {"preset": "eros-like", "magnitude": m_eros,
-      "craters": ["c=0.15,k=-2,d_min_m=40,d_max_m=1500,age_max_gyr=3.5"]}),
-    ("Perlin base + N_cum = 0.5 D^-2 (fbm-cratered)",
-     {"preset": "fbm-cratered", "magnitude": m_small}),
-    ("two-phase faulting + N_cum = 0.1 D^-2 (faulted-cratered)",
-     {"preset": "faulted-cratered", "magnitude": m_small}),
-]
-fig, axes = plt.subplots(2, 2, figsize=(13, 9.5))
-for ax, (title, given) in zip(axes.ravel(), scenes, strict=True):
-    body = build(Scene.from_settings({**given, "seed": 2014}))
-    render_preview(body, png, sun_azimuth_deg=60, sun_elevation_deg=25, width_px=800,
-                   height_px=560)
-    ax.imshow(mpimg.imread(png))
-    ax.set_title(f"{title}\n{len(body.craters):,} craters, magnitude {body.magnitude}",
-                 fontsize=10)
+fig, axes = plt.subplots(2, 3, figsize=(16, 9))
+for col, name in enumerate(("eros", "itokawa", "bennu")):
+    body = build(Scene.from_settings({"preset": name, "seed": 2014,
+                                      **(coarse[name] if small else {})}))
+    target = body if hasattr(body, "radii_m") else body.to_pyvista()
+    render_preview(target, png, **view)
+    axes[0, col].imshow(mpimg.imread(png))
+    axes[0, col].set_title(f"preset '{name}': {len(body.craters):,} craters, "
+                           f"{len(body.boulders):,} boulders", fontsize=10)
+    model = read_shape_model(PRESETS[name].model_path, units="km")
+    faces = np.hstack([np.full((len(model.faces), 1), 3), model.faces]).ravel()
+    real = pv.PolyData(np.asarray(model.vertices) - np.asarray(model.vertices).mean(0), faces)
+    render_preview(real, png, **view)
+    axes[1, col].imshow(mpimg.imread(png))
+    axes[1, col].set_title(f"shape model {PRESETS[name].model} "
+                           f"({len(model.faces):,} facets)", fontsize=10)
+for ax in axes.ravel():
     ax.axis("off")
 png.unlink()
 fig.tight_layout()

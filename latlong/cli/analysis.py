@@ -7,6 +7,7 @@ plot with a legend and listed in one CSV and one summary table.
 
 from __future__ import annotations
 
+import textwrap
 from pathlib import Path
 
 import numpy as np
@@ -120,8 +121,9 @@ def cmd_slopes(args) -> int:
         plot_slopes(args.plot, shown, xlabel=f"{kind} slope (deg), 3 deg bins",
                     ylabel="share of the surface area (%)",
                     title=(f"{kind} slopes: normals averaged over {args.radius_deg:g} deg "
-                           "caps\n(" + ("vs the radial direction" if grav is None
-                                        else f"vs {against}") + ")"),
+                           "caps\n" + textwrap.fill("(" + ("vs the radial direction"
+                                                           if grav is None
+                                                           else f"vs {against}") + ")", 60)),
                     full_range=True)
     if not args.quiet:
         print(slope_table(results))
