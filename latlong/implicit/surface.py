@@ -1,7 +1,8 @@
 """The implicit build (:func:`implicit_surface`) and its result (:class:`ImplicitSurface`).
 
 The pipeline is in the :mod:`latlong.implicit` notes. This module runs it: packing and
-metaballs (:mod:`.packing`, :mod:`.metaballs`), the field on a voxel grid grown until the
+metaballs (:mod:`.packing`, :mod:`.metaballs`), the coarse field (the constraint's signed
+distance, :mod:`.distance`, blended with the metaballs') on a voxel grid grown until the
 surface stays inside it, the crater impulses (:mod:`.layers`) and Gabor noise
 (:mod:`.gabor`) added near the surface, then marching cubes (VTK flying edges) on the
 zero level: a closed, outward oriented triangle mesh, of which only the largest
@@ -258,7 +259,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                              f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer polygons "
                              "or a larger voxel")
         grid = VoxelGrid(glo, h, shape)
-        bar.set_description("metaballs")
+        bar.set_description("coarse field")
         base = _coarse_field(meta, smooth, grid, weight, band + 2.0 * h)
         rim = max(base[0].max(), base[-1].max(), base[:, 0].max(), base[:, -1].max(),
                   base[:, :, 0].max(), base[:, :, -1].max())  # on the grid's boundary

@@ -123,6 +123,17 @@ def test_mesh_distance_is_the_distance_to_a_sphere():
         mesh_distance(model, VoxelGrid(np.full(3, 40.0), 0.5, (4, 4, 4)))
 
 
+def test_grid_normals_of_a_distance_field():
+    grid = VoxelGrid(np.full(3, -12.0), 0.5, (49, 49, 49))
+    k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")
+    values = 10.0 - np.linalg.norm(grid.origin + np.stack([i, j, k], -1) * grid.h, axis=-1)
+    rng = np.random.default_rng(3)
+    p = rng.normal(size=(500, 3))
+    p *= (10.0 / np.linalg.norm(p, axis=1))[:, None]
+    n = grid.normals(values, p)
+    np.testing.assert_allclose(n, p / 10.0, atol=2e-3)  # outward, between grid points
+
+
 def test_smoothed_constraint_keeps_the_vertices():
     model = lumpy_model()
     smooth, levels = smoothed_constraint(model, model.mean_edge_m / 3.0)
