@@ -4,7 +4,7 @@ its flat facets a smooth surface.
 
 :func:`smoothed_constraint` subdivides the constraint (VTK's modified butterfly scheme,
 Zorin, Schroeder & Sweldens 1996: it keeps every vertex of the model and gives a
-smooth limit surface through them) until its edges are no longer than the voxel, so
+smooth limit surface through them) until its edges are at most 1.5 voxels long, so
 that marching cubes does not show the model's facets. :func:`mesh_distance` computes
 the exact signed Euclidean distance to a closed mesh in a band of 1.5 voxels around it
 (closest point on each triangle, sign from angle-weighted pseudo-normals; numba,
@@ -38,6 +38,7 @@ facet scale: on Bennu's radar model the slope KS distance of
 :func:`~latlong.implicit.fidelity.shape_fidelity` is 0.41 against butterfly's 0.02);
 ``linear`` keeps the facets."""
 _MAX_LEVELS = 4
+_EDGE_VOXELS = 1.5  # the subdivided constraint's mean edge, voxels (at most)
 _BAND_VOXELS = 1.5  # exact distances within this many voxels of the mesh
 
 
@@ -46,12 +47,14 @@ def smoothed_constraint(model: ShapeModel, voxel_m: float, *, smooth: str = "but
     """The constraint subdivided for a grid of ``voxel_m``, and the number of levels.
 
     ``subdivisions=None`` takes the fewest levels (each halves the edges) that bring
-    the mean edge to at most ``voxel_m`` (at most 4); ``smooth="none"`` (or 0 levels)
-    returns the model unchanged.
+    the mean edge to at most 1.5 ``voxel_m`` (at most 4; finer facets do not show
+    through marching cubes at that voxel: on Eros's 7790-plate model 2 and 3 levels
+    give the same distance and slope distribution, 3 takes 0.6 s longer);
+    ``smooth="none"`` (or 0 levels) returns the model unchanged.
     """
     check_choice("smooth", smooth, SMOOTHING)
     if subdivisions is None:
-        ratio = model.mean_edge_m / voxel_m
+        ratio = model.mean_edge_m / (_EDGE_VOXELS * voxel_m)
         subdivisions = min(_MAX_LEVELS, max(0, math.ceil(math.log2(ratio)))) if ratio > 1 else 0
     subdivisions = check_int("subdivisions", subdivisions, 0, _MAX_LEVELS)
     if smooth == "none" or subdivisions == 0:

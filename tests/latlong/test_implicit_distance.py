@@ -136,7 +136,7 @@ def test_grid_normals_of_a_distance_field():
 
 def test_smoothed_constraint_keeps_the_vertices():
     model = lumpy_model()
-    smooth, levels = smoothed_constraint(model, model.mean_edge_m / 3.0)
+    smooth, levels = smoothed_constraint(model, model.mean_edge_m / 5.0)
     assert levels == 2 and len(smooth.faces) == 16 * len(model.faces)
     np.testing.assert_allclose(smooth.vertices[:len(model.vertices)], model.vertices,
                                atol=1e-9)  # interpolating: every model vertex stays
