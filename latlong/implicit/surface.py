@@ -348,10 +348,15 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                            base_faces, kept)
 
 
-@dataclasses.dataclass(frozen=True)
+@dataclasses.dataclass(frozen=True, slots=True)
 class _FieldNormals:
+    """The crater impulses' normals from the coarse field (when the constraint's field
+    is blended in; the bare metaballs give theirs analytically)."""
+
     grid: VoxelGrid
+    """The field's grid."""
     values: np.ndarray
+    """The coarse field, > 0 inside."""
 
     def normals(self, points):
         return self.grid.normals(self.values, points)
