@@ -2,12 +2,17 @@
 
 Top row: the LCSN crater kernels of Li 2022 Fig. 6 (normalised), and kernel_3 fitted to
 Fassett & Thomson's degradation of a 1 km crater over 0-3 Gyr (Table A.1). Middle: the
-constraint (NEAR MSI plate model), its non-uniform sphere packing and the metaball
-surface fitted to it. Bottom: three LCSN crater layers on the multi-level grid (3 km
-fresh craters on 4 km cells, 1 km fresh on 2 km cells, simple bowls on 1 km cells) and
-Gabor micro-detail fitted by example to the LOLA LDEM_4 crop in ``tests/data`` (its
-7.6 km pixels read as 100 m, 12 m rms), from two sides. Writes ``implicit_asteroid.png``.
-Environment: ``CRATERFORM_EXAMPLE_OUT`` (default ``out``), ``CRATERFORM_EXAMPLE_SMALL=1``.
+constraint (NEAR MSI plate model), its non-uniform sphere packing, the bare metaball
+surface fitted to it (``constraint_weight=0``: one dome per ball) and the coarse surface
+the body is built on (the default ``constraint_weight=1``: the constraint's own signed
+distance, smooth where the constraint is smooth), each with its mean distance to the
+constraint and the KS distance of its slope-against-a-5 %-smoothed-copy distribution from
+the constraint's (:func:`latlong.implicit.shape_fidelity`). Bottom: three LCSN crater
+layers on the multi-level grid (3 km fresh craters on 4 km cells, 1 km fresh on 2 km
+cells, simple bowls on 1 km cells) and Gabor micro-detail fitted by example to the LOLA
+LDEM_4 crop in ``tests/data`` (its 7.6 km pixels read as 100 m, 12 m rms), from two sides.
+Writes ``implicit_asteroid.png``. Environment: ``CRATERFORM_EXAMPLE_OUT`` (default ``out``),
+``CRATERFORM_EXAMPLE_SMALL=1``.
 """
 
 import os
@@ -23,8 +28,13 @@ import numpy as np  # noqa: E402
 import craters  # noqa: E402
 import dem  # noqa: E402
 from latlong import render_preview  # noqa: E402
-from latlong.implicit import LcsnLayer, fit_gabor, implicit_surface  # noqa: E402
-from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model  # noqa: E402
+from latlong.implicit import (  # noqa: E402
+    LcsnLayer,
+    fit_gabor,
+    implicit_surface,
+    shape_fidelity,
+)
+from latlong.shapes import ShapeModel, read_shape_model  # noqa: E402
 
 small = os.environ.get("CRATERFORM_EXAMPLE_SMALL") == "1"
 out = Path(os.environ.get("CRATERFORM_EXAMPLE_OUT", "out"))
@@ -68,22 +78,25 @@ layers = [LcsnLayer("table-a1-3km-0gyr", 2000, 4000, exponent=3.0, probability=0
                     depth_ratio=(0.1, 0.2))]
 gabor = fit_gabor(dem.read(data / "ldem4_crop.lbl").heights, 100.0, amplitude_m=12.0)
 surf = implicit_surface(model, layers, gabor=gabor, target_polygons=polygons, rng=2022)
-coarse = ShapeModel(surf.base_vertices, surf.base_faces).to_pyvista()
-axis = float(np.ptp(moved.vertices, axis=0).max())
-fit = mean_surface_distance(coarse, moved, rng=0)
+coarse = ShapeModel(surf.base_vertices, surf.base_faces)
+bare = implicit_surface(model, target_polygons=polygons, constraint_weight=0.0, rng=2022)
+bare = ShapeModel(bare.base_vertices, bare.base_faces)
+fits = [shape_fidelity(m, moved, fine=0.02 if small else 0.01) for m in (bare, coarse)]
 import pyvista as pv  # noqa: E402
 
 balls = pv.merge([pv.Sphere(radius=float(rad), center=tuple(c), theta_resolution=16,
                             phi_resolution=16)
                   for c, rad in zip(surf.packing.centers, surf.packing.radii, strict=True)])
 pk = surf.metadata["packing"]
-sub = grid[1, :].subgridspec(1, 3)
+sub = grid[1, :].subgridspec(1, 4)
 panels = [
-    (sub[0], moved.to_pyvista(), f"constraint: NEAR MSI plate model, {len(model.faces)} facets"),
+    (sub[0], moved.to_pyvista(), f"constraint: NEAR MSI plates, {len(model.faces)} facets"),
     (sub[1], balls, f"sphere packing: {pk['spheres']} balls, coverage {pk['coverage']:.0%}"),
-    (sub[2], coarse, (f"metaballs (blend {surf.metaballs.blend:g}): {fit:.0f} m = "
-                      f"{100 * fit / axis:.2f} % of the long axis from it")),
 ]
+for spec, mesh, label, f in ((sub[2], bare, f"bare metaballs (blend {surf.metaballs.blend:g})",
+                              fits[0]), (sub[3], coarse, "coarse surface (weight 1)", fits[1])):
+    panels.append((spec, mesh.to_pyvista(), (f"{label}\n{100 * f.mean_fraction:.2f} % of the "
+                   f"axis off, slope KS {f.slope_ks:.2f}")))
 bottom = grid[2, :].subgridspec(1, 2)
 n_by_layer = [int((surf.catalog["layer"] == i).sum()) for i in range(3)]
 title = (f"{len(surf.faces):,} triangles, {len(surf.catalog)} craters "

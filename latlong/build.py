@@ -190,7 +190,8 @@ def _build_implicit(scene: Scene, progress: bool):
         surf = implicit_surface(imp.shape, imp.layers, gabor=imp.gabor, voxel_m=imp.voxel_m,
                                 target_polygons=imp.polygons, cell_m=imp.cell_m,
                                 packing_voxels=imp.packing_voxels,
-                                min_sphere_m=imp.min_sphere_m, rng=scene.seed,
+                                min_sphere_m=imp.min_sphere_m,
+                                constraint_weight=imp.constraint_weight, rng=scene.seed,
                                 progress=progress)
     except (ParameterError, ParameterTypeError) as exc:  # the scene's names (settings)
         raise exc.renamed({"target_polygons": "polygons"}.get(exc.name, exc.name)) from None

@@ -66,6 +66,7 @@ _BOULDER_SHAPE = {"boulder_flatten": "flatten", "boulder_elongation": "elongatio
 _IMPLICIT = {"shape": "shape", "shape_units": "units", "lcsn": "layers", "gabor": "gabor",
              "polygons": "polygons", "voxel_m": "voxel_m", "packing_voxels": "packing_voxels",
              "min_sphere_m": "min_sphere_m", "cell_m": "cell_m",
+             "constraint_weight": "constraint_weight",
              "shape_crossings": "crossings"}
 _EXAMPLE = ("gabor_example", "gabor_pixel_m", "gabor_amplitude_m")
 _PREVIEW = {f.name: f.name for f in dataclasses.fields(PreviewSettings)}

@@ -340,6 +340,9 @@ class ImplicitSettings:
     """Voxels along the constraint's longest side for the sphere packing, [8, 1024]."""
     min_sphere_m: float | None = None
     """Smallest packed sphere, metres (default 2 packing voxels)."""
+    constraint_weight: float = 1.0
+    """Weight of the constraint's own signed distance in the coarse field, [0, 1]: 1
+    follows the constraint, 0 is the bare metaball surface (one dome per packed ball)."""
     cell_m: float | None = None
     """Cell size of grid level 0, metres (default: the largest d_max_m); >= every d_max_m."""
     crossings: str = "error"
@@ -367,6 +370,8 @@ class ImplicitSettings:
                                      f"{type(self.gabor).__name__}")
         _set(self, "polygons", check_int("polygons", self.polygons, 100, 10**9))
         _set(self, "packing_voxels", check_int("packing_voxels", self.packing_voxels, 8, 1024))
+        _set(self, "constraint_weight",
+             check_range("constraint_weight", self.constraint_weight, 0.0, 1.0))
         for key in ("voxel_m", "min_sphere_m", "cell_m"):
             if getattr(self, key) is not None:
                 _set(self, key, check_positive(key, getattr(self, key)))

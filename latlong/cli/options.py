@@ -171,6 +171,10 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "voxels along the constraint's longest side for the sphere packing", "implicit"),
     Opt(("--min-sphere-m",), "min_sphere_m", float,
         "smallest packed sphere, metres (default 2 packing voxels)", "implicit"),
+    Opt(("--constraint-weight",), "constraint_weight", float,
+        "weight in [0, 1] of the constraint's own signed distance in the coarse field: 1 "
+        "follows the constraint (smooth where it is smooth), 0 the bare metaballs over the "
+        "packing (one dome per ball)", "implicit"),
     Opt(("--cell-m",), "cell_m", float,
         "cell size of grid level 0, metres (default: the largest d_max_m)", "implicit"),
     Opt(("--lcsn",), "lcsn", str,

@@ -392,18 +392,23 @@ def _gabor_points_kernel(points, pos, wave, env, amp, phase, cutoff2, out):
 
 # --------------------------------------------------------------------------- distance
 @njit(cache=True, parallel=True)
-def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_order, out):
+def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_order, far2,
+                            reach, out):
     """Signed distance from the tangent plane at the closest foot point.
 
     ``nearest`` holds, per grid point, the (k, j, i) of the nearest seed grid point
     (scipy's distance-transform indices); ``foot`` and ``normal`` the surface point and
     unit inward normal of each seed. The foot point closest to the grid point is
-    searched among the seeds in the 5 x 5 x 5 block around that seed; the distance is
+    searched among the seeds in the block of (2 reach + 1)^3 grid points around that
+    seed (reach 2 for the thin seed layer of the metaballs); the distance is
     measured to its tangent plane (feet are about a voxel apart: the distance to the
     nearest foot itself would be off by (gap / 2)^2 / (2 depth)) -- unless the point lies
     more than two voxels along that plane from the foot (the plane's extension says
     nothing there: near a fold it reads ~0 deep inside the body); then the distance to
     the foot itself. The sign is the first-order field's. Needs at least one seed.
+    Points more than ``sqrt(far2)`` voxels from their nearest seed skip the search and
+    take the distance to that seed's foot (an upper bound, for where only a rough
+    distance matters; ``far2 = inf`` searches everywhere).
     """
     nz, ny, nx = out.shape
     for k in prange(nz):
@@ -415,11 +420,17 @@ def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_or
                 k0 = nearest[0, k, j, i]
                 j0 = nearest[1, k, j, i]
                 i0 = nearest[2, k, j, i]
+                if (k - k0) ** 2 + (j - j0) ** 2 + (i - i0) ** 2 > far2:
+                    s = seed_id[k0, j0, i0]
+                    d = np.sqrt((px - foot[s, 0]) ** 2 + (py - foot[s, 1]) ** 2 +
+                                (pz - foot[s, 2]) ** 2)
+                    out[k, j, i] = d if first_order[k, j, i] > 0 else -d
+                    continue
                 best = np.inf
                 arg = -1
-                for kk in range(max(0, k0 - 2), min(nz, k0 + 3)):
-                    for jj in range(max(0, j0 - 2), min(ny, j0 + 3)):
-                        for ii in range(max(0, i0 - 2), min(nx, i0 + 3)):
+                for kk in range(max(0, k0 - reach), min(nz, k0 + reach + 1)):
+                    for jj in range(max(0, j0 - reach), min(ny, j0 + reach + 1)):
+                        for ii in range(max(0, i0 - reach), min(nx, i0 + reach + 1)):
                             s = seed_id[kk, jj, ii]
                             if s < 0:
                                 continue

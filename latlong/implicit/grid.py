@@ -77,6 +77,22 @@ class VoxelGrid:
                             values[dn[:, 2], dn[:, 1], dn[:, 0]]) / np.maximum(span, 1e-300)
         return out
 
+    def normals(self, values, points) -> np.ndarray:
+        """Outward unit normals ``-grad values / |grad values|`` at points (n, 3): the
+        central-difference gradient trilinearly interpolated from the 8 grid points
+        around each point."""
+        pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+        top = np.array(self.shape[::-1]) - 2
+        f = (pts - self.origin) / self.h
+        i0 = np.clip(np.floor(f), 0, top).astype(np.int64)
+        t = np.clip(f - i0, 0.0, 1.0)
+        grad = np.zeros((len(pts), 3))
+        for corner in np.ndindex(2, 2, 2):
+            c = np.array(corner)
+            w = np.prod(np.where(c == 1, t, 1.0 - t), axis=1)
+            grad += w[:, None] * self.gradient(values, self.origin + (i0 + c) * self.h)
+        return -grad / np.maximum(np.linalg.norm(grad, axis=1, keepdims=True), 1e-300)
+
     def contour(self, values: np.ndarray):
         """Flying-edges zero level of ``values`` (> 0 inside): (vertices, faces) outward."""
         import pyvista as pv

@@ -178,12 +178,13 @@ def layer_levels(layers, cell_m: float) -> list[int]:
     return levels
 
 
-def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, metaballs, rng):
+def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, surface, rng):
     """Draw every layer's impulses on the base surface (module notes).
 
     Returns the kernel arrays (``centers, normals, kinds, params, support, zhalf,
     amplitude``; ``params`` rows kappa, beta, gamma, a, b scaled and weighted) and the
-    catalog columns. ``metaballs`` gives the normals at the impulses.
+    catalog columns. ``surface.normals(points)`` gives the normals at the impulses
+    (the :class:`Metaballs`, or the coarse field on its grid).
     """
     a, b, c = (base_verts[base_faces[:, k]] for k in range(3))
     centroid = (a + b + c) / 3.0
@@ -257,7 +258,7 @@ def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, metaba
         cols["apparent_diameter_m"].append(m.get("D_a", math.nan) * scale)
         cols["weight"].append(hscale)
         s = e
-    normals = metaballs.normals(out["centers"]) if total else np.zeros((0, 3))
+    normals = surface.normals(out["centers"]) if total else np.zeros((0, 3))
     out["normals"] = np.ascontiguousarray(normals)
     cat_cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     return out, cat_cols

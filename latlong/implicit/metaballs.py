@@ -157,5 +157,5 @@ def metaball_distance(meta: Metaballs, grid: VoxelGrid) -> np.ndarray:
     nearest = distance_transform_edt(~seed, return_distances=False, return_indices=True)
     dist = np.empty(grid.shape)
     _k._closest_distance_kernel(grid.origin, grid.h, nearest, seed_id, foot,
-                                np.ascontiguousarray(unit), first, dist)
+                                np.ascontiguousarray(unit), first, np.inf, 2, dist)
     return dist

@@ -1,7 +1,8 @@
 """The implicit build (:func:`implicit_surface`) and its result (:class:`ImplicitSurface`).
 
 The pipeline is in the :mod:`latlong.implicit` notes. This module runs it: packing and
-metaballs (:mod:`.packing`, :mod:`.metaballs`), the field on a voxel grid grown until the
+metaballs (:mod:`.packing`, :mod:`.metaballs`), the coarse field (the constraint's signed
+distance, :mod:`.distance`, blended with the metaballs') on a voxel grid grown until the
 surface stays inside it, the crater impulses (:mod:`.layers`) and Gabor noise
 (:mod:`.gabor`) added near the surface, then marching cubes (VTK flying edges) on the
 zero level: a closed, outward oriented triangle mesh, of which only the largest
@@ -28,6 +29,7 @@ from craters._shared import (
     ParameterTypeError,
     check_int,
     check_positive,
+    check_range,
     normalize_rng,
     physical_memory_bytes,
     progress_bar,
@@ -36,6 +38,7 @@ from craters._shared.meshio import MESH_SUFFIXES, MeshSource, array_source, writ
 
 from ..shapes import ShapeModel, read_shape_model
 from . import _kernels as _k
+from .distance import mesh_distance, smoothed_constraint
 from .gabor import GaborNoise, add_gabor, gabor_impulses
 from .grid import VoxelGrid
 from .layers import LcsnLayer, draw_impulses, largest_height, layer_levels, measure_shape
@@ -145,8 +148,8 @@ def _estimate_bytes(shape) -> int:
 def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None = None,
                      target_polygons: int = 200_000, units: str | None = None,
                      cell_m: float | None = None, packing_voxels: int = 128,
-                     min_sphere_m: float | None = None, rng=None,
-                     progress: bool = False) -> ImplicitSurface:
+                     min_sphere_m: float | None = None, constraint_weight: float = 1.0,
+                     rng=None, progress: bool = False) -> ImplicitSurface:
     """Build an implicit asteroid from a constraint mesh (module notes).
 
     Parameters
@@ -167,6 +170,12 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
         Cell size of grid level 0, metres (default: the largest d_max_m of the layers).
     packing_voxels, min_sphere_m
         :func:`sphere_packing` resolution and smallest ball.
+    constraint_weight : float
+        Weight in [0, 1] of the constraint's own signed distance in the coarse field
+        (:func:`~latlong.implicit.distance.mesh_distance` of the constraint after a
+        butterfly subdivision to the voxel): 1 (default) follows the constraint, smooth
+        where it is smooth; 0 is the bare metaball surface over the packing (Li et al.;
+        one dome per packed ball shows); between, the two signed distances are blended.
     rng : int, Generator or None
         Seed: impulses, diameters, depths, Gabor impulses (and the fit's samples).
 
@@ -196,6 +205,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
         raise TypeError(f"`gabor` must be a latlong.implicit.GaborNoise; got "
                         f"{type(gabor).__name__}")
     target_polygons = check_int("target_polygons", target_polygons, 100, 10**9)
+    weight = check_range("constraint_weight", constraint_weight, 0.0, 1.0)
     seed = int(rng) if isinstance(rng, int | np.integer) and not isinstance(rng, bool) else None
     rng = normalize_rng(rng)
     centre = constraint.volume_centroid
@@ -226,6 +236,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
         raise exc.renamed({"n_voxels": "packing_voxels",
                            "min_radius_m": "min_sphere_m"}.get(exc.name, exc.name)) from None
     meta = fit_metaballs(packing, model, rng=rng.integers(2**63))
+    smooth, levels_sub = smoothed_constraint(model, h) if weight > 0 else (model, 0)
     times["packing_s"] = time.perf_counter() - t0
     bar.update()
 
@@ -248,8 +259,8 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                              f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer polygons "
                              "or a larger voxel")
         grid = VoxelGrid(glo, h, shape)
-        bar.set_description("metaballs")
-        base = metaball_distance(meta, grid)
+        bar.set_description("coarse field")
+        base = _coarse_field(meta, smooth, grid, weight, band + 2.0 * h)
         rim = max(base[0].max(), base[-1].max(), base[:, 0].max(), base[:, -1].max(),
                   base[:, :, 0].max(), base[:, :, -1].max())  # on the grid's boundary
         if rim < -band:
@@ -260,8 +271,9 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
 
     bar.set_description("impulses")
     base_verts, base_faces = grid.contour(base)
-    imp, cat_cols = draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, meta,
-                              rng)
+    normals = meta if weight == 0.0 else _FieldNormals(grid, base)
+    imp, cat_cols = draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces,
+                                  normals, rng)
     field = base.copy()
     if len(imp["centers"]):
         # the ball around the support cylinder (radius support, half-height 2 zhalf)
@@ -322,6 +334,8 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
                     "max_radius_m": float(packing.radii.max()),
                     "odd_columns": packing.odd_columns},
         "metaballs": {"blend": meta.blend, "iso": meta.iso, "fit_mean_m": meta.fit_mean_m},
+        "constraint": {"weight": weight, "smoothing": "butterfly",
+                       "subdivisions": levels_sub, "triangles": len(smooth.faces)},
         "seed": seed, "cell_m": cell_m, "levels": levels,
         "layers": [{**dataclasses.asdict(la), "kernel": la.kernel if isinstance(la.kernel, str)
                     else dataclasses.asdict(la.kernel)} for la in layers],
@@ -332,6 +346,34 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
     kept = {k: imp[k] for k in ("centers", "normals", "kinds", "params", "support", "zhalf")}
     return ImplicitSurface(verts, faces, catalog, metadata, packing, meta, times, base_verts,
                            base_faces, kept)
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class _FieldNormals:
+    """The crater impulses' normals from the coarse field (when the constraint's field
+    is blended in; the bare metaballs give theirs analytically)."""
+
+    grid: VoxelGrid
+    """The field's grid."""
+    values: np.ndarray
+    """The coarse field, > 0 inside."""
+
+    def normals(self, points):
+        return self.grid.normals(self.values, points)
+
+
+def _coarse_field(meta: Metaballs, smooth: ShapeModel, grid: VoxelGrid, weight: float,
+                  exact_m: float) -> np.ndarray:
+    """Signed distance of the coarse surface (> 0 inside): ``weight`` x that of the
+    smoothed constraint (exact to ``exact_m`` from it, an upper bound beyond) +
+    (1 - ``weight``) x that of the metaball surface."""
+    if weight == 0.0:
+        return metaball_distance(meta, grid)
+    dist = mesh_distance(smooth, grid, exact_m=exact_m)
+    if weight < 1.0:
+        dist *= weight
+        dist += (1.0 - weight) * metaball_distance(meta, grid)
+    return dist
 
 
 def _largest_piece(verts, faces):

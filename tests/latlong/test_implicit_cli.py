@@ -112,6 +112,7 @@ def test_config_file(run_cli, tmp_path):
     ([*BENNU, "--polygons", "5"], ["--polygons"]),
     ([*BENNU, "--voxel-m", "-1"], ["--voxel-m"]),
     ([*BENNU, "--packing-voxels", "3"], ["--packing-voxels"]),
+    ([*BENNU, "--constraint-weight", "1.5"], ["--constraint-weight", "[0, 1]"]),
     ([*BENNU, "--packing-voxels", "1024"], ["--packing-voxels = 1024", "GiB"]),
     ([*BENNU, "--lcsn", "kernel=fig6-kernel1,d_min_m=10,d_max_m=20,exponent=-300"],
      ["--lcsn", "exponent"]),
