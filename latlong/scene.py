@@ -45,6 +45,7 @@ from .settings import (
     ShapeBase,
     SphereBase,
 )
+from .shapes import read_shape_model
 
 __all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
 
@@ -280,7 +281,10 @@ def _latlong_scene(cls, given: dict) -> Scene:
     p = PRESETS[preset] if preset else None
     base = p.base if p else base
     if p is not None and p.model is not None:
-        shape_path = str(p.model_path)
+        # the bundled model, recorded by its place in the package (not this machine's path)
+        units = {**p.settings, **given}.get("shape_units", "km")
+        model = read_shape_model(p.model_path, units=units)
+        shape_path = dataclasses.replace(model, source=f"latlong/data/shapes/{p.model}")
     for group, keys in _GROUPS.items():
         for key in keys:
             if key in given and group not in _GROUPS_OF_BASE[base]:
