@@ -152,3 +152,16 @@ def _feet_kernel(points, fids, verts, faces, face_n, foot, normal):
             normal[s, 0], normal[s, 1], normal[s, 2] = dx / d, dy / d, dz / d
         else:
             normal[s, 0], normal[s, 1], normal[s, 2] = face_n[f, 0], face_n[f, 1], face_n[f, 2]
+
+
+@njit(cache=True, parallel=True)
+def _nearest_sign_kernel(nearest, values, out):
+    """``out`` = 1 where ``values`` at the grid point's nearest seed (``nearest``: its
+    (k, j, i), scipy's distance-transform indices) is > 0, else -1: the gather
+    ``values[nearest[0], nearest[1], nearest[2]]`` without its index arrays."""
+    nz, ny, nx = out.shape
+    for k in prange(nz):
+        for j in range(ny):
+            for i in range(nx):
+                v = values[nearest[0, k, j, i], nearest[1, k, j, i], nearest[2, k, j, i]]
+                out[k, j, i] = 1 if v > 0.0 else -1

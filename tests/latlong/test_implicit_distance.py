@@ -103,6 +103,17 @@ def test_band_kernel_matches_reference():
     np.testing.assert_allclose(np.linalg.norm(normal, axis=1), 1.0)
 
 
+def test_nearest_sign_kernel_matches_the_gather():
+    rng = np.random.default_rng(3)
+    values = rng.normal(size=(7, 8, 9))
+    values[0, 0, :3] = 0.0  # 0 is not > 0
+    nearest = np.stack([rng.integers(0, m, (7, 8, 9)) for m in values.shape]).astype(np.int32)
+    out = np.empty(values.shape, np.int8)
+    DK._nearest_sign_kernel(nearest, values, out)
+    want = np.where(values[nearest[0], nearest[1], nearest[2]] > 0, 1, -1)
+    assert np.array_equal(out, want)
+
+
 def test_mesh_distance_is_the_distance_to_a_sphere():
     s = pv.Sphere(radius=10.0, theta_resolution=96, phi_resolution=96)
     model = ShapeModel(np.asarray(s.points, float), s.faces.reshape(-1, 4)[:, 1:].astype(int))
