@@ -208,9 +208,14 @@ def gabor_impulses(noise: GaborNoise, base: np.ndarray, grid: VoxelGrid, reach_m
     ``env``, ``amp``, ``phase``, ``reach``) and ``cutoff2``."""
     rho = math.sqrt(_CUTOFF2) / min(p.bandwidth for p in noise.patches)
     inner = base > -(reach_m + rho)
-    idx = np.argwhere(inner)
-    lo = grid.origin + idx.min(axis=0)[::-1] * grid.h
-    hi = grid.origin + idx.max(axis=0)[::-1] * grid.h
+    # the index box of ``inner`` from its projections (np.argwhere would list most of
+    # the grid's points)
+    ends = [np.flatnonzero(inner.any(axis=tuple(a for a in range(3) if a != axis)))
+            for axis in range(3)]
+    if not ends[0].size:
+        raise ValueError("no grid point lies near the coarse surface")
+    lo = grid.origin + np.array([e[0] for e in ends])[::-1] * grid.h
+    hi = grid.origin + np.array([e[-1] for e in ends])[::-1] * grid.h
 
     def keep(centres, s):
         return np.abs(grid.sample(base, centres)) < reach_m + rho + s * math.sqrt(3) / 2
