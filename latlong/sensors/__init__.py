@@ -8,6 +8,8 @@
       -> render (shading, cast shadows, sensor model, ground truth)
 """
 
+from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
 from .engine import BUILD_QUALITIES, Hits, RayMesh
 
-__all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
+__all__ = ["BUILD_QUALITIES", "Camera", "Hits", "Pose", "RayMesh", "quaternion_from_matrix",
+           "quaternion_to_matrix"]
