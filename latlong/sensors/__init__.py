@@ -10,6 +10,18 @@
 
 from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
 from .engine import BUILD_QUALITIES, Hits, RayMesh
+from .photometry import (
+    HAPKE_PRESETS,
+    REFLECTANCES,
+    Hapke,
+    Lambert,
+    LommelSeeliger,
+    LunarLambert,
+    radiance_factor,
+    reflectance_model,
+)
 
-__all__ = ["BUILD_QUALITIES", "Camera", "Hits", "Pose", "RayMesh", "quaternion_from_matrix",
-           "quaternion_to_matrix"]
+__all__ = ["BUILD_QUALITIES", "HAPKE_PRESETS", "REFLECTANCES", "Camera", "Hapke", "Hits",
+           "Lambert", "LommelSeeliger", "LunarLambert", "Pose", "RayMesh",
+           "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
+           "reflectance_model"]
