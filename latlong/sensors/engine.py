@@ -42,7 +42,7 @@ import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError
 
-from ._engine_kernels import _intersect_kernel, _occluded_kernel
+from ._engine_kernels import _intersect_kernel, _occluded_kernel, _vertex_normals_kernel
 
 __all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
 
@@ -194,6 +194,7 @@ class RayMesh:
         # bounding sphere of the float32 geometry, with room for its rounding
         self._radius = float(np.sqrt(((v - centre) ** 2).sum(axis=1).max())) * (1 + 1e-5) + 1e-6
         self._face_normals = None
+        self._vertex_normals = None
         lib, self._intersect1, self._occluded1 = _embree()
         self._lib = lib
         self._device = self._scene = None
@@ -266,6 +267,19 @@ class RayMesh:
             n.flags.writeable = False
             self._face_normals = n
         return self._face_normals
+
+    @property
+    def vertex_normals(self) -> np.ndarray:
+        """(n, 3) float64 unit vertex normals with Max's weights (Max 1999, "Weights for
+        computing vertex normals from facet normals", J. Graphics Tools 4(2): exact for
+        vertices on a sphere), computed once; they follow the faces' orientation; smooth
+        shading blends them."""
+        if self._vertex_normals is None:
+            out = np.empty_like(self._vertices)
+            _vertex_normals_kernel(self._vertices, self._index, out)
+            out.flags.writeable = False
+            self._vertex_normals = out
+        return self._vertex_normals
 
     @property
     def bounding_sphere(self) -> tuple[np.ndarray, float]:
