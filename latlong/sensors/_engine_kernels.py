@@ -42,11 +42,18 @@ def _moller_trumbore(ox, oy, oz, dx, dy, dz, ax, ay, az, bx, by, bz, cx, cy, cz)
 
 
 @njit(cache=True, inline="always")
+def _row(origins, i):
+    """The origin row of ray i: one shared origin (a (1, 3) array) or one per ray."""
+    return i if origins.shape[0] > 1 else 0
+
+
+@njit(cache=True, inline="always")
 def _ray_face(origins, directions, vertices, faces, i, f):
     """:func:`_moller_trumbore` of ray ``i`` against face ``f``."""
     a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+    r = _row(origins, i)
     return _moller_trumbore(
-        origins[i, 0], origins[i, 1], origins[i, 2],
+        origins[r, 0], origins[r, 1], origins[r, 2],
         directions[i, 0], directions[i, 1], directions[i, 2],
         vertices[a, 0], vertices[a, 1], vertices[a, 2],
         vertices[b, 0], vertices[b, 1], vertices[b, 2],
@@ -57,7 +64,7 @@ def _ray_face(origins, directions, vertices, faces, i, f):
 def _refine_kernel(origins, directions, vertices, faces, face, t_out, u_out, v_out):
     """Float64 Möller–Trumbore of each ray against its face (``face[i] >= 0``), in
     place; rays whose face is -1 are left alone (tests compare it with numpy)."""
-    for i in range(origins.shape[0]):
+    for i in range(directions.shape[0]):
         f = face[i]
         if f < 0:
             continue
@@ -70,9 +77,10 @@ def _refine_kernel(origins, directions, vertices, faces, face, t_out, u_out, v_o
 def _start(origins, directions, i, centre, radius):
     """Distance along ray i to where its float32 origin is taken (just before the
     bounding sphere, so a far camera loses no precision in float32)."""
-    tc = ((centre[0] - origins[i, 0]) * directions[i, 0]
-          + (centre[1] - origins[i, 1]) * directions[i, 1]
-          + (centre[2] - origins[i, 2]) * directions[i, 2])
+    r = _row(origins, i)
+    tc = ((centre[0] - origins[r, 0]) * directions[i, 0]
+          + (centre[1] - origins[r, 1]) * directions[i, 1]
+          + (centre[2] - origins[r, 2]) * directions[i, 2])
     return max(0.0, tc - radius)
 
 
@@ -86,8 +94,9 @@ def _aligned(raw):
 
 @njit(cache=True, inline="always")
 def _load_ray(buf, ibuf, origins, directions, i, centre, t0, tnear, tfar):
+    r = _row(origins, i)
     for k in range(3):
-        buf[k] = np.float32(origins[i, k] + t0 * directions[i, k] - centre[k])
+        buf[k] = np.float32(origins[r, k] + t0 * directions[i, k] - centre[k])
         buf[4 + k] = np.float32(directions[i, k])
     buf[3] = np.float32(tnear)
     buf[7] = np.float32(0.0)
@@ -104,7 +113,7 @@ def _load_ray(buf, ibuf, origins, directions, i, centre, t0, tnear, tfar):
 def _intersect_kernel(intersect1, scene, origins, directions, t_max, centre, radius,
                       vertices, faces, t_out, face_out, u_out, v_out):
     """Closest hit of every ray (Embree, float32), refined in float64 on its face."""
-    n = origins.shape[0]
+    n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
         raw = np.empty(40, np.float32)
         buf, ptr = _aligned(raw)
@@ -138,7 +147,7 @@ def _intersect_kernel(intersect1, scene, origins, directions, t_max, centre, rad
 def _occluded_kernel(occluded1, scene, origins, directions, t_min, t_max, centre, radius,
                      out):
     """True where something lies on the ray between ``t_min`` and ``t_max``."""
-    n = origins.shape[0]
+    n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
         raw = np.empty(40, np.float32)
         buf, ptr = _aligned(raw)
@@ -187,3 +196,19 @@ def _vertex_normals_kernel(vertices, faces, out):
             out[v, 0] /= n
             out[v, 1] /= n
             out[v, 2] /= n
+
+
+@njit(cache=True, parallel=True)
+def _unit_kernel(directions, out):
+    """Unit copies of the directions; the index of the first zero or non-finite one
+    (-1 when all are good)."""
+    n = directions.shape[0]
+    bad = n
+    for i in prange(n):
+        x, y, z = directions[i, 0], directions[i, 1], directions[i, 2]
+        norm = np.sqrt(x * x + y * y + z * z)
+        if not (norm > 0.0 and norm < np.inf):
+            bad = min(bad, i)
+            norm = 1.0
+        out[i, 0], out[i, 1], out[i, 2] = x / norm, y / norm, z / norm
+    return bad if bad < n else -1

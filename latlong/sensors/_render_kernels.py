@@ -39,6 +39,7 @@ def _surface_kernel(origin, dirs, t, face, u, v, vertices, faces, vnormals, smoo
                     pos, ng_out, ns_out, cosines, facing):
     """Per hit: position, geometric and shading normals (both turned towards the camera),
     cos i, cos e, cos g (``cosines`` columns), and whether the facet faces the sun."""
+    step = 1 if origin.shape[0] > 1 else 0  # one shared origin or one per ray
     for i in prange(t.shape[0]):
         f = face[i]
         if f < 0:
@@ -78,14 +79,35 @@ def _surface_kernel(origin, dirs, t, face, u, v, vertices, faces, vnormals, smoo
                 sx, sy, sz = nx, ny, nz
         else:
             sx, sy, sz = nx, ny, nz
+        r = i * step
         for k in range(3):
-            pos[i, k] = origin[i, k] + t[i] * dirs[i, k]
+            pos[i, k] = origin[r, k] + t[i] * dirs[i, k]
         ng_out[i, 0], ng_out[i, 1], ng_out[i, 2] = nx, ny, nz
         ns_out[i, 0], ns_out[i, 1], ns_out[i, 2] = sx, sy, sz
         cosines[i, 0] = sx * sun[0] + sy * sun[1] + sz * sun[2]
         cosines[i, 1] = -(sx * dirs[i, 0] + sy * dirs[i, 1] + sz * dirs[i, 2])
         cosines[i, 2] = -(sun[0] * dirs[i, 0] + sun[1] * dirs[i, 1] + sun[2] * dirs[i, 2])
         facing[i] = nx * sun[0] + ny * sun[1] + nz * sun[2] > 0.0
+
+
+@njit(cache=True, parallel=True)
+def _ground_truth_kernel(t, face, dirs, axis, cosines, ns, lit, depth, rng, angles, normals,
+                         sunlit):
+    """The float32 ground-truth images (NaN where the ray missed): depth along ``axis``,
+    range, incidence / emission / phase in degrees, shading normals, lit fraction."""
+    for i in prange(t.shape[0]):
+        if face[i] < 0:
+            depth[i] = rng[i] = sunlit[i] = np.nan
+            for k in range(3):
+                angles[i, k] = np.nan
+                normals[i, k] = np.nan
+            continue
+        rng[i] = t[i]
+        depth[i] = t[i] * (dirs[i, 0] * axis[0] + dirs[i, 1] * axis[1] + dirs[i, 2] * axis[2])
+        sunlit[i] = lit[i]
+        for k in range(3):
+            angles[i, k] = math.degrees(math.acos(min(1.0, max(-1.0, cosines[i, k]))))
+            normals[i, k] = ns[i, k]
 
 
 @njit(cache=True, parallel=True)

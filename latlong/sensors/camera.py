@@ -40,7 +40,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_finite, check_int, check_positive
 
-from ._camera_kernels import _distort, _undistort_kernel
+from ._camera_kernels import _distort, _pixel_rays_kernel, _undistort_kernel
 
 __all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix"]
 
@@ -263,9 +263,9 @@ class Camera:
         through the pixel centres (NaN where the distortion cannot be inverted)."""
         if not isinstance(pose, Pose):
             raise TypeError(f"`pose` must be a Pose; got {type(pose).__name__}")
-        d, ok = self.pixel_directions()
-        d = d @ pose.rotation.T
-        d[~ok] = np.nan
+        d = np.empty((self.height, self.width, 3))
+        _pixel_rays_kernel(self.fx, self.fy, self.cx, self.cy, *self.distortion,
+                           self.distorted, pose.rotation, d)
         return pose.position_m.copy(), d
 
     def project(self, points_m, pose: Pose) -> tuple[np.ndarray, np.ndarray]:

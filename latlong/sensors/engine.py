@@ -42,7 +42,12 @@ import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError
 
-from ._engine_kernels import _intersect_kernel, _occluded_kernel, _vertex_normals_kernel
+from ._engine_kernels import (
+    _intersect_kernel,
+    _occluded_kernel,
+    _unit_kernel,
+    _vertex_normals_kernel,
+)
 
 __all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
 
@@ -123,22 +128,25 @@ def _embree():
 
 
 def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
-    """(k, 3) float64 origins and unit directions (one origin may serve all rays)."""
-    d = np.asarray(directions, dtype=np.float64)
-    o = np.asarray(origins, dtype=np.float64)
+    """Float64 origins ((1, 3) when one origin serves all rays, else (k, 3)) and unit
+    directions (k, 3)."""
+    d = np.ascontiguousarray(directions, dtype=np.float64)
+    o = np.ascontiguousarray(origins, dtype=np.float64)
     if d.ndim != 2 or d.shape[1] != 3:
         raise ParameterError("directions", f"must be (k, 3); got shape {d.shape}")
-    if o.shape == (3,) or o.shape == (1, 3):
-        o = np.broadcast_to(o.reshape(1, 3), d.shape)
-    if o.shape != d.shape:
-        raise ParameterError("origins", f"must be (k, 3) like `directions` {d.shape}; "
-                             f"got shape {o.shape}")
-    norm = np.sqrt(np.einsum("ij,ij->i", d, d))
-    if not (np.isfinite(norm).all() and np.isfinite(o).all()):
-        raise ParameterError("directions", "origins and directions must be finite")
-    if (norm == 0).any():
-        raise ParameterError("directions", f"must be non-zero; ray {int(np.argmin(norm))} is 0")
-    return np.ascontiguousarray(o), np.ascontiguousarray(d / norm[:, None])
+    if o.shape == (3,):
+        o = o.reshape(1, 3)
+    if o.shape != d.shape and o.shape != (1, 3):
+        raise ParameterError("origins", f"must be (k, 3) like `directions` {d.shape} or one "
+                             f"(3,) origin; got shape {o.shape}")
+    if not np.isfinite(o).all():
+        raise ParameterError("origins", "must be finite")
+    unit = np.empty_like(d)
+    bad = _unit_kernel(d, unit)
+    if bad >= 0:
+        raise ParameterError("directions", f"must be finite and non-zero; ray {bad} is "
+                             f"{d[bad].tolist()}")
+    return o, unit
 
 
 def _limits(name: str, value, k: int) -> np.ndarray:

@@ -30,7 +30,12 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_range
 
-from ._render_kernels import _shade_kernel, _shadow_rays_kernel, _surface_kernel
+from ._render_kernels import (
+    _ground_truth_kernel,
+    _shade_kernel,
+    _shadow_rays_kernel,
+    _surface_kernel,
+)
 from .camera import Camera, Pose
 from .engine import RayMesh
 from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
@@ -239,17 +244,20 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     h, w = camera.height, camera.width
     origin, dirs = camera.rays(pose)
     dirs = dirs.reshape(-1, 3)
-    valid = np.isfinite(dirs).all(axis=1)
-    dirs_cast = np.where(valid[:, None], dirs, np.array([0.0, 0.0, 1.0]))
-    hits = mesh.intersect(origin, dirs_cast)
-    face = np.where(valid, hits.face, -1)
+    valid = ~np.isnan(dirs[:, 0])
+    if not valid.all():  # beyond the distortion model's fold: cast along the axis, no hit
+        dirs[~valid] = pose.rotation[:, 2]
+    origin = origin.reshape(1, 3)
+    hits = mesh.intersect(origin, dirs)
+    face = hits.face
+    if not valid.all():
+        face[~valid] = -1
     n = len(face)
-    origins = np.broadcast_to(origin, (n, 3))
     pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
     facing = np.empty(n, dtype=np.bool_)
     vnormals = _vertex_normals(mesh, normals)
     smooth = vnormals is not None
-    _surface_kernel(origins, dirs_cast, hits.t_m, face, hits.u, hits.v, mesh.vertices,
+    _surface_kernel(origin, dirs, hits.t_m, face, hits.u, hits.v, mesh.vertices,
                     mesh.faces, vnormals if smooth else np.zeros((1, 3)), smooth,
                     sun.direction, pos, ng, ns, cosines, facing)
     lit = _sunlit(mesh, pos, ng, facing, sun, samples, seed)
@@ -257,17 +265,14 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     refl = np.empty(n)
     _shade_kernel(model.code, model.vector(), cosines, lit, albedo, refl)
     refl = refl.reshape(h, w)
-    miss = face < 0
-    rng_m = np.where(miss, np.nan, hits.t_m)
-    depth = rng_m * (dirs_cast @ pose.rotation[:, 2])
-    with np.errstate(invalid="ignore"):
-        angles = np.degrees(np.arccos(np.clip(cosines, -1.0, 1.0))).astype(np.float32)
-    lit_f = np.where(miss, np.nan, lit).astype(np.float32)
+    depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))
+    angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))
+    _ground_truth_kernel(hits.t_m, face, dirs, pose.rotation[:, 2], cosines, ns, lit, depth,
+                         rng_m, angles, normals32, sunlit)
     return Frame(image=expose(refl, sensor, seed=seed), reflectance=refl,
-                 depth_m=depth.reshape(h, w).astype(np.float32),
-                 range_m=rng_m.reshape(h, w).astype(np.float32),
-                 position_m=pos.reshape(h, w, 3), normals=ns.reshape(h, w, 3).astype(np.float32),
+                 depth_m=depth.reshape(h, w), range_m=rng_m.reshape(h, w),
+                 position_m=pos.reshape(h, w, 3), normals=normals32.reshape(h, w, 3),
                  incidence_deg=angles[:, 0].reshape(h, w),
                  emission_deg=angles[:, 1].reshape(h, w),
                  phase_deg=angles[:, 2].reshape(h, w), face=face.reshape(h, w),
-                 sunlit=lit_f.reshape(h, w), camera=camera, pose=pose, sun=sun)
+                 sunlit=sunlit.reshape(h, w), camera=camera, pose=pose, sun=sun)
