@@ -57,15 +57,17 @@ def main():
     print(f"BVH build ({args.quality}): {t_bvh:.2f} s; peak RSS {rss0:.2f} -> "
           f"{peak_rss_gb():.2f} GB")
 
-    # the preview's default view: from (lat 0, lon -90) at the distance that frames the body
+    # the preview's default view: from (lat 0, lon -90), framed as the preview frames it
     view_lat, view_lon = 0.0, -90.0
     toward, right, up = camera_frame(view_lat, view_lon)
     fov_v = 30.0  # the preview's vertical field of view
-    extent = float(np.linalg.norm(verts.max(0) - verts.min(0))) / 2
-    distance = 1.08 * extent / math.tan(math.radians(fov_v / 2)) + extent
+    centre = 0.5 * (verts.min(0) + verts.max(0))
+    rel = verts - centre
+    half = max(float(np.abs(rel @ right).max()), float(np.abs(rel @ up).max()))
+    distance = float((rel @ toward).max()) + 1.08 * half / math.tan(math.radians(fov_v / 2))
     size = args.size
     camera = Camera.from_fov(fov_v, size, size)  # square: horizontal = vertical
-    pose = Pose.look_at(toward * distance, [0.0, 0.0, 0.0], up)
+    pose = Pose.look_at(centre + toward * distance, centre, up)
     sun_dir = math.cos(math.radians(20)) * right + math.sin(math.radians(20)) * toward
     sun = Sun(sun_dir)
 
