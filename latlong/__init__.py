@@ -15,6 +15,7 @@ packing, LCSN craters, Gabor noise, marching cubes).
                           | slopes, preview
     scene (Scene: settings, presets) -> build(scene) -> Body   (writes nothing)
     implicit/ (packing, metaballs, LCSN layers, Gabor, marching cubes) -> to_body
+    sensors/ (ray engine over Embree, cameras, photometry, render: frames + ground truth)
     cli/ (the `latlong` command; the library never imports it)
 
 Imports point down that picture and into ``craters`` (never ``dem``). ``latlong build
@@ -62,6 +63,7 @@ from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
 from .presets import PRESETS
 from .preview import PreviewSettings, render_preview
 from .scene import SETTING_DEFAULTS, SETTINGS, Scene
+from .sensors import render
 from .settings import (
     BodySettings,
     BoulderSettings,
@@ -140,6 +142,7 @@ __all__ = [
     "radius_spectrum",
     "random_faults",
     "read_shape_model",
+    "render",
     "render_preview",
     "slope_summary",
     "slopes",

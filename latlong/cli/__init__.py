@@ -1,7 +1,8 @@
 """The ``latlong`` command line (a private subpackage: the library never imports it).
 
 ``build`` (:mod:`.build`), ``info`` / ``presets`` / ``render`` / ``export``
-(:mod:`.body`), ``slopes`` / ``spectrum`` (:mod:`.analysis`); the option table of build
+(:mod:`.body`), ``slopes`` / ``spectrum`` (:mod:`.analysis`), ``camera``
+(:mod:`.camera`); the option table of build
 and render, which also gives the TOML keys, is :mod:`.options`. Bad input: one line
 ``error: ...`` naming the flag, exit code 2.
 """
@@ -17,6 +18,7 @@ from craters._shared.cli import OneLineParser, run_cli
 from .analysis import add_parsers as add_analysis_parsers
 from .body import add_body_parsers
 from .build import add_build_parser
+from .camera import add_camera_parser
 from .options import BUILD_OPTIONS, RENDER_OPTIONS, add_options, flag_of
 
 __all__ = ["BUILD_OPTIONS", "RENDER_OPTIONS", "build_parser", "main"]
@@ -41,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_build_parser(sub, _add_groups)
     add_body_parsers(sub, _add_groups)
     add_analysis_parsers(sub)
+    add_camera_parser(sub)
     return parser
 
 

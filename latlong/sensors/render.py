@@ -1,0 +1,278 @@
+"""Render a frame: primary rays, hits refined in float64, shading, cast shadows, the
+sensor, and the per-pixel ground truth.
+
+For each pixel centre the camera's ray (:meth:`Camera.rays`) is cast into the model's
+:class:`RayMesh`. At the hit the *geometric* normal is the facet's and the *shading*
+normal is the facet's (``normals="face"``) or the barycentric blend of the mesh's
+area-weighted vertex normals (``normals="smooth"``, the default: a tessellated smooth
+surface is shaded as the surface, not as its facets); both are turned towards the
+camera. cos i, cos e, cos g follow from the shading normal, the sun direction and the
+ray. A point is lit when its facet faces the sun and a shadow ray (from the point
+lifted by ``2e-6`` of the model's bounding radius along the facet normal, above
+float32 rounding) reaches the sun unobstructed: cast shadows always. With a sun of
+angular radius > 0 and ``soft_shadow_samples`` > 0 the lit fraction is the mean over
+samples drawn uniformly over the solar disk (counter-based per pixel and sample, seeded):
+penumbrae. I/F (:mod:`.photometry`) x lit fraction x the optional per-vertex albedo
+factor gives the ``reflectance`` image; the :class:`Sensor` turns it into the ``image``.
+
+Ground truth per pixel (NaN / -1 where the ray misses): ``depth_m`` (camera z) and
+``range_m`` (distance) as float32, ``position_m`` (body frame, float64), ``normals``
+(shading normal, body frame, float32), ``incidence_deg``, ``emission_deg``,
+``phase_deg`` (float32), ``face`` (int64 face index), ``sunlit`` (lit fraction).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from craters._shared import ParameterError, check_int, check_range
+
+from ._render_kernels import (
+    _ground_truth_kernel,
+    _shade_kernel,
+    _shadow_rays_kernel,
+    _surface_kernel,
+)
+from .camera import Camera, Pose
+from .engine import RayMesh
+from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
+from .sensor import Sensor, expose
+
+__all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render", "scene_mesh"]
+
+#: Angular radius of the sun seen from 1 au, degrees (696 000 km / 1 au).
+SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
+#: Shadow rays start this fraction of the model's bounding radius above the surface.
+SHADOW_OFFSET = 2e-6
+
+
+@dataclass(frozen=True, slots=True)
+class Sun:
+    """The light: a direction towards the sun and its angular size."""
+
+    direction: np.ndarray
+    """(3,) unit vector from the surface towards the sun, body frame (normalised; a zero
+    vector is an error)."""
+    angular_radius_deg: float = 0.0
+    """Angular radius of the solar disk, degrees (0: a point; 0.2666 at 1 au), [0, 5]."""
+
+    def __post_init__(self):
+        try:
+            d = np.array(self.direction, dtype=np.float64).reshape(-1)
+        except (TypeError, ValueError):
+            raise ParameterError("sun_direction", f"must be 3 numbers; got "
+                                 f"{self.direction!r}") from None
+        norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
+        if d.shape != (3,) or not np.isfinite(d).all():
+            raise ParameterError("sun_direction", f"must be 3 finite numbers; got "
+                                 f"{self.direction!r}")
+        if not norm > 0:
+            raise ParameterError("sun_direction", "must not be the zero vector")
+        d = d / norm
+        d.flags.writeable = False
+        object.__setattr__(self, "direction", d)
+        object.__setattr__(self, "angular_radius_deg", check_range(
+            "angular_radius_deg", self.angular_radius_deg, 0.0, 5.0))
+
+    @classmethod
+    def at_distance(cls, direction, distance_au: float) -> Sun:
+        """The sun seen from ``distance_au`` au (its angular radius from its size)."""
+        d = check_range("distance_au", distance_au, 0.01, 1000.0)
+        return cls(direction, math.degrees(math.asin(6.957e8 / (d * 1.495978707e11))))
+
+
+@dataclass(frozen=True, slots=True)
+class Frame:
+    """One rendered frame and its ground truth (module notes); images are (H, W)."""
+
+    image: np.ndarray
+    """The sensor's image: uint16 / uint8 DN or float32 I/F (:class:`Sensor`)."""
+    reflectance: np.ndarray
+    """float64 I/F with shadows, before the sensor (0 in shadow and on the sky)."""
+    depth_m: np.ndarray
+    """float32 distance along the optical axis (camera z), metres; NaN on the sky."""
+    range_m: np.ndarray
+    """float32 distance from the camera centre, metres; NaN on the sky."""
+    position_m: np.ndarray
+    """(H, W, 3) float64 surface point, body frame, metres; NaN on the sky."""
+    normals: np.ndarray
+    """(H, W, 3) float32 unit shading normal (towards the camera), body frame."""
+    incidence_deg: np.ndarray
+    """float32 incidence angle (shading normal to the sun), degrees."""
+    emission_deg: np.ndarray
+    """float32 emission angle (shading normal to the camera), degrees."""
+    phase_deg: np.ndarray
+    """float32 phase angle (sun - surface - camera), degrees."""
+    face: np.ndarray
+    """int64 index of the face seen; -1 on the sky."""
+    sunlit: np.ndarray
+    """float32 lit fraction of the solar disk seen from the point, [0, 1]."""
+    camera: Camera = field(repr=False)
+    """The camera."""
+    pose: Pose = field(repr=False)
+    """The camera's pose."""
+    sun: Sun = field(repr=False)
+    """The light."""
+
+
+def scene_mesh(geometry, *, build_quality: str = "medium") -> RayMesh:
+    """A :class:`RayMesh` for a RayMesh (returned as is), a ``latlong.Body`` (its mesh
+    and its boulders), a ``latlong.ShapeModel`` or a ``(vertices, faces)`` pair."""
+    if isinstance(geometry, RayMesh):
+        return geometry
+    from ..body import Body
+    from ..shapes import ShapeModel
+
+    if isinstance(geometry, Body):
+        verts, faces = geometry.vertices(), geometry.grid.triangles()
+        if geometry.boulders is not None and len(geometry.boulders):
+            from craters.boulders import boulder_world_meshes
+
+            bv, bf = boulder_world_meshes(geometry.boulders)
+            faces = np.concatenate([faces, bf + len(verts)])
+            verts = np.concatenate([verts, bv])
+        return RayMesh(verts, faces, build_quality=build_quality)
+    if isinstance(geometry, ShapeModel):
+        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
+    if isinstance(geometry, tuple) and len(geometry) == 2:
+        return RayMesh(*geometry, build_quality=build_quality)
+    raise TypeError("`geometry` must be a RayMesh, a Body, a ShapeModel or (vertices, faces);"
+                    f" got {type(geometry).__name__}")
+
+
+def camera_inside(mesh: RayMesh, position_m) -> bool:
+    """True when a point is inside a closed model (or under an open surface): the first
+    hits of rays along the six axes and eight diagonals all see the back of a facet."""
+    dirs = np.concatenate([np.eye(3), -np.eye(3),
+                           np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1)
+                                     for z in (-1, 1)], dtype=np.float64)])
+    hits = mesh.intersect(np.asarray(position_m, dtype=np.float64), dirs)
+    if not hits.hit.any():
+        return False
+    n = mesh.face_normals[hits.face[hits.hit]]
+    return bool((np.einsum("ij,ij->i", n, dirs[hits.hit]) > 0).all())
+
+
+def _model(reflectance):
+    if reflectance is None:
+        return LommelSeeliger()
+    if not isinstance(reflectance, Lambert | LommelSeeliger | LunarLambert | Hapke):
+        raise TypeError("`reflectance` must be a reflectance model (latlong.sensors."
+                        f"photometry); got {type(reflectance).__name__}")
+    return reflectance
+
+
+def _vertex_albedo(mesh: RayMesh, vertex_albedo, hits) -> np.ndarray:
+    if vertex_albedo is None:
+        return np.ones(len(hits.face))
+    a = np.asarray(vertex_albedo, dtype=np.float64)
+    if a.shape != (len(mesh.vertices),) or not np.isfinite(a).all() or (a < 0).any():
+        raise ParameterError("vertex_albedo", f"must be {len(mesh.vertices)} finite factors "
+                             ">= 0, one per vertex")
+    out = np.zeros(len(hits.face))
+    ok = hits.hit
+    tri = mesh.faces[hits.face[ok]]
+    u, v = hits.u[ok], hits.v[ok]
+    out[ok] = (1 - u - v) * a[tri[:, 0]] + u * a[tri[:, 1]] + v * a[tri[:, 2]]
+    return out
+
+
+def _vertex_normals(mesh: RayMesh, normals):
+    """The vertex normals to blend (None: the facets' own)."""
+    if isinstance(normals, str):
+        if normals not in ("smooth", "face"):
+            raise ParameterError("normals", f"must be 'smooth', 'face' or (n, 3) vertex "
+                                 f"normals; got {normals!r}")
+        return mesh.vertex_normals if normals == "smooth" else None
+    n = np.ascontiguousarray(normals, dtype=np.float64)
+    if n.shape != mesh.vertices.shape or not np.isfinite(n).all():
+        raise ParameterError("normals", f"must be 'smooth', 'face' or {mesh.vertices.shape} "
+                             "finite vertex normals")
+    return n
+
+
+def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndarray:
+    """Lit fraction per hit: facet faces the sun and the shadow ray is free."""
+    lit = np.zeros(len(pos))
+    cand = np.flatnonzero(facing)
+    if not len(cand):
+        return lit
+    eps = SHADOW_OFFSET * mesh.bounding_sphere[1]
+    radius = math.radians(sun.angular_radius_deg) if samples else 0.0
+    p, n = np.ascontiguousarray(pos[cand]), np.ascontiguousarray(ng[cand])
+    o, d = np.empty_like(p), np.empty_like(p)
+    face_ok = np.empty(len(cand), dtype=np.bool_)
+    total = np.zeros(len(cand))
+    for k in range(max(samples, 1)):
+        _shadow_rays_kernel(p, n, eps, sun.direction, radius, seed, k, o, d, face_ok)
+        free = face_ok & ~mesh.occluded(o, d, np.inf)
+        total += free
+    lit[cand] = total / max(samples, 1)
+    return lit
+
+
+def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
+           sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
+           soft_shadow_samples: int = 0, seed: int = 0) -> Frame:
+    """Render one frame of ``geometry`` (a :class:`RayMesh`: build it once with
+    :func:`scene_mesh` and share it between frames) seen by ``camera`` at ``pose``, lit
+    by ``sun`` (a :class:`Sun` or a direction towards it). See the module notes.
+
+    ``reflectance`` defaults to Lommel–Seeliger with normal albedo 0.12; ``sensor``
+    to :class:`Sensor` (); ``normals`` is ``"smooth"``, ``"face"`` or an (n, 3) array of
+    vertex normals to blend (e.g. a sphere's exact radial directions); ``vertex_albedo``
+    an optional (n,) factor per vertex; ``seed`` keys the sun-disk samples and the
+    sensor noise.
+    """
+    if not isinstance(camera, Camera):
+        raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
+    if not isinstance(pose, Pose):
+        raise TypeError(f"`pose` must be a Pose; got {type(pose).__name__}")
+    sun = sun if isinstance(sun, Sun) else Sun(sun)
+    model = _model(reflectance)
+    sensor = Sensor() if sensor is None else sensor
+    if not isinstance(sensor, Sensor):
+        raise TypeError(f"`sensor` must be a Sensor; got {type(sensor).__name__}")
+    samples = check_int("soft_shadow_samples", soft_shadow_samples, 0, 1024)
+    seed = check_int("seed", seed, 0, 2**63 - 1)
+    if sun.angular_radius_deg == 0.0:
+        samples = 0
+    mesh = scene_mesh(geometry)
+    h, w = camera.height, camera.width
+    origin, dirs = camera.rays(pose)
+    dirs = dirs.reshape(-1, 3)
+    valid = ~np.isnan(dirs[:, 0])
+    if not valid.all():  # beyond the distortion model's fold: cast along the axis, no hit
+        dirs[~valid] = pose.rotation[:, 2]
+    origin = origin.reshape(1, 3)
+    hits = mesh.intersect(origin, dirs)
+    face = hits.face
+    if not valid.all():
+        face[~valid] = -1
+    n = len(face)
+    pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
+    facing = np.empty(n, dtype=np.bool_)
+    vnormals = _vertex_normals(mesh, normals)
+    smooth = vnormals is not None
+    _surface_kernel(origin, dirs, hits.t_m, face, hits.u, hits.v, mesh.vertices,
+                    mesh.faces, vnormals if smooth else np.zeros((1, 3)), smooth,
+                    sun.direction, pos, ng, ns, cosines, facing)
+    lit = _sunlit(mesh, pos, ng, facing, sun, samples, seed)
+    albedo = _vertex_albedo(mesh, vertex_albedo, hits)
+    refl = np.empty(n)
+    _shade_kernel(model.code, model.vector(), cosines, lit, albedo, refl)
+    refl = refl.reshape(h, w)
+    depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))
+    angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))
+    _ground_truth_kernel(hits.t_m, face, dirs, pose.rotation[:, 2], cosines, ns, lit, depth,
+                         rng_m, angles, normals32, sunlit)
+    return Frame(image=expose(refl, sensor, seed=seed), reflectance=refl,
+                 depth_m=depth.reshape(h, w), range_m=rng_m.reshape(h, w),
+                 position_m=pos.reshape(h, w, 3), normals=normals32.reshape(h, w, 3),
+                 incidence_deg=angles[:, 0].reshape(h, w),
+                 emission_deg=angles[:, 1].reshape(h, w),
+                 phase_deg=angles[:, 2].reshape(h, w), face=face.reshape(h, w),
+                 sunlit=sunlit.reshape(h, w), camera=camera, pose=pose, sun=sun)

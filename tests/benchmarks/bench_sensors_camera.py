@@ -1,0 +1,106 @@
+"""Benchmark: the camera (latlong.render) against the pyvista preview (plain script).
+
+A body of magnitude M (default 1000: 6 M vertices, 12 M triangles), radius 1 km, Perlin
+fBm relief (+-30 m); one view at 1024 x 1024 with the sun 20 degrees above the local
+horizon of the view's centre (long cast shadows). Measures, in the same run:
+
+* the BVH build (``scene_mesh``: Embree, 12 M triangles) and its memory (peak RSS
+  before and after, ``resource``),
+* ``latlong.render`` of the frame with cast shadows, after the BVH (best of ``--repeat``;
+  the first call also computes the vertex normals and is reported separately),
+* ``latlong.render_preview`` of the same view (pyvista/VTK, no shadows, same size),
+  and prints the ratios. Usage:
+``python tests/benchmarks/bench_sensors_camera.py [--magnitude M] [--size N] [--repeat R]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import resource
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+
+def peak_rss_gb() -> float:
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1e6
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--magnitude", type=int, default=1000)
+    parser.add_argument("--size", type=int, default=1024)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--quality", default="medium", help="Embree build quality")
+    args = parser.parse_args()
+
+    import latlong
+    from latlong import Body, LatLongGrid, perlin_fbm
+    from latlong.preview import camera_frame
+    from latlong.sensors import Camera, Pose, RayMesh, Sun
+
+    t0 = time.perf_counter()
+    grid = LatLongGrid(args.magnitude)
+    heights = perlin_fbm(grid, 2.0, 8, 0.5, 2.0, 30.0, rng=1)
+    body = Body.from_heights(grid, 1000.0, heights)
+    verts, faces = body.vertices(), grid.triangles()
+    print(f"body M={args.magnitude}: {len(verts):,} vertices, {len(faces):,} triangles "
+          f"({time.perf_counter() - t0:.1f} s to make); peak RSS {peak_rss_gb():.2f} GB")
+
+    rss0 = peak_rss_gb()
+    t0 = time.perf_counter()
+    mesh = RayMesh(verts, faces, build_quality=args.quality)
+    t_bvh = time.perf_counter() - t0
+    print(f"BVH build ({args.quality}): {t_bvh:.2f} s; peak RSS {rss0:.2f} -> "
+          f"{peak_rss_gb():.2f} GB")
+
+    # the preview's default view: from (lat 0, lon -90), framed as the preview frames it
+    view_lat, view_lon = 0.0, -90.0
+    toward, right, up = camera_frame(view_lat, view_lon)
+    fov_v = 30.0  # the preview's vertical field of view
+    centre = 0.5 * (verts.min(0) + verts.max(0))
+    rel = verts - centre
+    half = max(float(np.abs(rel @ right).max()), float(np.abs(rel @ up).max()))
+    distance = float((rel @ toward).max()) + 1.08 * half / math.tan(math.radians(fov_v / 2))
+    size = args.size
+    camera = Camera.from_fov(fov_v, size, size)  # square: horizontal = vertical
+    pose = Pose.look_at(centre + toward * distance, centre, up)
+    sun_dir = math.cos(math.radians(20)) * right + math.sin(math.radians(20)) * toward
+    sun = Sun(sun_dir)
+
+    t0 = time.perf_counter()
+    frame = latlong.render(mesh, camera, pose, sun)
+    t_first = time.perf_counter() - t0
+    times = []
+    for _ in range(args.repeat):
+        t0 = time.perf_counter()
+        frame = latlong.render(mesh, camera, pose, sun)
+        times.append(time.perf_counter() - t0)
+    t_render = min(times)
+    hit = frame.face >= 0
+    shadow = hit & (frame.sunlit == 0)
+    print(f"latlong.render {size}x{size} with shadows: {t_render:.3f} s best of "
+          f"{args.repeat} ({', '.join(f'{t:.3f}' for t in times)}); first call "
+          f"{t_first:.2f} s (vertex normals); {hit.mean():.0%} of pixels on the body, "
+          f"{shadow.sum() / max(hit.sum(), 1):.0%} of those in shadow")
+
+    with tempfile.TemporaryDirectory() as tmp:
+        png = Path(tmp) / "preview.png"
+        times_p = []
+        for _ in range(max(1, min(args.repeat, 2))):
+            t0 = time.perf_counter()
+            latlong.render_preview(body, png, view_lat_deg=view_lat, view_lon_deg=view_lon,
+                                   width_px=size, height_px=size)
+            times_p.append(time.perf_counter() - t0)
+    t_prev = min(times_p)
+    print(f"latlong.render_preview same view: {t_prev:.2f} s best of {len(times_p)}")
+    print(f"ratio preview / render: {t_prev / t_render:.1f}x (target >= 5); render "
+          f"{t_render:.3f} s (target <= 1 s); BVH {t_bvh:.1f} s (target <= 10 s); peak RSS "
+          f"{peak_rss_gb():.2f} GB")
+
+
+if __name__ == "__main__":
+    main()
