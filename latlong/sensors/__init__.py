@@ -1,0 +1,1 @@
+"""Sensors: camera and LIDAR (issue 17)."""

@@ -1,0 +1,215 @@
+"""Ground-truth labels of surface points: crater ids, boulder ids, projected rim ellipses.
+
+Crater id of a surface point ``p`` (body frame): the catalog row of the crater whose rim
+contains it. A crater with centre ``c`` (``centre_x_m, centre_y_m, centre_z_m``, on the
+surface where it was stamped) and rim radius ``R`` (``rim_radius_m``, else
+``diameter_m / 2``) contains ``p`` when
+
+* the catalog has the crater's up axis ``normal_x, normal_y, normal_z`` (craters stamped
+  on a mesh surface, LCSN craters): the distance from ``c`` measured in the crater's
+  tangent plane, ``|(p - c) - ((p - c).n) n|``, is at most ``R`` and the height
+  ``|(p - c).n|`` is at most ``R`` (a slab that keeps the far side of a small body out);
+* otherwise (craters on a lat/long body, stamped around the body's origin): the arc
+  ``|c| angle(p, c)`` is at most ``R`` (the distance the stamping kernel uses) and
+  ``| |p| - |c| |`` is at most ``R``.
+
+Where craters overlap the youngest wins, i.e. the **last row** of the catalog that
+contains the point: catalogs are in stamping order (oldest first), and the youngest
+crater is the one whose rim the surface shows. Irregular rims (the stamping's random
+rim perturbation, a few per cent of ``R``) are not in the catalog: the label follows the
+nominal circular rim. Ids are catalog rows (0-based), -1 for no crater; boulder ids are
+boulder catalog rows from the mesh's per-triangle ``boulder_id`` (-1 on the surface).
+
+Rim ellipses: the rim crest of each crater is the circle of radius ``R`` around ``c`` in
+the crater's tangent plane (normal: the catalog's up axis, else the radial direction of
+``c``), lifted by ``rim_height_m`` along the up axis when the catalog has it: the
+stamping replaces the terrain inside the rim by a fitted plane plus the bowl, so the crest
+stands ``rim_height_m`` above the tangent plane, not above the curved ground (on a 500 m
+body a 40 m rim is 1.6 m above the sphere there; the arc of the label rule and the plane
+radius differ by ``R^3 / (6 |c|^2)``, 4 cm). Its image through a pinhole camera is an
+exact conic (the circle's plane maps to the image by a homography ``H = K [r e1, r e2,
+centre]``; the unit circle ``diag(1, 1, -1)`` maps to ``H^-T diag(1, 1, -1) H^-1``),
+an ellipse whenever the whole circle is in front of the camera. Pixel coordinates are
+OpenCV's with pixel centres at integer + 0.5: pixel (col i, row j) covers
+``[i, i + 1) x [j, j + 1)`` and ``u = fx X / Z + cx``, ``v = fy Y / Z + cy``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from craters._shared import ParameterError
+
+from .poses import rotation_matrix
+
+__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_circles", "rim_ellipses"]
+
+#: Fields of :func:`rim_ellipses` (pixels; the angle of the major axis from +x towards
+#: +y, i.e. clockwise on the picture, degrees in [0, 180)).
+ELLIPSE_DTYPE = np.dtype([("crater_id", "<i8"), ("centre_x_px", "<f8"), ("centre_y_px", "<f8"),
+                          ("semi_major_px", "<f8"), ("semi_minor_px", "<f8"),
+                          ("angle_deg", "<f8")])
+
+
+def _centres_radii(catalog):
+    names = catalog.dtype.names or ()
+    if not all(k in names for k in ("centre_x_m", "centre_y_m", "centre_z_m")):
+        raise ParameterError("catalog", "needs centre_x_m, centre_y_m, centre_z_m columns (a "
+                             "catalog as stamped)")
+    c = np.stack([catalog["centre_x_m"], catalog["centre_y_m"], catalog["centre_z_m"]],
+                 1).astype(np.float64)
+    if "rim_radius_m" in names:
+        r = np.asarray(catalog["rim_radius_m"], dtype=np.float64)
+    elif "diameter_m" in names:
+        r = 0.5 * np.asarray(catalog["diameter_m"], dtype=np.float64)
+    else:
+        raise ParameterError("catalog", "needs rim_radius_m or diameter_m")
+    normals = None
+    if all(k in names for k in ("normal_x", "normal_y", "normal_z")):
+        normals = np.stack([catalog["normal_x"], catalog["normal_y"], catalog["normal_z"]],
+                           1).astype(np.float64)
+        normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    return c, r, normals
+
+
+def crater_labels(points, catalog) -> np.ndarray:
+    """(k,) int64 crater id (catalog row) of each surface point, -1 outside every rim.
+
+    Parameters
+    ----------
+    points : (k, 3) array_like
+        Surface points in the body frame, metres (rows of NaN/inf give -1).
+    catalog : structured array
+        Craters as stamped (module notes for the columns and the overlap rule).
+
+    Examples
+    --------
+    >>> import craters
+    >>> cat = craters.make_catalog(x_m=[0.0, 0.0], y_m=[0.0, 0.0], diameter_m=[20.0, 4.0],
+    ...                            centre_x_m=[100.0, 100.0], centre_y_m=[0.0, 4.0],
+    ...                            centre_z_m=[0.0, 0.0])
+    >>> crater_labels([[100.0, 0, 0], [99.0, 4.5, 0], [100.0, 30, 0]], cat).tolist()
+    [0, 1, -1]
+    """
+    p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    out = np.full(len(p), -1, dtype=np.int64)
+    if catalog is None or not len(catalog) or not len(p):
+        return out
+    c, r, normals = _centres_radii(catalog)
+    ok = np.flatnonzero(np.isfinite(p).all(axis=1))
+    tree = cKDTree(p[ok])
+    # every point that passes either rule is within 2 R of the centre (chord <= arc + dr)
+    near = tree.query_ball_point(c, 2.0 * r + 1e-9 * np.abs(c).max(axis=1))
+    for row in range(len(c)):  # oldest first: later rows overwrite
+        idx = ok[np.asarray(near[row], dtype=np.int64)]
+        if not len(idx):
+            continue
+        q = p[idx]
+        if normals is not None:
+            d = q - c[row]
+            h = d @ normals[row]
+            inside = (np.linalg.norm(d - h[:, None] * normals[row], axis=1) <= r[row]) \
+                & (np.abs(h) <= r[row])
+        else:
+            rc = np.linalg.norm(c[row])
+            rq = np.linalg.norm(q, axis=1)
+            cross = np.linalg.norm(np.cross(q, c[row]), axis=1)
+            arc = rc * np.arctan2(cross, q @ c[row])
+            inside = (arc <= r[row]) & (np.abs(rq - rc) <= r[row])
+        out[idx[inside]] = row
+    return out
+
+
+def boulder_labels(face, face_boulder_id) -> np.ndarray:
+    """(k,) int64 boulder id of each hit (``face`` -1 = a miss) from the per-triangle
+    ``face_boulder_id`` (-1 on the surface)."""
+    face = np.asarray(face, dtype=np.int64)
+    ids = np.asarray(face_boulder_id, dtype=np.int64)
+    return np.where(face >= 0, ids[np.maximum(face, 0)], -1)
+
+
+def rim_circles(catalog):
+    """The rim crest circle of each crater (module notes): ``(centres (n, 3), normals
+    (n, 3), radii (n,))`` in the body frame, metres."""
+    c, r, normals = _centres_radii(catalog)
+    lift = np.asarray(catalog["rim_height_m"], dtype=np.float64) \
+        if "rim_height_m" in catalog.dtype.names else np.zeros(len(c))
+    up = normals if normals is not None else c / np.linalg.norm(c, axis=1, keepdims=True)
+    return c + lift[:, None] * up, up, r
+
+
+def _basis(n):
+    a = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0.0, 0.0]], [[0.0, 1.0, 0.0]])
+    e1 = np.cross(n, a)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    return e1, np.cross(n, e1)
+
+
+def _conic_ellipse(q):
+    """(cx, cy, a, b, angle_deg) of the ellipse x^T q x = 0, or None if not an ellipse."""
+    m = q[:2, :2]
+    try:
+        centre = np.linalg.solve(m, -q[:2, 2])
+    except np.linalg.LinAlgError:
+        return None
+    k = -(q[2, 2] + q[:2, 2] @ centre)
+    lam, vec = np.linalg.eigh(m / k)
+    if not (lam > 0).all():
+        return None
+    a, b = 1.0 / np.sqrt(lam)  # eigh: ascending, so a (from the smaller lam) is major
+    angle = np.degrees(np.arctan2(vec[1, 0], vec[0, 0])) % 180.0
+    return centre[0], centre[1], a, b, angle
+
+
+def rim_ellipses(catalog, intrinsics, position_m, quaternion_wxyz, *, ids=None,
+                 width: int | None = None, height: int | None = None) -> np.ndarray:
+    """The projected rim ellipse of each crater in front of a pinhole camera.
+
+    Parameters
+    ----------
+    catalog : structured array
+        Craters as stamped (module notes).
+    intrinsics : (fx, fy, cx, cy)
+        Pinhole intrinsics, pixels (pixel centres at integer + 0.5).
+    position_m, quaternion_wxyz
+        The camera pose: position in the body frame (metres) and the camera-to-body
+        rotation (OpenCV camera frame: x right, y down, z forward).
+    ids : array_like of int, optional
+        Only these craters (e.g. the ids present in a label image: the visible ones).
+    width, height : int, optional
+        With both, only ellipses whose bounding box meets the picture are kept.
+
+    Returns
+    -------
+    structured array of :data:`ELLIPSE_DTYPE`, one row per crater whose whole rim is in
+    front of the camera, in catalog order.
+    """
+    fx, fy, cx, cy = (float(v) for v in intrinsics)
+    k_mat = np.array([[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]])
+    rot = rotation_matrix(quaternion_wxyz)
+    t = np.asarray(position_m, dtype=np.float64).reshape(3)
+    out = np.zeros(0, ELLIPSE_DTYPE)
+    if catalog is None or not len(catalog):
+        return out
+    centres, normals, radii = rim_circles(catalog)
+    rows = np.arange(len(centres)) if ids is None else np.unique(np.asarray(ids, np.int64))
+    rows = rows[(rows >= 0) & (rows < len(centres))]
+    cc = (centres[rows] - t) @ rot  # camera frame: R^T (x - t)
+    e1, e2 = _basis(normals[rows] @ rot)
+    keep = []
+    for i, row in enumerate(rows):
+        r = radii[row]
+        if cc[i, 2] - r * np.hypot(e1[i, 2], e2[i, 2]) <= 0.0:
+            continue  # part of the rim behind the camera: no ellipse
+        h = k_mat @ np.stack([r * e1[i], r * e2[i], cc[i]], 1)
+        hinv = np.linalg.inv(h)
+        e = _conic_ellipse(hinv.T @ np.diag([1.0, 1.0, -1.0]) @ hinv)
+        if e is None:
+            continue
+        if width is not None and height is not None:
+            ext = e[2]
+            if e[0] + ext < 0 or e[0] - ext > width or e[1] + ext < 0 or e[1] - ext > height:
+                continue
+        keep.append((int(row), *e))
+    return np.array(keep, dtype=ELLIPSE_DTYPE) if keep else out

@@ -1,0 +1,137 @@
+"""What the sensors see: one triangle mesh in the body frame (metres) with its boulder ids
+and the catalogs that label it.
+
+A model is a :class:`latlong.Body` or its ``.npz``, a ``latlong.mesh.MeshSurface``
+(``--surface mesh``), or any mesh file pyvista reads (PLY, OBJ, STL, VTP, VTK, GLB:
+``dem mesh`` outputs, shape models). The body's placed boulders are part of the mesh
+(as the exports write them: boulders after the surface, ``boulder_id`` = catalog row);
+a mesh file's ``boulder_id`` point array is kept when it has one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import craters
+from craters._shared import ParameterError, check_choice
+
+from ..body import Body, load
+from ..export import body_mesh_source
+
+__all__ = ["MESH_SUFFIXES", "SceneGeometry", "scene_geometry"]
+
+#: Mesh files read through pyvista.
+MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk", ".glb", ".gltf")
+_UNITS = {"m": 1.0, "km": 1000.0}
+
+
+@dataclass(frozen=True, slots=True)
+class SceneGeometry:
+    """A triangle mesh in the body frame and the ground truth that labels it."""
+
+    vertices: np.ndarray
+    """(n, 3) float64 positions, metres, body frame."""
+    faces: np.ndarray
+    """(m, 3) int64 vertex indices."""
+    face_boulder_id: np.ndarray
+    """(m,) int32 boulder catalog row of each triangle, -1 on the surface."""
+    craters: np.ndarray | None = None
+    """The crater catalog as stamped (rows in stamping order, oldest first) or None."""
+    boulders: np.ndarray | None = None
+    """The boulder catalog as placed or None."""
+    source: str = ""
+    """Where it came from."""
+
+
+def _from_source(src, craters_, boulders, source) -> SceneGeometry:
+    verts, ids = [], []
+    for xyz, values in src.vertex_chunks():
+        verts.append(np.asarray(xyz, dtype=np.float64))
+        ids.append(np.asarray(values.get("boulder_id", np.full(len(xyz), -1)), np.int32))
+    faces = np.concatenate([np.asarray(f, dtype=np.int64) for f in src.faces()])
+    vid = np.concatenate(ids)
+    return SceneGeometry(np.concatenate(verts), faces, vid[faces[:, 0]], craters_, boulders,
+                         source)
+
+
+def _read_mesh(path: Path, units: str) -> SceneGeometry:
+    import pyvista as pv
+
+    try:
+        mesh = pv.read(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is an unreadable mesh
+        raise ValueError(f"cannot read mesh {str(path)!r}: {exc}".splitlines()[0]) from None
+    if isinstance(mesh, pv.MultiBlock):
+        mesh = mesh.combine(merge_points=False)
+    if not isinstance(mesh, pv.PolyData):
+        mesh = mesh.extract_surface()
+    mesh = mesh.triangulate()
+    faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
+        else np.zeros((0, 3), np.int64)
+    if not len(faces):
+        raise ValueError(f"mesh {str(path)!r} has no triangles")
+    verts = np.asarray(mesh.points, dtype=np.float64) * _UNITS[units]
+    if not np.isfinite(verts).all():
+        raise ValueError(f"mesh {str(path)!r} has non-finite vertices")
+    if "boulder_id" in mesh.point_data:
+        fid = np.asarray(mesh.point_data["boulder_id"]).astype(np.int32)[faces[:, 0]]
+    else:
+        fid = np.full(len(faces), -1, dtype=np.int32)
+    return SceneGeometry(verts, faces, fid, None, None, str(path))
+
+
+def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
+    """The mesh and catalogs of ``model`` (module notes).
+
+    Parameters
+    ----------
+    model : Body, MeshSurface, SceneGeometry, or path
+        A body, a ``--surface mesh`` surface, or a file: ``.npz`` (a body) or a mesh
+        (``MESH_SUFFIXES``).
+    units : {"m", "km"}
+        Units of a mesh file's coordinates (bodies are in metres).
+    craters : structured array or path, optional
+        A crater catalog (CSV or array with ``centre_x_m, centre_y_m, centre_z_m`` and
+        ``rim_radius_m`` or ``diameter_m``) to use instead of the model's own.
+    """
+    check_choice("units", units, tuple(_UNITS))
+    if isinstance(model, SceneGeometry):
+        geo = model
+    elif isinstance(model, Body):
+        geo = _from_source(body_mesh_source(model), model.craters, model.boulders,
+                           repr(model))
+    elif hasattr(model, "mesh_source") and hasattr(model, "faces"):
+        geo = _from_source(model.mesh_source(), model.craters, model.boulders, "mesh surface")
+    elif isinstance(model, str | Path):
+        path = Path(model)
+        if not path.is_file():
+            raise ParameterError("model", f"file {str(path)!r} does not exist")
+        suffix = path.suffix.lower()
+        if suffix == ".npz":
+            body = load(path)
+            geo = _from_source(body_mesh_source(body), body.craters, body.boulders, str(path))
+        elif suffix in MESH_SUFFIXES:
+            geo = _read_mesh(path, units)
+        else:
+            raise ParameterError("model", f"must be a body .npz or a mesh file "
+                                 f"({' '.join(MESH_SUFFIXES)}); got {str(path)!r}")
+    else:
+        raise TypeError(f"`model` must be a Body, a mesh surface or a path; got "
+                        f"{type(model).__name__}")
+    if craters is not None:
+        if isinstance(craters, str | Path):
+            craters = craters_catalog(craters)
+        geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id,
+                            np.asarray(craters), geo.boulders, geo.source)
+    return geo
+
+
+def craters_catalog(path) -> np.ndarray:
+    """A crater catalog CSV (as ``latlong build --catalog`` writes it)."""
+    try:
+        return craters.read_catalog(path)
+    except (OSError, KeyError) as exc:
+        raise ValueError(f"cannot read crater catalog {str(path)!r}: {exc}") from None
