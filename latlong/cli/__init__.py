@@ -17,6 +17,8 @@ from craters._shared.cli import OneLineParser, run_cli
 from .analysis import add_parsers as add_analysis_parsers
 from .body import add_body_parsers
 from .build import add_build_parser
+from .lidar import FLAGS as LIDAR_FLAGS
+from .lidar import add_lidar_parser
 from .options import BUILD_OPTIONS, RENDER_OPTIONS, add_options, flag_of
 
 __all__ = ["BUILD_OPTIONS", "RENDER_OPTIONS", "build_parser", "main"]
@@ -41,6 +43,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_build_parser(sub, _add_groups)
     add_body_parsers(sub, _add_groups)
     add_analysis_parsers(sub)
+    add_lidar_parser(sub)
     return parser
 
 
@@ -48,6 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     flags = {o.key: flag_of(o.key) for o in BUILD_OPTIONS}
+    if args.command == "lidar":
+        flags = LIDAR_FLAGS
     return run_cli(lambda: args.func(args), flags=flags)
 
 

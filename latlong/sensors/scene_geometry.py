@@ -10,6 +10,7 @@ a mesh file's ``boulder_id`` point array is kept when it has one.
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -59,11 +60,18 @@ def _from_source(src, craters_, boulders, source) -> SceneGeometry:
 
 def _read_mesh(path: Path, units: str) -> SceneGeometry:
     import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkObject
 
+    shown = vtkObject.GetGlobalWarningDisplay()
+    vtkObject.GlobalWarningDisplayOff()  # a bad file: one line from us, not VTK's report
     try:
-        mesh = pv.read(path)
+        with pv.vtk_verbosity("off"), warnings.catch_warnings():
+            warnings.simplefilter("error")
+            mesh = pv.read(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure is an unreadable mesh
         raise ValueError(f"cannot read mesh {str(path)!r}: {exc}".splitlines()[0]) from None
+    finally:
+        vtkObject.SetGlobalWarningDisplay(shown)
     if isinstance(mesh, pv.MultiBlock):
         mesh = mesh.combine(merge_points=False)
     if not isinstance(mesh, pv.PolyData):
@@ -72,7 +80,7 @@ def _read_mesh(path: Path, units: str) -> SceneGeometry:
     faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
         else np.zeros((0, 3), np.int64)
     if not len(faces):
-        raise ValueError(f"mesh {str(path)!r} has no triangles")
+        raise ValueError(f"cannot read mesh {str(path)!r}: no triangles in it")
     verts = np.asarray(mesh.points, dtype=np.float64) * _UNITS[units]
     if not np.isfinite(verts).all():
         raise ValueError(f"mesh {str(path)!r} has non-finite vertices")
