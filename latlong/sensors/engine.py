@@ -106,6 +106,8 @@ class RayMesh:
         self._scene = rtcore_scene.EmbreeScene(self._device)
         mesh_construction.TriangleMesh(self._scene, self.vertices.astype(np.float32),
                                        self.faces.astype(np.int32))
+        # Embree builds the BVH at the first query: build it here, once
+        self._scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
 
     def _rays(self, origins, directions):
         o = np.ascontiguousarray(origins, dtype=np.float64).reshape(-1, 3)

@@ -37,16 +37,18 @@ OpenCV's with pixel centres at integer + 0.5: pixel (col i, row j) covers
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial import cKDTree
 
 from craters._shared import ParameterError
 
+from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kernel
 from .poses import rotation_matrix
 
 __all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_circles", "rim_ellipses"]
 
 #: Fields of :func:`rim_ellipses` (pixels; the angle of the major axis from +x towards
 #: +y, i.e. clockwise on the picture, degrees in [0, 180)).
+_GRID_CELLS = 128  # cells along the longest side of the points' box
+
 ELLIPSE_DTYPE = np.dtype([("crater_id", "<i8"), ("centre_x_px", "<f8"), ("centre_y_px", "<f8"),
                           ("semi_major_px", "<f8"), ("semi_minor_px", "<f8"),
                           ("angle_deg", "<f8")])
@@ -97,27 +99,31 @@ def crater_labels(points, catalog) -> np.ndarray:
     if catalog is None or not len(catalog) or not len(p):
         return out
     c, r, normals = _centres_radii(catalog)
-    ok = np.flatnonzero(np.isfinite(p).all(axis=1))
-    tree = cKDTree(p[ok])
-    # every point that passes either rule is within 2 R of the centre (chord <= arc + dr)
-    near = tree.query_ball_point(c, 2.0 * r + 1e-9 * np.abs(c).max(axis=1))
-    for row in range(len(c)):  # oldest first: later rows overwrite
-        idx = ok[np.asarray(near[row], dtype=np.int64)]
-        if not len(idx):
-            continue
-        q = p[idx]
-        if normals is not None:
-            d = q - c[row]
-            h = d @ normals[row]
-            inside = (np.linalg.norm(d - h[:, None] * normals[row], axis=1) <= r[row]) \
-                & (np.abs(h) <= r[row])
-        else:
-            rc = np.linalg.norm(c[row])
-            rq = np.linalg.norm(q, axis=1)
-            cross = np.linalg.norm(np.cross(q, c[row]), axis=1)
-            arc = rc * np.arctan2(cross, q @ c[row])
-            inside = (arc <= r[row]) & (np.abs(rq - rc) <= r[row])
-        out[idx[inside]] = row
+    p = np.ascontiguousarray(p)
+    finite = np.empty(len(p), dtype=np.bool_)
+    lo, hi = np.zeros(3), np.zeros(3)
+    n_ok = _finite_box_kernel(p, finite, lo, hi)
+    if not n_ok:
+        return out
+    ok = slice(None) if n_ok == len(p) else np.flatnonzero(finite)
+    q = p if n_ok == len(p) else np.ascontiguousarray(p[ok])
+    reach = 2.0 * r[:, None]  # every point either rule accepts is within 2 R of the centre
+    rows = np.flatnonzero(((c + reach >= lo) & (c - reach <= hi)).all(axis=1) & (r > 0))
+    if not len(rows):
+        return out
+    h = max(float(np.max(hi - lo)) / _GRID_CELLS,
+            1e-9 * max(1.0, float(np.abs(lo).max()), float(np.abs(hi).max())))
+    dims = (np.floor((hi - lo) / h).astype(np.int64) + 1)
+    offsets = np.zeros(int(np.prod(dims)) + 1, dtype=np.int64)
+    order = np.empty(len(q), dtype=np.int64)
+    _bin_points_kernel(q, lo, h, dims, offsets, order)
+    sub = np.full(len(q), -1, dtype=np.int64)
+    use = normals is not None
+    _label_kernel(q, lo, h, dims, offsets, order, np.ascontiguousarray(c[rows]),
+                  np.ascontiguousarray(r[rows]),
+                  np.ascontiguousarray(normals[rows]) if use else np.zeros((len(rows), 3)),
+                  use, sub)
+    out[ok] = np.where(sub >= 0, rows[np.maximum(sub, 0)], -1)
     return out
 
 

@@ -34,6 +34,7 @@ offset.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -129,7 +130,22 @@ class LidarSettings:
 
 def beam_pattern(settings: LidarSettings) -> tuple[np.ndarray, np.ndarray]:
     """Beam axes in the sensor frame (n, 3) unit vectors, row-major over the W x H range
-    image, and each beam's firing time after the frame time (n,) seconds."""
+    image, and each beam's firing time after the frame time (n,) seconds (read-only
+    arrays, computed once per settings)."""
+    if not isinstance(settings, LidarSettings):
+        raise TypeError(f"`settings` must be LidarSettings; got {type(settings).__name__}")
+    return _beam_pattern(settings)
+
+
+@functools.lru_cache(maxsize=4)
+def _beam_pattern(settings: LidarSettings) -> tuple[np.ndarray, np.ndarray]:
+    dirs, dt = _beam_arrays(settings)
+    dirs.setflags(write=False)
+    dt.setflags(write=False)
+    return dirs, dt
+
+
+def _beam_arrays(settings: LidarSettings) -> tuple[np.ndarray, np.ndarray]:
     w, h = settings.beams
     n = w * h
     if settings.pattern == "rosette":
@@ -249,8 +265,10 @@ def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_w
     rng_out = np.zeros((nb, nmax))
     lam_out = np.zeros((nb, nmax))
     best_out = np.zeros((nb, nmax), dtype=np.int64)
-    hit_point = np.full((nb, nmax, 3), np.nan)
-    hit_face = np.full((nb, nmax), -1, dtype=np.int64)
+    labelled = geometry is not None
+    best_t = np.zeros((nb, nmax)) if labelled else None
+    best_face = np.full((nb, nmax), -1, dtype=np.int64) if labelled else None
+    best_dir = np.zeros((nb, nmax, 3)) if labelled else None
     step = max(1, _SUBRAYS_PER_CHUNK // nr)
     for s in range(0, nb, step):
         e = min(s + step, nb)
@@ -263,42 +281,36 @@ def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_w
                 + np.tan(sub[None, :, 1:]) * p2[:, None]
             d = (d / np.linalg.norm(d, axis=2, keepdims=True)).reshape(-1, 3) @ rot.T
         hits = mesh.intersect(np.broadcast_to(origin, d.shape), d, settings.max_range_m)
-        t = hits.t_m.reshape(e - s, nr)
-        hit = hits.face >= 0
-        cos_i = np.zeros(len(d))
-        cos_i[hit] = np.abs(np.einsum("ij,ij->i", mesh.face_normals[hits.face[hit]], d[hit]))
-        cos_i = cos_i.reshape(e - s, nr)
-        lam = weight[None] * cos_i
-        tf = np.where(np.isfinite(t), t, 0.0)
-        energy = lam / np.where(tf > 0, tf, 1.0) ** 2
-        # range step to a neighbouring sub-ray on the same surface (spacing 2 r_e / sqrt(N))
-        tan_i = np.sqrt(1.0 - np.minimum(cos_i, 1.0) ** 2) / np.maximum(cos_i, _COS_85)
-        slack = tf * tan_i * spacing
-        _returns_kernel(t, energy, lam, slack, settings.multiple_returns,
+        _returns_kernel(hits.t_m.reshape(e - s, nr), hits.face.reshape(e - s, nr), d,
+                        mesh.face_normals, weight, spacing, _COS_85, settings.multiple_returns,
                         float(settings.return_separation_m), nmax,
                         float(settings.range_noise_m), key, s, counts[s:e], rng_out[s:e],
-                        np.zeros((e - s, nmax)), lam_out[s:e], best_out[s:e])
-        got = np.arange(nmax)[None] < counts[s:e, None]
-        flat = (np.arange(e - s)[:, None] * nr + best_out[s:e])[got]
-        hit_point[s:e][got] = origin + hits.t_m[flat, None] * d[flat]
-        hit_face[s:e][got] = hits.face[flat]
-    got = np.arange(nmax)[None] < counts[:, None]
-    beam = np.broadcast_to(np.arange(nb)[:, None], got.shape)[got]
-    rng_m = rng_out[got]
-    craters_ = geometry.craters if geometry is not None else None
-    labels_c = crater_labels(hit_point[got], craters_) if craters_ is not None \
-        else np.full(len(beam), -1)
-    labels_b = boulder_labels(hit_face[got], geometry.face_boulder_id) \
-        if geometry is not None else np.full(len(beam), -1)
+                        lam_out[s:e], best_out[s:e])
+        if labelled:
+            rows, ks = np.nonzero(np.arange(nmax)[None] < counts[s:e, None])
+            flat = rows * nr + best_out[s:e][rows, ks]
+            best_t[s + rows, ks] = hits.t_m[flat]
+            best_face[s + rows, ks] = hits.face[flat]
+            best_dir[s + rows, ks] = d[flat]
+    beam, ks = np.nonzero(np.arange(nmax)[None] < counts[:, None])
+    rng_m = rng_out[beam, ks]
+    n = len(beam)
+    labels_c = np.full(n, -1)
+    labels_b = np.full(n, -1)
+    if labelled:
+        if geometry.craters is not None:
+            pts = origin + best_t[beam, ks, None] * best_dir[beam, ks]
+            labels_c = crater_labels(pts, geometry.craters)
+        labels_b = boulder_labels(best_face[beam, ks], geometry.face_boulder_id)
     image = np.full(nb, np.nan, dtype=np.float32)
     image[counts > 0] = rng_out[counts > 0, 0]
     total = weight.sum()
     return LidarFrame(
         position_m=origin + rng_m[:, None] * axes[beam],
         range_m=rng_m,
-        intensity=np.round(np.clip(lam_out[got] / total, 0.0, 1.0) * 65535).astype(np.uint16),
-        return_number=np.broadcast_to(np.arange(1, nmax + 1, dtype=np.uint8)[None],
-                                      got.shape)[got].copy(),
+        intensity=np.round(np.clip(lam_out[beam, ks] / total, 0.0, 1.0)
+                           * 65535).astype(np.uint16),
+        return_number=(ks + 1).astype(np.uint8),
         number_of_returns=np.repeat(counts, counts).astype(np.uint8),
         beam=beam.astype(np.int64),
         time_s=time_s + offsets_s[beam],

@@ -196,10 +196,20 @@ def test_bad_settings():
         lidar_frame(RayMesh(*plane()), LidarSettings(beams=(2, 2)), [0, 0, 10], [1, 1, 0, 0])
 
 
-def returns_reference(t, energy, lam, slack, multiple, sep, nmax):
-    """Pure-numpy/Python reference of _returns_kernel without noise."""
+def returns_reference(t, face, d, normals, weight, spacing, multiple, sep, nmax):
+    """Pure-numpy/Python reference of _returns_kernel without noise: (range, lambert)
+    per return per beam."""
+    nb, nr = t.shape
+    cos_i = np.zeros((nb, nr))
+    hit = np.isfinite(t)
+    cos_i[hit] = np.minimum(np.abs(np.einsum("ij,ij->i", normals[face[hit]],
+                                             d.reshape(nb, nr, 3)[hit])), 1.0)
+    lam = weight[None] * cos_i
+    energy = np.where(hit, lam / np.where(hit, t, 1.0) ** 2, 0.0)
+    cf = np.maximum(cos_i, np.cos(np.radians(85.0)))
+    slack = np.where(hit, t, 0.0) * np.sqrt(1 - cf**2) / cf * spacing
     out = []
-    for b in range(t.shape[0]):
+    for b in range(nb):
         order = np.argsort(t[b], kind="stable")
         order = order[np.isfinite(t[b][order])]
         groups = []
@@ -219,15 +229,18 @@ def test_returns_kernel_matches_reference(multiple, rng):
     nb, nr, nmax = 50, 12, 3
     t = rng.uniform(10, 20, (nb, nr))
     t[rng.random((nb, nr)) < 0.3] = np.inf
-    energy = rng.uniform(0.1, 1, (nb, nr))
-    lam = rng.uniform(0.1, 1, (nb, nr))
-    slack = rng.uniform(0, 0.3, (nb, nr))
+    normals = rng.normal(size=(7, 3))
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    face = np.where(np.isfinite(t), rng.integers(0, 7, (nb, nr)), -1)
+    d = rng.normal(size=(nb * nr, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    weight = rng.uniform(0.2, 1.0, nr)
     n = np.zeros(nb, np.int64)
-    rr, ee, ll = (np.zeros((nb, nmax)) for _ in range(3))
+    rr, ll = np.zeros((nb, nmax)), np.zeros((nb, nmax))
     best = np.zeros((nb, nmax), np.int64)
-    _returns_kernel(t, energy, lam, slack, multiple, 0.5, nmax, 0.0, np.uint64(0), 0, n, rr,
-                    ee, ll, best)
-    ref = returns_reference(t, energy, lam, slack, multiple, 0.5, nmax)
+    _returns_kernel(t, face, d, normals, weight, 0.02, np.cos(np.radians(85.0)), multiple,
+                    0.5, nmax, 0.0, np.uint64(0), 0, n, rr, ll, best)
+    ref = returns_reference(t, face, d, normals, weight, 0.02, multiple, 0.5, nmax)
     for b in range(nb):
         assert n[b] == len(ref[b])
         for k, (r, lsum) in enumerate(ref[b]):

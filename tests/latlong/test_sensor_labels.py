@@ -165,3 +165,43 @@ def test_boulder_ids_of_a_body_with_boulders():
     up = np.array([b["normal_x"], b["normal_y"], b["normal_z"]])
     hits = RayMesh(geo.vertices, geo.faces).intersect((top + 50 * up)[None], -up[None])
     assert boulder_labels(hits.face, geo.face_boulder_id).tolist() == [2]
+
+
+def labels_reference(points, catalog):
+    """Pure-numpy reference of crater_labels: every crater against every point."""
+    c = np.stack([catalog["centre_x_m"], catalog["centre_y_m"], catalog["centre_z_m"]], 1)
+    r = catalog["rim_radius_m"]
+    out = np.full(len(points), -1)
+    for row in range(len(c)):
+        if "normal_x" in catalog.dtype.names:
+            n = np.array([catalog["normal_x"][row], catalog["normal_y"][row],
+                          catalog["normal_z"][row]])
+            d = points - c[row]
+            h = d @ n
+            inside = (np.linalg.norm(d - h[:, None] * n, axis=1) <= r[row]) & (np.abs(h) <= r[row])
+        else:
+            rc = np.linalg.norm(c[row])
+            ang = np.arctan2(np.linalg.norm(np.cross(points, c[row]), axis=1), points @ c[row])
+            inside = (rc * ang <= r[row]) & (np.abs(np.linalg.norm(points, axis=1) - rc) <= r[row])
+        out[inside] = row
+    return out
+
+
+@pytest.mark.parametrize("with_normals", [False, True])
+def test_crater_labels_kernel_matches_reference(with_normals, rng):
+    n_cr = 60
+    u = rng.normal(size=(n_cr, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    cols = dict(x_m=np.zeros(n_cr), y_m=np.zeros(n_cr), diameter_m=rng.uniform(5, 200, n_cr),
+                centre_x_m=300 * u[:, 0], centre_y_m=300 * u[:, 1], centre_z_m=300 * u[:, 2])
+    cols["rim_radius_m"] = cols["diameter_m"] / 2
+    if with_normals:
+        cols.update(normal_x=u[:, 0], normal_y=u[:, 1], normal_z=u[:, 2])
+    cat = craters.make_catalog(**cols)
+    p = rng.normal(size=(20000, 3))
+    p *= (300 + rng.normal(0, 10, 20000))[:, None] / np.linalg.norm(p, axis=1, keepdims=True)
+    p[:5] = np.nan
+    got = crater_labels(p, cat)
+    ref = labels_reference(np.nan_to_num(p, nan=1e9), cat)
+    np.testing.assert_array_equal(got, ref)
+    assert (got >= 0).sum() > 1000 and (got[:5] == -1).all()
