@@ -29,7 +29,9 @@ body a 40 m rim is 1.6 m above the sphere there; the arc of the label rule and t
 radius differ by ``R^3 / (6 |c|^2)``, 4 cm). Its image through a pinhole camera is an
 exact conic (the circle's plane maps to the image by a homography ``H = K [r e1, r e2,
 centre]``; the unit circle ``diag(1, 1, -1)`` maps to ``H^-T diag(1, 1, -1) H^-1``),
-an ellipse whenever the whole circle is in front of the camera. Pixel coordinates are
+an ellipse whenever the whole circle is in front of the camera. :func:`rim_curves` can
+instead fit each rim's height and tilt to the stamped surface (the same homography
+with the fitted axes), which follows worn, tilted and overprinted rims. Pixel coordinates are
 OpenCV's with pixel centres at integer + 0.5: pixel (col i, row j) covers
 ``[i, i + 1) x [j, j + 1)`` and ``u = fx X / Z + cx``, ``v = fy Y / Z + cy``.
 """
@@ -37,13 +39,15 @@ OpenCV's with pixel centres at integer + 0.5: pixel (col i, row j) covers
 from __future__ import annotations
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 from craters._shared import ParameterError
 
 from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kernel
 from .poses import rotation_matrix
+from .scene_geometry import SceneGeometry
 
-__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_circles", "rim_ellipses"]
+__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_curves", "rim_ellipses"]
 
 #: Fields of :func:`rim_ellipses` (pixels; the angle of the major axis from +x towards
 #: +y, i.e. clockwise on the picture, degrees in [0, 180)).
@@ -135,14 +139,53 @@ def boulder_labels(face, face_boulder_id) -> np.ndarray:
     return np.where(face >= 0, ids[np.maximum(face, 0)], -1)
 
 
-def rim_circles(catalog):
-    """The rim crest circle of each crater (module notes): ``(centres (n, 3), normals
-    (n, 3), radii (n,))`` in the body frame, metres."""
+def rim_curves(catalog, surface=None):
+    """The rim crest of each crater as a planar curve in 3-D: ``(centres (n, 3), axis1
+    (n, 3), axis2 (n, 3))`` in the body frame, metres; the rim's points are ``centre +
+    cos(theta) axis1 + sin(theta) axis2``.
+
+    Without ``surface``: the circle of radius ``R`` in the tangent plane lifted by
+    ``rim_height_m`` (module notes). With ``surface`` (a :class:`SceneGeometry`, whose
+    boulders are left out, or an (n, 3) array of surface vertices): fitted to the surface
+    as stamped - the plane ``h = a + b x + c y`` (heights along the up axis, x and y in
+    the tangent plane) of the vertices whose in-plane distance from the centre is within
+    5 % of ``R`` (15 % when fewer than 8 are), i.e. the crest's actual height and tilt
+    (craters on slopes or inside older craters, worn or overprinted rims); the rim is that
+    plane cut by the cylinder of radius ``R`` about the up axis. Craters with too few
+    vertices keep the catalog rule.
+    """
     c, r, normals = _centres_radii(catalog)
-    lift = np.asarray(catalog["rim_height_m"], dtype=np.float64) \
-        if "rim_height_m" in catalog.dtype.names else np.zeros(len(c))
     up = normals if normals is not None else c / np.linalg.norm(c, axis=1, keepdims=True)
-    return c + lift[:, None] * up, up, r
+    e1, e2 = _basis(up)
+    a = np.asarray(catalog["rim_height_m"], dtype=np.float64).copy() \
+        if "rim_height_m" in catalog.dtype.names else np.zeros(len(c))
+    tilt = np.zeros((len(c), 2))
+    if surface is not None and len(c):
+        verts = _surface_vertices(surface)
+        tree = cKDTree(verts)
+        for i, near in enumerate(tree.query_ball_point(c, 1.6 * r)):
+            d = verts[np.asarray(near, dtype=np.int64)] - c[i]
+            h, x, y = d @ up[i], d @ e1[i], d @ e2[i]
+            rho = np.hypot(x, y)
+            for width in (0.05, 0.15):
+                ring = (np.abs(rho - r[i]) <= width * r[i]) & (np.abs(h) <= r[i])
+                if ring.sum() >= 8:
+                    fit = np.stack([np.ones(int(ring.sum())), x[ring], y[ring]], 1)
+                    a[i], tilt[i, 0], tilt[i, 1] = np.linalg.lstsq(fit, h[ring], rcond=None)[0]
+                    break
+    return (c + a[:, None] * up, r[:, None] * (e1 + tilt[:, :1] * up),
+            r[:, None] * (e2 + tilt[:, 1:] * up))
+
+
+def _surface_vertices(surface) -> np.ndarray:
+    if isinstance(surface, SceneGeometry):
+        used = np.unique(surface.faces[surface.face_boulder_id < 0])
+        return surface.vertices[used]
+    verts = np.asarray(surface, dtype=np.float64)
+    if verts.ndim != 2 or verts.shape[1] != 3:
+        raise ParameterError("surface", f"must be a SceneGeometry or (n, 3) vertices; got "
+                             f"shape {verts.shape}")
+    return verts
 
 
 def _basis(n):
@@ -169,7 +212,8 @@ def _conic_ellipse(q):
 
 
 def rim_ellipses(catalog, intrinsics, position_m, quaternion_wxyz, *, ids=None,
-                 width: int | None = None, height: int | None = None) -> np.ndarray:
+                 width: int | None = None, height: int | None = None,
+                 rims=None) -> np.ndarray:
     """The projected rim ellipse of each crater in front of a pinhole camera.
 
     Parameters
@@ -185,6 +229,9 @@ def rim_ellipses(catalog, intrinsics, position_m, quaternion_wxyz, *, ids=None,
         Only these craters (e.g. the ids present in a label image: the visible ones).
     width, height : int, optional
         With both, only ellipses whose bounding box meets the picture are kept.
+    rims : tuple, optional
+        :func:`rim_curves` of the catalog, e.g. fitted to the model's surface once and
+        shared by the frames (default: ``rim_curves(catalog)``, the catalog rule).
 
     Returns
     -------
@@ -198,23 +245,22 @@ def rim_ellipses(catalog, intrinsics, position_m, quaternion_wxyz, *, ids=None,
     out = np.zeros(0, ELLIPSE_DTYPE)
     if catalog is None or not len(catalog):
         return out
-    centres, normals, radii = rim_circles(catalog)
+    centres, axis1, axis2 = rim_curves(catalog) if rims is None else rims
     rows = np.arange(len(centres)) if ids is None else np.unique(np.asarray(ids, np.int64))
     rows = rows[(rows >= 0) & (rows < len(centres))]
     cc = (centres[rows] - t) @ rot  # camera frame: R^T (x - t)
-    e1, e2 = _basis(normals[rows] @ rot)
+    a1, a2 = axis1[rows] @ rot, axis2[rows] @ rot
     keep = []
     for i, row in enumerate(rows):
-        r = radii[row]
-        if cc[i, 2] - r * np.hypot(e1[i, 2], e2[i, 2]) <= 0.0:
+        if cc[i, 2] - np.hypot(a1[i, 2], a2[i, 2]) <= 0.0:
             continue  # part of the rim behind the camera: no ellipse
-        h = k_mat @ np.stack([r * e1[i], r * e2[i], cc[i]], 1)
+        h = k_mat @ np.stack([a1[i], a2[i], cc[i]], 1)
         hinv = np.linalg.inv(h)
         e = _conic_ellipse(hinv.T @ np.diag([1.0, 1.0, -1.0]) @ hinv)
         if e is None:
             continue
         if width is not None and height is not None:
-            ext = e[2]
+            ext = e[2]  # the semi-major axis bounds the ellipse
             if e[0] + ext < 0 or e[0] - ext > width or e[1] + ext < 0 or e[1] - ext > height:
                 continue
         keep.append((int(row), *e))

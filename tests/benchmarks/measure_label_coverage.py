@@ -4,17 +4,19 @@ Issue 17's acceptance: for the visible craters of a frame, the pixels labelled w
 crater's id all lie within its projected rim ellipse and cover >= 95 % of it. Frames: a
 512 x 512 flash LIDAR (one beam per pixel, its pinhole intrinsics) over a 1 km body
 (M = 400, ~4 m spacing) with ~1500 craters of 30-300 m (N_cum ~ D^-2, overlapping),
-seen at nadir and 35 degrees off nadir. Per crater whose ellipse has a semi-minor axis of
->= 8 px and lies in the frame: the share of its labelled pixels within the ellipse grown
-by 1.5 px, and the share of the ellipse's pixels labelled with its id - raw, and with the
-pixels of younger craters (which win where they overlap, by the label rule) and of
-nearer terrain (occlusion) set aside. Writes ``sensors_lidar_labels.png`` (range image,
+seen at nadir and 35 degrees off nadir, with the rim ellipses of the catalog rule and
+fitted to the surface (:func:`latlong.sensors.labels.rim_curves`). Per crater whose
+ellipse has a semi-minor axis of >= 8 px and lies in the frame: the share of its
+labelled pixels within the ellipse grown by 1.5 px, and the share of the ellipse's
+pixels labelled with its id - raw, and with the pixels of younger craters (which win
+where they overlap, by the label rule) set aside. Writes ``sensors_lidar_labels.png`` (range image,
 label image with the ellipses) to the folder given (default: the current one).
 Usage: ``python tests/benchmarks/measure_label_coverage.py [OUT_FOLDER]``.
 """
 
 from __future__ import annotations
 
+import itertools
 import sys
 from pathlib import Path
 
@@ -23,7 +25,7 @@ import numpy as np
 import craters
 from latlong import Body, LatLongGrid, stamp_craters
 from latlong.sensors.engine import RayMesh
-from latlong.sensors.labels import rim_ellipses
+from latlong.sensors.labels import rim_curves, rim_ellipses
 from latlong.sensors.lidar import LidarSettings, lidar_frame
 from latlong.sensors.poses import look_at
 from latlong.sensors.scene_geometry import scene_geometry
@@ -36,7 +38,7 @@ def ellipse_radius(e, i, j):
                     (-x * sa + y * ca) / e["semi_minor_px"])
 
 
-def measure(body, geo, mesh, pos, target, size=512):
+def measure(body, geo, mesh, pos, target, rims=None, size=512):
     q = look_at(pos, target)
     s = LidarSettings(beams=(size, size), fov_deg=30.0)
     fr = lidar_frame(mesh, s, pos, q, geometry=geo)
@@ -45,7 +47,7 @@ def measure(body, geo, mesh, pos, target, size=512):
     lab = lab.reshape(size, size)
     k = s.intrinsics()
     ell = rim_ellipses(body.craters, (k["fx"], k["fy"], k["cx"], k["cy"]), pos, q,
-                       ids=np.unique(lab[lab >= 0]), width=size, height=size)
+                       ids=np.unique(lab[lab >= 0]), width=size, height=size, rims=rims)
     i, j = np.meshgrid(np.arange(size) + 0.5, np.arange(size) + 0.5)
     rows = []
     for e in ell:
@@ -79,10 +81,13 @@ def main():
     print(f"body: R = 1 km, M = 400, {len(body.craters)} craters of 30-300 m")
     views = {"nadir": ([radius + 900.0, 0.0, 0.0], [0.0, 0.0, 0.0]),
              "35 deg off nadir": ([radius + 700.0, -500.0, 0.0], [radius, 0.0, 0.0])}
+    fitted = rim_curves(body.craters, geo)
     shown = []
-    for name, (pos, target) in views.items():
-        fr, lab, ell, rows = measure(body, geo, mesh, np.array(pos), np.array(target))
-        print(f"{name}: {len(rows)} craters fully in the frame with semi-minor >= 8 px")
+    for (name, (pos, target)), (rule, rims) in itertools.product(
+            views.items(), (("catalog rims", None), ("rims fitted to the surface", fitted))):
+        fr, lab, ell, rows = measure(body, geo, mesh, np.array(pos), np.array(target), rims)
+        print(f"{name}, {rule}: {len(rows)} craters fully in the frame with semi-minor "
+              ">= 8 px")
         print(f"  labelled pixels within their ellipse (+1.5 px): min {rows[:, 2].min():.4f}, "
               f"mean {rows[:, 2].mean():.4f}")
         print(f"  ellipse covered by its id: raw min {rows[:, 3].min():.3f} median "
@@ -92,7 +97,8 @@ def main():
         worst = rows[np.argmin(rows[:, 4])]
         print(f"  worst (younger set aside): crater {int(worst[0])}, semi-minor "
               f"{worst[1]:.1f} px, cover {worst[4]:.3f}")
-        shown.append((name, fr, lab, ell))
+        if rims is not None:
+            shown.append((name, fr, lab, ell))
     import matplotlib
 
     matplotlib.use("Agg")
@@ -112,7 +118,7 @@ def main():
                                            2 * e["semi_major_px"], 2 * e["semi_minor_px"],
                                            angle=e["angle_deg"], fill=False, color="k",
                                            lw=0.8))
-        axes[row, 1].set_title("crater_id per beam (colour) and projected rim ellipses")
+        axes[row, 1].set_title("crater_id per beam (colour), fitted rim ellipses")
         for a in axes[row]:
             a.set_xticks([])
             a.set_yticks([])

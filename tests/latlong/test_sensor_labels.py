@@ -8,7 +8,7 @@ import pytest
 import craters
 import latlong
 from latlong.sensors.engine import RayMesh
-from latlong.sensors.labels import boulder_labels, crater_labels, rim_circles, rim_ellipses
+from latlong.sensors.labels import boulder_labels, crater_labels, rim_curves, rim_ellipses
 from latlong.sensors.poses import look_at, rotation_matrix
 from latlong.sensors.scene_geometry import scene_geometry
 
@@ -42,13 +42,15 @@ def ellipse_radius(e, i, j):
                     (-x * sa + y * ca) / e["semi_minor_px"])
 
 
+@pytest.mark.parametrize("fitted", [False, True], ids=["catalog-rims", "fitted-rims"])
 @pytest.mark.parametrize("position_m", [[800.0, 0.0, 0.0], [760.0, -120.0, 80.0]],
                          ids=["nadir", "oblique"])
-def test_labels_fill_their_rim_ellipses(cratered_body, position_m):
+def test_labels_fill_their_rim_ellipses(cratered_body, position_m, fitted):
     """Issue 17's acceptance: the pixels labelled with a visible crater's id all lie within
     its projected rim ellipse (to the pixel: 1.5 px) and cover >= 95 % of it."""
     body = cratered_body
-    rm = RayMesh(*(lambda g: (g.vertices, g.faces))(scene_geometry(body)))
+    geo = scene_geometry(body)
+    rm = RayMesh(geo.vertices, geo.faces)
     q = look_at(position_m, [500.0, 20.0, -10.0])
     w = h = 256
     o, d, k, i, j = pinhole_rays(position_m, q, w, h, 25.0)
@@ -57,7 +59,8 @@ def test_labels_fill_their_rim_ellipses(cratered_body, position_m):
     lab = crater_labels(p, body.craters).reshape(h, w)
     ids = np.unique(lab[lab >= 0])
     assert len(ids) == 4
-    ell = rim_ellipses(body.craters, k, position_m, q, ids=ids, width=w, height=h)
+    rims = rim_curves(body.craters, geo) if fitted else None
+    ell = rim_ellipses(body.craters, k, position_m, q, ids=ids, width=w, height=h, rims=rims)
     assert ell["crater_id"].tolist() == ids.tolist()
     for e in ell:
         r = ellipse_radius(e, i, j)
@@ -118,26 +121,45 @@ def test_rim_ellipse_of_a_facing_circle_is_a_circle():
                 e["angle_deg"] == pytest.approx(180.0, abs=1e-6)
 
 
-def test_rim_ellipse_matches_projected_rim_points(cratered_body):
-    """Points of the 3-D rim circle project onto the ellipse (radius 1 within 1e-9)."""
+@pytest.mark.parametrize("fitted", [False, True])
+def test_rim_ellipse_matches_projected_rim_points(cratered_body, fitted):
+    """Points of the 3-D rim curve project onto the ellipse (radius 1 within 1e-9)."""
     cat = cratered_body.craters
     pos = [760.0, -120.0, 80.0]
     q = look_at(pos, [500.0, 20.0, -10.0])
     k = (600.0, 610.0, 128.0, 120.0)
-    ell = rim_ellipses(cat, k, pos, q)
-    centres, normals, radii = rim_circles(cat)
+    rims = rim_curves(cat, cratered_body.vertices() if fitted else None)
+    ell = rim_ellipses(cat, k, pos, q, rims=rims)
+    assert len(ell) == len(cat)
     rot = rotation_matrix(q)
+    th = np.linspace(0, 2 * np.pi, 50)[:, None]
     for e in ell:
         row = e["crater_id"]
-        n = normals[row]
-        e1 = np.cross(n, [0.3, 0.5, 0.8])
-        e1 /= np.linalg.norm(e1)
-        e2 = np.cross(n, e1)
-        th = np.linspace(0, 2 * np.pi, 50)[:, None]
-        x = ((centres[row] + radii[row] * (np.cos(th) * e1 + np.sin(th) * e2)) - pos) @ rot
+        x = (rims[0][row] + np.cos(th) * rims[1][row] + np.sin(th) * rims[2][row] - pos) @ rot
         u = k[0] * x[:, 0] / x[:, 2] + k[2]
         v = k[1] * x[:, 1] / x[:, 2] + k[3]
         np.testing.assert_allclose(ellipse_radius(e, u, v), 1.0, atol=1e-9)
+
+
+def test_fitted_rims_follow_a_tilted_surface():
+    """Vertices on a plane tilted by 10 deg about y, 3 m above a crater's centre: the
+    fitted rim lies in that plane, the cylinder's cut (axis2 flat, axis1 rising)."""
+    g = np.linspace(-60, 60, 121)
+    x, y = np.meshgrid(g, g)
+    tilt = np.tan(np.radians(10.0))
+    verts = np.stack([x.ravel(), y.ravel(), 3.0 + tilt * x.ravel()], 1)
+    cat = craters.make_catalog(x_m=[0.0], y_m=[0.0], diameter_m=[40.0], centre_x_m=[0.0],
+                               centre_y_m=[0.0], centre_z_m=[0.0], normal_x=[0.0],
+                               normal_y=[0.0], normal_z=[1.0], rim_height_m=[1.0])
+    centre, a1, a2 = rim_curves(cat, verts)
+    np.testing.assert_allclose(centre[0], [0.0, 0.0, 3.0], atol=1e-9)
+    th = np.linspace(0, 2 * np.pi, 40)[:, None]
+    rim = centre[0] + np.cos(th) * a1[0] + np.sin(th) * a2[0]
+    np.testing.assert_allclose(np.hypot(rim[:, 0], rim[:, 1]), 20.0, atol=1e-9)
+    np.testing.assert_allclose(rim[:, 2], 3.0 + tilt * rim[:, 0], atol=1e-9)
+    plain = rim_curves(cat)  # the catalog rule: rim_height_m above the centre, level
+    np.testing.assert_allclose(plain[0][0], [0.0, 0.0, 1.0])
+    assert plain[1][0][2] == 0.0 and plain[2][0][2] == 0.0
 
 
 def test_rim_ellipses_skip_craters_behind_the_camera(cratered_body):
