@@ -74,6 +74,27 @@ def _refine_kernel(vertices, faces, origins, directions, face, t, u, v):
         t[i] = (e2x * qx + e2y * qy + e2z * qz) * inv
 
 
+@njit(cache=True, parallel=True)
+def _face_normals_kernel(vertices, faces, out):
+    """Unit normals (right-hand rule over the corners) of every triangle; 0 if degenerate."""
+    for f in prange(faces.shape[0]):
+        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
+        ux = vertices[b, 0] - vertices[a, 0]
+        uy = vertices[b, 1] - vertices[a, 1]
+        uz = vertices[b, 2] - vertices[a, 2]
+        vx = vertices[c, 0] - vertices[a, 0]
+        vy = vertices[c, 1] - vertices[a, 1]
+        vz = vertices[c, 2] - vertices[a, 2]
+        nx = uy * vz - uz * vy
+        ny = uz * vx - ux * vz
+        nz = ux * vy - uy * vx
+        norm = np.sqrt(nx * nx + ny * ny + nz * nz)
+        if norm > 0:
+            out[f, 0], out[f, 1], out[f, 2] = nx / norm, ny / norm, nz / norm
+        else:
+            out[f, 0], out[f, 1], out[f, 2] = 0.0, 0.0, 0.0
+
+
 class RayMesh:
     """A triangle mesh ready for ray queries (the Embree BVH is built once, here).
 
@@ -98,10 +119,8 @@ class RayMesh:
                              f"{self.faces.shape}")
         if self.faces.min() < 0 or self.faces.max() >= len(self.vertices):
             raise ValueError("`faces` index vertices that do not exist")
-        tri = self.vertices[self.faces]
-        n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-        norm = np.linalg.norm(n, axis=1, keepdims=True)
-        self.face_normals = n / np.where(norm > 0, norm, 1.0)
+        self.face_normals = np.empty((len(self.faces), 3))
+        _face_normals_kernel(self.vertices, self.faces, self.face_normals)
         self._device = rtcore.EmbreeDevice()
         self._scene = rtcore_scene.EmbreeScene(self._device)
         mesh_construction.TriangleMesh(self._scene, self.vertices.astype(np.float32),

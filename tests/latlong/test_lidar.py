@@ -296,3 +296,11 @@ def test_bad_meshes_are_refused():
         RayMesh(np.zeros((3, 3)), [[0, 1, 5]])
     with pytest.raises(ValueError, match="vertices"):
         RayMesh(np.zeros((0, 3)), [[0, 1, 2]])
+
+
+def test_face_normals_match_numpy(scene):
+    v, f = scene
+    tri = v[f]
+    n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    np.testing.assert_allclose(RayMesh(v, f).face_normals,
+                               n / np.linalg.norm(n, axis=1, keepdims=True), atol=1e-12)

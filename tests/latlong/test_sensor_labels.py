@@ -172,7 +172,7 @@ def test_boulder_labels_from_faces():
     assert boulder_labels([0, 2, 4, -1], fb).tolist() == [-1, 3, 7, -1]
 
 
-def test_boulder_ids_of_a_body_with_boulders():
+def test_boulder_ids_of_a_body_with_boulders(tmp_path):
     body = latlong.Body.sphere(latlong.LatLongGrid(16), 200.0)
     rocks = latlong.boulder_population(body, craters.BoulderLayer(c=0.05, k=-2.0, d_min_m=4.0,
                                                                    d_max_m=8.0), rng=3)
@@ -187,6 +187,15 @@ def test_boulder_ids_of_a_body_with_boulders():
     up = np.array([b["normal_x"], b["normal_y"], b["normal_z"]])
     hits = RayMesh(geo.vertices, geo.faces).intersect((top + 50 * up)[None], -up[None])
     assert boulder_labels(hits.face, geo.face_boulder_id).tolist() == [2]
+    # the same ids from the body's mesh exports (PLY: craterform's own reader keeps the
+    # boulder_id property VTK drops; VTP through pyvista); OBJ has none
+    for suffix in (".ply", ".vtp", ".obj"):
+        path = body.export(tmp_path / f"b{suffix}")
+        got = scene_geometry(path)
+        np.testing.assert_allclose(got.vertices, geo.vertices, atol=1e-4)
+        np.testing.assert_array_equal(got.faces, geo.faces)
+        want = geo.face_boulder_id if suffix != ".obj" else np.full(len(geo.faces), -1)
+        np.testing.assert_array_equal(got.face_boulder_id, want)
 
 
 def labels_reference(points, catalog):
@@ -227,3 +236,4 @@ def test_crater_labels_kernel_matches_reference(with_normals, rng):
     ref = labels_reference(np.nan_to_num(p, nan=1e9), cat)
     np.testing.assert_array_equal(got, ref)
     assert (got >= 0).sum() > 1000 and (got[:5] == -1).all()
+
