@@ -19,6 +19,7 @@ crater is the one whose rim the surface shows. Irregular rims (the stamping's ra
 rim perturbation, a few per cent of ``R``) are not in the catalog: the label follows the
 nominal circular rim. Ids are catalog rows (0-based), -1 for no crater; boulder ids are
 boulder catalog rows from the mesh's per-triangle ``boulder_id`` (-1 on the surface).
+The two are independent: a boulder inside a rim carries the crater's id as well.
 
 Rim ellipses: the rim crest of each crater is the circle of radius ``R`` around ``c`` in
 the crater's tangent plane (normal: the catalog's up axis, else the radial direction of
