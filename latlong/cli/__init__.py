@@ -19,6 +19,8 @@ from .analysis import add_parsers as add_analysis_parsers
 from .body import add_body_parsers
 from .build import add_build_parser
 from .camera import add_camera_parser
+from .lidar import FLAGS as LIDAR_FLAGS
+from .lidar import add_lidar_parser
 from .options import BUILD_OPTIONS, RENDER_OPTIONS, add_options, flag_of
 
 __all__ = ["BUILD_OPTIONS", "RENDER_OPTIONS", "build_parser", "main"]
@@ -44,6 +46,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_body_parsers(sub, _add_groups)
     add_analysis_parsers(sub)
     add_camera_parser(sub)
+    add_lidar_parser(sub)
     return parser
 
 
@@ -51,6 +54,8 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     flags = {o.key: flag_of(o.key) for o in BUILD_OPTIONS}
+    if args.command == "lidar":
+        flags = LIDAR_FLAGS
     return run_cli(lambda: args.func(args), flags=flags)
 
 

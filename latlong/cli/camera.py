@@ -10,26 +10,28 @@ into FOLDER at the end, ``frames.json`` last.
 
 from __future__ import annotations
 
-import argparse
 import contextlib
-import csv
 import os
-import re
 import shutil
 import tempfile
 import time
 from pathlib import Path
 
-import numpy as np
-
 from craters._shared import ParameterError, ParameterTypeError, progress_bar
 from craters._shared.cli import CliError, parse_seed
 
-__all__ = ["add_camera_parser", "read_poses"]
+from .sensor_options import (
+    add_pose_options,
+    allow_negative_lists,
+    numbers,
+    output_folder,
+    poses_from_args,
+    refuse_inside,
+    wxh,
+)
 
-_NUM = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
-_NUMBER_LIST = rf"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(,{_NUM})*$"
-POSES_HEADER = ["time_s", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz"]
+__all__ = ["add_camera_parser"]
+
 #: library parameter -> flag, for messages
 FLAGS = {"quaternion_wxyz": "--quaternion", "position_m": "--position-m",
          "sun_direction": "--sun-direction", "fov_deg": "--fov-deg", "fx": "--intrinsics",
@@ -43,32 +45,6 @@ FLAGS = {"quaternion_wxyz": "--quaternion", "position_m": "--position-m",
          "p2": "--distortion", "k3": "--distortion", "poses": "--poses"}
 
 
-def _numbers(n: int, what: str):
-    def parse(text):
-        try:
-            vals = [float(p) for p in str(text).split(",")]
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"expected {what}; got {text!r}") from None
-        if len(vals) != n or not np.isfinite(vals).all():
-            raise argparse.ArgumentTypeError(f"expected {what} ({n} finite numbers); "
-                                             f"got {text!r}")
-        return vals
-    return parse
-
-
-def _size(text):
-    parts = str(text).lower().split("x")
-    try:
-        w, h = (int(p) for p in parts)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected WxH in pixels, e.g. 1024x768; got "
-                                         f"{text!r}") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise argparse.ArgumentTypeError(f"width and height must be in [1, 16384]; got "
-                                         f"{text!r}")
-    return w, h
-
-
 @contextlib.contextmanager
 def _flagged():
     """Library parameter errors shown under the command's flags."""
@@ -78,35 +54,6 @@ def _flagged():
         if exc.name in FLAGS:
             raise CliError(exc.shown_as(FLAGS[exc.name])) from None
         raise
-
-
-def read_poses(path):
-    """The poses of a CSV file with the header ``time_s,x_m,y_m,z_m,qw,qx,qy,qz``."""
-    from latlong.sensors import Pose
-
-    path = Path(path)
-    if not path.is_file():
-        raise CliError(f"--poses {str(path)!r} does not exist")
-    poses = []
-    with open(path, newline="") as fh:
-        rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
-    if not rows or [c.strip() for c in rows[0]] != POSES_HEADER:
-        raise CliError(f"--poses {str(path)!r}: the first line must be "
-                       f"{','.join(POSES_HEADER)}")
-    if len(rows) < 2:
-        raise CliError(f"--poses {str(path)!r} has no poses")
-    for k, row in enumerate(rows[1:], start=2):
-        try:
-            t, x, y, z, qw, qx, qy, qz = (float(c) for c in row)
-        except ValueError:
-            raise CliError(f"--poses {str(path)!r} line {k}: expected 8 numbers; got "
-                           f"{','.join(row)!r}") from None
-        try:
-            poses.append(Pose([x, y, z], [qw, qx, qy, qz], t))
-        except (ParameterError, ParameterTypeError) as exc:
-            raise CliError(f"--poses {str(path)!r} line {k}: {exc.shown_as(exc.name)}") \
-                from None
-    return poses
 
 
 def _camera(args):
@@ -126,35 +73,6 @@ def _camera(args):
         return Camera.from_fov(args.fov_deg, w, h, **dist)
 
 
-def _poses(args):
-    from latlong.sensors import Pose
-
-    if args.poses is not None:
-        if args.position_m is not None or args.quaternion is not None:
-            raise CliError("give --poses or --position-m/--quaternion, not both")
-        return read_poses(args.poses)
-    if args.position_m is None or args.quaternion is None:
-        raise CliError("give --position-m X,Y,Z and --quaternion W,X,Y,Z, or --poses FILE.csv")
-    with _flagged():
-        return [Pose(args.position_m, args.quaternion, 0.0)]
-
-
-def _output_folder(args) -> Path:
-    out = Path(args.output)
-    if out.is_symlink():
-        raise CliError(f"-o/--output {str(out)!r} is a symbolic link; give a real folder")
-    if out.exists() and not out.is_dir():
-        raise CliError(f"-o/--output {str(out)!r} exists and is not a folder")
-    if out.is_dir() and any(out.iterdir()) and not args.force:
-        raise CliError(f"-o/--output {str(out)!r} is not empty; use --force to write into it")
-    parent = out.parent if str(out.parent) else Path(".")
-    if not parent.is_dir():
-        raise CliError(f"-o/--output {str(out)!r}: folder {str(parent)!r} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise CliError(f"-o/--output {str(out)!r}: folder {str(parent)!r} is not writable")
-    return out
-
-
 def _move_into(tmp: Path, out: Path) -> None:
     """Move the rendered files into ``out`` (``frames.json`` last)."""
     if not out.exists():
@@ -168,18 +86,20 @@ def _move_into(tmp: Path, out: Path) -> None:
 
 
 def cmd_camera(args) -> int:
-    from latlong.sensors import Sensor, Sun, camera_inside, reflectance_model, render, scene_mesh
-    from latlong.sensors.output import (
-        frame_entry,
-        manifest,
-        read_model,
-        write_frame,
-        write_manifest,
+    from latlong.sensors import (
+        Sensor,
+        Sun,
+        reflectance_model,
+        render,
+        rim_curves,
+        scene_geometry,
+        scene_mesh,
     )
+    from latlong.sensors.output import frame_entry, manifest, write_frame, write_manifest
 
-    out = _output_folder(args)
+    out = output_folder(args)
     camera = _camera(args)
-    poses = _poses(args)
+    poses = poses_from_args(args)
     with _flagged():
         sun = Sun(args.sun_direction, args.sun_angular_radius_deg)
         model = reflectance_model(args.reflectance, albedo=args.albedo,
@@ -192,14 +112,17 @@ def cmd_camera(args) -> int:
         if not 0 <= args.soft_shadow_samples <= 1024:
             raise CliError(f"--soft-shadow-samples must be in [0, 1024]; got "
                            f"{args.soft_shadow_samples}")
-        geometry = read_model(args.model, units=args.units)
+        try:
+            geometry = scene_geometry(args.model, units=args.units, craters=args.catalog)
+        except ValueError as exc:
+            raise CliError(str(exc).replace("`model`", "MODEL")) from None
         t0 = time.perf_counter()
         mesh = scene_mesh(geometry)
-    for k, pose in enumerate(poses):
-        if camera_inside(mesh, pose.position_m):
-            where = "--position-m" if args.poses is None else f"--poses frame {k}"
-            raise CliError(f"{where}: the camera at {pose.position_m.tolist()} is inside "
-                           f"the model {str(args.model)!r}")
+    poses = poses if poses is not None else poses_from_args(args, mesh)
+    refuse_inside(mesh, poses, args, "camera")
+    rims = None
+    if geometry.craters is not None and len(geometry.craters):
+        rims = rim_curves(geometry.craters, geometry)
     if not args.quiet:
         print(f"model {args.model}: {len(mesh.faces)} triangles, BVH built in "
               f"{time.perf_counter() - t0:.1f} s")
@@ -207,13 +130,13 @@ def cmd_camera(args) -> int:
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
     try:
         entries = []
-        for k, pose in progress_bar(list(enumerate(poses)), enabled=not args.quiet,
-                                    desc="frames"):
-            frame = render(mesh, camera, pose, sun, reflectance=model, sensor=sensor,
-                           soft_shadow_samples=args.soft_shadow_samples, seed=args.seed)
+        for k in progress_bar(range(len(poses)), enabled=not args.quiet, desc="frames"):
+            frame = render(mesh, camera, poses[k], sun, reflectance=model, sensor=sensor,
+                           soft_shadow_samples=args.soft_shadow_samples, seed=args.seed,
+                           ground_truth=geometry)
             files = write_frame(tmp, k, frame, depth_format=args.depth_format,
                                 extra=args.all_ground_truth)
-            entries.append(frame_entry(frame, files))
+            entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
         doc = manifest(camera, entries, model=str(args.model), reflectance=args.reflectance,
                        reflectance_parameters={k: getattr(model, k)
                                                for k in model.__dataclass_fields__},
@@ -237,29 +160,26 @@ def add_camera_parser(sub) -> None:
     c = sub.add_parser("camera", help="render camera frames (image, depth, range, normals) "
                        "of a body or a mesh, with a frames.json manifest")
     # "--position-m -3000,0,0": a comma list of numbers starting with "-" is a value
-    c._negative_number_matcher = re.compile(_NUMBER_LIST)
+    allow_negative_lists(c)
     c.add_argument("model", help="a body .npz or a mesh file (.ply .obj .stl .vtp .vtk .glb)")
     c.add_argument("-o", "--output", required=True, help="output folder (required)")
     c.add_argument("--units", choices=("m", "km"), default="m",
                    help="units of a mesh file's coordinates (default: m)")
+    c.add_argument("--catalog", help="crater catalog CSV that labels the frames (default: "
+                   "the body's own; a mesh file has none)")
     p = c.add_argument_group("pose (body frame; camera-to-body rotation, OpenCV camera frame)")
-    p.add_argument("--position-m", type=_numbers(3, "X,Y,Z"),
-                   help="camera position X,Y,Z in metres (default: none; or --poses)")
-    p.add_argument("--quaternion", type=_numbers(4, "W,X,Y,Z"),
-                   help="camera-to-body unit quaternion W,X,Y,Z (default: none)")
-    p.add_argument("--poses", help="CSV of poses with the header time_s,x_m,y_m,z_m,qw,qx,"
-                   "qy,qz (default: none)")
+    add_pose_options(p, "camera")
     i = c.add_argument_group("intrinsics (pixel centres at integer + 0.5)")
-    i.add_argument("--size", type=_size, required=True, help="image size WxH in pixels "
-                   "(required)")
+    i.add_argument("--size", type=wxh("in pixels", "1024x768"), required=True,
+                   help="image size WxH in pixels (required)")
     i.add_argument("--fov-deg", type=float, help="horizontal field of view, degrees, "
                    "centred square pixels (default: none; or --intrinsics)")
-    i.add_argument("--intrinsics", type=_numbers(4, "fx,fy,cx,cy"),
+    i.add_argument("--intrinsics", type=numbers(4, "fx,fy,cx,cy"),
                    help="fx,fy,cx,cy in pixels (default: none)")
-    i.add_argument("--distortion", type=_numbers(5, "k1,k2,p1,p2,k3"),
+    i.add_argument("--distortion", type=numbers(5, "k1,k2,p1,p2,k3"),
                    help="Brown-Conrady coefficients k1,k2,p1,p2,k3 as OpenCV (default: none)")
     s = c.add_argument_group("light and surface")
-    s.add_argument("--sun-direction", type=_numbers(3, "X,Y,Z"), required=True,
+    s.add_argument("--sun-direction", type=numbers(3, "X,Y,Z"), required=True,
                    help="direction towards the sun X,Y,Z, body frame (required)")
     s.add_argument("--sun-angular-radius-deg", type=float, default=0.0,
                    help="angular radius of the sun, degrees; 0.2666 at 1 au (default: 0)")

@@ -42,14 +42,36 @@ from craters._shared import ParameterError, check_finite, check_int, check_posit
 
 from ._camera_kernels import _distort, _pixel_rays_kernel, _undistort_kernel
 
-__all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix"]
+__all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix",
+           "unit_quaternions"]
 
 #: How far a quaternion's norm may be from 1 (CSV files round to ~1e-7).
 QUATERNION_TOLERANCE = 1e-6
 
 
+def unit_quaternions(q, name: str = "quaternion_wxyz") -> np.ndarray:
+    """``q`` (..., 4) as float64 unit quaternions w, x, y, z; a norm further than
+    ``QUATERNION_TOLERANCE`` from 1 (or a non-finite value) is a :class:`ParameterError`
+    naming ``name``."""
+    try:
+        q = np.array(q, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ParameterError(name, f"must be quaternions w, x, y, z; got {q!r}") from None
+    if q.ndim == 0 or q.shape[-1] != 4 or not np.isfinite(q).all():
+        raise ParameterError(name, f"must be finite quaternions w, x, y, z; got {q.tolist()}")
+    norm = np.linalg.norm(q, axis=-1)
+    bad = np.abs(norm - 1.0) > QUATERNION_TOLERANCE
+    if bad.any():
+        i = int(np.argmax(bad.reshape(-1)))
+        raise ParameterError(name, f"must be a unit quaternion (norm within "
+                             f"{QUATERNION_TOLERANCE:g} of 1); got norm "
+                             f"{norm.reshape(-1)[i]:.9g} for {q.reshape(-1, 4)[i].tolist()}")
+    return q / norm[..., None]
+
+
 def quaternion_to_matrix(q) -> np.ndarray:
-    """3 x 3 rotation matrix of a unit quaternion (w, x, y, z) (Hamilton convention).
+    """Rotation matrix (3, 3) (or (..., 3, 3)) of unit quaternion(s) (w, x, y, z) (Hamilton
+    convention); a quaternion whose norm is not 1 within 1e-6 is an error.
 
     Examples
     --------
@@ -58,11 +80,12 @@ def quaternion_to_matrix(q) -> np.ndarray:
            [ 1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
-    w, x, y, z = np.asarray(q, dtype=np.float64)
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+    w, x, y, z = np.moveaxis(unit_quaternions(q), -1, 0)
+    return np.stack([
+        np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
+        np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
+        np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
+    ], -2)
 
 
 def quaternion_from_matrix(m) -> np.ndarray:
@@ -122,12 +145,7 @@ class Pose:
 
     def __post_init__(self):
         object.__setattr__(self, "position_m", _vector("position_m", self.position_m, 3))
-        q = np.array(_vector("quaternion_wxyz", self.quaternion_wxyz, 4))
-        norm = float(np.linalg.norm(q))
-        if abs(norm - 1.0) > QUATERNION_TOLERANCE:
-            raise ParameterError("quaternion_wxyz", f"must be a unit quaternion (norm within "
-                                 f"{QUATERNION_TOLERANCE:g} of 1); got norm {norm:.9g}")
-        q /= norm
+        q = unit_quaternions(_vector("quaternion_wxyz", self.quaternion_wxyz, 4))
         q.flags.writeable = False
         object.__setattr__(self, "quaternion_wxyz", q)
         object.__setattr__(self, "time_s", check_finite("time_s", self.time_s))

@@ -38,7 +38,9 @@ from ._render_kernels import (
 )
 from .camera import Camera, Pose
 from .engine import RayMesh
+from .labels import boulder_labels, crater_labels
 from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
+from .scene_geometry import SceneGeometry
 from .sensor import Sensor, expose
 
 __all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render", "scene_mesh"]
@@ -116,13 +118,22 @@ class Frame:
     """The camera's pose."""
     sun: Sun = field(repr=False)
     """The light."""
+    crater_id: np.ndarray | None = None
+    """int32 catalog row of the crater whose rim contains the surface point seen, -1 for
+    none (:func:`~latlong.sensors.labels.crater_labels`); None without ``ground_truth``."""
+    boulder_id: np.ndarray | None = None
+    """int32 boulder catalog row of the boulder seen, -1 for none; None without
+    ``ground_truth``."""
 
 
 def scene_mesh(geometry, *, build_quality: str = "medium") -> RayMesh:
-    """A :class:`RayMesh` for a RayMesh (returned as is), a ``latlong.Body`` (its mesh
-    and its boulders), a ``latlong.ShapeModel`` or a ``(vertices, faces)`` pair."""
+    """A :class:`RayMesh` for a RayMesh (returned as is), a :class:`SceneGeometry`, a
+    ``latlong.Body`` (its mesh and its boulders), a ``latlong.ShapeModel`` or a
+    ``(vertices, faces)`` pair."""
     if isinstance(geometry, RayMesh):
         return geometry
+    if isinstance(geometry, SceneGeometry):
+        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
     from ..body import Body
     from ..shapes import ShapeModel
 
@@ -216,7 +227,8 @@ def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndar
 
 def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
-           soft_shadow_samples: int = 0, seed: int = 0) -> Frame:
+           soft_shadow_samples: int = 0, seed: int = 0,
+           ground_truth: SceneGeometry | None = None) -> Frame:
     """Render one frame of ``geometry`` (a :class:`RayMesh`: build it once with
     :func:`scene_mesh` and share it between frames) seen by ``camera`` at ``pose``, lit
     by ``sun`` (a :class:`Sun` or a direction towards it). See the module notes.
@@ -225,7 +237,8 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     to :class:`Sensor` (); ``normals`` is ``"smooth"``, ``"face"`` or an (n, 3) array of
     vertex normals to blend (e.g. a sphere's exact radial directions); ``vertex_albedo``
     an optional (n,) factor per vertex; ``seed`` keys the sun-disk samples and the
-    sensor noise.
+    sensor noise; ``ground_truth`` (the :class:`SceneGeometry` the mesh was built from:
+    same triangles, with its catalogs) adds the crater-id and boulder-id label images.
     """
     if not isinstance(camera, Camera):
         raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
@@ -240,7 +253,13 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     seed = check_int("seed", seed, 0, 2**63 - 1)
     if sun.angular_radius_deg == 0.0:
         samples = 0
+    if ground_truth is not None and not isinstance(ground_truth, SceneGeometry):
+        raise TypeError("`ground_truth` must be a SceneGeometry; got "
+                        f"{type(ground_truth).__name__}")
     mesh = scene_mesh(geometry)
+    if ground_truth is not None and len(ground_truth.faces) != len(mesh.faces):
+        raise ParameterError("ground_truth", f"must describe the rendered mesh: "
+                             f"{len(ground_truth.faces)} triangles, not {len(mesh.faces)}")
     h, w = camera.height, camera.width
     origin, dirs = camera.rays(pose)
     dirs = dirs.reshape(-1, 3)
@@ -275,4 +294,17 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
                  incidence_deg=angles[:, 0].reshape(h, w),
                  emission_deg=angles[:, 1].reshape(h, w),
                  phase_deg=angles[:, 2].reshape(h, w), face=face.reshape(h, w),
-                 sunlit=sunlit.reshape(h, w), camera=camera, pose=pose, sun=sun)
+                 sunlit=sunlit.reshape(h, w), camera=camera, pose=pose, sun=sun,
+                 **_labels(ground_truth, pos, face, h, w))
+
+
+def _labels(geometry: SceneGeometry | None, pos, face, h: int, w: int) -> dict:
+    """The crater-id and boulder-id images of the points seen (none without catalogs)."""
+    if geometry is None:
+        return {}
+    boulder = boulder_labels(face, geometry.face_boulder_id).astype(np.int32)
+    crater = np.full(len(face), -1, dtype=np.int32)
+    if geometry.craters is not None and len(geometry.craters):
+        rows = np.flatnonzero(face >= 0)  # a boulder inside a rim carries both ids
+        crater[rows] = crater_labels(pos[rows], geometry.craters)
+    return {"crater_id": crater.reshape(h, w), "boulder_id": boulder.reshape(h, w)}

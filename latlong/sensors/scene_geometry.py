@@ -1,0 +1,209 @@
+"""What the sensors see: one triangle mesh in the body frame (metres) with its boulder ids
+and the catalogs that label it.
+
+A model is a :class:`latlong.Body` or its ``.npz``, a ``latlong.mesh.MeshSurface``
+(``--surface mesh``), or any mesh file pyvista reads (PLY, OBJ, STL, VTP, VTK, GLB:
+``dem mesh`` outputs, shape models). The body's placed boulders are part of the mesh
+(as the exports write them: boulders after the surface, ``boulder_id`` = catalog row);
+a mesh file's ``boulder_id`` point array is kept when it has one.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import craters
+from craters._shared import ParameterError, check_choice
+
+from ..body import Body, load
+from ..export import body_mesh_source
+
+__all__ = ["MESH_SUFFIXES", "SceneGeometry", "scene_geometry"]
+
+#: Mesh files read through pyvista.
+MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk", ".glb", ".gltf")
+_UNITS = {"m": 1.0, "km": 1000.0}
+
+
+@dataclass(frozen=True, slots=True)
+class SceneGeometry:
+    """A triangle mesh in the body frame and the ground truth that labels it."""
+
+    vertices: np.ndarray
+    """(n, 3) float64 positions, metres, body frame."""
+    faces: np.ndarray
+    """(m, 3) int64 vertex indices."""
+    face_boulder_id: np.ndarray
+    """(m,) int32 boulder catalog row of each triangle, -1 on the surface."""
+    craters: np.ndarray | None = None
+    """The crater catalog as stamped (rows in stamping order, oldest first) or None."""
+    boulders: np.ndarray | None = None
+    """The boulder catalog as placed or None."""
+    source: str = ""
+    """Where it came from."""
+
+
+def _from_source(src, craters_, boulders, source) -> SceneGeometry:
+    verts, ids = [], []
+    for xyz, values in src.vertex_chunks():
+        verts.append(np.asarray(xyz, dtype=np.float64))
+        ids.append(np.asarray(values.get("boulder_id", np.full(len(xyz), -1)), np.int32))
+    faces = np.concatenate([np.asarray(f, dtype=np.int64) for f in src.faces()])
+    vid = np.concatenate(ids)
+    return SceneGeometry(np.concatenate(verts), faces, vid[faces[:, 0]], craters_, boulders,
+                         source)
+
+
+_PLY_TYPES = {"float": "<f4", "float32": "<f4", "double": "<f8", "float64": "<f8",
+              "int": "<i4", "int32": "<i4", "uint": "<u4", "uint32": "<u4", "short": "<i2",
+              "int16": "<i2", "ushort": "<u2", "uint16": "<u2", "char": "i1", "int8": "i1",
+              "uchar": "u1", "uint8": "u1"}
+
+
+def _read_triangle_ply(path: Path):
+    """A binary little-endian PLY of triangles with scalar vertex properties (as the
+    craterform writers make them): ``(xyz, faces, {property: values})``, or None for any
+    other PLY (then pyvista reads it; VTK's reader drops the extra properties such as
+    ``boulder_id``)."""
+    with open(path, "rb") as fh:
+        if fh.readline().strip() != b"ply":
+            return None
+        elements, fmt = [], None
+        while True:
+            line = fh.readline()
+            if not line:
+                return None
+            words = line.decode("ascii", "replace").split()
+            if not words or words[0] in ("comment", "obj_info"):
+                continue
+            if words[0] == "format":
+                fmt = words[1]
+            elif words[0] == "element":
+                elements.append((words[1], int(words[2]), []))
+            elif words[0] == "property" and elements:
+                elements[-1][2].append(words[1:])
+            elif words[0] == "end_header":
+                break
+        names = [e[0] for e in elements]
+        if fmt != "binary_little_endian" or names != ["vertex", "face"]:
+            return None
+        (_, nv, vprops), (_, nf, fprops) = elements
+        if any(len(p) != 2 or p[0] not in _PLY_TYPES for p in vprops) or len(fprops) != 1 \
+                or fprops[0][0] != "list" or fprops[0][1] not in _PLY_TYPES \
+                or fprops[0][2] not in _PLY_TYPES:
+            return None
+        vdt = np.dtype([(p[1], _PLY_TYPES[p[0]]) for p in vprops])
+        fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]]), ("i", _PLY_TYPES[fprops[0][2]], 3)])
+        verts = np.fromfile(fh, dtype=vdt, count=nv)
+        faces = np.fromfile(fh, dtype=fdt, count=nf)
+    if len(verts) != nv or len(faces) != nf or not {"x", "y", "z"} <= set(vdt.names) \
+            or (faces["n"] != 3).any():
+        return None
+    xyz = np.stack([verts["x"], verts["y"], verts["z"]], 1).astype(np.float64)
+    return xyz, faces["i"].astype(np.int64), {k: verts[k] for k in vdt.names}
+
+
+def _read_mesh(path: Path, units: str) -> SceneGeometry:
+    if path.suffix.lower() == ".ply":
+        try:
+            ply = _read_triangle_ply(path)
+        except (OSError, ValueError):
+            ply = None
+        if ply is not None:
+            verts, faces, fields = ply
+            if len(faces) and (faces.min() < 0 or faces.max() >= len(verts)):
+                raise ValueError(f"cannot read mesh {str(path)!r}: face indices out of range")
+            return _mesh_geometry(verts * _UNITS[units], faces, fields, path)
+    import pyvista as pv
+    from vtkmodules.vtkCommonCore import vtkObject
+
+    shown = vtkObject.GetGlobalWarningDisplay()
+    vtkObject.GlobalWarningDisplayOff()  # a bad file: one line from us, not VTK's report
+    try:
+        with pv.vtk_verbosity("off"), warnings.catch_warnings():
+            warnings.simplefilter("error")
+            mesh = pv.read(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is an unreadable mesh
+        raise ValueError(f"cannot read mesh {str(path)!r}: {exc}".splitlines()[0]) from None
+    finally:
+        vtkObject.SetGlobalWarningDisplay(shown)
+    if isinstance(mesh, pv.MultiBlock):
+        mesh = mesh.combine(merge_points=False)
+    if not isinstance(mesh, pv.PolyData):
+        mesh = mesh.extract_surface()
+    mesh = mesh.triangulate()
+    faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
+        else np.zeros((0, 3), np.int64)
+    return _mesh_geometry(np.asarray(mesh.points, dtype=np.float64) * _UNITS[units], faces,
+                          {k: np.asarray(mesh.point_data[k]) for k in mesh.point_data.keys()},
+                          path)
+
+
+def _mesh_geometry(verts, faces, fields, path) -> SceneGeometry:
+    if not len(faces):
+        raise ValueError(f"cannot read mesh {str(path)!r}: no triangles in it")
+    if not np.isfinite(verts).all():
+        raise ValueError(f"mesh {str(path)!r} has non-finite vertices")
+    if "boulder_id" in fields:
+        fid = np.asarray(fields["boulder_id"]).astype(np.int32)[faces[:, 0]]
+    else:
+        fid = np.full(len(faces), -1, dtype=np.int32)
+    return SceneGeometry(verts, faces, fid, None, None, str(path))
+
+
+def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
+    """The mesh and catalogs of ``model`` (module notes).
+
+    Parameters
+    ----------
+    model : Body, MeshSurface, SceneGeometry, or path
+        A body, a ``--surface mesh`` surface, or a file: ``.npz`` (a body) or a mesh
+        (``MESH_SUFFIXES``).
+    units : {"m", "km"}
+        Units of a mesh file's coordinates (bodies are in metres).
+    craters : structured array or path, optional
+        A crater catalog (CSV or array with ``centre_x_m, centre_y_m, centre_z_m`` and
+        ``rim_radius_m`` or ``diameter_m``) to use instead of the model's own.
+    """
+    check_choice("units", units, tuple(_UNITS))
+    if isinstance(model, SceneGeometry):
+        geo = model
+    elif isinstance(model, Body):
+        geo = _from_source(body_mesh_source(model), model.craters, model.boulders,
+                           repr(model))
+    elif hasattr(model, "mesh_source") and hasattr(model, "faces"):
+        geo = _from_source(model.mesh_source(), model.craters, model.boulders, "mesh surface")
+    elif isinstance(model, str | Path):
+        path = Path(model)
+        if not path.is_file():
+            raise ParameterError("model", f"file {str(path)!r} does not exist")
+        suffix = path.suffix.lower()
+        if suffix == ".npz":
+            body = load(path)
+            geo = _from_source(body_mesh_source(body), body.craters, body.boulders, str(path))
+        elif suffix in MESH_SUFFIXES:
+            geo = _read_mesh(path, units)
+        else:
+            raise ParameterError("model", f"must be a body .npz or a mesh file "
+                                 f"({' '.join(MESH_SUFFIXES)}); got {str(path)!r}")
+    else:
+        raise TypeError(f"`model` must be a Body, a mesh surface or a path; got "
+                        f"{type(model).__name__}")
+    if craters is not None:
+        if isinstance(craters, str | Path):
+            craters = craters_catalog(craters)
+        geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id,
+                            np.asarray(craters), geo.boulders, geo.source)
+    return geo
+
+
+def craters_catalog(path) -> np.ndarray:
+    """A crater catalog CSV (as ``latlong build --catalog`` writes it)."""
+    try:
+        return craters.read_catalog(path)
+    except (OSError, KeyError) as exc:
+        raise ValueError(f"cannot read crater catalog {str(path)!r}: {exc}") from None
