@@ -1,4 +1,9 @@
-"""Off-screen pictures of a body (pyvista/VTK): Lambertian shading, one directional sun.
+"""Quick pictures of a body: Lambertian shading, one directional sun, cast shadows.
+
+Rendered by the sensors' ray engine (:func:`latlong.sensors.render`, Embree): every
+pixel's ray finds the surface, a shadow ray towards the sun decides whether it is lit,
+and the grey surface (0.78, 0.76, 0.72) takes ``0.03 + cos(incidence)`` where lit and
+0.03 in shadow (smooth shading normals), black sky.
 
 The camera looks at the centre of the body's bounding box from the direction
 (``view_lat_deg``, ``view_lon_deg``) in the body-fixed frame, at ``camera_distance_m``
@@ -10,10 +15,8 @@ writes a contact sheet of six views along +x, -x, +y, -y, +z, -z with the same s
 
 from __future__ import annotations
 
-import ctypes.util
 import dataclasses
 import math
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -31,8 +34,8 @@ from craters._shared import (
 from .body import Body
 from .grid import LatLongGrid
 
-__all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "render_preview",
-           "sun_direction"]
+__all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "preview_view",
+           "render_preview", "sun_direction"]
 
 #: Bodies above this magnitude are resampled to it for pictures (a picture of a few
 #: thousand pixels cannot show more, and the renderer's memory stays bounded).
@@ -79,16 +82,6 @@ class PreviewSettings:
         object.__setattr__(self, "views", views)
 
 
-def _headless_setup() -> None:
-    """Prefer EGL off-screen rendering when there is no X display (set before VTK loads)."""
-    if os.environ.get("DISPLAY") or os.environ.get("VTK_DEFAULT_OPENGL_WINDOW"):
-        return
-    if ctypes.util.find_library("EGL"):
-        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
-    elif ctypes.util.find_library("OSMesa"):
-        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkOSOpenGLRenderWindow"
-
-
 def camera_frame(view_lat_deg: float = 0.0, view_lon_deg: float = -90.0):
     """(toward_camera, right, up) unit vectors for a camera in direction (lat, lon).
 
@@ -131,44 +124,71 @@ def _picture_body(body: Body) -> Body:
     small = LatLongGrid(PREVIEW_MAX_MAGNITUDE)
     radii = body.grid.interpolate(body.radii_m, (np.pi / 2) - small.latitudes(),
                                   small.longitudes())
-    return Body(small, radii, radius_m=body.radius_m, stretch=body.stretch)
+    return Body(small, radii, radius_m=body.radius_m, stretch=body.stretch,
+                boulders=body.boulders)
 
 
-def _render(mesh, centre, extent, *, sun, view, width_px, height_px, camera_distance_m):
-    import pyvista as pv
+#: The preview camera's vertical field of view, degrees.
+VIEW_ANGLE_DEG = 30.0
+#: The surface colour (RGB in [0, 1]) and the ambient share of the light.
+SURFACE_RGB = (0.78, 0.76, 0.72)
+AMBIENT = 0.03
+
+
+def preview_view(vertices, view, width_px: int, height_px: int,
+                 camera_distance_m: float | None = None):
+    """The preview's camera and pose for ``vertices`` (n, 3) seen along ``view``
+    (:func:`camera_frame`): the centre of the bounding box at the centre of the picture
+    and, unless ``camera_distance_m`` is given, the silhouette filling it with an 8 %
+    margin (vertical field of view :data:`VIEW_ANGLE_DEG`)."""
+    from .sensors import Camera, Pose
 
     v, right, up = view
-    plotter = pv.Plotter(off_screen=True, window_size=(width_px, height_px), lighting="none")
-    try:
-        plotter.set_background("black")
-        plotter.add_mesh(mesh, color=(0.78, 0.76, 0.72), smooth_shading=True, ambient=0.03,
-                         diffuse=1.0, specular=0.0, show_scalar_bar=False)
-        light = pv.Light(position=tuple(centre + sun * 10 * extent), focal_point=tuple(centre),
-                         light_type="scene light", intensity=1.0)
-        light.positional = False
-        plotter.add_light(light)
-        view_angle = 30.0  # vertical field of view, degrees
-        rel = np.asarray(mesh.points) - centre
-        half_w = float(np.abs(rel @ right).max())
-        half_h = float(np.abs(rel @ up).max())
-        depth = float((rel @ v).max())  # nearest point towards the camera
-        tan_v = math.tan(math.radians(view_angle / 2))
-        tan_h = tan_v * width_px / height_px
-        fit = depth + 1.08 * max(half_w / tan_h, half_h / tan_v)
-        distance = camera_distance_m if camera_distance_m else fit
-        plotter.camera_position = [tuple(centre + v * distance), tuple(centre), tuple(up)]
-        plotter.camera.view_angle = view_angle
-        near = max(distance - 2 * extent, 1e-3 * distance)
-        plotter.camera.clipping_range = (near, distance + 2 * extent)
-        return plotter.screenshot(return_img=True)
-    finally:
-        plotter.close()
+    lo, hi = vertices.min(axis=0), vertices.max(axis=0)
+    centre = 0.5 * (lo + hi)
+    rel = vertices - centre
+    tan_v = math.tan(math.radians(VIEW_ANGLE_DEG / 2))
+    tan_h = tan_v * width_px / height_px
+    fit = float((rel @ v).max()) + 1.08 * max(float(np.abs(rel @ right).max()) / tan_h,
+                                              float(np.abs(rel @ up).max()) / tan_v)
+    distance = camera_distance_m if camera_distance_m else fit
+    f = 0.5 * height_px / tan_v
+    camera = Camera(f, f, 0.5 * width_px, 0.5 * height_px, width_px, height_px)
+    return camera, Pose.look_at(centre + v * distance, centre, up)
+
+
+def _render(mesh, *, sun, view, width_px, height_px, camera_distance_m) -> np.ndarray:
+    from .sensors import Sun, render
+
+    camera, pose = preview_view(mesh.vertices, view, width_px, height_px, camera_distance_m)
+    frame = render(mesh, camera, pose, Sun(sun))
+    cos_i = np.cos(np.radians(frame.incidence_deg.astype(np.float64)))
+    light = np.where(frame.face >= 0, AMBIENT + np.clip(cos_i, 0.0, None) * frame.sunlit, 0.0)
+    rgb = np.clip(light[..., None] * np.array(SURFACE_RGB) * 255.0 + 0.5, 0.0, 255.0)
+    return rgb.astype(np.uint8)
+
+
+def _preview_mesh(body):
+    """The ray mesh of a Body (resampled to :data:`PREVIEW_MAX_MAGNITUDE`, with its
+    boulders), a ``pyvista.PolyData`` or a ``(vertices, faces)`` pair."""
+    from .sensors import RayMesh, scene_mesh
+
+    if isinstance(body, Body):
+        return scene_mesh(_picture_body(body))
+    if isinstance(body, tuple) and len(body) == 2:
+        return RayMesh(*body)
+    if type(body).__name__ == "PolyData":
+        mesh = body.triangulate()
+        faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
+        return RayMesh(np.asarray(mesh.points, dtype=np.float64), faces)
+    raise TypeError(f"`body` must be a Body, a pyvista.PolyData or (vertices, faces); got "
+                    f"{type(body).__name__}")
 
 
 def render_preview(body: Body, path, settings: PreviewSettings | None = None, **kwargs) -> Path:
-    """Render ``body`` (a Body or a closed ``pyvista.PolyData`` mesh in metres) off-screen
-    to a PNG at ``path`` (atomic); see the module notes. The camera and sun are
-    ``settings`` (:class:`PreviewSettings`) or its fields as keyword arguments."""
+    """Render ``body`` (a Body, a closed ``pyvista.PolyData`` mesh or ``(vertices,
+    faces)`` in metres) to a PNG at ``path`` (atomic); see the module notes. The camera and
+    sun are ``settings`` (:class:`PreviewSettings`) or its fields as keyword arguments."""
     if settings is None:
         settings = PreviewSettings(**kwargs)
     elif kwargs:
@@ -179,30 +199,10 @@ def render_preview(body: Body, path, settings: PreviewSettings | None = None, **
     view_lat_deg, view_lon_deg = settings.view_lat_deg, settings.view_lon_deg
     width_px, height_px, views = settings.width_px, settings.height_px, settings.views
     camera_distance_m = settings.camera_distance_m
-    _headless_setup()  # before VTK loads
-    import pyvista as pv
-
-    if not isinstance(body, Body | pv.PolyData):
-        raise TypeError(f"`body` must be a Body or a pyvista.PolyData; got "
-                        f"{type(body).__name__}")
     path = Path(path)
     if path.suffix.lower() != ".png":
         raise ValueError(f"picture path must end in .png; got {str(path)!r}")
-    if isinstance(body, Body):
-        mesh = _picture_body(body).to_pyvista()
-        if body.boulders is not None and len(body.boulders):
-            from craters.boulders import boulder_world_meshes
-
-            bv, bf = boulder_world_meshes(body.boulders)
-            rocks = pv.PolyData(bv, np.hstack([np.full((len(bf), 1), 3), bf]).ravel())
-            mesh = mesh.merge(rocks)
-    else:
-        mesh = body
-    mesh = mesh.compute_normals(cell_normals=False, point_normals=True, split_vertices=False,
-                                consistent_normals=False, auto_orient_normals=False)
-    lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
-    centre = 0.5 * (lo + hi)
-    extent = 0.5 * float(np.linalg.norm(hi - lo))  # radius of the bounding sphere
+    mesh = _preview_mesh(body)
     if views == 1:
         directions = [("", view_lat_deg, view_lon_deg)]
     else:
@@ -211,7 +211,7 @@ def render_preview(body: Body, path, settings: PreviewSettings | None = None, **
     for _, la, lo_deg in directions:
         frame = camera_frame(la, lo_deg)
         sun = sun_direction(sun_azimuth_deg, sun_elevation_deg, la, lo_deg)
-        images.append(_render(mesh, centre, extent, sun=sun, view=frame, width_px=width_px,
+        images.append(_render(mesh, sun=sun, view=frame, width_px=width_px,
                               height_px=height_px, camera_distance_m=camera_distance_m))
     if views == 1:
         sheet = images[0]

@@ -8,7 +8,9 @@ horizon of the view's centre (long cast shadows). Measures, in the same run:
   before and after, ``resource``),
 * ``latlong.render`` of the frame with cast shadows, after the BVH (best of ``--repeat``;
   the first call also computes the vertex normals and is reported separately),
-* ``latlong.render_preview`` of the same view (pyvista/VTK, no shadows, same size),
+* the pyvista preview of the same view (``pyvista_preview`` below: the preview as it
+  was up to commit 2bb7aa7, VTK off-screen, Lambert, no shadows, same size; previews now
+  go through the engine) and today's ``latlong.render_preview`` (BVH build included),
   and prints the ratios. Usage:
 ``python tests/benchmarks/bench_sensors_camera.py [--magnitude M] [--size N] [--repeat R]``.
 """
@@ -23,6 +25,38 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+
+def pyvista_preview(body, png, view, size):
+    """The preview's pyvista/VTK renderer as it was up to 2bb7aa7 (the reference)."""
+    import pyvista as pv
+    from PIL import Image
+
+    mesh = body.to_pyvista().compute_normals(cell_normals=False, point_normals=True,
+                                             split_vertices=False, consistent_normals=False,
+                                             auto_orient_normals=False)
+    lo, hi = mesh.points.min(axis=0), mesh.points.max(axis=0)
+    centre, extent = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
+    v, right, up = view
+    plotter = pv.Plotter(off_screen=True, window_size=(size, size), lighting="none")
+    try:
+        plotter.set_background("black")
+        plotter.add_mesh(mesh, color=(0.78, 0.76, 0.72), smooth_shading=True, ambient=0.03,
+                         diffuse=1.0, specular=0.0, show_scalar_bar=False)
+        light = pv.Light(position=tuple(centre + right * 10 * extent),
+                         focal_point=tuple(centre), light_type="scene light", intensity=1.0)
+        light.positional = False
+        plotter.add_light(light)
+        rel = np.asarray(mesh.points) - centre
+        tan_v = math.tan(math.radians(15.0))
+        fit = float((rel @ v).max()) + 1.08 * max(float(np.abs(rel @ right).max()),
+                                                  float(np.abs(rel @ up).max())) / tan_v
+        plotter.camera_position = [tuple(centre + v * fit), tuple(centre), tuple(up)]
+        plotter.camera.view_angle = 30.0
+        plotter.camera.clipping_range = (max(fit - 2 * extent, 1e-3 * fit), fit + 2 * extent)
+        Image.fromarray(plotter.screenshot(return_img=True)).save(png)
+    finally:
+        plotter.close()
 
 
 def peak_rss_gb() -> float:
@@ -89,15 +123,19 @@ def main():
 
     with tempfile.TemporaryDirectory() as tmp:
         png = Path(tmp) / "preview.png"
-        times_p = []
+        times_p, times_n = [], []
         for _ in range(max(1, min(args.repeat, 2))):
+            t0 = time.perf_counter()
+            pyvista_preview(body, png, (toward, right, up), size)
+            times_p.append(time.perf_counter() - t0)
             t0 = time.perf_counter()
             latlong.render_preview(body, png, view_lat_deg=view_lat, view_lon_deg=view_lon,
                                    width_px=size, height_px=size)
-            times_p.append(time.perf_counter() - t0)
+            times_n.append(time.perf_counter() - t0)
     t_prev = min(times_p)
-    print(f"latlong.render_preview same view: {t_prev:.2f} s best of {len(times_p)}")
-    print(f"ratio preview / render: {t_prev / t_render:.1f}x (target >= 5); render "
+    print(f"pyvista preview (up to 2bb7aa7) same view: {t_prev:.2f} s best of {len(times_p)}; "
+          f"latlong.render_preview now (engine, BVH build included): {min(times_n):.2f} s")
+    print(f"ratio pyvista preview / render: {t_prev / t_render:.1f}x (target >= 5); render "
           f"{t_render:.3f} s (target <= 1 s); BVH {t_bvh:.1f} s (target <= 10 s); peak RSS "
           f"{peak_rss_gb():.2f} GB")
 
