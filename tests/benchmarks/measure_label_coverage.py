@@ -24,10 +24,11 @@ import numpy as np
 
 import craters
 from latlong import Body, LatLongGrid, stamp_craters
-from latlong.sensors.camera import Pose
+from latlong.sensors.camera import Camera, Pose
 from latlong.sensors.engine import RayMesh
 from latlong.sensors.labels import rim_curves, rim_ellipses
 from latlong.sensors.lidar import LidarSettings, lidar_frame
+from latlong.sensors.render import Sun, render
 from latlong.sensors.scene_geometry import scene_geometry
 
 
@@ -42,14 +43,19 @@ def ellipse_radius(e, i, j):
                     (-x * sa + y * ca) / e["semi_minor_px"])
 
 
-def measure(body, geo, mesh, pos, target, rims=None, size=512):
+def measure(body, geo, mesh, pos, target, rims=None, size=512, sensor="lidar"):
     q = _look_at(pos, target)
     s = LidarSettings(beams=(size, size), fov_deg=30.0)
-    fr = lidar_frame(mesh, s, pos, q, geometry=geo)
-    lab = np.full(size * size, -1)
-    lab[fr.beam] = fr.crater_id
-    lab = lab.reshape(size, size)
     k = s.intrinsics()
+    if sensor == "camera":  # the camera's crater-id image, same intrinsics and pose
+        cam = Camera(k["fx"], k["fy"], k["cx"], k["cy"], size, size)
+        fr = render(mesh, cam, Pose(pos, q), Sun(pos / np.linalg.norm(pos)), ground_truth=geo)
+        lab = fr.crater_id.astype(np.int64)
+    else:
+        fr = lidar_frame(mesh, s, pos, q, geometry=geo)
+        lab = np.full(size * size, -1)
+        lab[fr.beam] = fr.crater_id
+        lab = lab.reshape(size, size)
     ell = rim_ellipses(body.craters, (k["fx"], k["fy"], k["cx"], k["cy"]), pos, q,
                        ids=np.unique(lab[lab >= 0]), width=size, height=size, rims=rims)
     i, j = np.meshgrid(np.arange(size) + 0.5, np.arange(size) + 0.5)
@@ -87,9 +93,18 @@ def main():
              "35 deg off nadir": ([radius + 700.0, -500.0, 0.0], [radius, 0.0, 0.0])}
     fitted = rim_curves(body.craters, geo)
     shown = []
-    for (name, (pos, target)), (rule, rims) in itertools.product(
-            views.items(), (("catalog rims", None), ("rims fitted to the surface", fitted))):
-        fr, lab, ell, rows = measure(body, geo, mesh, np.array(pos), np.array(target), rims)
+    for (name, (pos, target)), (rule, rims), sensor in itertools.product(
+            views.items(), (("catalog rims", None), ("rims fitted to the surface", fitted)),
+            ("lidar", "camera")):
+        fr, lab, ell, rows = measure(body, geo, mesh, np.array(pos), np.array(target), rims,
+                                     sensor=sensor)
+        if sensor == "camera":
+            print(f"{name}, {rule}, camera frame (latlong.render crater_id):")
+            print(f"  labelled pixels within their ellipse (+1.5 px): min "
+                  f"{rows[:, 2].min():.4f}; ellipse covered, younger craters set aside: min "
+                  f"{rows[:, 4].min():.3f} median {np.median(rows[:, 4]):.3f}, >= 0.95 for "
+                  f"{np.mean(rows[:, 4] >= 0.95):.0%}")
+            continue
         print(f"{name}, {rule}: {len(rows)} craters fully in the frame with semi-minor "
               ">= 8 px")
         print(f"  labelled pixels within their ellipse (+1.5 px): min {rows[:, 2].min():.4f}, "
