@@ -91,10 +91,10 @@ def cmd_camera(args) -> int:
         Sun,
         reflectance_model,
         render,
-        rim_curves,
         scene_geometry,
         scene_mesh,
     )
+    from latlong.sensors.labels import surface_tree
     from latlong.sensors.output import frame_entry, manifest, write_frame, write_manifest
 
     out = output_folder(args)
@@ -118,14 +118,15 @@ def cmd_camera(args) -> int:
             raise CliError(str(exc).replace("`model`", "MODEL")) from None
         t0 = time.perf_counter()
         mesh = scene_mesh(geometry)
+        t_bvh = time.perf_counter() - t0
     poses = poses if poses is not None else poses_from_args(args, mesh)
     refuse_inside(mesh, poses, args, "camera")
-    rims = None
+    tree = None  # the surface's k-d tree, for the rims of the craters seen
     if geometry.craters is not None and len(geometry.craters):
-        rims = rim_curves(geometry.craters, geometry)
+        tree = surface_tree(geometry)
     if not args.quiet:
         print(f"model {args.model}: {len(mesh.faces)} triangles, BVH built in "
-              f"{time.perf_counter() - t0:.1f} s")
+              f"{t_bvh:.1f} s")
     parent = out.parent if str(out.parent) else Path(".")
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
     try:
@@ -136,7 +137,8 @@ def cmd_camera(args) -> int:
                            ground_truth=geometry)
             files = write_frame(tmp, k, frame, depth_format=args.depth_format,
                                 extra=args.all_ground_truth)
-            entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
+            entries.append(frame_entry(frame, files, craters=geometry.craters,
+                                       surface=tree))
         doc = manifest(camera, entries, model=str(args.model), reflectance=args.reflectance,
                        reflectance_parameters={k: getattr(model, k)
                                                for k in model.__dataclass_fields__},

@@ -47,7 +47,8 @@ from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kerne
 from .camera import quaternion_to_matrix
 from .scene_geometry import SceneGeometry
 
-__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_curves", "rim_ellipses"]
+__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_curves", "rim_ellipses",
+           "surface_tree"]
 
 #: Fields of :func:`rim_ellipses` (pixels; the angle of the major axis from +x towards
 #: +y, i.e. clockwise on the picture, degrees in [0, 180)).
@@ -139,7 +140,7 @@ def boulder_labels(face, face_boulder_id) -> np.ndarray:
     return np.where(face >= 0, ids[np.maximum(face, 0)], -1)
 
 
-def rim_curves(catalog, surface=None):
+def rim_curves(catalog, surface=None, *, ids=None):
     """The rim crest of each crater as a planar curve in 3-D: ``(centres (n, 3), axis1
     (n, 3), axis2 (n, 3))`` in the body frame, metres; the rim's points are ``centre +
     cos(theta) axis1 + sin(theta) axis2``.
@@ -152,7 +153,8 @@ def rim_curves(catalog, surface=None):
     5 % of ``R`` (15 % when fewer than 8 are), i.e. the crest's actual height and tilt
     (craters on slopes or inside older craters, worn or overprinted rims); the rim is that
     plane cut by the cylinder of radius ``R`` about the up axis. Craters with too few
-    vertices keep the catalog rule.
+    vertices keep the catalog rule. ``ids`` (catalog rows) limits the fit to those craters
+    (the others keep the catalog rule): a frame's visible craters, not a whole catalog.
     """
     c, r, normals = _centres_radii(catalog)
     up = normals if normals is not None else c / np.linalg.norm(c, axis=1, keepdims=True)
@@ -161,11 +163,11 @@ def rim_curves(catalog, surface=None):
         if "rim_height_m" in catalog.dtype.names else np.zeros(len(c))
     tilt = np.zeros((len(c), 2))
     if surface is not None and len(c):
-        from scipy.spatial import cKDTree  # scipy.spatial loads argparse: only when used
-
-        verts = _surface_vertices(surface)
-        tree = cKDTree(verts)
-        for i, near in enumerate(tree.query_ball_point(c, 1.6 * r)):
+        tree = surface_tree(surface)
+        verts = tree.data
+        rows = np.arange(len(c)) if ids is None else np.unique(np.asarray(ids, np.int64))
+        rows = rows[(rows >= 0) & (rows < len(c))]
+        for i, near in zip(rows, tree.query_ball_point(c[rows], 1.6 * r[rows]), strict=True):
             d = verts[np.asarray(near, dtype=np.int64)] - c[i]
             h, x, y = d @ up[i], d @ e1[i], d @ e2[i]
             rho = np.hypot(x, y)
@@ -177,6 +179,17 @@ def rim_curves(catalog, surface=None):
                     break
     return (c + a[:, None] * up, r[:, None] * (e1 + tilt[:, :1] * up),
             r[:, None] * (e2 + tilt[:, 1:] * up))
+
+
+def surface_tree(surface):
+    """A ``scipy.spatial.cKDTree`` of a surface's vertices (a :class:`SceneGeometry` without
+    its boulders, or (n, 3) vertices), to share between :func:`rim_curves` calls (a tree
+    given is returned as it is)."""
+    from scipy.spatial import cKDTree  # scipy.spatial loads argparse: only when used
+
+    if isinstance(surface, cKDTree):
+        return surface
+    return cKDTree(_surface_vertices(surface))
 
 
 def _surface_vertices(surface) -> np.ndarray:

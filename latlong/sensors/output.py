@@ -26,7 +26,7 @@ import numpy as np
 from craters._shared import ParameterError, atomic_path
 
 from .camera import Camera
-from .labels import ELLIPSE_DTYPE, rim_ellipses
+from .labels import ELLIPSE_DTYPE, rim_curves, rim_ellipses
 from .render import Frame
 
 __all__ = ["frame_entry", "manifest", "write_frame", "write_manifest"]
@@ -79,10 +79,11 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
     return {"crater_id": None, "boulder_id": None, **files}
 
 
-def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
-    """The manifest's record of one frame; with the crater catalog (and its
-    :func:`~latlong.sensors.labels.rim_curves`), the projected rim ellipses (pinhole,
-    pixels) of the craters whose id is in the frame's label image."""
+def frame_entry(frame: Frame, files: dict, *, craters=None, surface=None) -> dict:
+    """The manifest's record of one frame; with the crater catalog, the projected rim
+    ellipses (pinhole, pixels) of the craters whose id is in the frame's label image,
+    their rims fitted to ``surface`` (a SceneGeometry or its :func:`~latlong.sensors.
+    labels.surface_tree`; :func:`~latlong.sensors.labels.rim_curves`) when given."""
     entry = {"time_s": frame.pose.time_s,
              "position_m": [float(v) for v in frame.pose.position_m],
              "quaternion_wxyz": [float(v) for v in frame.pose.quaternion_wxyz],
@@ -91,6 +92,7 @@ def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
     if craters is not None and frame.crater_id is not None:
         cam = frame.camera
         seen = np.unique(frame.crater_id[frame.crater_id >= 0])
+        rims = None if surface is None else rim_curves(craters, surface, ids=seen)
         ell = rim_ellipses(craters, (cam.fx, cam.fy, cam.cx, cam.cy), frame.pose.position_m,
                            frame.pose.quaternion_wxyz, ids=seen, rims=rims)
         entry["rim_ellipses"] = [{k: (int(e[k]) if k == "crater_id" else float(e[k]))
