@@ -89,6 +89,7 @@ def cmd_camera(args) -> int:
     from latlong.sensors import (
         Sensor,
         Sun,
+        ejecta_albedo,
         reflectance_model,
         render,
         scene_geometry,
@@ -121,6 +122,12 @@ def cmd_camera(args) -> int:
         t_bvh = time.perf_counter() - t0
     poses = poses if poses is not None else poses_from_args(args, mesh)
     refuse_inside(mesh, poses, args, "camera")
+    albedo = None
+    if args.bright_ejecta:
+        try:
+            albedo = ejecta_albedo(geometry, contrast=args.bright_ejecta)
+        except (ParameterError, ParameterTypeError) as exc:
+            raise CliError(exc.shown_as("--bright-ejecta")) from None
     tree = None  # the surface's k-d tree, for the rims of the craters seen
     if geometry.craters is not None and len(geometry.craters):
         tree = surface_tree(geometry)
@@ -134,7 +141,7 @@ def cmd_camera(args) -> int:
         for k in progress_bar(range(len(poses)), enabled=not args.quiet, desc="frames"):
             frame = render(mesh, camera, poses[k], sun, reflectance=model, sensor=sensor,
                            soft_shadow_samples=args.soft_shadow_samples, seed=args.seed,
-                           ground_truth=geometry)
+                           ground_truth=geometry, vertex_albedo=albedo)
             files = write_frame(tmp, k, frame, depth_format=args.depth_format,
                                 extra=args.all_ground_truth)
             entries.append(frame_entry(frame, files, craters=geometry.craters,
@@ -191,6 +198,10 @@ def add_camera_parser(sub) -> None:
                    help=f"{'|'.join(REFLECTANCES)} (default: lommel-seeliger)")
     s.add_argument("--albedo", type=float, help="normal albedo of lambert, lommel-seeliger "
                    "or lunar-lambert (default: 0.12)")
+    s.add_argument("--bright-ejecta", type=float, default=0.0,
+                   help="albedo contrast of fresh craters' ejecta (0.5 = 50 %% brighter at the "
+                   "rim, fading as (r/R)^-3 and with degradation; needs a crater catalog) "
+                   "(default: 0 = off)")
     s.add_argument("--hapke-preset", default="s-type",
                    help=f"Hapke parameters: {'|'.join(HAPKE_PRESETS)} (default: s-type)")
     d = c.add_argument_group("sensor")

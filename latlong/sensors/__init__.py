@@ -15,6 +15,7 @@
 ``latlong.render`` is :func:`latlong.sensors.render.render`.
 """
 
+from .albedo import ejecta_albedo
 from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
 from .engine import BUILD_QUALITIES, Hits, RayMesh
 from .labels import ELLIPSE_DTYPE, boulder_labels, crater_labels, rim_curves, rim_ellipses
@@ -39,7 +40,8 @@ __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "Frame", "Hapke",
            "Hits", "Lambert", "LidarFrame", "LidarSettings", "LommelSeeliger", "LunarLambert",
            "Pose", "Poses", "RayMesh", "SceneGeometry", "Sensor", "Sun", "beam_pattern",
-           "boulder_labels", "camera_inside", "crater_labels", "expose", "lidar_frame",
+           "boulder_labels", "camera_inside", "crater_labels", "ejecta_albedo", "expose",
+           "lidar_frame",
            "lidar_run", "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
            "read_poses", "reflectance_model", "render", "rim_curves", "rim_ellipses",
            "scene_geometry", "scene_mesh", "write_las"]

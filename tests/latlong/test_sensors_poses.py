@@ -117,3 +117,27 @@ def test_camera_pose_options_conflict(run_cli, cratered_npz, tmp_path):
                    "--size", "96x80", "--sun-direction", "1,0,0", "--position-m", "1,2,3")
     assert proc.returncode == 2 and "one of" in proc.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_bright_ejecta_brightens_fresh_craters_only(cratered_npz):
+    """--bright-ejecta: around a fresh crater the albedo factor is 1 + contrast at the rim
+    and follows (r/R)^-3 outside; craters at or above the fresh degradation leave it 1."""
+    from latlong import load
+    from latlong.sensors import ejecta_albedo, scene_geometry
+
+    geo = scene_geometry(load(cratered_npz))
+    cat = geo.craters
+    a = ejecta_albedo(geo, contrast=0.5, fresh_degradation=1.0)
+    assert a.min() >= 1.0 and a.max() <= 1.5 + 1e-12
+    i = int(np.argmin(cat["degradation"]))
+    c = np.array([cat["centre_x_m"][i], cat["centre_y_m"][i], cat["centre_z_m"][i]])
+    r = np.linalg.norm(geo.vertices - c, axis=1) / cat["rim_radius_m"][i]
+    w = 1.0 - cat["degradation"][i]
+    inside = r <= 1.0
+    assert (a[inside] >= 1.0 + 0.5 * w - 1e-12).all()
+    ring = (r > 1.5) & (r < 2.5)
+    assert (a[ring] >= 1.0 + 0.5 * w * r[ring] ** -3 - 1e-12).all()
+    mature = ejecta_albedo(geo, contrast=0.5, fresh_degradation=float(cat["degradation"].min()))
+    assert (mature == 1.0).all()  # every crater at or above the threshold
+    with pytest.raises(ValueError, match="contrast"):
+        ejecta_albedo(geo, contrast=-1.0)
