@@ -23,8 +23,8 @@ POSE_FLAGS = {"quaternion_wxyz": "--quaternion", "position_m": "--position-m",
               "n_frames": "--frames", "start_range_m": "--range-m",
               "end_range_m": "--range-m", "path_angle_deg": "--path-angle-deg",
               "path_azimuth_deg": "--path-azimuth-deg", "duration_s": "--duration-s",
-              "lat_deg": "--target-lat-lon", "lon_deg": "--target-lat-lon",
-              "target_m": "--target-m", "time_s": "--time-s"}
+              "vertical": "--vertical", "lat_deg": "--target-lat-lon",
+              "lon_deg": "--target-lat-lon", "target_m": "--target-m", "time_s": "--time-s"}
 
 
 def allow_negative_lists(parser: argparse.ArgumentParser) -> None:
@@ -91,6 +91,9 @@ def add_pose_options(group, sensor: str) -> None:
     group.add_argument("--path-azimuth-deg", type=float, default=0.0,
                        help="direction of that tilt from local north towards east, degrees "
                        "(default: 0)")
+    group.add_argument("--vertical", type=numbers(3, "X,Y,Z"),
+                       help="local vertical at the target of a generated approach, body "
+                       "frame; 0,0,1 for a dem mesh (default: the target's radial direction)")
     group.add_argument("--duration-s", type=float,
                        help="time from the first to the last generated frame, seconds "
                        "(default: one second per frame)")
@@ -134,7 +137,8 @@ def poses_from_args(args, mesh=None):
             else args.target_m
         return approach(target, n_frames=args.frames, start_range_m=args.range_m[0],
                         end_range_m=args.range_m[1], path_angle_deg=args.path_angle_deg,
-                        path_azimuth_deg=args.path_azimuth_deg, duration_s=args.duration_s)
+                        path_azimuth_deg=args.path_azimuth_deg, duration_s=args.duration_s,
+                        vertical=args.vertical)
     except (ParameterError, ParameterTypeError) as exc:
         raise _shown(exc, POSE_FLAGS) from None
 

@@ -149,13 +149,17 @@ def surface_point(mesh, lat_deg: float, lon_deg: float) -> np.ndarray:
 
 def approach(target_m, *, n_frames: int, start_range_m: float, end_range_m: float,
              path_angle_deg: float = 0.0, path_azimuth_deg: float = 0.0,
-             duration_s: float | None = None, up=(0.0, 0.0, 1.0)) -> Poses:
+             duration_s: float | None = None, up=(0.0, 0.0, 1.0), vertical=None) -> Poses:
     """A straight approach or descent towards ``target_m`` (a surface point, body frame,
     metres): ``n_frames`` cameras looking at the target along one line, at ranges spaced
     geometrically from ``start_range_m`` to ``end_range_m`` (equal ratios between frames,
     as a descent slows down). The line leaves the target ``path_angle_deg`` from its local
-    vertical (the radial direction; 0 = straight down) towards ``path_azimuth_deg`` (from
-    local north towards east). Times run 0 .. ``duration_s`` (default: one second per
+    vertical towards ``path_azimuth_deg`` (from local north towards east; 0 = straight
+    down). The local vertical is ``vertical`` (body frame) or, by default, the target's
+    radial direction from the origin (a body); give ``vertical=(0, 0, 1)`` for an open
+    surface in a local frame with z up, such as a ``dem mesh`` (x east, y north). North
+    points towards the body's +z axis (+y where the vertical is +z: x is then east).
+    Times run 0 .. ``duration_s`` (default: one second per
     frame). ``up`` (body frame) points up the pictures (another axis if along the view).
 
     Examples
@@ -165,19 +169,26 @@ def approach(target_m, *, n_frames: int, start_range_m: float, end_range_m: floa
     ([1400.0, 1200.0, 1100.0], [0.0, 1.0, 2.0])
     """
     target = np.asarray(target_m, dtype=np.float64).reshape(3)
-    if not np.isfinite(target).all() or not np.linalg.norm(target) > 0:
-        raise ParameterError("target_m", f"must be a finite point off the origin; got "
-                             f"{target.tolist()}")
+    if not np.isfinite(target).all() or (vertical is None and not np.linalg.norm(target) > 0):
+        raise ParameterError("target_m", f"must be a finite point (off the origin without "
+                             f"`vertical`); got {target.tolist()}")
     n = check_int("n_frames", n_frames, 1, 100_000)
     r0 = check_positive("start_range_m", start_range_m)
     r1 = check_positive("end_range_m", end_range_m)
     angle = np.radians(check_range("path_angle_deg", path_angle_deg, 0.0, 89.0))
     az = np.radians(check_finite("path_azimuth_deg", path_azimuth_deg))
     duration = float(n - 1) if duration_s is None else check_positive("duration_s", duration_s)
-    vertical = target / np.linalg.norm(target)
+    if vertical is None:
+        vertical = target / np.linalg.norm(target)
+    else:
+        vertical = np.asarray(vertical, dtype=np.float64).reshape(-1)
+        if vertical.shape != (3,) or not np.isfinite(vertical).all() \
+                or not np.linalg.norm(vertical) > 0:
+            raise ParameterError("vertical", "must be 3 finite numbers, not all zero")
+        vertical = vertical / np.linalg.norm(vertical)
     east = np.cross([0.0, 0.0, 1.0], vertical)
     east = east / np.linalg.norm(east) if np.linalg.norm(east) > 1e-12 else np.array(
-        [0.0, 1.0, 0.0])
+        [1.0, 0.0, 0.0])
     north = np.cross(vertical, east)
     line = np.cos(angle) * vertical + np.sin(angle) * (np.cos(az) * north + np.sin(az) * east)
     ranges = r0 * (r1 / r0) ** (np.arange(n) / max(n - 1, 1))

@@ -93,6 +93,29 @@ def test_poses_csv_mesh_file_and_options(run_cli, mesh_ply, tmp_path):
     assert again.returncode == 2 and "--force" in again.stderr
 
 
+def test_approach_over_a_dem_mesh_with_vertical(run_cli, tmp_path):
+    """A ``dem mesh``-like open surface (x east, y north, z = height) lying below the
+    datum: ``--vertical 0,0,1`` brings the generated cameras down from above; without it
+    the radial direction of the target points down and the camera would be under it."""
+    import dem
+
+    z = -1500.0 + 30.0 * np.sin(np.arange(33)[:, None] / 4.0) * np.cos(np.arange(33) / 5.0)
+    mesh = tmp_path / "site.ply"
+    dem.mesh.to_mesh(dem.Dem(z, pixel_size_m=20.0), mesh)
+    out = tmp_path / "landing"
+    args = ["latlong", "camera", str(mesh), "--target-m", "0,0,-1500", "--range-m",
+            "400,200", "--frames", "2", "--path-angle-deg", "20", *BASE, "-q"]
+    below = run_cli(*args, "-o", str(out))
+    assert below.returncode == 2 and "inside" in below.stderr
+    proc = run_cli(*args, "--vertical", "0,0,1", "-o", str(out))
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((out / "frames.json").read_text())
+    assert [round(f["position_m"][2]) for f in doc["frames"]] == [-1124, -1312]
+    from PIL import Image
+
+    assert np.asarray(Image.open(out / doc["frames"][1]["files"]["depth"])).min() > 150
+
+
 BAD = [
     (["--position-m", "0,0,0", "--quaternion", Q], "inside"),
     (["--position-m", "-3000,200,100", "--quaternion", "1,0.2,0,0"], "--quaternion"),

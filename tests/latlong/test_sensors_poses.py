@@ -33,9 +33,28 @@ def test_approach_ranges_times_and_aim():
     assert line @ east > 0.49
 
 
+@pytest.mark.parametrize("target", [[0.0, 0.0, -1500.0], [0.0, 0.0, 0.0], [2e3, -1e3, 50.0]])
+def test_approach_over_a_local_frame_with_z_up(target):
+    """A DEM mesh (x east, y north, z = height, heights below the datum too): with
+    ``vertical=(0, 0, 1)`` the cameras come down from above, whatever the target's
+    height; the default (the radial direction) would put them under the ground."""
+    p = approach(target, n_frames=3, start_range_m=5000.0, end_range_m=500.0,
+                 path_angle_deg=30.0, path_azimuth_deg=90.0, vertical=(0.0, 0.0, 2.0))
+    line = (p.position_m - target) / np.linalg.norm(p.position_m - target, axis=1)[:, None]
+    np.testing.assert_allclose(line, [[0.5, 0.0, np.sqrt(3) / 2]] * 3, atol=1e-12)  # east
+    north = approach(target, n_frames=1, start_range_m=100.0, end_range_m=100.0,
+                     path_angle_deg=45.0, vertical=(0, 0, 1))
+    np.testing.assert_allclose(north.position_m[0] - target, [0, 50 * np.sqrt(2),
+                                                              50 * np.sqrt(2)], atol=1e-9)
+    if target[2] < 0:  # the old behaviour: below the surface, looking up
+        assert approach(target, n_frames=1, start_range_m=100.0,
+                        end_range_m=100.0).position_m[0, 2] < target[2]
+
+
 @pytest.mark.parametrize(("kwargs", "needle"), [
     ({"n_frames": 0}, "n_frames"), ({"start_range_m": -1.0}, "start_range_m"),
-    ({"path_angle_deg": 95.0}, "path_angle_deg"), ({"duration_s": 0.0}, "duration_s")])
+    ({"path_angle_deg": 95.0}, "path_angle_deg"), ({"duration_s": 0.0}, "duration_s"),
+    ({"vertical": (0.0, 0.0, 0.0)}, "vertical"), ({"vertical": (1.0, 2.0)}, "vertical")])
 def test_approach_bad_input_names_the_parameter(kwargs, needle):
     args = {"n_frames": 3, "start_range_m": 100.0, "end_range_m": 10.0, **kwargs}
     with pytest.raises(ValueError, match=needle):
