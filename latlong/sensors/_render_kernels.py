@@ -111,8 +111,11 @@ def _ground_truth_kernel(t, face, dirs, axis, cosines, ns, lit, depth, rng, angl
 
 
 @njit(cache=True, parallel=True)
-def _shadow_rays_kernel(pos, ng, eps, sun, radius_rad, seed, sample, out_o, out_d, facing):
-    """Shadow-ray origins (offset ``eps`` along the geometric normal) and directions: the
+def _shadow_rays_kernel(pos, ng, offset, centre, floor, sun, radius_rad, seed, sample, out_o,
+                        out_d, facing):
+    """Shadow-ray origins (lifted along the geometric normal by ``offset`` times the point's
+    distance from ``centre``, at least ``floor``: the float32 BVH's rounding grows with
+    that distance) and directions: the
     sun's centre (``radius_rad`` 0) or sample ``sample`` of a uniform draw over the solar
     disk (a spherical cap of half-angle ``radius_rad``); ``facing``: the facet faces
     that direction."""
@@ -142,6 +145,10 @@ def _shadow_rays_kernel(pos, ng, eps, sun, radius_rad, seed, sample, out_o, out_
             dy = ct * sun[1] + cp * e1y + sp * e2y
             dz = ct * sun[2] + cp * e1z + sp * e2z
         out_d[i, 0], out_d[i, 1], out_d[i, 2] = dx, dy, dz
+        rx = pos[i, 0] - centre[0]
+        ry = pos[i, 1] - centre[1]
+        rz = pos[i, 2] - centre[2]
+        eps = max(offset * math.sqrt(rx * rx + ry * ry + rz * rz), floor)
         for k in range(3):
             out_o[i, k] = pos[i, k] + eps * ng[i, k]
         facing[i] = ng[i, 0] * dx + ng[i, 1] * dy + ng[i, 2] * dz > 0.0

@@ -47,7 +47,10 @@ __all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render", "sce
 
 #: Angular radius of the sun seen from 1 au, degrees (696 000 km / 1 au).
 SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
-#: Shadow rays start this fraction of the model's bounding radius above the surface.
+#: Shadow rays start this fraction of the point's distance from the model's centre (the
+#: centre of its bounding box, where the engine's float32 frame is) above the surface, at
+#: least 1e-3 of that times the bounding radius: a 700 km DEM mesh lifts points near its
+#: centre by millimetres, not by 2e-6 of its radius (1.4 m, shortening low-sun shadows).
 SHADOW_OFFSET = 2e-6
 
 
@@ -211,14 +214,16 @@ def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndar
     cand = np.flatnonzero(facing)
     if not len(cand):
         return lit
-    eps = SHADOW_OFFSET * mesh.bounding_sphere[1]
+    centre, radius_m = mesh.bounding_sphere  # the engine's float32 frame is centred here
+    floor = 1e-3 * SHADOW_OFFSET * radius_m
     radius = math.radians(sun.angular_radius_deg) if samples else 0.0
     p, n = np.ascontiguousarray(pos[cand]), np.ascontiguousarray(ng[cand])
     o, d = np.empty_like(p), np.empty_like(p)
     face_ok = np.empty(len(cand), dtype=np.bool_)
     total = np.zeros(len(cand))
     for k in range(max(samples, 1)):
-        _shadow_rays_kernel(p, n, eps, sun.direction, radius, seed, k, o, d, face_ok)
+        _shadow_rays_kernel(p, n, SHADOW_OFFSET, centre, floor, sun.direction, radius, seed,
+                            k, o, d, face_ok)
         free = face_ok & ~mesh.occluded(o, d, np.inf)
         total += free
     lit[cand] = total / max(samples, 1)
