@@ -167,7 +167,10 @@ def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
         Units of a mesh file's coordinates (bodies are in metres).
     craters : structured array or path, optional
         A crater catalog (CSV or array with ``centre_x_m, centre_y_m, centre_z_m`` and
-        ``rim_radius_m`` or ``diameter_m``) to use instead of the model's own.
+        ``rim_radius_m`` or ``diameter_m``) to use instead of the model's own; a map
+        catalog (``x_m, y_m``, as ``dem enhance`` writes it for a ``dem mesh`` in the same
+        local frame, z up) is placed on the surface straight below each centre (off the
+        mesh: no label).
     """
     check_choice("units", units, tuple(_UNITS))
     if isinstance(model, SceneGeometry):
@@ -196,9 +199,34 @@ def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
     if craters is not None:
         if isinstance(craters, str | Path):
             craters = craters_catalog(craters)
-        geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id,
-                            np.asarray(craters), geo.boulders, geo.source)
+        craters = np.asarray(craters)
+        names = craters.dtype.names or ()
+        if "centre_x_m" not in names and {"x_m", "y_m"} <= set(names):
+            craters = _placed_on_surface(craters, geo)
+        geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id, craters,
+                            geo.boulders, geo.source)
     return geo
+
+
+def _placed_on_surface(catalog, geo: SceneGeometry) -> np.ndarray:
+    """A map catalog (``x_m, y_m``: a ``dem`` catalog in the mesh's local frame, z up) with
+    ``centre_*`` on the surface straight below the highest point and ``normal_*`` = +z;
+    every row kept (ids are rows), ``centre_z_m`` NaN where the vertical misses the mesh."""
+    import numpy.lib.recfunctions as rfn
+
+    from .engine import RayMesh
+
+    x = np.asarray(catalog["x_m"], dtype=np.float64)
+    y = np.asarray(catalog["y_m"], dtype=np.float64)
+    top = float(geo.vertices[:, 2].max()) + 1.0
+    mesh = RayMesh(geo.vertices, geo.faces)
+    hits = mesh.intersect(np.stack([x, y, np.full(len(x), top)], 1),
+                          np.tile([0.0, 0.0, -1.0], (len(x), 1)))
+    z = np.where(hits.hit, top - hits.t_m, np.nan)
+    zero = np.zeros(len(x))
+    return np.asarray(rfn.append_fields(
+        catalog, ["centre_x_m", "centre_y_m", "centre_z_m", "normal_x", "normal_y",
+                  "normal_z"], [x, y, z, zero, zero, zero + 1.0], usemask=False))
 
 
 def craters_catalog(path) -> np.ndarray:

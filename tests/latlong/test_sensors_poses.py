@@ -160,3 +160,27 @@ def test_bright_ejecta_brightens_fresh_craters_only(cratered_npz):
     assert (mature == 1.0).all()  # every crater at or above the threshold
     with pytest.raises(ValueError, match="contrast"):
         ejecta_albedo(geo, contrast=-1.0)
+
+
+def test_map_catalog_on_a_dem_mesh_is_placed_on_the_surface():
+    """A dem catalog (x_m, y_m in the mesh's local frame) labels a dem mesh: centres on the
+    surface below them, +z normals, rows kept (ids = rows), NaN where off the mesh."""
+    from latlong.sensors import crater_labels, scene_geometry
+    from latlong.sensors.scene_geometry import SceneGeometry
+
+    n = 21
+    xs = np.linspace(-100.0, 100.0, n)
+    gx, gy = np.meshgrid(xs, xs)
+    verts = np.stack([gx.ravel(), gy.ravel(), 5.0 + 0.01 * gx.ravel()], 1)
+    idx = np.arange(n * n).reshape(n, n)
+    a, b, c, d = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel(), idx[1:, :-1].ravel(), \
+        idx[1:, 1:].ravel()
+    faces = np.concatenate([np.stack([a, b, d], 1), np.stack([a, d, c], 1)])
+    geo = SceneGeometry(verts, faces, np.full(len(faces), -1, np.int32))
+    cat = craters.make_catalog(x_m=[500.0, 10.0], y_m=[0.0, 20.0], diameter_m=[20.0, 30.0])
+    placed = scene_geometry(geo, craters=cat).craters
+    assert len(placed) == 2 and np.isnan(placed["centre_z_m"][0])
+    assert placed["centre_z_m"][1] == pytest.approx(5.1, abs=1e-9)
+    assert placed["normal_z"][1] == 1.0
+    pts = [[10.0, 20.0, 5.1], [10.0, 40.0, 5.1], [500.0, 0.0, 5.0]]
+    assert crater_labels(pts, placed).tolist() == [1, -1, -1]
