@@ -31,6 +31,7 @@ from craters._shared import (
     check_range,
 )
 
+from ._preview_kernels import _extent_kernel
 from .body import Body
 from .grid import LatLongGrid
 
@@ -143,14 +144,15 @@ def preview_view(vertices, view, width_px: int, height_px: int,
     margin (vertical field of view :data:`VIEW_ANGLE_DEG`)."""
     from .sensors import Camera, Pose
 
-    v, right, up = view
+    v, right, up = (np.ascontiguousarray(a, dtype=np.float64) for a in view)
+    vertices = np.ascontiguousarray(vertices, dtype=np.float64)
     lo, hi = vertices.min(axis=0), vertices.max(axis=0)
     centre = 0.5 * (lo + hi)
-    rel = vertices - centre
+    ext = np.empty(3)
+    _extent_kernel(vertices, centre, v, right, up, ext)
     tan_v = math.tan(math.radians(VIEW_ANGLE_DEG / 2))
     tan_h = tan_v * width_px / height_px
-    fit = float((rel @ v).max()) + 1.08 * max(float(np.abs(rel @ right).max()) / tan_h,
-                                              float(np.abs(rel @ up).max()) / tan_v)
+    fit = float(ext[0]) + 1.08 * max(float(ext[1]) / tan_h, float(ext[2]) / tan_v)
     distance = camera_distance_m if camera_distance_m else fit
     f = 0.5 * height_px / tan_v
     camera = Camera(f, f, 0.5 * width_px, 0.5 * height_px, width_px, height_px)
@@ -173,14 +175,16 @@ def _preview_mesh(body):
     boulders), a ``pyvista.PolyData`` or a ``(vertices, faces)`` pair."""
     from .sensors import RayMesh, scene_mesh
 
+    # a preview traces one frame (or six): Embree's fastest (Morton) build pays off, 1.4 s
+    # instead of 5.3 s for 12 M triangles here, for about the same frame time
     if isinstance(body, Body):
-        return scene_mesh(_picture_body(body))
+        return scene_mesh(_picture_body(body), build_quality="low")
     if isinstance(body, tuple) and len(body) == 2:
-        return RayMesh(*body)
+        return RayMesh(*body, build_quality="low")
     if type(body).__name__ == "PolyData":
         mesh = body.triangulate()
         faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
-        return RayMesh(np.asarray(mesh.points, dtype=np.float64), faces)
+        return RayMesh(np.asarray(mesh.points, dtype=np.float64), faces, build_quality="low")
     raise TypeError(f"`body` must be a Body, a pyvista.PolyData or (vertices, faces); got "
                     f"{type(body).__name__}")
 

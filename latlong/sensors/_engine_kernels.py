@@ -212,3 +212,21 @@ def _unit_kernel(directions, out):
             norm = 1.0
         out[i, 0], out[i, 1], out[i, 2] = x / norm, y / norm, z / norm
     return bad if bad < n else -1
+
+
+@njit(cache=True)
+def _shift_kernel(vertices, centre, out):
+    """``out[:n] = float32(vertices - centre)``; returns the largest squared distance of a
+    vertex from ``centre`` (float64), in one pass over the vertices."""
+    r2 = 0.0
+    for i in range(vertices.shape[0]):
+        x = vertices[i, 0] - centre[0]
+        y = vertices[i, 1] - centre[1]
+        z = vertices[i, 2] - centre[2]
+        out[i, 0] = np.float32(x)
+        out[i, 1] = np.float32(y)
+        out[i, 2] = np.float32(z)
+        d = x * x + y * y + z * z
+        if d > r2:
+            r2 = d
+    return r2

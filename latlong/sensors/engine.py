@@ -45,6 +45,7 @@ from craters._shared import ParameterError, ParameterTypeError
 from ._engine_kernels import (
     _intersect_kernel,
     _occluded_kernel,
+    _shift_kernel,
     _unit_kernel,
     _vertex_normals_kernel,
 )
@@ -199,8 +200,6 @@ class RayMesh:
         self._index = np.ascontiguousarray(f, dtype=np.uint32)  # Embree's index buffer
         self._index.flags.writeable = False
         self._centre = centre
-        # bounding sphere of the float32 geometry, with room for its rounding
-        self._radius = float(np.sqrt(((v - centre) ** 2).sum(axis=1).max())) * (1 + 1e-5) + 1e-6
         self._face_normals = None
         self._vertex_normals = None
         lib, self._intersect1, self._occluded1 = _embree()
@@ -213,7 +212,9 @@ class RayMesh:
         # float32 vertices relative to the centre; one padding row: Embree reads the last
         # vertex with a 16-byte load
         self._vbuf = np.zeros((len(v) + 1, 3), dtype=np.float32)
-        np.subtract(v, centre, out=self._vbuf[:-1], casting="unsafe")
+        r2 = _shift_kernel(v, centre, self._vbuf)
+        # bounding sphere of the float32 geometry, with room for its rounding
+        self._radius = float(np.sqrt(r2)) * (1 + 1e-5) + 1e-6
         scene = lib.rtcNewScene(self._device)
         self._scene = scene
         lib.rtcSetSceneFlags(scene, _SCENE_FLAG_ROBUST)

@@ -68,3 +68,17 @@ def test_lit_pixels_follow_lambert(tmp_path):
     got = img.reshape(-1)[hit]
     inner = (n @ -pose.rotation[:, 2]) > 0.3  # away from the limb's facets
     assert np.abs(got[inner] - expect[inner]).max() < 4.0
+
+
+def test_extent_kernel_matches_numpy():
+    from latlong._preview_kernels import _extent_kernel
+
+    rng = np.random.default_rng(4)
+    v = rng.normal(size=(500, 3)) * [300.0, 200.0, 100.0] + 50.0
+    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+    view, right, up = camera_frame(20.0, 35.0)
+    out = np.empty(3)
+    _extent_kernel(v, centre, view, right, up, out)
+    rel = v - centre
+    np.testing.assert_allclose(out, [(rel @ view).max(), np.abs(rel @ right).max(),
+                                     np.abs(rel @ up).max()], rtol=1e-14)

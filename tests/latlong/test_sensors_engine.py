@@ -232,3 +232,17 @@ def test_same_bytes_for_any_thread_count():
         out.add(proc.stdout.strip())
     assert len(out) == 1, out
     assert len(hashlib.sha256().hexdigest()) == len(out.pop())
+
+
+def test_shift_kernel_matches_numpy():
+    from latlong.sensors._engine_kernels import _shift_kernel
+
+    rng = np.random.default_rng(5)
+    v = rng.normal(size=(1000, 3)) * 1e5 + 3e6
+    centre = 0.5 * (v.min(axis=0) + v.max(axis=0))
+    out = np.zeros((1001, 3), dtype=np.float32)
+    r2 = _shift_kernel(v, centre, out)
+    ref = np.zeros_like(out)
+    np.subtract(v, centre, out=ref[:-1], casting="unsafe")
+    np.testing.assert_array_equal(out, ref)
+    assert r2 == ((v - centre) ** 2).sum(axis=1).max()
