@@ -56,6 +56,9 @@ __all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
 #: medium = binned SAH (Embree's default; faster rays), high = SAH with spatial splits.
 BUILD_QUALITIES = {"low": 0, "medium": 1, "high": 2}
 _SCENE_FLAG_ROBUST = 1 << 2  # conservative traversal: no rays leak between triangles
+# a compact BVH: 12 M triangles built in 2.8-3.5 s instead of 7.0-10.6 s on this machine
+# (less memory to fault in: peak 1.87 GB instead of 2.24 GB), frames ~20 % slower to trace
+_SCENE_FLAG_COMPACT = 1 << 1
 _GEOMETRY_TRIANGLE = 0
 _BUFFER_INDEX, _BUFFER_VERTEX = 0, 1
 _FORMAT_UINT3, _FORMAT_FLOAT3 = 0x5003, 0x9003
@@ -217,7 +220,7 @@ class RayMesh:
         self._radius = float(np.sqrt(r2)) * (1 + 1e-5) + 1e-6
         scene = lib.rtcNewScene(self._device)
         self._scene = scene
-        lib.rtcSetSceneFlags(scene, _SCENE_FLAG_ROBUST)
+        lib.rtcSetSceneFlags(scene, _SCENE_FLAG_ROBUST | _SCENE_FLAG_COMPACT)
         lib.rtcSetSceneBuildQuality(scene, quality)
         geom = lib.rtcNewGeometry(self._device, _GEOMETRY_TRIANGLE)
         lib.rtcSetSharedGeometryBuffer(geom, _BUFFER_VERTEX, 0, _FORMAT_FLOAT3,
