@@ -231,6 +231,180 @@ def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale,
 
 
 @njit(cache=True)
+def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths, rim_tabs,
+               seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
+               out_centre, out_maxdh, out_nvert, out_spacing, out_erased, up, naive, stop_after,
+               inner_parallel, ang_bound):
+    """Stamp crater ``c`` (see :func:`_stamp_body_kernel`); False, with nothing written,
+    when its gather cap would exceed ``ang_bound`` (radians: the wave schedule's bound)."""
+    smax = max(stretch[0], max(stretch[1], stretch[2]))
+    smin = min(stretch[0], min(stretch[1], stretch[2]))
+    n_rim = rim_tabs.shape[1]
+    delta = np.empty(n_rim)
+    la = np.radians(lat[c])
+    lo = np.radians(lon[c])
+    colat = 0.5 * np.pi - la
+    uc0 = np.cos(la) * np.cos(lo)
+    uc1 = np.cos(la) * np.sin(lo)
+    uc2 = np.sin(la)
+    rc = _interpolate_one(m, ring_offsets, radii, colat, lo)
+    pc0, pc1, pc2, rloc = _stretched(stretch, rc, uc0, uc1, uc2)
+    a0 = pc0 / rloc
+    a1 = pc1 / rloc
+    a2 = pc2 / rloc
+    # east = z x a, north = a x east (x axis as east at the poles)
+    e0v = -a1
+    e1v = a0
+    e2v = 0.0
+    en = np.sqrt(e0v * e0v + e1v * e1v)
+    if en < 1e-12:
+        e0v, e1v, e2v = 1.0, 0.0, 0.0
+    else:
+        e0v /= en
+        e1v /= en
+    n0 = a1 * e2v - a2 * e1v
+    n1 = a2 * e0v - a0 * e2v
+    n2 = a0 * e1v - a1 * e0v
+    radius = 0.5 * diam[c]
+    rho_max = 0.0
+    for k in range(n_rim):
+        rho_max = max(rho_max, rim_tabs[c, k])
+    reach = xe * radius * (1.0 + rho_max)
+    nominal = rloc * np.pi / (2 * m)
+    ang = min(np.pi, (reach + 2.0 * nominal) / rloc * smax / smin)
+    if ang > ang_bound:
+        return False  # the surface moved more than the wave schedule allowed for
+    if naive:
+        cand = _scan_all(unit, uc0, uc1, uc2, np.cos(ang))
+        cnt = cand.shape[0]
+    else:
+        cnt = _gather_kernel(m, ring_offsets, colat, lo, ang, np.empty(0, np.int64), True)
+        cand = np.empty(cnt, np.int64)
+        _gather_kernel(m, ring_offsets, colat, lo, ang, cand, False)
+    # local coordinates of the candidates
+    keep = 0
+    idx = np.empty(cnt, np.int64)
+    pmag = np.empty(cnt)
+    dist = np.empty(cnt)
+    az = np.empty(cnt)
+    xl = np.empty(cnt)
+    yl = np.empty(cnt)
+    hgt = np.empty(cnt)
+    limit = reach + 2.0 * nominal
+    n_inside = 0
+    for q in range(cnt):
+        i = cand[q]
+        r = radii[i]
+        ring = np.searchsorted(ring_offsets, i, side="right") - 1
+        o = ring_offsets[ring]
+        ux, uy, uz = _unit_of(m, ring, i - o, ring_offsets[ring + 1] - o)
+        p0v, p1v, p2v, pm = _stretched(stretch, r, ux, uy, uz)
+        b0 = p0v / pm
+        b1 = p1v / pm
+        b2 = p2v / pm
+        dot = b0 * a0 + b1 * a1 + b2 * a2
+        cx0 = b1 * a2 - b2 * a1
+        cx1 = b2 * a0 - b0 * a2
+        cx2 = b0 * a1 - b1 * a0
+        angle = np.arctan2(np.sqrt(cx0 * cx0 + cx1 * cx1 + cx2 * cx2), dot)
+        d = rloc * angle
+        if d > limit:
+            continue
+        theta = np.arctan2(b0 * n0 + b1 * n1 + b2 * n2, b0 * e0v + b1 * e1v + b2 * e2v)
+        idx[keep] = i
+        pmag[keep] = pm
+        dist[keep] = d
+        az[keep] = theta
+        xl[keep] = d * np.cos(theta)
+        yl[keep] = d * np.sin(theta)
+        hgt[keep] = pm - rloc
+        keep += 1
+        if d <= reach:
+            n_inside += 1
+    if stop_after == 1:
+        return True
+    # local vertex spacing from the vertex density inside the reach
+    if n_inside >= 4:
+        sp = np.sqrt(np.pi * reach * reach / n_inside)
+    else:
+        sp = max(nominal, 0.5 * reach)
+    # the plane of the obliterated region, fitted to the vertices' true local
+    # coordinates (at least 2 spacings across, so that craters of a few vertex
+    # spacings still get the local tilt: radial heights on a stretched body are
+    # tilted even where the surface is smooth)
+    p0, gx, gy, qa, qb, qc = _fit_quadric_points(xl, yl, hgt, dist, keep,
+                                                max(radius, 2.0 * sp))
+    # the local grid holds the terrain relative to that plane (binned at the local
+    # vertex spacing, holes filled), from which the rim offsets are sampled
+    nh = int(np.ceil(limit / sp)) + 1
+    g = 2 * nh + 1
+    acc = np.zeros((g, g))
+    num = np.zeros((g, g))
+    for q in range(keep):
+        gi = int(np.round(yl[q] / sp)) + nh
+        gj = int(np.round(xl[q] / sp)) + nh
+        if 0 <= gi < g and 0 <= gj < g:
+            acc[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+            num[gi, gj] += 1.0
+    known = num > 0
+    for gi in range(g):
+        for gj in range(g):
+            if known[gi, gj]:
+                acc[gi, gj] /= num[gi, gj]
+    local = _fill_holes(acc, known)
+    if stop_after == 2:
+        return True
+    # slope: angle between the local surface normal (from the fitted base) and the
+    # normal of the reference body (the stretched sphere, S^-2 P_c; radial when
+    # unstretched), so that an elongated body's shape is not mistaken for steep ground
+    l0 = a0 - gx * e0v - gy * n0
+    l1 = a1 - gx * e1v - gy * n1
+    l2 = a2 - gx * e2v - gy * n2
+    if up.shape[0] > 0:  # the given "up" (e.g. against self-gravity on a shape model)
+        r0 = up[c, 0]
+        r1 = up[c, 1]
+        r2 = up[c, 2]
+    else:
+        r0 = pc0 / (stretch[0] * stretch[0])
+        r1 = pc1 / (stretch[1] * stretch[1])
+        r2 = pc2 / (stretch[2] * stretch[2])
+    cr0 = l1 * r2 - l2 * r1
+    cr1 = l2 * r0 - l0 * r2
+    cr2 = l0 * r1 - l1 * r0
+    slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                  l0 * r0 + l1 * r1 + l2 * r2))
+    out_slope[c] = slope
+    out_centre[c, 0] = pc0
+    out_centre[c, 1] = pc1
+    out_centre[c, 2] = pc2
+    out_spacing[c] = sp
+    if slope_erosion and slope >= full_deg:
+        out_erased[c] = True  # steeper than the angle of repose: erased, not stamped
+        return True
+    scale = slope_factor(slope, onset_deg, full_deg) if slope_erosion else 1.0
+    # delta = plane - terrain at the rim = -(residual grid) there
+    rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
+    octaves = roughness_octaves(radius, sp)
+    dh = np.empty(keep)
+    if inner_parallel and keep >= PARALLEL_MIN:
+        _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
+                        yl[:keep], hgt[:keep], radius, tabs[c], scale, depths[c], xe,
+                        rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
+                        radius, octaves, gain, dh)
+    else:
+        _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
+                     scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
+                     rough, seeds[c], radius, octaves, gain, dh)
+    big = 0.0
+    for q in range(keep):
+        big = max(big, abs(dh[q]))
+    out_scale[c] = scale
+    out_maxdh[c] = big
+    out_nvert[c] = keep
+    return True
+
+
+@njit(cache=True)
 def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
                        rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                        out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
@@ -253,166 +427,8 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
     ``stop_after`` = 1 stops after the gather and local coordinates, 2 after the local
     grid and base fit (to time the stages).
     """
-    smax = max(stretch[0], max(stretch[1], stretch[2]))
-    smin = min(stretch[0], min(stretch[1], stretch[2]))
-    n_rim = rim_tabs.shape[1]
-    delta = np.empty(n_rim)
     for c in range(lat.shape[0]):
-        la = np.radians(lat[c])
-        lo = np.radians(lon[c])
-        colat = 0.5 * np.pi - la
-        uc0 = np.cos(la) * np.cos(lo)
-        uc1 = np.cos(la) * np.sin(lo)
-        uc2 = np.sin(la)
-        rc = _interpolate_one(m, ring_offsets, radii, colat, lo)
-        pc0, pc1, pc2, rloc = _stretched(stretch, rc, uc0, uc1, uc2)
-        a0 = pc0 / rloc
-        a1 = pc1 / rloc
-        a2 = pc2 / rloc
-        # east = z x a, north = a x east (x axis as east at the poles)
-        e0v = -a1
-        e1v = a0
-        e2v = 0.0
-        en = np.sqrt(e0v * e0v + e1v * e1v)
-        if en < 1e-12:
-            e0v, e1v, e2v = 1.0, 0.0, 0.0
-        else:
-            e0v /= en
-            e1v /= en
-        n0 = a1 * e2v - a2 * e1v
-        n1 = a2 * e0v - a0 * e2v
-        n2 = a0 * e1v - a1 * e0v
-        radius = 0.5 * diam[c]
-        rho_max = 0.0
-        for k in range(n_rim):
-            rho_max = max(rho_max, rim_tabs[c, k])
-        reach = xe * radius * (1.0 + rho_max)
-        nominal = rloc * np.pi / (2 * m)
-        ang = min(np.pi, (reach + 2.0 * nominal) / rloc * smax / smin)
-        if naive:
-            cand = _scan_all(unit, uc0, uc1, uc2, np.cos(ang))
-            cnt = cand.shape[0]
-        else:
-            cnt = _gather_kernel(m, ring_offsets, colat, lo, ang, np.empty(0, np.int64), True)
-            cand = np.empty(cnt, np.int64)
-            _gather_kernel(m, ring_offsets, colat, lo, ang, cand, False)
-        # local coordinates of the candidates
-        keep = 0
-        idx = np.empty(cnt, np.int64)
-        pmag = np.empty(cnt)
-        dist = np.empty(cnt)
-        az = np.empty(cnt)
-        xl = np.empty(cnt)
-        yl = np.empty(cnt)
-        hgt = np.empty(cnt)
-        limit = reach + 2.0 * nominal
-        n_inside = 0
-        for q in range(cnt):
-            i = cand[q]
-            r = radii[i]
-            ring = np.searchsorted(ring_offsets, i, side="right") - 1
-            o = ring_offsets[ring]
-            ux, uy, uz = _unit_of(m, ring, i - o, ring_offsets[ring + 1] - o)
-            p0v, p1v, p2v, pm = _stretched(stretch, r, ux, uy, uz)
-            b0 = p0v / pm
-            b1 = p1v / pm
-            b2 = p2v / pm
-            dot = b0 * a0 + b1 * a1 + b2 * a2
-            cx0 = b1 * a2 - b2 * a1
-            cx1 = b2 * a0 - b0 * a2
-            cx2 = b0 * a1 - b1 * a0
-            angle = np.arctan2(np.sqrt(cx0 * cx0 + cx1 * cx1 + cx2 * cx2), dot)
-            d = rloc * angle
-            if d > limit:
-                continue
-            theta = np.arctan2(b0 * n0 + b1 * n1 + b2 * n2, b0 * e0v + b1 * e1v + b2 * e2v)
-            idx[keep] = i
-            pmag[keep] = pm
-            dist[keep] = d
-            az[keep] = theta
-            xl[keep] = d * np.cos(theta)
-            yl[keep] = d * np.sin(theta)
-            hgt[keep] = pm - rloc
-            keep += 1
-            if d <= reach:
-                n_inside += 1
-        if stop_after == 1:
-            continue
-        # local vertex spacing from the vertex density inside the reach
-        if n_inside >= 4:
-            sp = np.sqrt(np.pi * reach * reach / n_inside)
-        else:
-            sp = max(nominal, 0.5 * reach)
-        # the plane of the obliterated region, fitted to the vertices' true local
-        # coordinates (at least 2 spacings across, so that craters of a few vertex
-        # spacings still get the local tilt: radial heights on a stretched body are
-        # tilted even where the surface is smooth)
-        p0, gx, gy, qa, qb, qc = _fit_quadric_points(xl, yl, hgt, dist, keep,
-                                                    max(radius, 2.0 * sp))
-        # the local grid holds the terrain relative to that plane (binned at the local
-        # vertex spacing, holes filled), from which the rim offsets are sampled
-        nh = int(np.ceil(limit / sp)) + 1
-        g = 2 * nh + 1
-        acc = np.zeros((g, g))
-        num = np.zeros((g, g))
-        for q in range(keep):
-            gi = int(np.round(yl[q] / sp)) + nh
-            gj = int(np.round(xl[q] / sp)) + nh
-            if 0 <= gi < g and 0 <= gj < g:
-                acc[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-                num[gi, gj] += 1.0
-        known = num > 0
-        for gi in range(g):
-            for gj in range(g):
-                if known[gi, gj]:
-                    acc[gi, gj] /= num[gi, gj]
-        local = _fill_holes(acc, known)
-        if stop_after == 2:
-            continue
-        # slope: angle between the local surface normal (from the fitted base) and the
-        # normal of the reference body (the stretched sphere, S^-2 P_c; radial when
-        # unstretched), so that an elongated body's shape is not mistaken for steep ground
-        l0 = a0 - gx * e0v - gy * n0
-        l1 = a1 - gx * e1v - gy * n1
-        l2 = a2 - gx * e2v - gy * n2
-        if up.shape[0] > 0:  # the given "up" (e.g. against self-gravity on a shape model)
-            r0 = up[c, 0]
-            r1 = up[c, 1]
-            r2 = up[c, 2]
-        else:
-            r0 = pc0 / (stretch[0] * stretch[0])
-            r1 = pc1 / (stretch[1] * stretch[1])
-            r2 = pc2 / (stretch[2] * stretch[2])
-        cr0 = l1 * r2 - l2 * r1
-        cr1 = l2 * r0 - l0 * r2
-        cr2 = l0 * r1 - l1 * r0
-        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
-                                      l0 * r0 + l1 * r1 + l2 * r2))
-        out_slope[c] = slope
-        out_centre[c, 0] = pc0
-        out_centre[c, 1] = pc1
-        out_centre[c, 2] = pc2
-        out_spacing[c] = sp
-        if slope_erosion and slope >= full_deg:
-            out_erased[c] = True  # steeper than the angle of repose: erased, not stamped
-            continue
-        scale = slope_factor(slope, onset_deg, full_deg) if slope_erosion else 1.0
-        # delta = plane - terrain at the rim = -(residual grid) there
-        rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
-        octaves = roughness_octaves(radius, sp)
-        dh = np.empty(keep)
-        if keep >= PARALLEL_MIN:
-            _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
-                            yl[:keep], hgt[:keep], radius, tabs[c], scale, depths[c], xe,
-                            rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
-                            radius, octaves, gain, dh)
-        else:
-            _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
-                         scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
-                         rough, seeds[c], radius, octaves, gain, dh)
-        big = 0.0
-        for q in range(keep):
-            big = max(big, abs(dh[q]))
-        out_scale[c] = scale
-        out_maxdh[c] = big
-        out_nvert[c] = keep
+        _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
+                   rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
+                   out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
+                   out_erased, up, naive, stop_after, True, np.inf)

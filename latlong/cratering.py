@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 
+import numba
 import numpy as np
 
 import craters as _craters
@@ -13,6 +14,7 @@ from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
 from craters.targets import Target
 
 from ._crater_kernels import _stamp_body_kernel
+from ._wave_kernels import _stamp_waves_kernel, _wave_schedule_kernel
 from .body import Body
 from .mesh.cratering import down_directions
 from .surface import band_areas, sample_surface_points
@@ -21,6 +23,45 @@ __all__ = ["body_population", "crater_extents_deg", "stamp_craters"]
 
 logger = logging.getLogger(__name__)
 _BATCH = 256  # craters per kernel call when a progress bar is shown
+#: The wave schedule allows each crater's local radius to fall to this share of its
+#: value before stamping (checked: beyond it the craters are stamped serially).
+WAVE_RADIUS_SHARE = 0.8
+
+
+def _stamp_in_waves(body: Body, cat, rim_tabs, ejecta_edge: float, args, progress) -> bool:
+    """Stamp ``cat`` in parallel waves (:mod:`latlong._wave_kernels`): the same radii as
+    the serial kernel, bit for bit. ``args``: the serial kernel's arguments (full
+    arrays). False if a crater's cap outgrew its scheduled bound (then nothing is valid)."""
+    m = body.grid.magnitude
+    n = len(cat)
+    stretch = np.asarray(body.stretch, dtype=np.float64)
+    lat = np.radians(np.asarray(cat["lat_deg"], dtype=np.float64))
+    lon = np.mod(np.radians(np.asarray(cat["lon_deg"], dtype=np.float64)), 2.0 * np.pi)
+    reach = ejecta_edge * 0.5 * np.asarray(cat["diameter_m"], dtype=np.float64) \
+        * (1.0 + rim_tabs.max(axis=1))
+    # the cap each crater will gather, for a local radius down to WAVE_RADIUS_SHARE of
+    # today's: earlier craters would have to move the surface by more than that
+    rloc = WAVE_RADIUS_SHARE * _local_radii(body, cat["lat_deg"], cat["lon_deg"])
+    bound = np.minimum(np.pi, (reach / rloc + np.pi / m) * stretch.max() / stretch.min())
+    bound = np.ascontiguousarray(bound * (1.0 + 1e-9))
+    n_theta = int(np.clip(np.pi / (2.0 * np.median(bound)), 4, 4096))
+    wave = np.empty(n, dtype=np.int64)
+    n_waves = _wave_schedule_kernel(np.pi / 2 - lat, lon, bound, n_theta, wave)
+    order = np.lexsort((-reach / rloc, wave))  # by wave, the largest caps first
+    starts = np.searchsorted(wave[order], np.arange(n_waves + 1))
+    ok = np.ones(n, dtype=np.bool_)
+    chunks = np.linspace(0, n_waves, min(n_waves, 100 if progress else 1) + 1).astype(int)
+    bar = progress_bar(total=n, enabled=progress, desc="craters")
+    try:
+        for w0, w1 in zip(chunks[:-1], chunks[1:], strict=True):
+            _stamp_waves_kernel(order, starts[w0:w1 + 1], *args, bound,
+                                numba.get_num_threads(), ok)
+            bar.update(int(starts[w1] - starts[w0]))
+    finally:
+        bar.close()
+    logger.debug("%d craters in %d waves (%d alone)", n, n_waves,
+                 int((np.diff(starts) == 1).sum()))
+    return bool(ok.all())
 
 
 def body_population(body: Body, layers, *, rng=None) -> np.ndarray:
@@ -185,15 +226,25 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     offs = grid.ring_offsets()
     up = _gravity_up(body, lat, lon) if slope_reference == "gravity" and n and slope_erosion \
         else np.empty((0, 3))
-    step = _BATCH if progress else max(n, 1)
-    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
-        e = min(s + step, n)
-        _stamp_body_kernel(grid.magnitude, offs, unit, radii, stretch, lat[s:e], lon[s:e],
-                           diam[s:e], prof.tables[s:e], prof.depth_m[s:e], rim_tabs[s:e],
-                           seeds[s:e], ejecta_edge, bool(slope_erosion), onset, full,
-                           rough_arr, gain, scale[s:e], outs["slope"][s:e], centre[s:e],
-                           outs["maxdh"][s:e], outs["nvert"][s:e], outs["sp"][s:e],
-                           erased[s:e], up[s:e])
+    args = (grid.magnitude, offs, radii, stretch, lat, lon, diam, prof.tables, prof.depth_m,
+            rim_tabs, seeds, ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain,
+            scale, outs["slope"], centre, outs["maxdh"], outs["nvert"], outs["sp"], erased, up)
+    done = False
+    if numba.get_num_threads() > 1 and n > 1:
+        done = _stamp_in_waves(body, cat, rim_tabs, ejecta_edge, args, progress)
+        if not done:  # a surface moved more than the schedule allowed: redo serially
+            logger.info("wave schedule outgrown; stamping %d craters serially", n)
+            radii[:] = body.radii_m
+    if not done:
+        step = _BATCH if progress else max(n, 1)
+        for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+            e = min(s + step, n)
+            _stamp_body_kernel(grid.magnitude, offs, unit, radii, stretch, lat[s:e], lon[s:e],
+                               diam[s:e], prof.tables[s:e], prof.depth_m[s:e],
+                               rim_tabs[s:e], seeds[s:e], ejecta_edge, bool(slope_erosion),
+                               onset, full, rough_arr, gain, scale[s:e], outs["slope"][s:e],
+                               centre[s:e], outs["maxdh"][s:e], outs["nvert"][s:e],
+                               outs["sp"][s:e], erased[s:e], up[s:e])
     if n and (radii <= 0).any():
         raise ValueError("craters pushed the surface through the body centre; lower the "
                          "largest diameter or max_extent_deg")
