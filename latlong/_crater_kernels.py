@@ -22,7 +22,7 @@ from craters.kernels import (
     table_value,
 )
 
-from ._grid_kernels import _interpolate_one, _ring_size, _unit_of
+from ._grid_kernels import _interpolate_one, _ring_size
 
 
 @njit(cache=True)
@@ -292,12 +292,30 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     hgt = np.empty(cnt)
     limit = reach + 2.0 * nominal
     n_inside = 0
+    # candidates come ring by ring (the gather's order): the ring and its latitude's
+    # cosine and sine are found once per ring, the same values as _unit_of's
+    ring = -1
+    o = 0
+    n_ring = 1
+    clat = 0.0
+    slat = 1.0
     for q in range(cnt):
         i = cand[q]
         r = radii[i]
-        ring = np.searchsorted(ring_offsets, i, side="right") - 1
-        o = ring_offsets[ring]
-        ux, uy, uz = _unit_of(m, ring, i - o, ring_offsets[ring + 1] - o)
+        if ring < 0 or i < o or i >= o + n_ring:
+            ring = np.searchsorted(ring_offsets, i, side="right") - 1
+            o = ring_offsets[ring]
+            n_ring = ring_offsets[ring + 1] - o
+            lat_r = 0.5 * np.pi - ring * (np.pi / (2 * m))
+            clat = np.cos(lat_r)
+            slat = np.sin(lat_r)
+        if ring == 0:
+            ux, uy, uz = 0.0, 0.0, 1.0
+        elif ring == 2 * m:
+            ux, uy, uz = 0.0, 0.0, -1.0
+        else:
+            lon_v = (2.0 * np.pi * (i - o)) / n_ring
+            ux, uy, uz = clat * np.cos(lon_v), clat * np.sin(lon_v), slat
         p0v, p1v, p2v, pm = _stretched(stretch, r, ux, uy, uz)
         b0 = p0v / pm
         b1 = p1v / pm

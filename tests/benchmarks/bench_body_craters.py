@@ -2,11 +2,15 @@
 
 R = 10 km body (6 M vertices), N_cum ~ D^-2 between 20 m and 2 km, roughness on, each
 crater diffused for its age on a small body of that size (craters.small_body).
-Reports craters/s, the share of time per stage (population, profile tables, gather + local
-coordinates, local grid + plane fit, crater evaluation + write-back) and, in the same
-run, craters/s of a naive stamp that scans every vertex per crater.
-Usage: ``python tests/benchmarks/bench_body_craters.py [--quick]`` (quick: M = 300, R = 3
-km, D 20-600 m).
+``--moon``: issue 20's other benchmark, M = 330 (653 k vertices), the Moon (R = 1737.4
+km, flat sphere), 2000 craters of 25-250 km.
+Reports, in one run: craters/s and vertex-updates/s of ``stamp_craters`` on one thread
+(the serial kernel) and on all threads (parallel waves, same bytes: checked), best of
+``--repeat``, and their ratio; the share of time per stage (population, profile tables,
+gather + local coordinates, local grid + plane fit, crater evaluation + write-back) and
+craters/s of a naive stamp that scans every vertex per crater.
+Usage: ``python tests/benchmarks/bench_body_craters.py [--quick | --moon] [--repeat R]``
+(quick: M = 300, R = 3 km, D 20-600 m).
 """
 
 from __future__ import annotations
@@ -14,6 +18,7 @@ from __future__ import annotations
 import argparse
 import time
 
+import numba
 import numpy as np
 
 import craters
@@ -45,29 +50,48 @@ def run_kernel(body, cat, prof, rng, **switches):
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true")
+    parser.add_argument("--moon", action="store_true")
+    parser.add_argument("--repeat", type=int, default=3)
     args = parser.parse_args()
-    m, radius, n_target, d_max = ((300, 3000.0, 5000, 600.0) if args.quick
-                                  else (1000, 10_000.0, 50_000, 2000.0))
+    m, radius, n_target, d_min, d_max = (
+        (300, 3000.0, 5000, 20.0, 600.0) if args.quick
+        else (330, 1_737_400.0, 2000, 25_000.0, 250_000.0) if args.moon
+        else (1000, 10_000.0, 50_000, 20.0, 2000.0))
     grid = LatLongGrid(m)
     t0 = time.perf_counter()
     grid.unit_vectors()
     body = Body.sphere(grid, radius)
     t_setup = time.perf_counter() - t0
     area = 4 * np.pi * radius**2
-    c = n_target / (area * (20.0**-2 - d_max**-2))
+    c = n_target / (area * (d_min**-2 - d_max**-2))
     t0 = time.perf_counter()
-    cat = craters.power_law_population(radius=radius, c=c, k=-2.0, d_min=20.0, d_max=d_max,
+    cat = craters.power_law_population(radius=radius, c=c, k=-2.0, d_min=d_min, d_max=d_max,
                                        rng=1)
     t_pop = time.perf_counter() - t0
-    target = craters.small_body(radius)
-    stamp_craters(Body.sphere(LatLongGrid(8), radius), cat[:2], target=target)  # compile
-    t0 = time.perf_counter()
-    out = stamp_craters(body, cat, rng=2, target=target)
-    t_total = time.perf_counter() - t0
+    target = "moon" if args.moon else craters.small_body(radius)
+    threads = numba.get_num_threads()
+    runs = {}
+    for nt in (1, threads):
+        numba.set_num_threads(nt)
+        stamp_craters(body, cat[:50], rng=2, target=target)  # compile this path
+        times = []
+        for _ in range(args.repeat):
+            t0 = time.perf_counter()
+            out = stamp_craters(body, cat, rng=2, target=target)
+            times.append(time.perf_counter() - t0)
+        runs[nt] = (min(times), out)
+    numba.set_num_threads(threads)
+    updates = runs[1][1].craters["n_vertices"].sum()
+    same = np.array_equal(runs[1][1].radii_m, runs[threads][1].radii_m)
     print(f"M={m} ({grid.n_vertices:,} vertices), R={radius:g} m, {len(cat)} craters "
-          f"(D 20-{d_max:g} m, N_cum ~ D^-2), roughness on: {t_total:.1f} s = "
-          f"{len(cat) / t_total:.0f} craters/s; {out.craters['n_vertices'].sum():.3g} "
-          "vertex updates")
+          f"(D {d_min:g}-{d_max:g} m, N_cum ~ D^-2), roughness on; {updates:.3g} vertex "
+          f"updates; best of {args.repeat}:")
+    for nt, (t, _) in runs.items():
+        print(f"  {nt} thread(s): {t:.2f} s = {len(cat) / t:.0f} craters/s, "
+              f"{updates / t / 1e6:.2f} M vertex-updates/s ({updates / t / nt / 1e6:.2f} M "
+              "per core)")
+    print(f"  {threads} threads / 1 thread: x{runs[1][0] / runs[threads][0]:.2f}; radii "
+          f"{'identical' if same else 'DIFFERENT'}")
     rng = np.random.default_rng(3)
     small = Body.sphere(LatLongGrid(8), radius)
     t0 = time.perf_counter()
