@@ -179,6 +179,41 @@ def _fill_holes(grid, known):
     return out
 
 
+@njit(cache=True)
+def _fill_rim_cells(grid, known, cy, cx, pixel, radius, rim_tab):
+    """:func:`_fill_holes` only for the cells that the rim offsets' bilinear samples read
+    (the same samples as ``rim_offsets``; each filled cell gets the same value as there,
+    the other unknown cells are left as they are): the rim needs a ring of cells, not
+    the whole grid."""
+    g = grid.shape[0]
+    total = 0.0
+    n_known = 0
+    for i in range(g):
+        for j in range(g):
+            if known[i, j]:
+                total += grid[i, j]
+                n_known += 1
+    mean = total / n_known if n_known else 0.0
+    out = grid.copy()
+    done = known.copy()
+    n = rim_tab.shape[0]
+    for k in range(n):
+        theta = -np.pi + 2.0 * np.pi * k / n
+        r = radius * (1.0 + rim_tab[k])
+        fy = cy + r * np.sin(theta) / pixel
+        fx = cx + r * np.cos(theta) / pixel
+        if not (0.0 <= fy <= g - 1 and 0.0 <= fx <= g - 1):
+            continue
+        i0 = min(int(fy), g - 2) if g > 1 else 0
+        j0 = min(int(fx), g - 2) if g > 1 else 0
+        for i in (i0, min(i0 + 1, g - 1)):
+            for j in (j0, min(j0 + 1, g - 1)):
+                if not done[i, j]:
+                    out[i, j] = idw8(grid, known, i, j, _STEP8, mean)
+                    done[i, j] = True
+    return out
+
+
 @njit(cache=True, inline="always")
 def _stretched(stretch, r, ux, uy, uz):
     """Position ``stretch * r * u`` of radius r along unit vector u, and its length."""
@@ -369,7 +404,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
         for gj in range(g):
             if known[gi, gj]:
                 acc[gi, gj] /= num[gi, gj]
-    local = _fill_holes(acc, known)
+    local = _fill_rim_cells(acc, known, float(nh), float(nh), sp, radius, rim_tabs[c])
     if stop_after == 2:
         return True
     # slope: angle between the local surface normal (from the fitted base) and the
