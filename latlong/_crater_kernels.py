@@ -159,9 +159,8 @@ _STEP8 = np.sqrt((DR8 * DR8 + DC8 * DC8).astype(np.float64))
 
 
 @njit(cache=True)
-def _fill_holes(grid, known):
-    """Fill unknown cells by the inverse-distance average of the nearest known cell in
-    each of the 8 directions; cells that see none get the mean of the known cells."""
+def _known_mean(grid, known):
+    """Mean of the known cells of a square grid (0 if none), row by row."""
     g = grid.shape[0]
     total = 0.0
     n_known = 0
@@ -170,7 +169,15 @@ def _fill_holes(grid, known):
             if known[i, j]:
                 total += grid[i, j]
                 n_known += 1
-    mean = total / n_known if n_known else 0.0
+    return total / n_known if n_known else 0.0
+
+
+@njit(cache=True)
+def _fill_holes(grid, known):
+    """Fill unknown cells by the inverse-distance average of the nearest known cell in
+    each of the 8 directions; cells that see none get the mean of the known cells."""
+    g = grid.shape[0]
+    mean = _known_mean(grid, known)
     out = grid.copy()
     for i in range(g):
         for j in range(g):
@@ -186,14 +193,7 @@ def _fill_rim_cells(grid, known, cy, cx, pixel, radius, rim_tab):
     the other unknown cells are left as they are): the rim needs a ring of cells, not
     the whole grid."""
     g = grid.shape[0]
-    total = 0.0
-    n_known = 0
-    for i in range(g):
-        for j in range(g):
-            if known[i, j]:
-                total += grid[i, j]
-                n_known += 1
-    mean = total / n_known if n_known else 0.0
+    mean = _known_mean(grid, known)
     out = grid.copy()
     done = known.copy()
     n = rim_tab.shape[0]
