@@ -114,12 +114,13 @@ def cmd_camera(args) -> int:
             raise CliError(f"--soft-shadow-samples must be in [0, 1024]; got "
                            f"{args.soft_shadow_samples}")
         try:
-            geometry = scene_geometry(args.model, units=args.units, craters=args.catalog)
+            geometry = scene_geometry(args.model, units=args.units)
+            t0 = time.perf_counter()
+            mesh = scene_mesh(geometry)
+            t_bvh = time.perf_counter() - t0
+            geometry = scene_geometry(geometry, craters=args.catalog, mesh=mesh)
         except ValueError as exc:
             raise CliError(str(exc).replace("`model`", "MODEL")) from None
-        t0 = time.perf_counter()
-        mesh = scene_mesh(geometry)
-        t_bvh = time.perf_counter() - t0
     poses = poses if poses is not None else poses_from_args(args, mesh)
     refuse_inside(mesh, poses, args, "camera")
     albedo = None

@@ -40,8 +40,9 @@ def cmd_lidar(args) -> int:
         pulse_rate_hz=args.pulse_rate_hz)
     output_folder(args)
     poses = poses_from_args(args)
-    geo = scene_geometry(args.model, units=args.units, craters=args.catalog)
+    geo = scene_geometry(args.model, units=args.units)
     mesh = RayMesh(geo.vertices, geo.faces)
+    geo = scene_geometry(geo, craters=args.catalog, mesh=mesh)  # a map catalog: one BVH
     poses = poses if poses is not None else poses_from_args(args, mesh)
     refuse_inside(mesh, poses, args, "sensor")
     seed = args.seed if args.seed is not None else int(np.random.default_rng().integers(2**63))

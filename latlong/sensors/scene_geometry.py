@@ -155,7 +155,7 @@ def _mesh_geometry(verts, faces, fields, path) -> SceneGeometry:
     return SceneGeometry(verts, faces, fid, None, None, str(path))
 
 
-def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
+def scene_geometry(model, *, units: str = "m", craters=None, mesh=None) -> SceneGeometry:
     """The mesh and catalogs of ``model`` (module notes).
 
     Parameters
@@ -171,6 +171,8 @@ def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
         catalog (``x_m, y_m``, as ``dem enhance`` writes it for a ``dem mesh`` in the same
         local frame, z up) is placed on the surface straight below each centre (off the
         mesh: no label).
+    mesh : RayMesh, optional
+        The model's ray mesh if already built (places a map catalog; else one is built).
     """
     check_choice("units", units, tuple(_UNITS))
     if isinstance(model, SceneGeometry):
@@ -202,13 +204,13 @@ def scene_geometry(model, *, units: str = "m", craters=None) -> SceneGeometry:
         craters = np.asarray(craters)
         names = craters.dtype.names or ()
         if "centre_x_m" not in names and {"x_m", "y_m"} <= set(names):
-            craters = _placed_on_surface(craters, geo)
+            craters = _placed_on_surface(craters, geo, mesh)
         geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id, craters,
                             geo.boulders, geo.source)
     return geo
 
 
-def _placed_on_surface(catalog, geo: SceneGeometry) -> np.ndarray:
+def _placed_on_surface(catalog, geo: SceneGeometry, mesh=None) -> np.ndarray:
     """A map catalog (``x_m, y_m``: a ``dem`` catalog in the mesh's local frame, z up) with
     ``centre_*`` on the surface straight below the highest point and ``normal_*`` = +z;
     every row kept (ids are rows), ``centre_z_m`` NaN where the vertical misses the mesh."""
@@ -219,7 +221,7 @@ def _placed_on_surface(catalog, geo: SceneGeometry) -> np.ndarray:
     x = np.asarray(catalog["x_m"], dtype=np.float64)
     y = np.asarray(catalog["y_m"], dtype=np.float64)
     top = float(geo.vertices[:, 2].max()) + 1.0
-    mesh = RayMesh(geo.vertices, geo.faces)
+    mesh = RayMesh(geo.vertices, geo.faces) if mesh is None else mesh
     hits = mesh.intersect(np.stack([x, y, np.full(len(x), top)], 1),
                           np.tile([0.0, 0.0, -1.0], (len(x), 1)))
     z = np.where(hits.hit, top - hits.t_m, np.nan)
