@@ -95,7 +95,7 @@ def cmd_camera(args) -> int:
         scene_geometry,
         scene_mesh,
     )
-    from latlong.sensors.labels import surface_tree
+    from latlong.sensors.labels import FittedRims
     from latlong.sensors.output import frame_entry, manifest, write_frame, write_manifest
 
     out = output_folder(args)
@@ -129,9 +129,9 @@ def cmd_camera(args) -> int:
             albedo = ejecta_albedo(geometry, contrast=args.bright_ejecta)
         except (ParameterError, ParameterTypeError) as exc:
             raise CliError(exc.shown_as("--bright-ejecta")) from None
-    tree = None  # the surface's k-d tree, for the rims of the craters seen
+    rims = None  # the rims of the craters seen, fitted to the surface once each
     if geometry.craters is not None and len(geometry.craters):
-        tree = surface_tree(geometry)
+        rims = FittedRims(geometry.craters, geometry)
     if not args.quiet:
         print(f"model {args.model}: {len(mesh.faces)} triangles, BVH built in "
               f"{t_bvh:.1f} s")
@@ -145,8 +145,7 @@ def cmd_camera(args) -> int:
                            ground_truth=geometry, vertex_albedo=albedo)
             files = write_frame(tmp, k, frame, depth_format=args.depth_format,
                                 extra=args.all_ground_truth)
-            entries.append(frame_entry(frame, files, craters=geometry.craters,
-                                       surface=tree))
+            entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
         doc = manifest(camera, entries, model=str(args.model), reflectance=args.reflectance,
                        reflectance_parameters={k: getattr(model, k)
                                                for k in model.__dataclass_fields__},

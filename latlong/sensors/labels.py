@@ -47,8 +47,8 @@ from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kerne
 from .camera import quaternion_to_matrix
 from .scene_geometry import SceneGeometry
 
-__all__ = ["ELLIPSE_DTYPE", "boulder_labels", "crater_labels", "rim_curves", "rim_ellipses",
-           "surface_tree"]
+__all__ = ["ELLIPSE_DTYPE", "FittedRims", "boulder_labels", "crater_labels", "rim_curves",
+           "rim_ellipses", "surface_tree"]
 
 #: Fields of :func:`rim_ellipses` (pixels; the angle of the major axis from +x towards
 #: +y, i.e. clockwise on the picture, degrees in [0, 180)).
@@ -179,6 +179,29 @@ def rim_curves(catalog, surface=None, *, ids=None):
                     break
     return (c + a[:, None] * up, r[:, None] * (e1 + tilt[:, :1] * up),
             r[:, None] * (e2 + tilt[:, 1:] * up))
+
+
+class FittedRims:
+    """:func:`rim_curves` of a catalog fitted to a surface on demand and kept: each
+    crater is fitted once, the first time a frame sees it (a fit depends on the crater
+    alone, so the arrays equal ``rim_curves(catalog, surface, ids=...)`` on those ids)."""
+
+    def __init__(self, catalog, surface):
+        self._catalog = catalog
+        self._tree = surface_tree(surface)
+        self._rims = tuple(np.array(a) for a in rim_curves(catalog))  # the catalog rule
+        self._fitted = np.zeros(len(catalog), dtype=np.bool_)
+
+    def __call__(self, ids):
+        """The rims (centres, axis1, axis2), with the craters ``ids`` fitted."""
+        ids = np.unique(np.asarray(ids, dtype=np.int64))
+        new = ids[~self._fitted[ids]]
+        if len(new):
+            fresh = rim_curves(self._catalog, self._tree, ids=new)
+            for mine, theirs in zip(self._rims, fresh, strict=True):
+                mine[new] = theirs[new]
+            self._fitted[new] = True
+        return self._rims
 
 
 def surface_tree(surface):

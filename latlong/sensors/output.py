@@ -26,7 +26,7 @@ import numpy as np
 from craters._shared import ParameterError, atomic_path
 
 from .camera import Camera
-from .labels import ELLIPSE_DTYPE, rim_curves, rim_ellipses
+from .labels import ELLIPSE_DTYPE, rim_ellipses
 from .render import Frame
 
 __all__ = ["frame_entry", "manifest", "write_frame", "write_manifest"]
@@ -79,11 +79,11 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
     return {"crater_id": None, "boulder_id": None, **files}
 
 
-def frame_entry(frame: Frame, files: dict, *, craters=None, surface=None) -> dict:
+def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
     """The manifest's record of one frame; with the crater catalog, the projected rim
     ellipses (pinhole, pixels) of the craters whose id is in the frame's label image,
-    their rims fitted to ``surface`` (a SceneGeometry or its :func:`~latlong.sensors.
-    labels.surface_tree`; :func:`~latlong.sensors.labels.rim_curves`) when given."""
+    their rims from ``rims`` (a :class:`~latlong.sensors.labels.FittedRims` shared by
+    the frames) when given, else the catalog rule."""
     entry = {"time_s": frame.pose.time_s,
              "position_m": [float(v) for v in frame.pose.position_m],
              "quaternion_wxyz": [float(v) for v in frame.pose.quaternion_wxyz],
@@ -92,9 +92,9 @@ def frame_entry(frame: Frame, files: dict, *, craters=None, surface=None) -> dic
     if craters is not None and frame.crater_id is not None:
         cam = frame.camera
         seen = np.unique(frame.crater_id[frame.crater_id >= 0])
-        rims = None if surface is None else rim_curves(craters, surface, ids=seen)
         ell = rim_ellipses(craters, (cam.fx, cam.fy, cam.cx, cam.cy), frame.pose.position_m,
-                           frame.pose.quaternion_wxyz, ids=seen, rims=rims)
+                           frame.pose.quaternion_wxyz, ids=seen,
+                           rims=None if rims is None else rims(seen))
         entry["rim_ellipses"] = [{k: (int(e[k]) if k == "crater_id" else float(e[k]))
                                   for k in ELLIPSE_DTYPE.names} for e in ell]
     return entry

@@ -184,3 +184,17 @@ def test_map_catalog_on_a_dem_mesh_is_placed_on_the_surface():
     assert placed["normal_z"][1] == 1.0
     pts = [[10.0, 20.0, 5.1], [10.0, 40.0, 5.1], [500.0, 0.0, 5.0]]
     assert crater_labels(pts, placed).tolist() == [1, -1, -1]
+
+
+def test_fitted_rims_equal_rim_curves_on_the_ids_seen(cratered_npz):
+    from latlong import load
+    from latlong.sensors import rim_curves, scene_geometry
+    from latlong.sensors.labels import FittedRims
+
+    geo = scene_geometry(load(cratered_npz))
+    rims = FittedRims(geo.craters, geo)
+    rims([3, 1, 4])
+    got = rims([1, 5, 9, 2])  # 1 from the first call, the others new
+    want = rim_curves(geo.craters, geo, ids=[1, 2, 3, 4, 5, 9])
+    for a, b in zip(got, want, strict=True):
+        np.testing.assert_array_equal(a, b)
