@@ -16,7 +16,14 @@ from latlong import (
     stamp_craters,
     surface_positions,
 )
-from latlong._crater_kernels import _fill_holes, _fit_plane_points, _gather_kernel
+from latlong._crater_kernels import (
+    _cholesky_solve6,
+    _fill_holes,
+    _fit_plane_points,
+    _fit_quadric_points,
+    _gather_kernel,
+    _local_coordinates,
+)
 
 PROFILE_TOL = 0.02  # of the depth
 AZIMUTH_STD_TOL = 0.005  # of the depth
@@ -236,3 +243,73 @@ def test_body_population_counts_the_actual_area():
     area = 4 * np.pi * 100.0**2 * 1.5  # a 2:1:1 prolate spheroid has ~1.48x the area
     mean = area * 0.5 * (5.0**-2 - 20.0**-2)
     assert abs(len(cat) - mean) < 0.05 * mean + 4 * np.sqrt(mean)
+
+
+def test_cholesky_solve6_matches_numpy(rng):
+    for _ in range(20):
+        a = rng.standard_normal((30, 6))
+        ata = a.T @ a
+        b = rng.standard_normal(6)
+        lo, x = ata.copy(), b.copy()
+        assert _cholesky_solve6(lo, x, 0.0)
+        assert np.allclose(x, np.linalg.solve(ata, b), rtol=1e-10, atol=1e-12)
+    singular = np.ones((6, 6))  # rank 1: the second pivot falls to rounding
+    assert not _cholesky_solve6(singular.copy(), np.ones(6), 1e-15 * 6)
+
+
+def test_fit_quadric_points_matches_lstsq(rng):
+    x, y = rng.uniform(-5, 5, 300), rng.uniform(-5, 5, 300)
+    h = 1.5 + 0.3 * x - 0.7 * y + 0.02 * x * x - 0.05 * x * y + 0.01 * y * y \
+        + 0.01 * rng.standard_normal(300)
+    dist = np.hypot(x, y)
+    got = _fit_quadric_points(x, y, h, dist, 300, 4.0)
+    sel = dist <= 4.0
+    a = np.stack([np.ones(sel.sum()), x[sel], y[sel], x[sel] ** 2, x[sel] * y[sel],
+                  y[sel] ** 2], 1)
+    assert np.allclose(got, np.linalg.lstsq(a, h[sel], rcond=None)[0], rtol=1e-8, atol=1e-10)
+    # collinear points: the regularised system still gives the line, nothing wild
+    xs = np.linspace(-3, 3, 40)
+    got = _fit_quadric_points(xs, 0 * xs, 2.0 + xs, np.abs(xs), 40, 4.0)
+    assert np.allclose(got, [2.0, 1.0, 0.0, 0.0, 0.0, 0.0], atol=1e-9)
+
+
+@pytest.mark.parametrize("lat,lon,stretch", [(10.0, 30.0, (1.0, 1.0, 1.0)),
+                                             (-70.0, 359.0, (1.3, 1.0, 0.8)),
+                                             (89.5, 120.0, (1.0, 1.0, 1.0))])
+def test_local_coordinates_match_numpy(rng, lat, lon, stretch):
+    """The kernel's local coordinates (longitudes by rotation along each ring, the
+    azimuth's cos and sin from its components) against the direct numpy formulas."""
+    g = LatLongGrid(60)
+    radii = 1000.0 * (1.0 + 0.01 * rng.standard_normal(g.n_vertices))
+    st = np.array(stretch)
+    la, lo = np.radians(lat), np.radians(lon)
+    cand_n = _gather_kernel(60, g.ring_offsets(), np.pi / 2 - la, lo, 0.4,
+                            np.empty(0, np.int64), True)
+    cand = np.empty(cand_n, np.int64)
+    _gather_kernel(60, g.ring_offsets(), np.pi / 2 - la, lo, 0.4, cand, False)
+    pc = st * 1000.0 * unit(lat, lon)
+    rloc = np.linalg.norm(pc)
+    a = pc / rloc
+    e = np.cross([0.0, 0.0, 1.0], a)
+    e = e / np.linalg.norm(e) if np.linalg.norm(e) > 1e-12 else np.array([1.0, 0.0, 0.0])
+    n = np.cross(a, e)
+    reach, limit = 150.0, 250.0
+    out = [np.empty(cand_n) for _ in range(7)]
+    out[0] = np.empty(cand_n, np.int64)
+    keep, inside = _local_coordinates(cand, 60, np.array(g.ring_offsets()), radii, st, *a,
+                                      *e, *n, rloc, reach, limit, *out)
+    p = st * radii[cand, None] * g.unit_vectors()[cand]
+    pm = np.linalg.norm(p, axis=1)
+    b = p / pm[:, None]
+    d = rloc * np.arctan2(np.linalg.norm(np.cross(b, a), axis=1), b @ a)
+    sel = d <= limit
+    az = np.arctan2(b @ n, b @ e)
+    assert keep == sel.sum() and inside == (d <= reach).sum()
+    idx, pmag, dist, azk, xl, yl, hgt = (o[:keep] for o in out)
+    assert np.array_equal(idx, cand[sel])
+    assert np.allclose(pmag, pm[sel], rtol=1e-14, atol=0)
+    assert np.allclose(dist, d[sel], rtol=0, atol=1e-9)
+    assert np.allclose(azk[dist > 1e-6], az[sel][dist > 1e-6], rtol=0, atol=1e-9)
+    assert np.allclose(xl, d[sel] * np.cos(az[sel]), rtol=0, atol=1e-9)
+    assert np.allclose(yl, d[sel] * np.sin(az[sel]), rtol=0, atol=1e-9)
+    assert np.allclose(hgt, pm[sel] - rloc, rtol=0, atol=1e-9)
