@@ -21,6 +21,10 @@ Grid frame: pixel (row i, column j) has its centre at ``x = j * pixel_size_m``,
    fading linearly to zero at the ejecta edge; the rim radius gets a periodic 1-D
    fractal perturbation (harmonics 2-16, amplitude ~ k^-1.5) of at most
    ``irregularity`` x R.
+
+On more than one numba thread the craters are stamped in parallel waves of craters whose
+boxes cannot overlap (:mod:`craters._wave_kernels`): the same bytes as the serial
+age-ordered stamp, whatever the thread count.
 """
 
 from __future__ import annotations
@@ -334,8 +338,9 @@ def _stamp_in_waves(args, progress: bool) -> None:
             bar.update(int(starts[w1] - starts[w0]))
     finally:
         bar.close()
-    logger.debug("%d craters in %d waves (cells of %d px; %d alone)", n, n_waves, cell,
-                 int((np.diff(starts) == 1).sum()))
+    logger.debug("%d craters in %d waves (cells of %d px; %d waves of one; %d craters of "
+                 ">= %d px alone)", n, n_waves, cell, int((np.diff(starts) == 1).sum()),
+                 int(alone.sum()), PARALLEL_MIN)
 
 
 def as_stamped(prof: StampingProfiles, scale: np.ndarray, diameter_m: np.ndarray) -> dict:
