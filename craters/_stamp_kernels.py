@@ -259,6 +259,37 @@ def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
 
 
 @njit(cache=True)
+def _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion,
+               onset_deg, full_deg, rough, gain, out_scale, out_slope, out_erased, delta,
+               inner_parallel):
+    """Stamp crater ``c`` into ``h`` in place (one step of :func:`_stamp_many_kernel`;
+    ``delta``: scratch of N_RIM). Its rows are written in parallel when it is large and
+    ``inner_parallel`` (False inside a parallel loop: numba does not nest them)."""
+    radius = 0.5 * diam[c]
+    r_px = radius / pixel
+    p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
+    slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
+    out_slope[c] = slope
+    scale = 1.0
+    if slope_erosion:
+        if slope >= full_deg:
+            out_erased[c] = True
+            return
+        scale = _slope_factor(slope, onset_deg, full_deg)
+    _rim_offsets(h, cy[c], cx[c], pixel, radius, rim_tabs[c], p0, gx, gy, delta)
+    octaves = _roughness_octaves(radius, pixel)
+    if inner_parallel:
+        _write_crater(h, cy[c], cx[c], pixel, radius, tabs[c], scale, depths[c], xe,
+                      rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], radius, octaves, gain)
+    else:
+        i_lo, i_hi, j_lo, j_hi = _crater_box(h, cy[c], cx[c], pixel, radius, xe, rim_tabs[c])
+        _write_rows(i_lo, i_hi + 1, j_lo, j_hi, h, cy[c], cx[c], pixel, radius, tabs[c], scale,
+                    depths[c], xe, rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], radius,
+                    octaves, gain)
+    out_scale[c] = scale
+
+
+@njit(cache=True)
 def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe,
                        slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
                        out_erased):
@@ -269,22 +300,10 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe
     written and ``out_erased`` is set; below, the relief is scaled by
     :func:`_slope_factor`, recorded in ``out_scale``), sample the rim offsets, write the
     profile table ``tabs[c]`` (``depths[c]``: its depth, for the roughness amplitude).
+    The serial reference of :func:`craters._wave_kernels._stamp_waves_kernel`.
     """
     delta = np.empty(rim_tabs.shape[1])
     for c in range(cx.shape[0]):
-        radius = 0.5 * diam[c]
-        r_px = radius / pixel
-        p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
-        slope = np.degrees(np.arctan(np.sqrt(gx * gx + gy * gy)))
-        out_slope[c] = slope
-        scale = 1.0
-        if slope_erosion:
-            if slope >= full_deg:
-                out_erased[c] = True
-                continue
-            scale = _slope_factor(slope, onset_deg, full_deg)
-        _rim_offsets(h, cy[c], cx[c], pixel, radius, rim_tabs[c], p0, gx, gy, delta)
-        _write_crater(h, cy[c], cx[c], pixel, radius, tabs[c], scale, depths[c], xe,
-                      rim_tabs[c], delta, p0, gx, gy, rough, seeds[c], radius,
-                      _roughness_octaves(radius, pixel), gain)
-        out_scale[c] = scale
+        _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion,
+                   onset_deg, full_deg, rough, gain, out_scale, out_slope, out_erased, delta,
+                   True)

@@ -21,6 +21,10 @@ Grid frame: pixel (row i, column j) has its centre at ``x = j * pixel_size_m``,
    fading linearly to zero at the ejecta edge; the rim radius gets a periodic 1-D
    fractal perturbation (harmonics 2-16, amplitude ~ k^-1.5) of at most
    ``irregularity`` x R.
+
+On more than one numba thread the craters are stamped in parallel waves of craters whose
+boxes cannot overlap (:mod:`craters._wave_kernels`): the same bytes as the serial
+age-ordered stamp, whatever the thread count.
 """
 
 from __future__ import annotations
@@ -28,10 +32,12 @@ from __future__ import annotations
 import dataclasses
 import logging
 
+import numba
 import numpy as np
 
 from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
-from ._stamp_kernels import N_RIM, _stamp_many_kernel
+from ._stamp_kernels import N_RIM, PARALLEL_MIN, _stamp_many_kernel
+from ._wave_kernels import WAVE_MARGIN, _stamp_waves_kernel, _wave_schedule_kernel
 from .catalog import make_catalog, sort_oldest_first, validate_catalog
 from .diffusion import profile_tables, tau_from_age, tau_from_degradation
 from .morphology import EJECTA_EDGE, fresh_morphometry, morphology_class
@@ -44,6 +50,7 @@ __all__ = ["Crater", "Roughness", "StampingProfiles", "resolve_roughness", "rim_
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
+WAVE_MIN = 64  # fewer craters than this (or one numba thread): the serial kernel
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -254,13 +261,18 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     erased = np.zeros(n, dtype=np.bool_)
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
     gain = 2.0 ** (rough.fractal_dimension - 3.0)
-    step = _BATCH if progress else max(n, 1)
-    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
-        e = min(s + step, n)
-        _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], prof.tables[s:e],
-                           prof.depth_m[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge,
-                           bool(slope_erosion), onset, full, rough_arr, gain, scale[s:e],
-                           slope[s:e], erased[s:e])
+    args = (h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds, ejecta_edge,
+            bool(slope_erosion), onset, full, rough_arr, gain, scale, slope, erased)
+    if numba.get_num_threads() > 1 and n >= WAVE_MIN:
+        _stamp_in_waves(args, progress)
+    else:
+        step = _BATCH if progress else max(n, 1)
+        for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+            e = min(s + step, n)
+            _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], prof.tables[s:e],
+                               prof.depth_m[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge,
+                               bool(slope_erosion), onset, full, rough_arr, gain, scale[s:e],
+                               slope[s:e], erased[s:e])
     if erased.any():
         logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
                     int(erased.sum()), n, full)
@@ -269,6 +281,66 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     cols = {k: cat[k] for k in names}
     cols.update(as_stamped(prof, scale, diam), slope_deg=slope, seed=seeds)
     return h, make_catalog(**cols)[~erased]
+
+
+def _crater_reach_px(pixel_size_m: float, diameter_m, rim_tabs, ejecta_edge: float) -> np.ndarray:
+    """Reach of each crater in pixels: ejecta edge x largest rim radius, plus one pixel
+    (the half-width of the box :func:`stamp_many` reads and writes)."""
+    rho = np.maximum(rim_tabs.max(axis=1, initial=0.0), 0.0)
+    return ejecta_edge * (0.5 * np.asarray(diameter_m)) * (1.0 + rho) / pixel_size_m + 1.0
+
+
+def _wave_schedule(shape, cy, cx, reach) -> tuple[np.ndarray, int, int]:
+    """Parallel waves of craters stamped in the given order on a raster of ``shape``:
+    ``(wave per crater, number of waves, cell size in pixels)``.
+
+    Centres ``cy, cx`` and ``reach`` in pixels (:func:`_crater_reach_px`). A crater's wave
+    is one more than the latest wave of the earlier craters whose boxes (plus a margin)
+    share a cell with its own (:mod:`craters._wave_kernels`), so craters of one wave never
+    overlap and each comes after every earlier crater it overlaps. Cells: the median box
+    (at least 8 pixels, at most 4 M cells in all), so small craters touch a few cells.
+    """
+    ny, nx = int(shape[0]), int(shape[1])
+    n = len(cy)
+    side = 2.0 * np.median(reach) + 2 * WAVE_MARGIN + 1 if n else 8.0
+    cell = int(max(side, 8.0, np.ceil(np.sqrt(ny * nx / 4.0e6))))
+    wave = np.zeros(n, dtype=np.int64)
+    n_waves = _wave_schedule_kernel(ny, nx, np.ascontiguousarray(cy, dtype=np.float64),
+                                    np.ascontiguousarray(cx, dtype=np.float64),
+                                    np.ascontiguousarray(reach, dtype=np.float64), cell, wave)
+    return wave, int(n_waves), cell
+
+
+def _box_pixels(n: int, c: np.ndarray, reach: np.ndarray) -> np.ndarray:
+    """Pixels along one axis of the crater boxes (``_crater_box``), 0 off the raster."""
+    lo = np.maximum(np.floor(c - reach), 0.0)
+    hi = np.minimum(np.ceil(c + reach), n - 1.0)
+    return np.maximum(hi - lo + 1.0, 0.0)
+
+
+def _stamp_in_waves(args, progress: bool) -> None:
+    """Stamp in parallel waves (:mod:`craters._wave_kernels`): the serial kernel's heights
+    and outputs, bit for bit. ``args``: the serial kernel's arguments (full arrays)."""
+    h, pixel, cx, cy, diam, _, _, rim_tabs, _, xe = args[:10]
+    n = len(cx)
+    reach = _crater_reach_px(pixel, diam, rim_tabs, xe)
+    wave, n_waves, cell = _wave_schedule(h.shape, cy, cx, reach)
+    cost = _box_pixels(h.shape[0], cy, reach) * _box_pixels(h.shape[1], cx, reach)
+    alone = cost >= PARALLEL_MIN
+    order = np.lexsort((-cost, wave))  # by wave, the costliest first
+    starts = np.searchsorted(wave[order], np.arange(n_waves + 1))
+    chunks = np.linspace(0, n_waves, min(n_waves, 100 if progress else 1) + 1).astype(int)
+    bar = progress_bar(total=n, enabled=progress, desc="craters")
+    try:
+        for w0, w1 in zip(chunks[:-1], chunks[1:], strict=True):
+            _stamp_waves_kernel(order, starts[w0:w1 + 1], alone, numba.get_num_threads(),
+                                *args)
+            bar.update(int(starts[w1] - starts[w0]))
+    finally:
+        bar.close()
+    logger.debug("%d craters in %d waves (cells of %d px; %d waves of one; %d craters of "
+                 ">= %d px alone)", n, n_waves, cell, int((np.diff(starts) == 1).sum()),
+                 int(alone.sum()), PARALLEL_MIN)
 
 
 def as_stamped(prof: StampingProfiles, scale: np.ndarray, diameter_m: np.ndarray) -> dict:
