@@ -61,7 +61,7 @@ MAX_VARIANTS = 1_000_000
 _SAFE = re.compile(r"[A-Za-z0-9.+-]{1,40}")
 _TMP_SUFFIX = ".batch-tmp"
 _ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
-_CONNECT_S = 20
+_CONNECT_S = 10
 
 
 def parse_seeds(seeds) -> tuple[int, ...]:
@@ -405,41 +405,17 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
     rows = {name: previous[name] for name in names if name in previous}
     ours = set(names)
     others = [r for name, r in previous.items() if name not in ours]
-    folder.mkdir(exist_ok=True)
-    for stale in folder.glob(f".*{_TMP_SUFFIX}"):
-        shutil.rmtree(stale, ignore_errors=True)
     redo = {j.variant.name for j in todo}
-    _write_index(index, columns, [*others, *(rows[n] for n in names
-                                             if n in rows and n not in redo)])
-    if todo:
-        with _client(scheduler, workers) as client, \
-                open(index, "a", newline="", encoding="utf-8") as fh:
-            from distributed import as_completed
-
-            writer = csv.DictWriter(fh, columns)
-            token = uuid.uuid4().hex[:8]
-            futures = {client.submit(_run_variant, task, j.payload, str(folder), j.variant.name,
-                                     key=f"craterform-batch-{token}-{j.variant.name}",
-                                     retries=retries, pure=False): j for j in todo}
-            bar = progress_bar(total=len(todo), enabled=progress, desc="batch")
-            try:
-                for fut in as_completed(futures):
-                    job = futures[fut]
-                    try:
-                        rec = fut.result()
-                    except Exception as exc:  # retries spent, worker lost too often, ...
-                        rec = {"status": "failed", "error": _one_line(exc)}
-                    row = rows[job.variant.name] = _row(job, rec)
-                    writer.writerow(row)
-                    fh.flush()
-                    bar.update()
-                    if on_done is not None:
-                        on_done(row)
-            except BaseException:
-                client.cancel(list(futures))
-                raise
-            finally:
-                bar.close()
+    with contextlib.ExitStack() as stack:
+        client = stack.enter_context(_client(scheduler, workers)) if todo else None
+        folder.mkdir(exist_ok=True)  # only once the cluster is there
+        for stale in folder.glob(f".*{_TMP_SUFFIX}"):
+            shutil.rmtree(stale, ignore_errors=True)
+        _write_index(index, columns, [*others, *(rows[n] for n in names
+                                                 if n in rows and n not in redo)])
+        if todo:
+            _collect(client, todo, task, folder, columns, rows, retries=retries,
+                     progress=progress, on_done=on_done)
     _write_index(index, columns, [*others, *(rows[n] for n in names)])
     mine = [rows[n] for n in names]
     failed = sum(r["status"] != "ok" for r in mine)
@@ -447,6 +423,38 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
                                                      if r["variant"] in redo),
                        skipped=len(jobs) - len(todo), failed=failed,
                        seconds=time.perf_counter() - started)
+
+
+def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str], rows: dict,
+             *, retries: int, progress: bool, on_done) -> None:
+    """Submit one task per job and append each finished variant's row to the index."""
+    from distributed import as_completed
+
+    token = uuid.uuid4().hex[:8]
+    futures = {client.submit(_run_variant, task, j.payload, str(folder), j.variant.name,
+                             key=f"craterform-batch-{token}-{j.variant.name}", retries=retries,
+                             pure=False): j for j in todo}
+    bar = progress_bar(total=len(todo), enabled=progress, desc="batch")
+    try:
+        with open(folder / INDEX, "a", newline="", encoding="utf-8") as fh:
+            writer = csv.DictWriter(fh, columns)
+            for fut in as_completed(futures):
+                job = futures[fut]
+                try:
+                    rec = fut.result()
+                except Exception as exc:  # retries spent, worker lost too often, ...
+                    rec = {"status": "failed", "error": _one_line(exc)}
+                row = rows[job.variant.name] = _row(job, rec)
+                writer.writerow(row)
+                fh.flush()
+                bar.update()
+                if on_done is not None:
+                    on_done(row)
+    except BaseException:
+        client.cancel(list(futures))
+        raise
+    finally:
+        bar.close()
 
 
 # --------------------------------------------------------------------------- in the worker
