@@ -39,14 +39,13 @@ import logging
 import os
 import re
 import shutil
-import sys
-import tempfile
 import time
 import uuid
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from .batch_tasks import TMP_SUFFIX, one_line, run_variant, sha256_file
 from .files import atomic_path, check_parent_folder
 from .progress import progress_bar
 from .validation import ParameterError, ParameterTypeError
@@ -59,9 +58,9 @@ INDEX = "index.csv"
 #: Most variants one batch takes.
 MAX_VARIANTS = 1_000_000
 _SAFE = re.compile(r"[A-Za-z0-9.+-]{1,40}")
-_TMP_SUFFIX = ".batch-tmp"
 _ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
 _CONNECT_S = 10
+_WORKERS_S = 60
 
 
 def parse_seeds(seeds) -> tuple[int, ...]:
@@ -235,15 +234,6 @@ class BatchResult:
         return 3600.0 * self.done / self.seconds if self.done and self.seconds > 0 else 0.0
 
 
-def sha256_file(path) -> str:
-    """The sha256 of a file's bytes (hex)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
-
-
 def _columns(keys: Sequence[str]) -> list[str]:
     return ["variant", "seed", *keys, "files", "sha256", "seconds", "peak_mb", "status",
             "error", "settings_sha256"]
@@ -316,20 +306,20 @@ def _check_address(scheduler, workers) -> None:
 def _client(scheduler: str | None, workers: int | None):
     """A dask client: of a new LocalCluster on 127.0.0.1, or of the scheduler at an
     address (which must have workers)."""
-    from distributed import Client, LocalCluster
-
     quiet = logging.getLogger("distributed")
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # the engine reports what happened to each variant
     try:
-        with _connected(Client, LocalCluster, scheduler, workers) as client:
+        with _connected(scheduler, workers) as client:
             yield client
     finally:
         quiet.setLevel(level)
 
 
 @contextlib.contextmanager
-def _connected(Client, LocalCluster, scheduler: str | None, workers: int | None):  # noqa: N803
+def _connected(scheduler: str | None, workers: int | None):
+    from distributed import Client, LocalCluster
+
     if scheduler is None:
         n = workers or os.cpu_count() or 1
         with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
@@ -347,18 +337,11 @@ def _connected(Client, LocalCluster, scheduler: str | None, workers: int | None)
                              f"({type(exc).__name__})") from None
     with client:
         try:
-            client.wait_for_workers(1, timeout=_CONNECT_S)
+            client.wait_for_workers(1, timeout=_WORKERS_S)
         except (OSError, TimeoutError):
             raise ParameterError("scheduler", f"{scheduler} has no workers (waited "
-                                 f"{_CONNECT_S} s)") from None
+                                 f"{_WORKERS_S} s)") from None
         yield client
-
-
-def _one_line(exc: BaseException) -> str:
-    text = str(exc) or type(exc).__name__
-    if not isinstance(exc, ValueError | TypeError):
-        text = f"{type(exc).__name__}: {text}"
-    return " ".join(text.split())
 
 
 def _row(job: Job, rec: dict) -> dict:
@@ -409,7 +392,7 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
     with contextlib.ExitStack() as stack:
         client = stack.enter_context(_client(scheduler, workers)) if todo else None
         folder.mkdir(exist_ok=True)  # only once the cluster is there
-        for stale in folder.glob(f".*{_TMP_SUFFIX}"):
+        for stale in folder.glob(f".*{TMP_SUFFIX}"):
             shutil.rmtree(stale, ignore_errors=True)
         _write_index(index, columns, [*others, *(rows[n] for n in names
                                                  if n in rows and n not in redo)])
@@ -431,7 +414,7 @@ def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str]
     from distributed import as_completed
 
     token = uuid.uuid4().hex[:8]
-    futures = {client.submit(_run_variant, task, j.payload, str(folder), j.variant.name,
+    futures = {client.submit(run_variant, task, j.payload, str(folder), j.variant.name,
                              key=f"craterform-batch-{token}-{j.variant.name}", retries=retries,
                              pure=False): j for j in todo}
     bar = progress_bar(total=len(todo), enabled=progress, desc="batch")
@@ -443,7 +426,7 @@ def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str]
                 try:
                     rec = fut.result()
                 except Exception as exc:  # retries spent, worker lost too often, ...
-                    rec = {"status": "failed", "error": _one_line(exc)}
+                    rec = {"status": "failed", "error": one_line(exc)}
                 row = rows[job.variant.name] = _row(job, rec)
                 writer.writerow(row)
                 fh.flush()
@@ -455,57 +438,3 @@ def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str]
         raise
     finally:
         bar.close()
-
-
-# --------------------------------------------------------------------------- in the worker
-def _run_variant(task, payload, folder: str, name: str) -> dict:
-    """Run one variant in a worker: the task writes into a temporary folder inside the
-    batch folder, then each entry is hashed and moved into place."""
-    start = time.perf_counter()
-    _reset_peak()
-    dest = Path(folder)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=_TMP_SUFFIX, dir=dest))
-    try:
-        try:
-            task(payload, tmp, name)
-        except (ValueError, TypeError) as exc:  # a bad variant: the same on any worker
-            return {"status": "failed", "error": _one_line(exc),
-                    "seconds": time.perf_counter() - start, "peak_mb": _peak_mb()}
-        files = sorted(p.relative_to(tmp).as_posix() for p in tmp.rglob("*") if p.is_file())
-        shas = [sha256_file(tmp / f) for f in files]
-        for entry in sorted(os.listdir(tmp)):
-            _move(tmp / entry, dest / entry, tmp)
-        return {"status": "ok", "files": files, "sha256": shas,
-                "seconds": time.perf_counter() - start, "peak_mb": _peak_mb()}
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
-
-
-def _move(src: Path, dst: Path, tmp: Path) -> None:
-    """Move a file or folder into place (a folder already there is swapped out first)."""
-    if src.is_dir() and dst.is_dir() and not dst.is_symlink():
-        os.replace(dst, tmp / f".old-{uuid.uuid4().hex}")
-    os.replace(src, dst)
-
-
-def _reset_peak() -> None:
-    """Reset this process's peak resident memory (Linux >= 4.0: /proc/self/clear_refs)."""
-    with contextlib.suppress(OSError):
-        with open("/proc/self/clear_refs", "w") as fh:
-            fh.write("5")
-
-
-def _peak_mb() -> float | None:
-    """This process's peak resident memory since :func:`_reset_peak`, MB (elsewhere than
-    Linux: since the process started)."""
-    with contextlib.suppress(OSError, ValueError):
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) / 1024.0
-    with contextlib.suppress(ImportError):
-        import resource
-
-        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
-        return peak / (2**20 if sys.platform == "darwin" else 1024.0)
-    return None
