@@ -306,6 +306,8 @@ def _check_address(scheduler, workers) -> None:
 def _client(scheduler: str | None, workers: int | None):
     """A dask client: of a new LocalCluster on 127.0.0.1, or of the scheduler at an
     address (which must have workers)."""
+    import distributed  # noqa: F401 - its import sets the level of its loggers
+
     quiet = logging.getLogger("distributed")
     level = quiet.level
     quiet.setLevel(logging.ERROR)  # the engine reports what happened to each variant
