@@ -19,6 +19,7 @@ import pytest
 import dem
 import latlong
 from craters._shared.batch import parse_seeds, read_index, sha256_file, variants
+from craters._shared.batch_tasks import run_variant
 from dem.cli import main as dem_main
 from latlong.cli import main as latlong_main
 
@@ -49,8 +50,7 @@ def scheduler():
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None, silence_logs=logging.ERROR,
-                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"},
-                      env={"NUMBA_NUM_THREADS": "1"}) as cluster:
+                      scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster:
         yield cluster.scheduler_address
 
 
@@ -114,6 +114,44 @@ def test_index_and_single_builds(tmp_path, scene, scheduler):
                                  "--catalog", str(single / f"{name}_craters.csv")]) == 0
         files = [f"{name}.npz", f"{name}_craters.csv"]
         assert _shas(single, files) == _shas(out, files)
+
+
+def test_default_local_cluster(tmp_path, scene):
+    """Without a scheduler the batch starts (and stops) its own cluster on 127.0.0.1."""
+    out = tmp_path / "batch"
+    result = latlong.batch(scene, "4", out=out, workers=1)
+    assert (result.done, result.failed) == (1, 0)
+    single = tmp_path / "single"
+    single.mkdir()
+    files = ["seed0004.npz", "seed0004_craters.csv"]
+    assert latlong_main(["build", "--config", str(scene), "--seed", "4", "-q", "-o",
+                         str(single / files[0]), "--catalog", str(single / files[1])]) == 0
+    assert _shas(single, files) == _shas(out, files)
+
+
+def _probe_task(payload, folder, name):
+    import numba
+
+    (folder / f"{name}.txt").write_text(f"{payload} {numba.get_num_threads()}")
+    if payload == "bad":
+        raise ValueError("`x` must be good")
+
+
+def test_a_variant_in_the_worker(tmp_path):
+    """The task writes under a temporary folder, its files are hashed and renamed into
+    place; ``threads`` limits numba in the task; a bad variant leaves nothing behind."""
+    import numba
+
+    try:
+        rec = run_variant(_probe_task, "fine", str(tmp_path), "v1", threads=1)
+        assert rec["status"] == "ok" and rec["files"] == ["v1.txt"]
+        assert (tmp_path / "v1.txt").read_text() == "fine 1"
+        assert rec["sha256"] == [sha256_file(tmp_path / "v1.txt")] and rec["peak_mb"] > 1
+        rec = run_variant(_probe_task, "bad", str(tmp_path), "v2")
+        assert rec["status"] == "failed" and rec["error"] == "`x` must be good"
+        assert sorted(p.name for p in tmp_path.iterdir()) == ["v1.txt"]
+    finally:
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
 
 
 def test_named_outputs_keep_their_bytes(tmp_path, scheduler):

@@ -23,8 +23,10 @@ loses nothing finished, and the file is rewritten in variant order at the end.
 files are all there with the recorded sha256, and redoes the others.
 
 Without a scheduler address the batch runs on a :class:`distributed.LocalCluster` on
-127.0.0.1: one single-threaded worker process per core (``NUMBA_NUM_THREADS=1``, so
-variants do not oversubscribe the cores), no dashboard. The workers must see the batch
+127.0.0.1: one single-threaded worker process per core, each task limited to one numba
+thread (``numba.set_num_threads``), so variants do not oversubscribe the cores; no
+dashboard. Workers of an existing cluster keep their own numba setting (start them
+with ``NUMBA_NUM_THREADS=1`` and ``--nthreads 1``). The workers must see the batch
 folder and the scene's input files at the same paths as the caller.
 """
 
@@ -326,7 +328,6 @@ def _connected(scheduler: str | None, workers: int | None):
         n = workers or os.cpu_count() or 1
         with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
                           dashboard_address=None, silence_logs=logging.ERROR,
-                          env={"NUMBA_NUM_THREADS": "1"},
                           # no dashboard; the scheduler's HTTP endpoints on a free port
                           scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
                 Client(cluster) as client:
@@ -400,7 +401,8 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
                                                  if n in rows and n not in redo)])
         if todo:
             _collect(client, todo, task, folder, columns, rows, retries=retries,
-                     progress=progress, on_done=on_done)
+                     progress=progress, on_done=on_done,
+                     threads=1 if scheduler is None else None)
     _write_index(index, columns, [*others, *(rows[n] for n in names)])
     mine = [rows[n] for n in names]
     failed = sum(r["status"] != "ok" for r in mine)
@@ -411,12 +413,13 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
 
 
 def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str], rows: dict,
-             *, retries: int, progress: bool, on_done) -> None:
-    """Submit one task per job and append each finished variant's row to the index."""
+             *, retries: int, progress: bool, on_done, threads: int | None) -> None:
+    """Submit one task per job (``threads`` numba threads each; None: the workers' own
+    setting) and append each finished variant's row to the index."""
     from distributed import as_completed
 
     token = uuid.uuid4().hex[:8]
-    futures = {client.submit(run_variant, task, j.payload, str(folder), j.variant.name,
+    futures = {client.submit(run_variant, task, j.payload, str(folder), j.variant.name, threads,
                              key=f"craterform-batch-{token}-{j.variant.name}", retries=retries,
                              pure=False): j for j in todo}
     bar = progress_bar(total=len(todo), enabled=progress, desc="batch")

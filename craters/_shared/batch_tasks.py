@@ -37,10 +37,13 @@ def one_line(exc: BaseException) -> str:
     return " ".join(text.split())
 
 
-def run_variant(task, payload, folder: str, name: str) -> dict:
+def run_variant(task, payload, folder: str, name: str, threads: int | None = None) -> dict:
     """Run one variant in a worker: the task writes into a temporary folder inside the
-    batch folder, then each entry is hashed and moved into place."""
+    batch folder, then each entry is hashed and moved into place. ``threads``: numba
+    threads of the task (None: the worker's own setting)."""
     start = time.perf_counter()
+    if threads is not None:
+        _limit_numba_threads(threads)
     _reset_peak()
     dest = Path(folder)
     tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=TMP_SUFFIX, dir=dest))
@@ -65,6 +68,17 @@ def _move(src: Path, dst: Path, tmp: Path) -> None:
     if src.is_dir() and dst.is_dir() and not dst.is_symlink():
         os.replace(dst, tmp / f".old-{uuid.uuid4().hex}")
     os.replace(src, dst)
+
+
+def _limit_numba_threads(threads: int) -> None:
+    """At most ``threads`` numba threads in this (the task's) thread. ``set_num_threads``
+    and not ``NUMBA_NUM_THREADS``: a spawned worker whose parent's main module imports
+    numba (``python -m latlong``) has numba's pool sized before dask sets the worker's
+    environment, and a later compilation would then fail on the mismatch."""
+    with contextlib.suppress(ImportError):
+        import numba
+
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
 def _reset_peak() -> None:
