@@ -312,7 +312,9 @@ def _client(scheduler: str | None, workers: int | None):
 
     quiet = logging.getLogger("distributed")
     level = quiet.level
-    quiet.setLevel(logging.ERROR)  # the engine reports what happened to each variant
+    # the index says what happened to each variant; dask's own messages (a heartbeat
+    # cut short when the local cluster closes, a lost worker) would only be noise
+    quiet.setLevel(logging.CRITICAL)
     try:
         with _connected(scheduler, workers) as client:
             yield client
@@ -327,7 +329,7 @@ def _connected(scheduler: str | None, workers: int | None):
     if scheduler is None:
         n = workers or os.cpu_count() or 1
         with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                          dashboard_address=None, silence_logs=logging.ERROR,
+                          dashboard_address=None, silence_logs=logging.CRITICAL,
                           # no dashboard; the scheduler's HTTP endpoints on a free port
                           scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
                 Client(cluster) as client:
