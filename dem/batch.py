@@ -15,7 +15,6 @@ workers from where the caller's working folder puts it.
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 from collections.abc import Callable, Mapping
 from pathlib import Path
@@ -25,9 +24,15 @@ from craters._shared import (
     ParameterTypeError,
     load_toml,
     package_version,
-    parameter_of,
 )
-from craters._shared.batch import BatchResult, Job, run_batch, value_text, variants
+from craters._shared.batch import (
+    BatchResult,
+    Job,
+    combinations,
+    run_batch,
+    variants,
+    vary_error,
+)
 
 from .config import EnhanceConfig
 from .enhance import enhance
@@ -70,13 +75,10 @@ def batch(config, seeds, *, out, vary: Mapping | None = None, scheduler: str | N
         Counts (``done``, ``skipped``, ``failed``), wall time, the index rows.
     """
     settings = _config_keys(config)
-    keys = _vary_keys(vary)
     seeds_of = variants(seeds, vary)  # checks seeds and vary
-    configs = {}
-    combos = itertools.product(*(vary[k] for k in keys)) if keys else [()]
-    for combo in combos:
-        values = tuple(zip(keys, combo, strict=True))
-        configs[repr(values)] = _combo_config(settings, values, seeds_of[0].seed)
+    allowed = [k for k in EnhanceConfig.keys() if k != "seed"]
+    configs = {repr(values): _combo_config(settings, values, seeds_of[0].seed)
+               for values in combinations(vary, allowed)}
     jobs = []
     for v in seeds_of:
         cfg = dataclasses.replace(configs[repr(v.values)], seed=v.seed)
@@ -100,23 +102,6 @@ def _config_keys(config) -> dict:
     return {k: v for k, v in config.items() if k not in _RUN_KEYS}
 
 
-def _vary_keys(vary) -> list[str]:
-    if vary is None:
-        return []
-    if not isinstance(vary, Mapping):
-        raise ParameterTypeError("vary", f"must map keys to lists of values; got "
-                                 f"{type(vary).__name__}")
-    allowed = [k for k in EnhanceConfig.keys() if k != "seed"]
-    for key in vary:
-        if key == "seed":
-            raise ParameterError("vary", "cannot vary `seed`: give the seeds as {}",
-                                 see=("seeds",))
-        if key not in allowed:
-            raise ParameterError("vary", f"{key!r} is not a key of the stack's description; "
-                                 f"allowed: {', '.join(allowed)}")
-    return list(vary)
-
-
 def _combo_config(settings: dict, values: tuple, seed: int) -> EnhanceConfig:
     """The description of one combination of varied values (its input file must exist);
     a bad value is an error of ``vary`` naming it."""
@@ -130,9 +115,7 @@ def _combo_config(settings: dict, values: tuple, seed: int) -> EnhanceConfig:
     except (TypeError, ValueError) as exc:
         if not values:
             raise
-        bad = [(k, v) for k, v in values if k == parameter_of(exc)] or values
-        text = ", ".join(f"{k}={value_text(v)}" for k, v in bad)
-        raise ParameterError("vary", f"{text}: {exc}") from None
+        raise vary_error(exc, values) from None
 
 
 def _enhance_variant(payload, folder: Path, name: str) -> None:

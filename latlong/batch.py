@@ -16,13 +16,19 @@ thread count).
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import json
 from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from craters._shared import ParameterError, ParameterTypeError, load_toml, package_version
-from craters._shared.batch import BatchResult, Job, run_batch, value_text, variants
+from craters._shared.batch import (
+    BatchResult,
+    Job,
+    combinations,
+    run_batch,
+    variants,
+    vary_error,
+)
 
 from .build import build
 from .outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
@@ -76,15 +82,11 @@ def batch(scene, seeds, *, out, vary: Mapping | None = None, scheduler: str | No
         Counts (``done``, ``skipped``, ``failed``), wall time, the index rows.
     """
     settings, outputs = _scene_parts(scene, vary)
-    keys = _vary_keys(vary)
     seeds_of = variants(seeds, vary)  # checks seeds and vary
     scenes = {}
-    combos = itertools.product(*(vary[k] for k in keys)) if keys else [()]
-    for combo in combos:
-        values = tuple(zip(keys, combo, strict=True))
+    for values in combinations(vary, [k for k in SETTINGS if k != "seed"]):
         s = _combo_scene(scene, settings, values, seeds_of[0].seed)
-        named = _outputs_for(s, outputs, "v")
-        named.check(s, paths=False)
+        _outputs_for(s, outputs, "v").check(s, paths=False)
         scenes[repr(values)] = s
     jobs = []
     for v in seeds_of:
@@ -119,22 +121,6 @@ def _scene_parts(scene, vary) -> tuple[dict | None, Outputs]:
     return settings, outputs
 
 
-def _vary_keys(vary) -> list[str]:
-    if vary is None:
-        return []
-    if not isinstance(vary, Mapping):
-        raise ParameterTypeError("vary", f"must map settings to lists of values; got "
-                                 f"{type(vary).__name__}")
-    for key in vary:
-        if key == "seed":
-            raise ParameterError("vary", "cannot vary `seed`: give the seeds as {}",
-                                 see=("seeds",))
-        if key not in SETTINGS:
-            raise ParameterError("vary", f"{key!r} is not a scene setting; allowed: "
-                                 f"{', '.join(k for k in SETTINGS if k != 'seed')}")
-    return list(vary)
-
-
 def _combo_scene(scene, settings: dict | None, values: tuple, seed: int) -> Scene:
     """The scene of one combination of varied values; a bad value is an error of ``vary``
     naming it."""
@@ -145,9 +131,7 @@ def _combo_scene(scene, settings: dict | None, values: tuple, seed: int) -> Scen
     except (ParameterError, ParameterTypeError) as exc:
         if not values:
             raise
-        bad = [(k, v) for k, v in values if k == exc.name] or values
-        text = ", ".join(f"{k}={value_text(v)}" for k, v in bad)
-        raise ParameterError("vary", f"{text}: {exc}") from None
+        raise vary_error(exc, values) from None
 
 
 def _outputs_for(scene: Scene, outputs: Outputs, name: str) -> Outputs:

@@ -6,12 +6,11 @@ Each variant is one task. A task is pure: it writes all its files into a tempora
 folder inside the batch folder (under their final names, so files that name themselves
 are the bytes a single build writes), hashes them and only then renames them into place;
 the index lists a variant only once all its files are in place, and running it again
-gives the same bytes. Tasks are
-submitted with ``retries`` (an exception that is not a bad input, e.g. a full disk, is
-tried again elsewhere); a worker that dies has its tasks rescheduled by the scheduler
-(``distributed.scheduler.allowed-failures``). A task that fails with a ``ValueError`` or
-``TypeError`` (a variant that passed the checks but cannot be built) is recorded as
-failed at once and never stops the others.
+gives the same bytes. Tasks are submitted with ``retries`` (an exception that is not a
+bad input, e.g. a full disk, is tried again elsewhere); a worker that dies has its tasks
+rescheduled by the scheduler (``distributed.scheduler.allowed-failures``). A task that
+fails with a ``ValueError`` or ``TypeError`` (a variant that passed the checks but cannot
+be built) is recorded as failed at once and never stops the others.
 
 The folder's ``index.csv`` has one row per variant: name, seed, the varied values, the
 files (``;``-separated, relative to the folder), the sha256 of each, the task's seconds
@@ -43,17 +42,17 @@ import re
 import shutil
 import time
 import uuid
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
 from .batch_tasks import TMP_SUFFIX, one_line, run_variant, sha256_file
 from .files import atomic_path, check_parent_folder
 from .progress import progress_bar
-from .validation import ParameterError, ParameterTypeError
+from .validation import ParameterError, ParameterTypeError, parameter_of
 
-__all__ = ["INDEX", "BatchResult", "Job", "Variant", "parse_seeds", "read_index", "run_batch",
-           "sha256_file", "value_text", "variants"]
+__all__ = ["INDEX", "BatchResult", "Job", "Variant", "combinations", "parse_seeds",
+           "read_index", "run_batch", "sha256_file", "value_text", "variants", "vary_error"]
 
 #: The index file of a batch folder.
 INDEX = "index.csv"
@@ -99,20 +98,22 @@ def parse_seeds(seeds) -> tuple[int, ...]:
             out.extend(range(lo, hi + 1))
     else:
         try:
-            out = [int(s) for s in seeds if not isinstance(s, bool) and int(s) == s]
-            if len(out) != len(list(seeds)):
-                raise TypeError
-        except (TypeError, ValueError):
+            given = list(seeds)
+            out = [int(s) for s in given if not isinstance(s, bool) and int(s) == s]
+        except (TypeError, ValueError, OverflowError):
+            given = None
+        if given is None or len(out) != len(given):
             raise ParameterTypeError("seeds", f"must be integers or text like '1-1000'; got "
-                                     f"{seeds!r}") from None
+                                     f"{seeds!r}")
     if not out:
         raise ParameterError("seeds", "must name at least one seed")
-    bad = [s for s in out if not 0 <= s < 2**63]
-    if bad:
-        raise ParameterError("seeds", f"must be in [0, 2**63); got {bad[0]}")
-    if len(set(out)) != len(out):
-        twice = next(s for s in out if out.count(s) > 1)
-        raise ParameterError("seeds", f"names seed {twice} twice")
+    seen = set()
+    for s in out:
+        if not 0 <= s < 2**63:
+            raise ParameterError("seeds", f"must be in [0, 2**63); got {s}")
+        if s in seen:
+            raise ParameterError("seeds", f"names seed {s} twice")
+        seen.add(s)
     return tuple(out)
 
 
@@ -146,6 +147,52 @@ class Variant:
     """(setting, value) of each varied setting, in the order given."""
 
 
+def _checked(vary, allowed: Collection[str] | None) -> Mapping:
+    """``vary`` (setting -> non-empty list of distinct values; settings of ``allowed``,
+    never ``seed``), or {} for None."""
+    if vary is None:
+        return {}
+    if not isinstance(vary, Mapping):
+        raise ParameterTypeError("vary", f"must map settings to lists of values; got "
+                                 f"{type(vary).__name__}")
+    for key, values in vary.items():
+        if key == "seed":
+            raise ParameterError("vary", "cannot vary `seed`: give the seeds as {}",
+                                 see=("seeds",))
+        if allowed is not None and key not in allowed:
+            raise ParameterError("vary", f"{key!r} is not a setting of this batch; allowed: "
+                                 f"{', '.join(allowed)}")
+        if isinstance(values, str) or not isinstance(values, Sequence) or not values:
+            raise ParameterError("vary", f"{key}: must be a non-empty list of values; got "
+                                 f"{values!r}")
+        for i, v in enumerate(values):
+            if any(_same(v, w) for w in values[:i]):
+                raise ParameterError("vary", f"{key}: value {value_text(v)!r} is given twice")
+    return vary
+
+
+def combinations(vary: Mapping | None, allowed: Collection[str] | None = None) -> list[tuple]:
+    """Every combination of the values of ``vary`` (setting -> values) as (setting, value)
+    pairs, in the order of :func:`variants`; ``[()]`` without ``vary``. Settings must be
+    in ``allowed`` (None: any) and never ``seed``.
+
+    Examples
+    --------
+    >>> combinations({"layers": [9, 11], "size": [129]})
+    [(('layers', 9), ('size', 129)), (('layers', 11), ('size', 129))]
+    """
+    vary = _checked(vary, allowed)
+    keys = list(vary)
+    return [tuple(zip(keys, c, strict=True)) for c in itertools.product(*vary.values())]
+
+
+def vary_error(exc: Exception, values: tuple) -> ParameterError:
+    """An error of a combination of varied values as an error of ``vary`` naming the value
+    it is about (or the whole combination)."""
+    bad = [(k, v) for k, v in values if k == parameter_of(exc)] or values
+    return ParameterError("vary", ", ".join(f"{k}={value_text(v)}" for k, v in bad) + f": {exc}")
+
+
 def variants(seeds, vary: Mapping[str, Sequence] | None = None) -> list[Variant]:
     """Every (seed, varied values) of a batch, seeds first: the cartesian product of the
     values of the settings in ``vary`` (setting -> values), for each seed. A value whose
@@ -158,34 +205,25 @@ def variants(seeds, vary: Mapping[str, Sequence] | None = None) -> list[Variant]
 'seed0002_radius-m=2000']
     """
     seeds = parse_seeds(seeds)
-    vary = {} if vary is None else vary
-    if not isinstance(vary, Mapping):
-        raise ParameterTypeError("vary", f"must map settings to lists of values; got "
-                                 f"{type(vary).__name__}")
-    labels = {}
-    for key, values in vary.items():
-        if isinstance(values, str) or not isinstance(values, Sequence) or not values:
-            raise ParameterError("vary", f"{key}: must be a non-empty list of values; got "
-                                 f"{values!r}")
-        for i, v in enumerate(values):
-            if any(_same(v, w) for w in values[:i]):
-                raise ParameterError("vary", f"{key}: value {value_text(v)!r} is given twice")
-        texts = [value_text(v) for v in values]
-        labels[key] = [t if _SAFE.fullmatch(t) else f"v{i + 1}" for i, t in enumerate(texts)]
+    vary = _checked(vary, None)
     count = len(seeds)
     for values in vary.values():
         count *= len(values)
     if count > MAX_VARIANTS:
         raise ParameterError("vary", f"makes {count} variants; at most {MAX_VARIANTS}")
+    labels = {}
+    for key, values in vary.items():
+        texts = [value_text(v) for v in values]
+        labels[key] = [t if _SAFE.fullmatch(t) else f"v{i + 1}" for i, t in enumerate(texts)]
     width = max(4, len(str(max(seeds))))
-    out = []
     keys = list(vary)
+    out = []
     for seed in seeds:
         for picks in itertools.product(*(range(len(vary[k])) for k in keys)):
+            pairs = tuple(zip(keys, picks, strict=True))
             name = f"seed{seed:0{width}d}" + "".join(
-                f"_{k.replace('_', '-')}={labels[k][i]}" for k, i in zip(keys, picks, strict=True))
-            out.append(Variant(name, seed, tuple((k, vary[k][i])
-                                                 for k, i in zip(keys, picks, strict=True))))
+                f"_{k.replace('_', '-')}={labels[k][i]}" for k, i in pairs)
+            out.append(Variant(name, seed, tuple((k, vary[k][i]) for k, i in pairs)))
     return out
 
 
