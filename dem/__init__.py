@@ -7,6 +7,7 @@
       -> detect_craters, crater_density, resolved_diameter_m (craterdensity)
       -> expand (expansion: RMD, 2x per level)                              -> Dem
       -> enhance (EnhanceConfig in config, the plan in planning)            -> Stack
+         batch (seeds x varied keys on dask.distributed)          -> stack folders
     Stack (stack: consistent layers + catalogs; write, read_stack)
       -> to_mesh (mesh: PLY/VTP) | slope, power_spectrum (terrain), fractal_fit (fractal)
 
@@ -25,6 +26,7 @@ craters and boulders per layer (:func:`enhance`) and their stitched meshes
 import logging
 
 from .analysis import band_power, laplacian
+from .batch import batch
 from .boulders import boulder_population, stamp_boulders
 from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
@@ -67,6 +69,7 @@ __all__ = [
     "SpectralFit",
     "Stack",
     "band_power",
+    "batch",
     "boulder_population",
     "crater_density",
     "detect_craters",

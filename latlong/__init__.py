@@ -14,6 +14,7 @@ packing, LCSN craters, Gabor noise, marching cubes).
                        -> export (PLY/OBJ/STL/VTP/VTK) | gltf + strips (patches, LODs)
                           | slopes, preview
     scene (Scene: settings, presets) -> build(scene) -> Body   (writes nothing)
+                                     -> outputs (write_outputs) | batch (seeds x settings, dask)
     implicit/ (packing, metaballs, LCSN layers, Gabor, marching cubes) -> to_body
     sensors/ (ray engine over Embree, cameras, photometry, render: frames + ground truth)
     cli/ (the `latlong` command; the library never imports it)
@@ -24,6 +25,7 @@ Imports point down that picture and into ``craters`` (never ``dem``). ``latlong 
 
 import logging
 
+from .batch import batch
 from .body import EXPORT_SUFFIXES, Body, load
 from .boulders import (
     BoulderLayer,
@@ -115,6 +117,7 @@ __all__ = [
     "ShapeModel",
     "apply_faults",
     "area_mean",
+    "batch",
     "body_population",
     "boulder",
     "boulder_meshes",

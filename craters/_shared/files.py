@@ -9,7 +9,8 @@ import tomllib
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-__all__ = ["atomic_path", "check_output_path", "check_parent_folder", "load_toml"]
+__all__ = ["atomic_path", "check_output_path", "check_parent_folder", "check_suffix",
+           "load_toml"]
 
 
 def check_parent_folder(path) -> None:
@@ -22,18 +23,24 @@ def check_parent_folder(path) -> None:
         raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} is not writable")
 
 
+def check_suffix(path, suffixes: Sequence[str]) -> Path:
+    """The output's suffix is one of ``suffixes`` (one-line ValueError)."""
+    path = Path(path)
+    if path.suffix.lower() not in suffixes:
+        raise ValueError(
+            f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}; "
+            f"allowed: {' '.join(suffixes)}"
+        )
+    return path
+
+
 def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = None) -> Path:
     """Validate an output path before any work is done.
 
     Raises ValueError for an unknown suffix, an existing file without ``force``, or a
     folder that does not exist or is not writable.
     """
-    path = Path(path)
-    if suffixes is not None and path.suffix.lower() not in suffixes:
-        raise ValueError(
-            f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}; "
-            f"allowed: {' '.join(suffixes)}"
-        )
+    path = Path(path) if suffixes is None else check_suffix(path, suffixes)
     check_parent_folder(path)
     if path.is_dir():
         raise ValueError(f"output {str(path)!r} is a folder")

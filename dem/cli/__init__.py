@@ -1,5 +1,6 @@
 """The ``dem`` command line: ``dem info``, ``fill``, ``expand`` (:mod:`.raster`),
-``enhance``, ``mesh`` (:mod:`.stack`), ``slopes`` and ``spectrum`` (:mod:`.analysis`).
+``enhance``, ``mesh`` (:mod:`.stack`), ``batch`` (:mod:`.batch`), ``slopes`` and ``spectrum``
+(:mod:`.analysis`).
 
 Every command takes its input (a DEM, or for ``mesh``, ``slopes`` and ``spectrum`` also
 a stack manifest) as its positional argument, or as the key ``input`` of a TOML file
@@ -19,7 +20,7 @@ import sys
 from craters._shared import package_version
 from craters._shared.cli import OneLineParser, run_cli
 
-from . import analysis, raster, stack
+from . import analysis, batch, raster, stack
 
 __all__ = ["build_parser", "main"]
 
@@ -30,7 +31,7 @@ def build_parser() -> OneLineParser:
                                                    "layer stacks with craters, meshes, info.")
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
-    for group in (raster, stack, analysis):
+    for group in (raster, stack, batch, analysis):
         group.register(sub)
     return parser
 

@@ -1,7 +1,7 @@
 """The ``latlong`` command line (a private subpackage: the library never imports it).
 
-``build`` (:mod:`.build`), ``info`` / ``presets`` / ``render`` / ``export``
-(:mod:`.body`), ``slopes`` / ``spectrum`` (:mod:`.analysis`), ``camera``
+``build`` (:mod:`.build`), ``batch`` (:mod:`.batch`), ``info`` / ``presets`` / ``render`` /
+``export`` (:mod:`.body`), ``slopes`` / ``spectrum`` (:mod:`.analysis`), ``camera``
 (:mod:`.camera`); the option table of build
 and render, which also gives the TOML keys, is :mod:`.options`. Bad input: one line
 ``error: ...`` naming the flag, exit code 2.
@@ -16,6 +16,7 @@ from craters._shared import package_version
 from craters._shared.cli import OneLineParser, run_cli
 
 from .analysis import add_parsers as add_analysis_parsers
+from .batch import add_batch_parser
 from .body import add_body_parsers
 from .build import add_build_parser
 from .camera import add_camera_parser
@@ -43,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
     add_build_parser(sub, _add_groups)
+    add_batch_parser(sub)
     add_body_parsers(sub, _add_groups)
     add_analysis_parsers(sub)
     add_camera_parser(sub)

@@ -1,0 +1,184 @@
+"""What a build writes: the outputs of a scene (the run options of ``latlong build``) and the
+one function that writes them, shared by ``latlong build`` and :func:`latlong.batch` so a
+batch variant's files are the bytes a single build of the same seed writes.
+
+:class:`Outputs` holds the file names (meshes and bodies by suffix, the crater catalog as
+CSV or craterstats ``.scc``, the boulder catalog, a preview picture) and is checked
+against the scene once, before any work (:meth:`Outputs.check`); :func:`write_outputs`
+writes a built body, mesh surface or implicit surface, every file atomically.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+
+import craters
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    check_output_path,
+    check_suffix,
+)
+
+from .body import EXPORT_SUFFIXES
+from .implicit import MESH_SUFFIXES
+from .preview import render_preview
+from .scene import Scene
+from .settings import ShapeBase
+from .surface import band_areas
+
+__all__ = ["OUTPUT_SETTINGS", "Outputs", "output_kind", "write_outputs"]
+
+#: The keys of a scene file that say what to write (not what to make).
+OUTPUT_SETTINGS = ("output", "catalog", "boulder_catalog", "preview", "catalog_columns")
+
+_SUFFIXES = {"latlong": (".npz", *EXPORT_SUFFIXES), "implicit": (".npz", *MESH_SUFFIXES),
+             "mesh": MESH_SUFFIXES}
+_EXTRA_SUFFIXES = {"catalog": (".csv", ".scc"), "boulder_catalog": (".csv",),
+                   "preview": (".png",)}
+
+
+def output_kind(scene: Scene) -> str:
+    """``latlong``, ``implicit`` or ``mesh`` (a shape base cratered on its own mesh)."""
+    mesh = isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh"
+    return "mesh" if mesh else scene.backend
+
+
+@dataclass(frozen=True, slots=True)
+class Outputs:
+    """The files of one build (None or empty: not written)."""
+
+    output: tuple[str, ...] = ()
+    """Bodies and meshes, format by suffix (.npz and the :data:`~latlong.EXPORT_SUFFIXES`)."""
+    catalog: str | None = None
+    """The crater catalog as stamped: .csv or .scc (craterstats)."""
+    boulder_catalog: str | None = None
+    """The boulder catalog as placed (.csv)."""
+    preview: str | None = None
+    """A preview picture (.png)."""
+    catalog_columns: str = "craterform"
+    """Column names of a CSV catalog (:data:`craters.CATALOG_COLUMNS`)."""
+
+    def __post_init__(self):
+        out = self.output
+        if isinstance(out, str | Path):
+            out = (out,)
+        if not isinstance(out, list | tuple) or not all(isinstance(o, str | Path) for o in out):
+            raise ParameterTypeError("output", f"must be a file name or a list of them; got "
+                                     f"{self.output!r}")
+        object.__setattr__(self, "output", tuple(str(o) for o in out))
+        for key in ("catalog", "boulder_catalog", "preview"):
+            value = getattr(self, key)
+            if value is not None and not isinstance(value, str | Path):
+                raise ParameterTypeError(key, f"must be a file name; got {value!r}")
+            object.__setattr__(self, key, None if value is None else str(value))
+        if self.catalog_columns not in craters.CATALOG_COLUMNS:
+            raise ParameterError("catalog_columns", f"must be one of "
+                                 f"{', '.join(craters.CATALOG_COLUMNS)}; got "
+                                 f"{self.catalog_columns!r}")
+        if self.catalog_columns != "craterform" and not str(self.catalog or "").lower(
+                ).endswith(".csv"):
+            raise ParameterError("catalog_columns", "applies to a CSV {}", see=("catalog",))
+
+    @classmethod
+    def from_settings(cls, settings: Mapping) -> Outputs:
+        """From the output keys of a scene file (:data:`OUTPUT_SETTINGS`; None: not given)."""
+        return cls(**{k: v for k, v in settings.items() if v is not None})
+
+    def files(self) -> list[str]:
+        """Every file named, in writing order (a .glb also writes its .json manifest)."""
+        return [*self.output, *(f for f in (self.catalog, self.boulder_catalog, self.preview)
+                                if f)]
+
+    def renamed(self, rename: Callable[[str], str]) -> Outputs:
+        """The same outputs with every file name passed through ``rename``."""
+        return dataclasses.replace(
+            self, output=tuple(map(rename, self.output)),
+            **{k: rename(getattr(self, k)) for k in ("catalog", "boulder_catalog", "preview")
+               if getattr(self, k)})
+
+    def check(self, scene: Scene, *, force: bool = False, paths: bool = True) -> None:
+        """Raise before any work if the scene cannot write these outputs: known suffixes for
+        its kind, catalogs only of layers it has, no file twice and (``paths``) folders
+        that exist, nothing overwritten without ``force``."""
+        kind = output_kind(scene)
+        if scene.backend == "implicit" and self.boulder_catalog:
+            raise ParameterError("boulder_catalog", "does not apply to {} implicit",
+                                 see=("backend",))
+        if kind == "mesh" and any(o.lower().endswith(".npz") for o in self.output):
+            raise ParameterError("output", ": {} mesh writes meshes (" + " ".join(MESH_SUFFIXES)
+                                 + "), not .npz (a lat/long body)", see=("surface",))
+        if scene.backend == "latlong":
+            if self.catalog and not scene.craters.layers:
+                raise ParameterError("catalog", "needs crater layers ({} or a cratered {})",
+                                     see=("craters", "preset"))
+            if self.boulder_catalog and not scene.boulders.layers:
+                raise ParameterError("boulder_catalog", "needs boulder layers ({})",
+                                     see=("boulders",))
+        seen = set()
+        for x in self.files():
+            key = Path(x).resolve()
+            if key in seen:
+                raise ValueError(f"output {x!r} is given twice")
+            seen.add(key)
+        named = [(o, _SUFFIXES[kind]) for o in self.output]
+        named += [(getattr(self, k), s) for k, s in _EXTRA_SUFFIXES.items() if getattr(self, k)]
+        for path, suffixes in named:
+            if paths:
+                check_output_path(path, force=force, suffixes=suffixes)
+            else:
+                check_suffix(path, suffixes)
+
+
+def write_outputs(made, scene: Scene, outputs: Outputs, *, progress: bool = False,
+                  done: Callable[[], None] | None = None) -> list[str]:
+    """Write what :func:`latlong.build` made of ``scene`` (a Body, a mesh surface or an
+    implicit surface) to ``outputs``, each file atomically; ``done()`` after each file.
+    Returns the files named (a .glb's .json manifest is written next to it)."""
+    done = done or (lambda: None)
+    kind = output_kind(scene)
+    if kind == "implicit":
+        body = None
+        if any(o.lower().endswith(".npz") for o in outputs.output):  # before any write
+            try:
+                body = made.to_body(scene.body.magnitude, crossings=scene.implicit.crossings)
+            except ValueError as exc:
+                raise ValueError(f".npz output (lat/long projection): {exc}") from None
+        for out in outputs.output:
+            (body.save if out.lower().endswith(".npz") else made.save)(out)
+            done()
+        catalog, area, axes = made.catalog, made.area_m2, None
+    else:
+        for out in outputs.output:
+            if kind == "mesh":
+                made.save(out, progress=progress)
+            elif out.lower().endswith(".npz"):
+                made.save(out)
+            else:
+                made.export(out, progress=progress)
+            done()
+        catalog = made.craters
+        if kind == "mesh":
+            area, axes = made.area_m2, None
+        else:
+            scc = str(outputs.catalog or "").lower().endswith(".scc")
+            area = float(band_areas(made).sum()) if scc else 0.0
+            axes = made.radius_m * made.stretch
+    if outputs.catalog:
+        if outputs.catalog.lower().endswith(".scc"):
+            craters.write_scc(catalog, outputs.catalog, area_m2=area, axes_m=axes,
+                              note="latlong build: the craters as stamped on the whole body")
+        else:
+            craters.write_catalog(catalog, outputs.catalog, columns=outputs.catalog_columns)
+        done()
+    if outputs.boulder_catalog:
+        craters.write_catalog(made.boulders, outputs.boulder_catalog)
+        done()
+    if outputs.preview:
+        view = made if kind == "latlong" else made.to_pyvista()
+        render_preview(view, outputs.preview, scene.preview)
+        done()
+    return outputs.files()
