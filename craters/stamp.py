@@ -297,13 +297,16 @@ def _wave_schedule(shape, cy, cx, reach) -> tuple[np.ndarray, int, int]:
     Centres ``cy, cx`` and ``reach`` in pixels (:func:`_crater_reach_px`). A crater's wave
     is one more than the latest wave of the earlier craters whose boxes (plus a margin)
     share a cell with its own (:mod:`craters._wave_kernels`), so craters of one wave never
-    overlap and each comes after every earlier crater it overlaps. Cells: the median box
-    (at least 8 pixels, at most 4 M cells in all), so small craters touch a few cells.
+    overlap and each comes after every earlier crater it overlaps. Cells: a quarter of
+    the median box side (at least 4 pixels, at most 4 M cells in all): small craters touch
+    about 25 cells, and craters that share a cell without overlapping (a later wave than
+    needed) are few: 10 000 craters of 8-200 m on 4097^2 pixels take 28 waves (42 with
+    cells of the median box, 26 with exact box overlaps) for a schedule of a few ms.
     """
     ny, nx = int(shape[0]), int(shape[1])
     n = len(cy)
-    side = 2.0 * np.median(reach) + 2 * WAVE_MARGIN + 1 if n else 8.0
-    cell = int(max(side, 8.0, np.ceil(np.sqrt(ny * nx / 4.0e6))))
+    side = 2.0 * np.median(reach) + 2 * WAVE_MARGIN + 1 if n else 16.0
+    cell = int(max(side / 4.0, 4.0, np.ceil(np.sqrt(ny * nx / 4.0e6))))
     wave = np.zeros(n, dtype=np.int64)
     n_waves = _wave_schedule_kernel(ny, nx, np.ascontiguousarray(cy, dtype=np.float64),
                                     np.ascontiguousarray(cx, dtype=np.float64),

@@ -92,7 +92,7 @@ def test_schedule_cells_from_the_median_box():
     rng = np.random.default_rng(4)
     cy, cx, reach = _random_craters(300, SHAPE, rng)
     wave, n_waves, cell = stamp_module._wave_schedule(SHAPE, cy, cx, reach)
-    assert cell == int(max(2 * np.median(reach) + 2 * WAVE_MARGIN + 1, 8))
+    assert cell == int(max((2 * np.median(reach) + 2 * WAVE_MARGIN + 1) / 4, 4))
     ref = np.empty(len(cy), dtype=np.int64)
     assert _wave_schedule_kernel(SHAPE[0], SHAPE[1], cy, cx, reach, cell, ref) == n_waves
     np.testing.assert_array_equal(wave, ref)
