@@ -8,7 +8,13 @@ The command-line helpers are in :mod:`craters._shared.cli`; nothing here imports
 importing a library never loads argparse.
 """
 
-from .files import atomic_path, check_output_path, check_parent_folder, load_toml
+from .files import (
+    BackgroundWriter,
+    atomic_path,
+    check_output_path,
+    check_parent_folder,
+    load_toml,
+)
 from .progress import progress_bar
 from .spec import parse_spec
 from .stats import area_slope_summary
@@ -27,7 +33,8 @@ from .validation import (
     parameter_of,
 )
 
-__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "area_slope_summary",
+__all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike", "about",
+           "area_slope_summary",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_parent_folder", "check_positive", "check_range", "human_bytes", "load_toml",
            "normalize_rng", "package_version", "parameter_of", "parse_spec",
