@@ -1,6 +1,8 @@
 """Raster I/O: GeoTIFF (and anything GDAL reads) through rasterio, PDS3 ``.IMG`` + ``.LBL``.
 
-All raster reading and writing of the ``dem`` package lives here.
+All raster reading and writing of the ``dem`` package lives here. Every GeoTIFF written
+is a cloud-optimised GeoTIFF (GDAL's COG driver: 256 x 256 tiles, overviews, the
+header and overviews before the full-resolution tiles), deterministic to the byte.
 """
 
 from __future__ import annotations
@@ -16,7 +18,6 @@ import rasterio
 from affine import Affine
 from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
-from rasterio.profiles import DefaultGTiffProfile
 
 from craters import get_target
 from craters._shared import about, atomic_path, check_int, parameter_of
@@ -32,8 +33,13 @@ logger = logging.getLogger(__name__)
 GEOTIFF_SUFFIXES = (".tif", ".tiff")
 #: Suffixes :func:`read` hands to the PDS3 reader instead of GDAL.
 PDS_SUFFIXES = (".img", ".lbl")
-# block size of tiled output (cloud-optimised GeoTIFF layout); smaller rasters are striped
+# tile size of the written cloud-optimised GeoTIFFs, pixels
 _BLOCK = 256
+# GDAL COG creation options: deflate with the floating-point predictor, 256 x 256 tiles,
+# overviews (averages of the known pixels) halving down to one tile, BigTIFF when needed,
+# no statistics (nothing that depends on how the file was made)
+_COG_OPTIONS = {"compress": "DEFLATE", "predictor": "FLOATING_POINT", "blocksize": _BLOCK,
+                "bigtiff": "IF_SAFER", "overview_resampling": "AVERAGE", "statistics": "NO"}
 
 # PDS3 SAMPLE_TYPE -> (numpy kind, byte order)
 _PDS_TYPES = {
@@ -375,15 +381,16 @@ def _pds_georef(proj: dict, label: dict, where: str):
 
 # --------------------------------------------------------------------------- write
 def write(dem: Dem, path) -> Path:
-    """Write ``dem`` to a GeoTIFF, atomically; the same DEM always gives the same bytes.
+    """Write ``dem`` to a cloud-optimised GeoTIFF, atomically; the same DEM always gives
+    the same bytes.
 
-    float32 heights with a NaN NoData value, deflate compression with the floating-point
-    predictor, 256 x 256 tiles when both sides are at least 256 pixels (the
-    cloud-optimised layout; smaller rasters are striped), BigTIFF when needed. The CRS,
-    transform and tags (including how the layer was made: ``CRATERFORM_GENERATOR``,
-    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``, the body radius if known,
-    ``CRATERFORM_BODY_RADIUS_M``, and without a CRS the pixel size,
-    ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is replaced.
+    float32 heights with a NaN NoData value, GDAL's COG layout: deflate compression with
+    the floating-point predictor, 256 x 256 tiles, overviews (averages) down to one
+    tile, BigTIFF when needed. The CRS, transform and tags (including how the layer was
+    made: ``CRATERFORM_GENERATOR``, ``_VERSION``, ``_SEED``, ``_PARAMETERS``,
+    ``_HISTORY``, the body radius if known, ``CRATERFORM_BODY_RADIUS_M``, and without a
+    CRS the pixel size, ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is
+    replaced.
 
     Examples
     --------
@@ -396,32 +403,40 @@ def write(dem: Dem, path) -> Path:
     """
     if not isinstance(dem, Dem):
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
-    path = Path(path)
-    if path.suffix.lower() not in GEOTIFF_SUFFIXES:
-        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF; allowed: "
-                         f"{' '.join(GEOTIFF_SUFFIXES)}")
+    path = _check_geotiff_path(path)
     rows, cols = dem.shape
-    profile = DefaultGTiffProfile()
-    profile.update(width=cols, height=rows, count=1, dtype="float32", nodata=np.nan,
-                   crs=dem.crs, transform=dem.transform, compress="deflate", predictor=3,
-                   bigtiff="IF_SAFER")
-    if min(rows, cols) >= _BLOCK:
-        profile.update(tiled=True, blockxsize=_BLOCK, blockysize=_BLOCK)
-    else:
-        profile.update(tiled=False)
-        del profile["blockxsize"], profile["blockysize"]
     data = dem.heights.astype(np.float32)
     with atomic_path(path) as tmp:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
-            with rasterio.open(tmp, "w", **profile) as ds:
+            # a copy-only driver: rasterio fills a MEM dataset, GDAL copies it on close
+            with rasterio.open(tmp, "w", driver="COG", width=cols, height=rows, count=1,
+                               dtype="float32", nodata=np.nan, crs=dem.crs,
+                               transform=dem.transform, **_COG_OPTIONS) as ds:
                 ds.write(data, 1)
-                tags = dict(dem.tags)
-                if dem.body_radius_m is not None:
-                    tags[RADIUS_TAG] = repr(dem.body_radius_m)
-                if dem.crs is None:
-                    tags[PIXEL_SIZE_TAG] = ",".join(map(repr, dem.pixel_size_m))
-                ds.update_tags(**tags)
-                ds.set_band_description(1, "height")
-                ds.units = ("metre",)
+                _write_metadata(ds, dem)
     return path
+
+
+def _check_geotiff_path(path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in GEOTIFF_SUFFIXES:
+        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF; allowed: "
+                         f"{' '.join(GEOTIFF_SUFFIXES)}")
+    return path
+
+
+def _file_tags(dem: Dem) -> dict:
+    """The tags written with ``dem``: its own, the body radius, the pixel size (no CRS)."""
+    tags = dict(dem.tags)
+    if dem.body_radius_m is not None:
+        tags[RADIUS_TAG] = repr(dem.body_radius_m)
+    if dem.crs is None:
+        tags[PIXEL_SIZE_TAG] = ",".join(map(repr, dem.pixel_size_m))
+    return tags
+
+
+def _write_metadata(ds, dem: Dem) -> None:
+    ds.update_tags(**_file_tags(dem))
+    ds.set_band_description(1, "height")
+    ds.units = ("metre",)

@@ -30,8 +30,10 @@ def test_read_geotiff_nodata_crs_transform(tiny_geotiff):
     assert d.heights[2, 5] == 2 + 10
 
 
-@pytest.mark.parametrize("shape,tiled", [((33, 40), False), ((300, 257), True)])
-def test_write_round_trip(tmp_path, shape, tiled):
+@pytest.mark.parametrize("shape", [(33, 40), (300, 257), (600, 530)])
+def test_write_round_trip_as_cloud_optimised_geotiff(tmp_path, shape):
+    from rio_cogeo.cogeo import cog_validate
+
     rng = np.random.default_rng(1)
     z = rng.normal(0, 100, shape).astype(np.float32).astype(np.float64)
     z[5, 7] = np.nan
@@ -41,10 +43,18 @@ def test_write_round_trip(tmp_path, shape, tiled):
     with rasterio.open(out) as ds:
         prof = ds.profile
         assert prof["dtype"] == "float32" and np.isnan(prof["nodata"])
-        assert prof["compress"] == "deflate" and prof["tiled"] == tiled
-        if tiled:
-            assert (prof["blockxsize"], prof["blockysize"]) == (256, 256)
+        assert prof["compress"] == "deflate" and prof["tiled"]
+        assert (prof["blockxsize"], prof["blockysize"]) == (256, 256)
         assert ds.tags()["SOURCE"] == "test" and ds.units == ("metre",)
+        assert ds.descriptions == ("height",)
+        assert (len(ds.overviews(1)) > 0) == (max(shape) > 256)
+    if shape == (600, 530):  # the first overview: averages of the known pixels
+        with rasterio.open(out, overview_level=0) as ov:
+            coarse = ov.read(1)
+        want = np.nanmean(z.reshape(300, 2, 265, 2), axis=(1, 3))
+        np.testing.assert_allclose(coarse, want, rtol=1e-5, atol=1e-3)
+    valid, errors, warnings = cog_validate(out, strict=True)
+    assert valid and not errors and not warnings
     back = dem.read(out)
     assert np.array_equal(back.heights, z, equal_nan=True)
     assert back.transform == t and back.crs == d.crs
