@@ -33,7 +33,7 @@ from .core import Dem
 from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
 from .craterfill import fill_crater_gaps, replace_crater
 from .enhance import enhance
-from .expansion import displacement_scales, expand, expansion_sizes
+from .expansion import ExpandedFile, displacement_scales, expand, expand_to_file, expansion_sizes
 from .fractal import (
     FractalFit,
     SpectralFit,
@@ -46,7 +46,7 @@ from .fractal import (
 )
 from .frame import LocalFrame, local_frame
 from .gaps import fill_gaps
-from .io import read, write
+from .io import WindowWriter, read, write
 from .mesh import to_mesh
 from .stack import Stack, read_stack
 from .terrain import (
@@ -63,11 +63,13 @@ __all__ = [
     "CraterDensity",
     "Dem",
     "EnhanceConfig",
+    "ExpandedFile",
     "SourceCraterLayer",
     "FractalFit",
     "LocalFrame",
     "SpectralFit",
     "Stack",
+    "WindowWriter",
     "band_power",
     "batch",
     "boulder_population",
@@ -77,6 +79,7 @@ __all__ = [
     "displacement_scales",
     "enhance",
     "expand",
+    "expand_to_file",
     "expansion_fit",
     "expansion_sizes",
     "fill_crater_gaps",

@@ -1,19 +1,30 @@
-"""A small PDS3 (ODL) label parser: enough for simple-cylindrical DEM products.
+"""A small PDS3 (ODL) label parser and reader of its facts: enough for simple-cylindrical
+DEM products.
 
-Pure text handling, no file access beyond what the caller passes in (raster reading is
-in :mod:`dem.io`). The label becomes nested dictionaries: ``KEY = value`` pairs at each
-level and ``OBJECT``/``GROUP`` blocks as sub-dictionaries under their name (the first
-block of a name wins). Values: ``int``, ``float``, ``str`` (quoted strings with their
-line breaks collapsed, bare identifiers, dates, radix numbers such as ``16#FF7FFFFB#``
-kept as text), lists for ``(...)`` and ``{...}``, and :class:`Quantity` (a float with a
-``unit``) for numbers followed by ``<unit>``.
+Label text handling and what the label says (sample types, constants, georeference);
+the image's bytes are read in :mod:`dem.io`. The label becomes nested dictionaries:
+``KEY = value`` pairs at each level and ``OBJECT``/``GROUP`` blocks as sub-dictionaries
+under their name (the first block of a name wins). Values: ``int``, ``float``, ``str``
+(quoted strings with their line breaks collapsed, bare identifiers, dates, radix numbers
+such as ``16#FF7FFFFB#`` kept as text), lists for ``(...)`` and ``{...}``, and
+:class:`Quantity` (a float with a ``unit``) for numbers followed by ``<unit>``.
 """
 
 from __future__ import annotations
 
+import logging
+import math
 import re
+from pathlib import Path
 
-__all__ = ["Quantity", "find_object", "parse_label"]
+import numpy as np
+from affine import Affine
+from rasterio.crs import CRS
+
+__all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "find_file", "find_object",
+           "georeference", "label_number", "label_text", "parse_label", "sample_constant"]
+
+logger = logging.getLogger(__name__)
 
 _TOKEN = re.compile(
     r'"(?P<str>[^"]*)"'  # double-quoted string (may span lines)
@@ -164,3 +175,136 @@ def find_object(label: dict, name: str) -> tuple[dict, dict] | tuple[None, None]
             if found[0] is not None:
                 return found
     return None, None
+
+
+#: PDS3 SAMPLE_TYPE -> (numpy kind, byte order)
+SAMPLE_TYPES = {
+    "LSB_INTEGER": ("i", "<"), "PC_INTEGER": ("i", "<"), "VAX_INTEGER": ("i", "<"),
+    "MSB_INTEGER": ("i", ">"), "INTEGER": ("i", ">"), "MAC_INTEGER": ("i", ">"),
+    "SUN_INTEGER": ("i", ">"),
+    "LSB_UNSIGNED_INTEGER": ("u", "<"), "PC_UNSIGNED_INTEGER": ("u", "<"),
+    "VAX_UNSIGNED_INTEGER": ("u", "<"),
+    "MSB_UNSIGNED_INTEGER": ("u", ">"), "UNSIGNED_INTEGER": ("u", ">"),
+    "MAC_UNSIGNED_INTEGER": ("u", ">"), "SUN_UNSIGNED_INTEGER": ("u", ">"),
+    "PC_REAL": ("f", "<"), "IEEE_REAL": ("f", ">"), "REAL": ("f", ">"),
+    "MAC_REAL": ("f", ">"), "SUN_REAL": ("f", ">"), "FLOAT": ("f", ">"),
+}
+SIMPLE_CYLINDRICAL = ("SIMPLE CYLINDRICAL", "SIMPLE_CYLINDRICAL", "EQUIRECTANGULAR")
+
+
+def find_file(folder: Path, name: str) -> Path | None:
+    """``folder / name``, matching the name case-insensitively (PDS names are upper-case)."""
+    exact = folder / name
+    if exact.is_file():
+        return exact
+    lower = name.lower()
+    for p in folder.iterdir():
+        if p.name.lower() == lower and p.is_file():
+            return p
+    return None
+
+
+def label_text(path: Path) -> tuple[str, Path]:
+    """The label text and the file it came from (detached ``.lbl`` or attached)."""
+    if path.suffix.lower() == ".lbl":
+        return path.read_text(encoding="latin-1"), path
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 20)
+    if head.startswith(b"PDS_VERSION_ID"):
+        text = head.decode("latin-1")
+        end = re.search(r"^\s*END\s*$", text, re.M)
+        return (text[:end.end()] if end else text), path
+    for suffix in (".lbl", ".LBL", ".Lbl"):
+        label = find_file(path.parent, path.stem + suffix)
+        if label is not None:
+            return label.read_text(encoding="latin-1"), label
+    raise ValueError(f"{str(path)!r}: no PDS label found (neither attached nor a .LBL "
+                     f"file next to it)")
+
+
+def label_number(block: dict, key: str, where: str, default=None, unit_scale=None) -> float:
+    """A numeric label value; ``unit_scale`` maps lower-case units to factors."""
+    value = block.get(key, default)
+    if value is None:
+        raise ValueError(f"{where}: the label has no {key}")
+    if not isinstance(value, int | float):
+        raise ValueError(f"{where}: label {key} = {value!r} is not a number")
+    factor = 1.0
+    if unit_scale is not None and isinstance(value, Quantity):
+        unit = value.unit.lower()
+        if unit not in unit_scale:
+            raise ValueError(f"{where}: label {key} has unit <{value.unit}>; expected one of "
+                             f"{', '.join(unit_scale)}")
+        factor = unit_scale[unit]
+    return float(value) * factor
+
+
+def sample_constant(value, kind: str, nbytes: int):
+    """A label constant (decimal or PDS radix ``16#...#``) in the raw sample's terms."""
+    if isinstance(value, int | float):
+        return value
+    m = re.fullmatch(r"(\d+)#([0-9A-Fa-f]+)#", str(value).strip())
+    if not m:
+        return None
+    raw = int(m.group(2), int(m.group(1)))
+    if kind == "f":
+        return float(np.frombuffer(raw.to_bytes(nbytes, "big"), dtype=f">f{nbytes}")[0])
+    return raw
+
+
+def georeference(proj: dict, label: dict, where: str):
+    """Transform (degrees), geographic CRS and radius (m) of a simple-cylindrical map."""
+    ptype = " ".join(str(proj.get("MAP_PROJECTION_TYPE", "")).upper().split())
+    if ptype not in SIMPLE_CYLINDRICAL:
+        raise ValueError(f"{where!r}: unsupported MAP_PROJECTION_TYPE {ptype or '(none)'!r}; "
+                         f"only simple cylindrical DEMs are read")
+    km = {"km": 1000.0, "kilometers": 1000.0, "kilometres": 1000.0, "m": 1.0, "meters": 1.0,
+          "metres": 1.0, "meter": 1.0, "metre": 1.0}
+    radius_m = label_number(proj, "A_AXIS_RADIUS", where, unit_scale=km)
+    if not isinstance(proj["A_AXIS_RADIUS"], Quantity):
+        radius_m *= 1000.0  # PDS3 gives axis radii in km
+    deg = {"deg": 1.0, "degree": 1.0, "degrees": 1.0}
+    center_lat = label_number(proj, "CENTER_LATITUDE", where, 0.0, deg)
+    if center_lat != 0.0:
+        raise ValueError(f"{where!r}: EQUIRECTANGULAR with CENTER_LATITUDE {center_lat:g} is "
+                         f"not supported (only 0, simple cylindrical)")
+    if str(proj.get("POSITIVE_LONGITUDE_DIRECTION", "EAST")).upper() != "EAST":
+        raise ValueError(f"{where!r}: only POSITIVE_LONGITUDE_DIRECTION = EAST is supported")
+    if "MAP_RESOLUTION" in proj:
+        res = label_number(proj, "MAP_RESOLUTION", where, unit_scale={"pix/deg": 1.0,
+                                                                 "pixel/degree": 1.0,
+                                                                 "pixels/degree": 1.0})
+    else:
+        scale_m = label_number(proj, "MAP_SCALE", where, unit_scale={
+            "m/pix": 1.0, "m/pixel": 1.0, "meters/pixel": 1.0, "metres/pixel": 1.0,
+            "km/pix": 1000.0, "km/pixel": 1000.0})
+        res = radius_m * math.pi / 180.0 / scale_m
+    if not res > 0:
+        raise ValueError(f"{where!r}: MAP_RESOLUTION must be > 0; got {res!r}")
+    center_lon = label_number(proj, "CENTER_LONGITUDE", where, 0.0, deg)
+    pix = {"pix": 1.0, "pixel": 1.0, "pixels": 1.0}
+    if "SAMPLE_PROJECTION_OFFSET" in proj and "LINE_PROJECTION_OFFSET" in proj:
+        # PDS3: sample (0-based, pixel centre) = SAMPLE_PROJECTION_OFFSET + res (lon - lon0)
+        spo = label_number(proj, "SAMPLE_PROJECTION_OFFSET", where, unit_scale=pix)
+        lpo = label_number(proj, "LINE_PROJECTION_OFFSET", where, unit_scale=pix)
+        west = center_lon - (spo + 0.5) / res
+        north = center_lat + (lpo + 0.5) / res
+    else:
+        west = label_number(proj, "WESTERNMOST_LONGITUDE", where, unit_scale=deg)
+        north = label_number(proj, "MAXIMUM_LATITUDE", where, unit_scale=deg)
+    for key, value in (("MAXIMUM_LATITUDE", north), ("WESTERNMOST_LONGITUDE", west)):
+        if key in proj and isinstance(proj[key], int | float):
+            stated = float(proj[key])
+            gap = abs(stated - value) * res
+            if key == "WESTERNMOST_LONGITUDE":
+                gap = min(gap, abs(abs(stated - value) - 360.0) * res)
+            if gap > 0.01:
+                logger.warning("%s: label %s = %g but the projection offsets put the edge at "
+                               "%g; using the offsets", where, key, stated, value)
+    target = str(label.get("TARGET_NAME", "body")).title()
+    crs = CRS.from_wkt(
+        f'GEOGCS["{target} (sphere, PDS label)",DATUM["D_{target}",'
+        f'SPHEROID["{target}",{radius_m!r},0]],PRIMEM["Reference_Meridian",0],'
+        f'UNIT["degree",0.0174532925199433]]')
+    transform = Affine(1.0 / res, 0.0, west, 0.0, -1.0 / res, north)
+    return transform, crs, radius_m

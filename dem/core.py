@@ -364,6 +364,19 @@ class Dem:
 
         ``heights`` is taken over without copying (callers pass fresh arrays).
         """
+        level = self._level if level is None else level
+        origin = self._origin if origin is None else origin
+        own_px = self._own_px if pixel_size_m is None else pixel_size_m
+        return Dem._own(heights, self._transform if transform is None else transform,
+                        self._crs, pixel_size_m=own_px, body_radius_m=self._radius,
+                        tags=self.step_tags(op, seed, parameters, level=level, origin=origin),
+                        level=level, origin=origin)
+
+    def step_tags(self, op: str, seed, parameters: dict, *, level: int | None = None,
+                  origin=None) -> dict:
+        """The tags of the DEM :meth:`with_step` makes (for a result written window by
+        window, which never exists as one ``Dem``): these tags, the step's
+        ``CRATERFORM_*`` tags and history, the lattice level and origin."""
         history = self.history
         history.append({"op": op, "seed": seed, "parameters": parameters})
         tags = dict(self._tags)
@@ -379,10 +392,7 @@ class Dem:
         if level or origin != (0, 0) or LEVEL_TAG in tags:
             tags[LEVEL_TAG] = str(level)
             tags[ORIGIN_TAG] = f"{origin[0]},{origin[1]}"
-        own_px = self._own_px if pixel_size_m is None else pixel_size_m
-        return Dem._own(heights, self._transform if transform is None else transform,
-                        self._crs, pixel_size_m=own_px, body_radius_m=self._radius,
-                        tags=tags, level=level, origin=origin)
+        return tags
 
     def window(self, region) -> Window:
         """The integer pixel window of ``region`` (any form :func:`parse_region` takes).

@@ -66,12 +66,16 @@ around the region and is given the whole DEM's ``fractal_dimension`` (the defaul
 estimate is per DEM); with a uniform ``roughness`` and a geographic CRS the amplitude
 ``roughness * resolution_m`` also depends on the crop's centre latitude. A finer layer's even
 pixels equal the coarser layer (the layer-stack consistency ``enhance`` relies on).
+:func:`expand_to_file` uses this to write results bigger than memory: tiles of the
+region, each expanded with its halo, each written into its window of the output file.
 """
 
 from __future__ import annotations
 
 import logging
 import math
+from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 from affine import Affine
@@ -91,7 +95,8 @@ from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import expansion_fit, local_msd
 
-__all__ = ["CONTEXT_PX", "displacement_scales", "expand", "expansion_sizes", "midpoint_factor"]
+__all__ = ["CONTEXT_PX", "TILE_PX", "ExpandedFile", "displacement_scales", "expand",
+           "expand_to_file", "expansion_sizes", "midpoint_factor"]
 
 logger = logging.getLogger(__name__)
 
@@ -218,6 +223,136 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     >>> e.shape, e.pixel_size_m, bool((e.heights[::4, ::4] == d.heights).all())
     ((17, 17), (2.0, 2.0), True)
     """
+    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
+    need = (plan.side + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
+    have = physical_memory_bytes()
+    if need > 0.85 * have:
+        raise ValueError(f"expanding {plan.width} x {plan.width} pixels {levels} levels gives "
+                         f"{plan.side} x {plan.side} pixels and needs about {human_bytes(need)} "
+                         f"of memory; this machine has {human_bytes(have)} (dem.expand_to_file "
+                         f"writes it tile by tile)")
+    heights = _expand_tile(dem, plan, plan.r0, plan.c0, plan.width, progress=progress)
+    return dem.with_step(heights, "dem.expand", plan.seed, plan.params,
+                         transform=plan.transform, pixel_size_m=plan.pixel_size_m,
+                         level=dem.level + plan.levels, origin=plan.origin)
+
+
+class ExpandedFile(NamedTuple):
+    """What :func:`expand_to_file` wrote."""
+
+    path: Path
+    """The cloud-optimised GeoTIFF."""
+    shape: tuple[int, int]
+    """Its rows and columns."""
+    seed: int | None
+    """The seed recorded (``rng`` when it is an int)."""
+    parameters: dict
+    """The step's parameters (``CRATERFORM_PARAMETERS``), as ``expand`` records them."""
+    tiles: int
+    """How many tiles were expanded."""
+
+
+#: Default largest output tile side of :func:`expand_to_file`, pixels (about 80 MB).
+TILE_PX = 2049
+
+
+def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | None = None,
+                   roughness: float | None = None, region=None, rng=None, *,
+                   tile_px: int | None = None, progress: bool = False) -> ExpandedFile:
+    """:func:`expand` written tile by tile into a GeoTIFF: results bigger than memory.
+
+    The region is expanded as square tiles of ``2^k + 1`` input pixels sharing their
+    edge pixels, each at most ``tile_px`` pixels a side once expanded (a tile of 3 input
+    pixels when even that is larger), each with its context halo at every level; the
+    counter-based randomness is keyed by global pixel index and every estimate (the
+    fractal dimension, the fallback roughness) is made once on the whole input DEM, so
+    every tile holds exactly the pixels of the whole expansion. Each tile goes into its
+    window of the output (:class:`dem.io.WindowWriter`): the file has the same bytes as
+    ``dem.write(expand(...), path)`` while the memory holds one tile (about 18 bytes an
+    output pixel of a tile) plus GDAL's block cache.
+
+    Parameters are those of :func:`expand`, plus:
+
+    path : str or Path
+        The ``.tif`` to write (atomically; an existing file is replaced).
+    tile_px : int, optional
+        Largest output tile side in pixels (>= 3); default :data:`TILE_PX` (2049, about
+        80 MB a tile).
+
+    Returns
+    -------
+    ExpandedFile
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> from dem.io import write
+    >>> d = Dem(np.random.default_rng(0).normal(0, 5, (17, 17)), pixel_size_m=8.0)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     info = expand_to_file(d, f"{tmp}/t.tif", 2, 2.3, rng=1, tile_px=17)
+    ...     whole = write(expand(d, 2, 2.3, rng=1), f"{tmp}/w.tif")
+    ...     same = info.path.read_bytes() == whole.read_bytes()
+    >>> info.shape, info.tiles, same
+    ((65, 65), 16, True)
+    """
+    from .io import WindowWriter
+
+    with about("tile_px"):
+        tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
+    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
+    step = 2**plan.levels
+    # input tile: 2^k + 1 pixels, the largest whose expansion fits tile_px (at least 3)
+    k = max(1, min((plan.width - 1).bit_length() - 1,
+                   ((tile_px - 1) // step).bit_length() - 1))
+    t_in = 2**k + 1
+    t_out = (t_in - 1) * step + 1
+    need = (t_out + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
+    have = physical_memory_bytes()
+    if need > 0.85 * have:
+        raise ValueError(f"one tile of {t_in} x {t_in} pixels expanded {levels} levels is "
+                         f"{t_out} x {t_out} pixels and needs about {human_bytes(need)} of "
+                         f"memory; this machine has {human_bytes(have)}")
+    n = (plan.width - 1) // (t_in - 1)
+    tags = dem.step_tags("dem.expand", plan.seed, plan.params, level=dem.level + plan.levels,
+                         origin=plan.origin)
+    with WindowWriter(path, (plan.side, plan.side), transform=plan.transform, crs=dem.crs,
+                      tags=tags, body_radius_m=dem.body_radius_m,
+                      pixel_size_m=plan.pixel_size_m) as out:
+        tiles = [(i, j) for i in range(n) for j in range(n)]
+        for i, j in progress_bar(tiles, enabled=progress, desc="expand tiles"):
+            z = _expand_tile(dem, plan, plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1),
+                             t_in)
+            # tiles share their edge pixels: each writes all but its last row / column,
+            # the last ones all (windows aligned to the output's blocks when large)
+            rows = t_out if i == n - 1 else t_out - 1
+            cols = t_out if j == n - 1 else t_out - 1
+            out.write(z[:rows, :cols], i * (t_out - 1), j * (t_out - 1))
+    return ExpandedFile(out.path, (plan.side, plan.side), plan.seed, plan.params, len(tiles))
+
+
+class _Plan(NamedTuple):
+    """An expansion's settings, made once for the whole region (:func:`_plan`)."""
+
+    r0: int
+    c0: int
+    width: int
+    levels: int
+    side: int
+    fractal_dimension: float
+    key: int
+    seed: int | None
+    params: dict
+    uniform_m: float | None
+    """The uniform amplitude (roughness x resolution), None for the local one."""
+    fallback_m: float
+    """The local amplitude where a pixel has no known neighbour."""
+    transform: Affine
+    pixel_size_m: tuple | None
+    origin: tuple[int, int]
+
+
+def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
+    """Check the arguments and make the estimates of the whole DEM (expand's parameters)."""
     dem = _check_dem(dem)
     with about("levels"):
         levels = check_int("levels", levels, 1, 16)
@@ -228,12 +363,6 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
         raise ValueError(f"the region has {unknown} unknown (NaN) pixels; fill them first "
                          f"(dem.fill_gaps, `dem fill`)")
     side = (width - 1) * 2**levels + 1
-    need = (side + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
-        raise ValueError(f"expanding {width} x {width} pixels {levels} levels gives {side} x "
-                         f"{side} pixels and needs about {human_bytes(need)} of memory; this "
-                         f"machine has {human_bytes(have)}")
     if fractal_dimension is not None:
         with about("fractal_dimension"):
             fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
@@ -251,27 +380,37 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     params["fractal_dimension"] = fractal_dimension
     resolution = dem.resolution_m
     if roughness is None:
-        amp, amp_r0, amp_c0 = _local_amplitude(dem, r0, c0, width,
-                                               fit.roughness * resolution)
+        uniform, fallback = None, fit.roughness * resolution
         params["roughness"] = "local"
         params["roughness_rms"] = fit.roughness
     else:
-        amp = np.full((1, 1), roughness * resolution)
-        amp_r0, amp_c0 = dem.origin[0] + r0, dem.origin[1] + c0
+        uniform, fallback = roughness * resolution, 0.0
         params["roughness"] = roughness
     with about("rng"):
         key, seed = key_from_rng(rng)
     params["key"] = key
-    heights = _expand_region(dem.heights, (r0, c0, width), dem.origin, dem.level, levels,
-                             key, fractal_dimension, amp, (amp_r0, amp_c0), progress=progress)
     scale = 0.5**levels
     shift = 0.5 - scale / 2.0  # keeps pixel centres: new (0, 0) on old (r0, c0)
     transform = (dem.transform @ Affine.translation(c0 + shift, r0 + shift)
                  @ Affine.scale(scale))
     px = None if dem.crs is not None else tuple(v * scale for v in dem.pixel_size_m)
     origin = ((dem.origin[0] + r0) * 2**levels, (dem.origin[1] + c0) * 2**levels)
-    return dem.with_step(heights, "dem.expand", seed, params, transform=transform,
-                         pixel_size_m=px, level=dem.level + levels, origin=origin)
+    return _Plan(r0, c0, width, levels, side, fractal_dimension, key, seed, params, uniform,
+                 fallback, transform, px, origin)
+
+
+def _expand_tile(dem: Dem, plan: _Plan, r0: int, c0: int, width: int, *,
+                 progress: bool = False) -> np.ndarray:
+    """The expansion of the square ``(r0, c0, width)`` of ``dem`` with ``plan``'s settings
+    (the same pixels as that part of the whole region's expansion)."""
+    if plan.uniform_m is None:
+        amp, amp_r0, amp_c0 = _local_amplitude(dem, r0, c0, width, plan.fallback_m)
+    else:
+        amp = np.full((1, 1), plan.uniform_m)
+        amp_r0, amp_c0 = dem.origin[0] + r0, dem.origin[1] + c0
+    return _expand_region(dem.heights, (r0, c0, width), dem.origin, dem.level, plan.levels,
+                          plan.key, plan.fractal_dimension, amp, (amp_r0, amp_c0),
+                          progress=progress)
 
 
 def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):

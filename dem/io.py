@@ -1,30 +1,45 @@
 """Raster I/O: GeoTIFF (and anything GDAL reads) through rasterio, PDS3 ``.IMG`` + ``.LBL``.
 
-All raster reading and writing of the ``dem`` package lives here.
+All raster reading and writing of the ``dem`` package lives here. Every GeoTIFF written
+is a cloud-optimised GeoTIFF (GDAL's COG driver: 256 x 256 tiles, overviews, the
+header and overviews before the full-resolution tiles), deterministic to the byte.
+DEMs bigger than memory: :func:`read` takes a ``window``, and :class:`WindowWriter`
+writes a raster window by window into the same COG :func:`write` makes of the whole.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
-import math
-import re
+import os
+import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
 import rasterio
+import rasterio.shutil
 from affine import Affine
-from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
-from rasterio.profiles import DefaultGTiffProfile
+from rasterio.windows import Window
 
 from craters import get_target
 from craters._shared import about, atomic_path, check_int, parameter_of
 
-from ._pds import Quantity, find_object, parse_label
+from ._pds import (
+    SAMPLE_TYPES,
+    Quantity,
+    find_file,
+    find_object,
+    georeference,
+    label_number,
+    label_text,
+    parse_label,
+    sample_constant,
+)
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
 
-__all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "read", "write"]
+__all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
@@ -32,27 +47,17 @@ logger = logging.getLogger(__name__)
 GEOTIFF_SUFFIXES = (".tif", ".tiff")
 #: Suffixes :func:`read` hands to the PDS3 reader instead of GDAL.
 PDS_SUFFIXES = (".img", ".lbl")
-# block size of tiled output (cloud-optimised GeoTIFF layout); smaller rasters are striped
+# tile size of the written cloud-optimised GeoTIFFs, pixels
 _BLOCK = 256
-
-# PDS3 SAMPLE_TYPE -> (numpy kind, byte order)
-_PDS_TYPES = {
-    "LSB_INTEGER": ("i", "<"), "PC_INTEGER": ("i", "<"), "VAX_INTEGER": ("i", "<"),
-    "MSB_INTEGER": ("i", ">"), "INTEGER": ("i", ">"), "MAC_INTEGER": ("i", ">"),
-    "SUN_INTEGER": ("i", ">"),
-    "LSB_UNSIGNED_INTEGER": ("u", "<"), "PC_UNSIGNED_INTEGER": ("u", "<"),
-    "VAX_UNSIGNED_INTEGER": ("u", "<"),
-    "MSB_UNSIGNED_INTEGER": ("u", ">"), "UNSIGNED_INTEGER": ("u", ">"),
-    "MAC_UNSIGNED_INTEGER": ("u", ">"), "SUN_UNSIGNED_INTEGER": ("u", ">"),
-    "PC_REAL": ("f", "<"), "IEEE_REAL": ("f", ">"), "REAL": ("f", ">"),
-    "MAC_REAL": ("f", ">"), "SUN_REAL": ("f", ">"), "FLOAT": ("f", ">"),
-}
-_SIMPLE_CYLINDRICAL = ("SIMPLE CYLINDRICAL", "SIMPLE_CYLINDRICAL", "EQUIRECTANGULAR")
-
+# GDAL COG creation options: deflate with the floating-point predictor, 256 x 256 tiles,
+# overviews (averages of the known pixels) halving down to one tile, BigTIFF when needed,
+# no statistics (nothing that depends on how the file was made)
+_COG_OPTIONS = {"compress": "DEFLATE", "predictor": "FLOATING_POINT", "blocksize": _BLOCK,
+                "bigtiff": "IF_SAFER", "overview_resampling": "AVERAGE", "statistics": "NO"}
 
 # --------------------------------------------------------------------------- read
 def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = None,
-         body: str | None = None) -> Dem:
+         body: str | None = None, *, window=None) -> Dem:
     """Read a DEM: a GeoTIFF (or any raster GDAL reads) or a PDS3 ``.IMG``/``.LBL`` pair.
 
     NoData pixels become NaN; the band's scale and offset are applied; the CRS,
@@ -81,6 +86,12 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     body : str, optional
         A body of :data:`craters.TARGETS` (``moon``, ``mars`` ...): its mean radius when
         neither ``body_radius_m`` nor the file gives one (a geographic CRS needs it).
+    window : rasterio Window or (row_off, col_off, rows, cols), optional
+        Read only these pixels (integers, inside the raster): the result is
+        ``read(path).crop(window)`` - its transform, lattice origin and pixel size are
+        the window's - without reading the rest of the file (GeoTIFFs read their
+        blocks, PDS3 images their lines), so a window of a DEM bigger than memory can
+        be worked on. A window whose every pixel is NoData is an error.
 
     Returns
     -------
@@ -98,12 +109,13 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         raise ValueError(f"DEM file {str(path)!r} does not exist")
     with about("band"):
         band = check_int("band", band, 1)
+    win = None if window is None else _check_window(window)
     if path.suffix.lower() in PDS_SUFFIXES:
-        heights, transform, crs, tags, label_radius = _read_pds(path, band)
+        heights, transform, crs, tags, label_radius = _read_pds(path, band, win)
         if body_radius_m is None:
             body_radius_m = label_radius
     else:
-        heights, transform, crs, tags = _read_gdal(path, band)
+        heights, transform, crs, tags = _read_gdal(path, band, win)
         # written by craterform: the body radius / the pixel size of a DEM without CRS
         try:
             if body_radius_m is None and RADIUS_TAG in tags:
@@ -116,8 +128,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     if body_radius_m is None and body is not None and crs is not None and crs.is_geographic:
         body_radius_m = get_target(body).radius_m
     if not np.isfinite(heights).any():
-        raise ValueError(f"{str(path)!r}: every pixel is NoData/NaN; there is no terrain to "
-                         f"work with")
+        where = "" if win is None else f" of the window {_window_text(win)}"
+        raise ValueError(f"{str(path)!r}: every pixel{where} is NoData/NaN; there is no "
+                         f"terrain to work with")
     level, origin = 0, (0, 0)
     try:
         if LEVEL_TAG in tags:
@@ -126,6 +139,10 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     except ValueError:
         logger.warning("%s: ignoring malformed %s/%s tags", path, LEVEL_TAG, ORIGIN_TAG)
         level, origin = 0, (0, 0)
+    if win is not None:  # as Dem.crop: the window's transform and lattice origin
+        r0, c0 = win[0], win[1]
+        transform = transform @ Affine.translation(c0, r0)
+        origin = (origin[0] + r0, origin[1] + c0)
     try:
         return Dem._own(heights, transform, crs, pixel_size_m=pixel_size_m,
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
@@ -134,7 +151,41 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
             raise type(exc)(f"{str(path)!r}: {exc}") from None
 
 
-def _read_gdal(path: Path, band: int):
+def _check_window(window) -> tuple[int, int, int, int]:
+    """(row_off, col_off, rows, cols) of a rasterio Window or a 4-tuple of integers."""
+    with about("window"):
+        if isinstance(window, Window):
+            vals = (window.row_off, window.col_off, window.height, window.width)
+        else:
+            try:
+                vals = tuple(window)
+            except TypeError:
+                vals = ()
+            if len(vals) != 4:
+                raise TypeError(f"`window` must be a rasterio Window or (row_off, col_off, "
+                                f"rows, cols); got {window!r}")
+        if any(isinstance(v, bool) or not float(v).is_integer() for v in vals):
+            raise ValueError(f"`window` must have integer offsets and sizes; got {window!r}")
+        r0, c0, h, w = (int(v) for v in vals)
+        if r0 < 0 or c0 < 0 or h < 1 or w < 1:
+            raise ValueError(f"`window` must have offsets >= 0 and sizes >= 1; got "
+                             f"(row_off, col_off, rows, cols) = {(r0, c0, h, w)}")
+    return r0, c0, h, w
+
+
+def _window_text(win) -> str:
+    return f"(row_off, col_off, rows, cols) = {tuple(win)}"
+
+
+def _check_inside(win, rows: int, cols: int, path: Path) -> None:
+    r0, c0, h, w = win
+    if r0 + h > rows or c0 + w > cols:
+        with about("window"):
+            raise ValueError(f"`window` {_window_text(win)} is not inside {str(path)!r} "
+                             f"({rows} x {cols} pixels)")
+
+
+def _read_gdal(path: Path, band: int, win=None):
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -143,7 +194,12 @@ def _read_gdal(path: Path, band: int):
                     with about("band"):
                         raise ValueError(f"`band` must be in [1, {ds.count}] for "
                                          f"{str(path)!r}; got {band}")
-                data = ds.read(band, masked=True)
+                if win is None:
+                    data = ds.read(band, masked=True)
+                else:
+                    _check_inside(win, ds.height, ds.width, path)
+                    data = ds.read(band, masked=True, window=Window(win[1], win[0], win[3],
+                                                                    win[2]))
                 scale, offset = ds.scales[band - 1], ds.offsets[band - 1]
                 transform, crs = ds.transform, ds.crs
                 tags = ds.tags()
@@ -159,68 +215,8 @@ def _read_gdal(path: Path, band: int):
 
 
 # --------------------------------------------------------------------------- PDS3
-def _find_file(folder: Path, name: str) -> Path | None:
-    """``folder / name``, matching the name case-insensitively (PDS names are upper-case)."""
-    exact = folder / name
-    if exact.is_file():
-        return exact
-    lower = name.lower()
-    for p in folder.iterdir():
-        if p.name.lower() == lower and p.is_file():
-            return p
-    return None
-
-
-def _label_text(path: Path) -> tuple[str, Path]:
-    """The label text and the file it came from (detached ``.lbl`` or attached)."""
-    if path.suffix.lower() == ".lbl":
-        return path.read_text(encoding="latin-1"), path
-    with open(path, "rb") as fh:
-        head = fh.read(1 << 20)
-    if head.startswith(b"PDS_VERSION_ID"):
-        text = head.decode("latin-1")
-        end = re.search(r"^\s*END\s*$", text, re.M)
-        return (text[:end.end()] if end else text), path
-    for suffix in (".lbl", ".LBL", ".Lbl"):
-        label = _find_file(path.parent, path.stem + suffix)
-        if label is not None:
-            return label.read_text(encoding="latin-1"), label
-    raise ValueError(f"{str(path)!r}: no PDS label found (neither attached nor a .LBL "
-                     f"file next to it)")
-
-
-def _number(block: dict, key: str, where: str, default=None, unit_scale=None) -> float:
-    """A numeric label value; ``unit_scale`` maps lower-case units to factors."""
-    value = block.get(key, default)
-    if value is None:
-        raise ValueError(f"{where}: the label has no {key}")
-    if not isinstance(value, int | float):
-        raise ValueError(f"{where}: label {key} = {value!r} is not a number")
-    factor = 1.0
-    if unit_scale is not None and isinstance(value, Quantity):
-        unit = value.unit.lower()
-        if unit not in unit_scale:
-            raise ValueError(f"{where}: label {key} has unit <{value.unit}>; expected one of "
-                             f"{', '.join(unit_scale)}")
-        factor = unit_scale[unit]
-    return float(value) * factor
-
-
-def _pds_constant(value, kind: str, nbytes: int):
-    """A label constant (decimal or PDS radix ``16#...#``) in the raw sample's terms."""
-    if isinstance(value, int | float):
-        return value
-    m = re.fullmatch(r"(\d+)#([0-9A-Fa-f]+)#", str(value).strip())
-    if not m:
-        return None
-    raw = int(m.group(2), int(m.group(1)))
-    if kind == "f":
-        return float(np.frombuffer(raw.to_bytes(nbytes, "big"), dtype=f">f{nbytes}")[0])
-    return raw
-
-
-def _read_pds(path: Path, band: int):
-    text, label_path = _label_text(path)
+def _read_pds(path: Path, band: int, win=None):
+    text, label_path = label_text(path)
     where = str(label_path)
     try:
         label = parse_label(text)
@@ -229,14 +225,14 @@ def _read_pds(path: Path, band: int):
     image, parent = find_object(label, "IMAGE")
     if image is None:
         raise ValueError(f"{where!r}: the PDS label has no IMAGE object")
-    lines = int(_number(image, "LINES", where))
-    samples = int(_number(image, "LINE_SAMPLES", where))
-    bands = int(_number(image, "BANDS", where, 1))
-    bits = int(_number(image, "SAMPLE_BITS", where))
+    lines = int(label_number(image, "LINES", where))
+    samples = int(label_number(image, "LINE_SAMPLES", where))
+    bands = int(label_number(image, "BANDS", where, 1))
+    bits = int(label_number(image, "SAMPLE_BITS", where))
     stype = str(image.get("SAMPLE_TYPE", "")).upper().replace(" ", "_")
-    if stype not in _PDS_TYPES:
+    if stype not in SAMPLE_TYPES:
         raise ValueError(f"{where!r}: unsupported SAMPLE_TYPE {stype or '(none)'!r}")
-    kind, order = _PDS_TYPES[stype]
+    kind, order = SAMPLE_TYPES[stype]
     if bits not in (8, 16, 32, 64) or (kind == "f" and bits < 32):
         raise ValueError(f"{where!r}: unsupported SAMPLE_BITS {bits} for {stype}")
     nbytes = bits // 8
@@ -247,8 +243,8 @@ def _read_pds(path: Path, band: int):
     if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
             "BAND_SEQUENTIAL":
         raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
-    prefix = int(_number(image, "LINE_PREFIX_BYTES", where, 0))
-    suffix = int(_number(image, "LINE_SUFFIX_BYTES", where, 0))
+    prefix = int(label_number(image, "LINE_PREFIX_BYTES", where, 0))
+    suffix = int(label_number(image, "LINE_SUFFIX_BYTES", where, 0))
     stride = prefix + samples * nbytes + suffix
 
     # where the samples are: ^IMAGE = "F.IMG" | ("F.IMG", record) | record | n <BYTES>
@@ -276,26 +272,29 @@ def _read_pds(path: Path, band: int):
     if data_name is None:
         data_path = label_path
     else:
-        data_path = _find_file(label_path.parent, data_name)
+        data_path = find_file(label_path.parent, data_name)
         if data_path is None:
             raise ValueError(f"{where!r}: the image file {data_name!r} it points to is missing")
     offset += (band - 1) * lines * stride
-    need = lines * stride
+    r0, c0, n_lines, n_samples = (0, 0, lines, samples) if win is None else win
+    if win is not None:
+        _check_inside(win, lines, samples, path)
+    need = n_lines * stride
     with open(data_path, "rb") as fh:
-        fh.seek(offset)
+        fh.seek(offset + r0 * stride)
         buf = fh.read(need)
     if len(buf) < need:
         raise ValueError(f"{str(data_path)!r} is truncated: {lines} x {samples} samples of "
-                         f"{nbytes} bytes need {need} bytes from offset {offset}; got "
-                         f"{len(buf)}")
-    rows = np.frombuffer(buf, dtype=np.uint8).reshape(lines, stride)
-    raw = np.ascontiguousarray(rows[:, prefix:prefix + samples * nbytes]).view(dtype)
-    raw = raw.reshape(lines, samples)
+                         f"{nbytes} bytes need {lines * stride} bytes from offset {offset}")
+    rows = np.frombuffer(buf, dtype=np.uint8).reshape(n_lines, stride)
+    first = prefix + c0 * nbytes
+    raw = np.ascontiguousarray(rows[:, first:first + n_samples * nbytes]).view(dtype)
+    raw = raw.reshape(n_lines, n_samples)
     heights = raw.astype(np.float64)
-    missing = _pds_constant(image.get("MISSING_CONSTANT"), kind, nbytes)
+    missing = sample_constant(image.get("MISSING_CONSTANT"), kind, nbytes)
     if missing is not None:
         heights[raw == missing] = np.nan
-    scale = _number(image, "SCALING_FACTOR", where, 1.0)
+    scale = label_number(image, "SCALING_FACTOR", where, 1.0)
     heights *= scale
 
     proj, _ = find_object(label, "IMAGE_MAP_PROJECTION")
@@ -305,7 +304,7 @@ def _read_pds(path: Path, band: int):
             tags[f"PDS_{key}"] = label[key]
     transform, crs, radius_m = Affine.identity(), None, None
     if proj is not None:
-        transform, crs, radius_m = _pds_georef(proj, label, where)
+        transform, crs, radius_m = georeference(proj, label, where)
     pds_offset = float(image.get("OFFSET", 0.0) or 0.0)
     if pds_offset:
         if radius_m is not None and abs(pds_offset - radius_m) <= 0.1 * radius_m:
@@ -315,75 +314,18 @@ def _read_pds(path: Path, band: int):
     return heights, transform, crs, tags, radius_m
 
 
-def _pds_georef(proj: dict, label: dict, where: str):
-    """Transform (degrees), geographic CRS and radius (m) of a simple-cylindrical map."""
-    ptype = " ".join(str(proj.get("MAP_PROJECTION_TYPE", "")).upper().split())
-    if ptype not in _SIMPLE_CYLINDRICAL:
-        raise ValueError(f"{where!r}: unsupported MAP_PROJECTION_TYPE {ptype or '(none)'!r}; "
-                         f"only simple cylindrical DEMs are read")
-    km = {"km": 1000.0, "kilometers": 1000.0, "kilometres": 1000.0, "m": 1.0, "meters": 1.0,
-          "metres": 1.0, "meter": 1.0, "metre": 1.0}
-    radius_m = _number(proj, "A_AXIS_RADIUS", where, unit_scale=km)
-    if not isinstance(proj["A_AXIS_RADIUS"], Quantity):
-        radius_m *= 1000.0  # PDS3 gives axis radii in km
-    deg = {"deg": 1.0, "degree": 1.0, "degrees": 1.0}
-    center_lat = _number(proj, "CENTER_LATITUDE", where, 0.0, deg)
-    if center_lat != 0.0:
-        raise ValueError(f"{where!r}: EQUIRECTANGULAR with CENTER_LATITUDE {center_lat:g} is "
-                         f"not supported (only 0, simple cylindrical)")
-    if str(proj.get("POSITIVE_LONGITUDE_DIRECTION", "EAST")).upper() != "EAST":
-        raise ValueError(f"{where!r}: only POSITIVE_LONGITUDE_DIRECTION = EAST is supported")
-    if "MAP_RESOLUTION" in proj:
-        res = _number(proj, "MAP_RESOLUTION", where, unit_scale={"pix/deg": 1.0,
-                                                                 "pixel/degree": 1.0,
-                                                                 "pixels/degree": 1.0})
-    else:
-        scale_m = _number(proj, "MAP_SCALE", where, unit_scale={
-            "m/pix": 1.0, "m/pixel": 1.0, "meters/pixel": 1.0, "metres/pixel": 1.0,
-            "km/pix": 1000.0, "km/pixel": 1000.0})
-        res = radius_m * math.pi / 180.0 / scale_m
-    if not res > 0:
-        raise ValueError(f"{where!r}: MAP_RESOLUTION must be > 0; got {res!r}")
-    center_lon = _number(proj, "CENTER_LONGITUDE", where, 0.0, deg)
-    pix = {"pix": 1.0, "pixel": 1.0, "pixels": 1.0}
-    if "SAMPLE_PROJECTION_OFFSET" in proj and "LINE_PROJECTION_OFFSET" in proj:
-        # PDS3: sample (0-based, pixel centre) = SAMPLE_PROJECTION_OFFSET + res (lon - lon0)
-        spo = _number(proj, "SAMPLE_PROJECTION_OFFSET", where, unit_scale=pix)
-        lpo = _number(proj, "LINE_PROJECTION_OFFSET", where, unit_scale=pix)
-        west = center_lon - (spo + 0.5) / res
-        north = center_lat + (lpo + 0.5) / res
-    else:
-        west = _number(proj, "WESTERNMOST_LONGITUDE", where, unit_scale=deg)
-        north = _number(proj, "MAXIMUM_LATITUDE", where, unit_scale=deg)
-    for key, value in (("MAXIMUM_LATITUDE", north), ("WESTERNMOST_LONGITUDE", west)):
-        if key in proj and isinstance(proj[key], int | float):
-            stated = float(proj[key])
-            gap = abs(stated - value) * res
-            if key == "WESTERNMOST_LONGITUDE":
-                gap = min(gap, abs(abs(stated - value) - 360.0) * res)
-            if gap > 0.01:
-                logger.warning("%s: label %s = %g but the projection offsets put the edge at "
-                               "%g; using the offsets", where, key, stated, value)
-    target = str(label.get("TARGET_NAME", "body")).title()
-    crs = CRS.from_wkt(
-        f'GEOGCS["{target} (sphere, PDS label)",DATUM["D_{target}",'
-        f'SPHEROID["{target}",{radius_m!r},0]],PRIMEM["Reference_Meridian",0],'
-        f'UNIT["degree",0.0174532925199433]]')
-    transform = Affine(1.0 / res, 0.0, west, 0.0, -1.0 / res, north)
-    return transform, crs, radius_m
-
-
 # --------------------------------------------------------------------------- write
 def write(dem: Dem, path) -> Path:
-    """Write ``dem`` to a GeoTIFF, atomically; the same DEM always gives the same bytes.
+    """Write ``dem`` to a cloud-optimised GeoTIFF, atomically; the same DEM always gives
+    the same bytes.
 
-    float32 heights with a NaN NoData value, deflate compression with the floating-point
-    predictor, 256 x 256 tiles when both sides are at least 256 pixels (the
-    cloud-optimised layout; smaller rasters are striped), BigTIFF when needed. The CRS,
-    transform and tags (including how the layer was made: ``CRATERFORM_GENERATOR``,
-    ``_VERSION``, ``_SEED``, ``_PARAMETERS``, ``_HISTORY``, the body radius if known,
-    ``CRATERFORM_BODY_RADIUS_M``, and without a CRS the pixel size,
-    ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is replaced.
+    float32 heights with a NaN NoData value, GDAL's COG layout: deflate compression with
+    the floating-point predictor, 256 x 256 tiles, overviews (averages) down to one
+    tile, BigTIFF when needed. The CRS, transform and tags (including how the layer was
+    made: ``CRATERFORM_GENERATOR``, ``_VERSION``, ``_SEED``, ``_PARAMETERS``,
+    ``_HISTORY``, the body radius if known, ``CRATERFORM_BODY_RADIUS_M``, and without a
+    CRS the pixel size, ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is
+    replaced.
 
     Examples
     --------
@@ -396,32 +338,154 @@ def write(dem: Dem, path) -> Path:
     """
     if not isinstance(dem, Dem):
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
-    path = Path(path)
-    if path.suffix.lower() not in GEOTIFF_SUFFIXES:
-        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF; allowed: "
-                         f"{' '.join(GEOTIFF_SUFFIXES)}")
+    path = _check_geotiff_path(path)
     rows, cols = dem.shape
-    profile = DefaultGTiffProfile()
-    profile.update(width=cols, height=rows, count=1, dtype="float32", nodata=np.nan,
-                   crs=dem.crs, transform=dem.transform, compress="deflate", predictor=3,
-                   bigtiff="IF_SAFER")
-    if min(rows, cols) >= _BLOCK:
-        profile.update(tiled=True, blockxsize=_BLOCK, blockysize=_BLOCK)
-    else:
-        profile.update(tiled=False)
-        del profile["blockxsize"], profile["blockysize"]
     data = dem.heights.astype(np.float32)
     with atomic_path(path) as tmp:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
-            with rasterio.open(tmp, "w", **profile) as ds:
+            # a copy-only driver: rasterio fills a MEM dataset, GDAL copies it on close
+            with rasterio.open(tmp, "w", driver="COG", width=cols, height=rows, count=1,
+                               dtype="float32", nodata=np.nan, crs=dem.crs,
+                               transform=dem.transform, **_COG_OPTIONS) as ds:
                 ds.write(data, 1)
-                tags = dict(dem.tags)
-                if dem.body_radius_m is not None:
-                    tags[RADIUS_TAG] = repr(dem.body_radius_m)
-                if dem.crs is None:
-                    tags[PIXEL_SIZE_TAG] = ",".join(map(repr, dem.pixel_size_m))
-                ds.update_tags(**tags)
-                ds.set_band_description(1, "height")
-                ds.units = ("metre",)
+                _write_metadata(ds, dem)
     return path
+
+
+def _check_geotiff_path(path) -> Path:
+    path = Path(path)
+    if path.suffix.lower() not in GEOTIFF_SUFFIXES:
+        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF; allowed: "
+                         f"{' '.join(GEOTIFF_SUFFIXES)}")
+    return path
+
+
+def _file_tags(tags, crs, body_radius_m, pixel_size_m) -> dict:
+    """The tags written with a DEM: its own, the body radius, the pixel size (no CRS)."""
+    tags = dict(tags)
+    if body_radius_m is not None:
+        tags[RADIUS_TAG] = repr(body_radius_m)
+    if crs is None:
+        tags[PIXEL_SIZE_TAG] = ",".join(map(repr, pixel_size_m))
+    return tags
+
+
+def _write_metadata(ds, dem: Dem) -> None:
+    _set_metadata(ds, _file_tags(dem.tags, dem.crs, dem.body_radius_m, dem.pixel_size_m))
+
+
+def _set_metadata(ds, tags: dict) -> None:
+    ds.update_tags(**tags)
+    ds.set_band_description(1, "height")
+    ds.units = ("metre",)
+
+
+class WindowWriter:
+    """A DEM written window by window into the cloud-optimised GeoTIFF :func:`write`
+    makes of the whole (the same bytes), for DEMs bigger than memory.
+
+    The windows go into a temporary tiled GeoTIFF next to ``path`` (256 x 256 blocks,
+    uncompressed: 4 bytes a pixel on disk while it exists); :meth:`close` copies it into
+    the COG at ``path`` (atomically) and removes it. Windows aligned to 256-pixel blocks
+    are written without reading anything back. GDAL's block cache is limited to
+    ``cache_mb`` while the writer is open, which bounds its memory. Use as a context
+    manager: an exception leaves ``path`` untouched and removes the temporary file.
+
+    Parameters
+    ----------
+    path : str or Path
+        The ``.tif`` to write.
+    shape : (int, int)
+        Rows and columns of the whole DEM.
+    transform, crs, tags, body_radius_m, pixel_size_m
+        What the whole DEM's ``Dem`` would have (``pixel_size_m`` only without a CRS).
+
+    Examples
+    --------
+    >>> import tempfile
+    >>> whole = Dem(np.arange(20.0).reshape(4, 5), pixel_size_m=2.0)
+    >>> with tempfile.TemporaryDirectory() as tmp:
+    ...     with WindowWriter(f"{tmp}/w.tif", (4, 5), pixel_size_m=2.0) as out:
+    ...         out.write(whole.heights[:2], 0, 0)
+    ...         out.write(whole.heights[2:], 2, 0)
+    ...     same = out.path.read_bytes() == write(whole, f"{tmp}/a.tif").read_bytes()
+    >>> same
+    True
+    """
+
+    def __init__(self, path, shape, *, transform: Affine | None = None, crs=None,
+                 tags=None, body_radius_m: float | None = None, pixel_size_m=None,
+                 cache_mb: int = 256):
+        self.path = _check_geotiff_path(path)
+        rows, cols = (check_int("shape", v, 1) for v in shape)
+        self.shape = (rows, cols)
+        transform = Affine.identity() if transform is None else transform
+        if crs is None:  # the pixel size tag, as a Dem without CRS writes it
+            if pixel_size_m is None:
+                with about("pixel_size_m"):
+                    raise ValueError("a DEM without CRS needs `pixel_size_m`")
+            pair = np.broadcast_to(np.asarray(pixel_size_m, dtype=np.float64), (2,))
+            pixel_size_m = tuple(float(v) for v in pair)
+        folder = self.path.parent if str(self.path.parent) else Path(".")
+        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part.tif",
+                                   dir=folder)
+        os.close(fd)
+        self._tmp = Path(tmp)
+        self._env = rasterio.Env(GDAL_CACHEMAX=int(cache_mb))
+        self._env.__enter__()
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", NotGeoreferencedWarning)
+                self._ds = rasterio.open(self._tmp, "w", driver="GTiff", width=cols,
+                                         height=rows, count=1, dtype="float32",
+                                         nodata=np.nan, crs=crs, transform=transform,
+                                         tiled=True, blockxsize=_BLOCK, blockysize=_BLOCK,
+                                         bigtiff="IF_SAFER", sparse_ok=True)
+                _set_metadata(self._ds, _file_tags(tags or {}, self._ds.crs, body_radius_m,
+                                                   pixel_size_m))
+        except BaseException:
+            self._discard()
+            raise
+
+    def write(self, heights, row_off: int, col_off: int) -> None:
+        """Write ``heights`` (rows, cols; metres, NaN = unknown) at pixel (row_off, col_off)."""
+        z = np.asarray(heights, dtype=np.float32)
+        if z.ndim != 2:
+            raise ValueError(f"`heights` must be 2-D; got shape {z.shape}")
+        win = (int(row_off), int(col_off), *z.shape)
+        _check_inside(win, *self.shape, self.path)
+        self._ds.write(z, 1, window=Window(win[1], win[0], win[3], win[2]))
+
+    def close(self) -> Path:
+        """Turn the written windows into the COG at ``path`` (unwritten pixels: NoData)."""
+        if self._ds is None:
+            return self.path
+        try:
+            self._ds.close()
+            with atomic_path(self.path) as tmp:
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore", NotGeoreferencedWarning)
+                    rasterio.shutil.copy(self._tmp, tmp, driver="COG", **_COG_OPTIONS)
+        finally:
+            self._discard()
+        return self.path
+
+    def _discard(self) -> None:
+        ds, self._ds = getattr(self, "_ds", None), None
+        if ds is not None and not ds.closed:
+            ds.close()
+        with contextlib.suppress(FileNotFoundError):
+            self._tmp.unlink()
+        env, self._env = self._env, None
+        if env is not None:
+            env.__exit__(None, None, None)
+
+    def __enter__(self) -> WindowWriter:
+        return self
+
+    def __exit__(self, exc_type, *exc) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self._discard()

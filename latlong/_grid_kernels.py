@@ -131,6 +131,29 @@ def _interpolate_kernel(m, ring_offsets, values, colat, lon, out):
 
 
 @njit(cache=True)
+def _zipper_a_steps(na, nb, steps):
+    """Ring-a advances among the first ``steps`` zipper steps of a band (closed form).
+
+    The zipper is a stable merge of the a-events k / na (k = 1..na) and the b-events
+    l / nb, ties to a: a-event k is step ``k + ceil(k nb / na) - 1`` (1-based), so the
+    count is the largest k with that step <= ``steps`` (binary search, O(log na)) - the
+    state :func:`_band_triangles_kernel` reaches after replaying ``steps`` steps. A pole
+    fan (na = 1) only advances ring b.
+    """
+    if na == 1:
+        return 0
+    lo = 0
+    hi = na
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if mid + (mid * nb + na - 1) // na - 1 <= steps:
+            lo = mid
+        else:
+            hi = mid - 1
+    return lo
+
+
+@njit(cache=True)
 def _band_strip_kernel(oa, na, ob, nb, south, step_lo, step_hi, out):
     """Triangle strip of zipper steps ``step_lo .. step_hi - 1`` of a band into ``out``.
 
@@ -140,17 +163,13 @@ def _band_strip_kernel(oa, na, ob, nb, south, step_lo, step_hi, out):
     winding alternation) matches the kind of advance: an a-advance at even parity with
     the tail (a, b), a b-advance at odd parity with (b, a) (mirrored in the south).
     Otherwise one repeated vertex (a degenerate triangle) flips the parity and the tail
-    order together. Alternating advances - most of a band - cost nothing. Returns the
+    order together. Alternating advances - most of a band - cost nothing. The zipper
+    state at ``step_lo`` is found in closed form (:func:`_zipper_a_steps`). Returns the
     number of vertices written (``out`` needs 2 + 2 * steps entries).
     """
-    i = 0
-    j = 0
+    i = _zipper_a_steps(na, nb, step_lo)
+    j = step_lo - i
     steps = na + nb if na > 1 else nb
-    for _ in range(step_lo):  # replay the zipper to the first step
-        if na > 1 and i < na and (j >= nb or (i + 1) * nb <= (j + 1) * na):
-            i += 1
-        else:
-            j += 1
     a = oa + (i % na)
     b = ob + (j % nb)
     # start in a canonical state: even parity with (a, b) north / (b, a) south
@@ -179,9 +198,47 @@ def _band_strip_kernel(oa, na, ob, nb, south, step_lo, step_hi, out):
     return k
 
 
+@njit(cache=True, nogil=True, parallel=True)
+def _lon_table_kernel(m, ring_offsets, out):
+    """cos and sin of the longitudes ``2 pi j / n`` of the northern rings 1..M into
+    ``out`` (3M(M+1), 2), ring r from row :func:`_lon_row`; a southern ring 2M - r has
+    the same n and the same longitudes, so it shares ring r's rows. Ring pairs (r,
+    M + 1 - r) per iteration balance the threads."""
+    for k in prange((m + 1) // 2):
+        for side in range(2):
+            r = k + 1 if side == 0 else m - k
+            if side == 1 and r == k + 1:
+                break
+            o = ring_offsets[r] - 1
+            n = 6 * r
+            for j in range(n):
+                lon = 2.0 * np.pi * j / n
+                out[o + j, 0] = np.cos(lon)
+                out[o + j, 1] = np.sin(lon)
+
+
 @njit(cache=True, inline="always")
-def _ring_positions(m, r, o, radii, stretch, out):
-    """Positions of ring r's vertices (radii times unit vectors, stretched) into out."""
+def _lon_row(m, r, ring_offsets):
+    """First row of ring r's longitudes (1 <= r <= 2M - 1) in :func:`_lon_table_kernel`'s
+    table."""
+    r = np.int64(r)  # a prange index may be unsigned: 2m - r must stay an integer
+    if r > m:
+        r = 2 * np.int64(m) - r
+    return ring_offsets[r] - 1
+
+
+def lon_table(m: int, ring_offsets) -> np.ndarray:
+    """:func:`_lon_table_kernel`'s table for a grid of magnitude ``m`` (8 B a vertex)."""
+    out = np.empty((3 * m * (m + 1), 2), dtype=np.float64)
+    _lon_table_kernel(m, ring_offsets, out)
+    return out
+
+
+@njit(cache=True, inline="always")
+def _ring_positions(m, r, o, radii, stretch, table, t0, out):
+    """Positions of ring r's vertices (radii times unit vectors, stretched) into out,
+    ``stretch * radius * sin(colatitude) * cos(longitude)`` ..., the longitudes'
+    cosines and sines from ``table`` rows ``t0 ..`` (:func:`lon_table`)."""
     n = _ring_size(r, m)
     colat = r * (np.pi / (2 * m))
     if n == 1:
@@ -193,9 +250,8 @@ def _ring_positions(m, r, o, radii, stretch, out):
     s = np.sin(colat)
     c = np.cos(colat)
     for j in range(n):
-        lon = 2.0 * np.pi * j / n
-        out[j, 0] = stretch[0] * radii[o + j] * s * np.cos(lon)
-        out[j, 1] = stretch[1] * radii[o + j] * s * np.sin(lon)
+        out[j, 0] = stretch[0] * radii[o + j] * s * table[t0 + j, 0]
+        out[j, 1] = stretch[1] * radii[o + j] * s * table[t0 + j, 1]
         out[j, 2] = stretch[2] * radii[o + j] * c
 
 

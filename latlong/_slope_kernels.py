@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._grid_kernels import _band_triangles_kernel, _ring_positions, _ring_size
+from ._grid_kernels import _band_triangles_kernel, _lon_row, _ring_positions, _ring_size
 
 
 @njit(cache=True)
@@ -39,13 +39,14 @@ def _vertex_normals_kernel(verts, tris, out, area):
 
 
 @njit(cache=True, parallel=True)
-def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, acc):
+def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc):
     """Area-weighted vertex normals of the body into ``acc``, streamed band by band (no
     triangle or vertex array of the whole body): each band's two rings (consecutive
     vertex numbers) are positioned and triangulated locally and passed to
     :func:`_vertex_normals_kernel`. Even bands first, then odd bands: the bands of one
     pass share no ring, so they run in parallel and every vertex receives its two bands'
-    contributions in a fixed order (deterministic)."""
+    contributions in a fixed order (deterministic). The longitudes' cosines and sines come
+    from ``lon_table`` (:func:`~latlong._grid_kernels.lon_table`)."""
     n_bands = 2 * m
     no_area = np.empty(0)
     for parity in range(2):
@@ -63,11 +64,29 @@ def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, ac
             ob = ring_offsets[rb]
             lo = min(oa, ob)
             pos = np.empty((na + nb, 3))
-            _ring_positions(m, ra, oa, radii, stretch, pos[oa - lo:oa - lo + na])
-            _ring_positions(m, rb, ob, radii, stretch, pos[ob - lo:ob - lo + nb])
+            _ring_positions(m, ra, oa, radii, stretch, lon_table,
+                            _lon_row(m, ra, ring_offsets), pos[oa - lo:oa - lo + na])
+            _ring_positions(m, rb, ob, radii, stretch, lon_table,
+                            _lon_row(m, rb, ring_offsets), pos[ob - lo:ob - lo + nb])
             tris = np.empty((band_offsets[band + 1] - band_offsets[band], 3), dtype=np.int64)
             _band_triangles_kernel(oa - lo, na, ob - lo, nb, south, tris, 0)
             _vertex_normals_kernel(pos, tris, acc[lo:lo + na + nb], no_area)
+
+
+@njit(cache=True, parallel=True)
+def _normalize_rows_kernel(acc):
+    """Scale the float32 rows of ``acc`` to unit length in place: the norm in float64,
+    ``sqrt((x^2 + y^2) + z^2)``, rounded to float32 and divided into each component
+    (rows of norm 0 are left alone)."""
+    for i in prange(acc.shape[0]):
+        x = np.float64(acc[i, 0])
+        y = np.float64(acc[i, 1])
+        z = np.float64(acc[i, 2])
+        norm = np.sqrt((x * x + y * y) + z * z)
+        if norm > 0:
+            d = np.float32(norm)
+            for c in range(3):
+                acc[i, c] = acc[i, c] / d
 
 
 @njit(cache=True, parallel=True)

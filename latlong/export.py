@@ -3,12 +3,16 @@ for the shared writers (PLY, OBJ, STL, VTP, VTK), and the patched-strip glTF for
 
 Nothing holds the whole triangle array: triangles are generated a few latitude bands at a
 time (``LatLongGrid.band_triangles``), so a 24 M-vertex body exports in a few hundred MB
-beyond the body itself. Every vertex has ``height_m`` (radius minus the reference
-radius). Placed boulders (``body.boulders``) are merged in at their finest level after
-the body's vertices and triangles, with a per-vertex ``boulder_id`` (-1 on the body,
-else the boulder's row in the catalog: ground truth for hazard detection) and, in OBJ,
-the face groups ``body`` and ``boulders``. ``.glb`` is the renderer export of
-:func:`latlong.export_glb` (patched triangle strips, manifest).
+beyond the body itself. PLY takes a fast path (``MeshSource.vertex_records`` /
+``face_records``): numba kernels write the packed records of 2 M vertices or triangles
+straight into one of two alternating buffers while the other is written on a background
+thread (the longitudes' cosines and sines, 8 B a vertex, are found once per pair of
+mirror rings); the bytes are those of the generic packing. Every vertex has ``height_m``
+(radius minus the reference radius). Placed boulders (``body.boulders``) are merged in at
+their finest level after the body's vertices and triangles, with a per-vertex
+``boulder_id`` (-1 on the body, else the boulder's row in the catalog: ground truth for
+hazard detection) and, in OBJ, the face groups ``body`` and ``boulders``. ``.glb`` is
+the renderer export of :func:`latlong.export_glb` (patched triangle strips, manifest).
 """
 
 from __future__ import annotations
@@ -17,9 +21,17 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared.meshio import MESH_SUFFIXES, MeshSource, write_mesh
+from craters._shared.meshio import (
+    MESH_SUFFIXES,
+    MeshSource,
+    pack_faces,
+    pack_vertices,
+    write_mesh,
+)
 from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
 
+from ._export_kernels import _ply_face_kernel, _ply_vertex_kernel
+from ._grid_kernels import lon_table
 from .gltf import export_glb
 
 __all__ = ["EXPORT_SUFFIXES", "body_mesh_source", "export_body"]
@@ -50,7 +62,14 @@ def body_mesh_source(body) -> MeshSource:
     top = catalog_shape(cat).levels[-1] if cat is not None else 0
     nbv = 0 if cat is None else len(cat) * (10 * 4**top + 2)
     nbt = 0 if cat is None else len(cat) * 20 * 4**top
-    stretch = np.asarray(body.stretch)
+    stretch = np.array(body.stretch, dtype=np.float64)
+
+    def boulder_vertex_chunks():
+        for s0, world, _ in iter_boulder_meshes(cat):
+            k, nv = world.shape[:2]
+            v = world.reshape(-1, 3)
+            yield v, {"height_m": np.linalg.norm(v / stretch, axis=-1) - body.radius_m,
+                      "boulder_id": np.repeat(np.arange(s0, s0 + k, dtype=np.int32), nv)}
 
     def vertex_chunks():
         heights = body.heights_m
@@ -61,11 +80,39 @@ def body_mesh_source(body) -> MeshSource:
                 values["boulder_id"] = np.full(e - s, -1, dtype=np.int32)
             yield body.vertices(s, e), values
         if cat is not None:
-            for s0, world, _ in iter_boulder_meshes(cat):
-                k, nv = world.shape[:2]
-                v = world.reshape(-1, 3)
-                yield v, {"height_m": np.linalg.norm(v / stretch, axis=-1) - body.radius_m,
-                          "boulder_id": np.repeat(np.arange(s0, s0 + k, dtype=np.int32), nv)}
+            yield from boulder_vertex_chunks()
+
+    def vertex_records(dtype):
+        # the body's records straight from a kernel into two alternating buffers
+        bufs = [np.empty(min(n, _CHUNK), dtype=dtype) for _ in range(2)]
+        radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
+        table = lon_table(grid.magnitude, grid.ring_offsets())
+        for k, s in enumerate(range(0, n, _CHUNK)):
+            e = min(s + _CHUNK, n)
+            buf = bufs[k % 2]
+            _ply_vertex_kernel(grid.magnitude, grid.ring_offsets(), radii, body.radius_m,
+                               stretch, table, s, e, buf.view(np.float32).reshape(len(buf), -1))
+            rec = buf[:e - s]
+            if cat is not None:
+                rec["boulder_id"] = -1
+            yield rec
+        if cat is not None:
+            for v, values in boulder_vertex_chunks():
+                yield pack_vertices(v, values, dtype)
+
+    def face_records(dtype):
+        ro, bo = grid.ring_offsets(), grid.band_offsets()
+        chunks = list(_band_chunks(grid))
+        size = max((int(bo[hi] - bo[lo]) for lo, hi in chunks), default=0)
+        bufs = [np.empty(size, dtype=dtype) for _ in range(2)]
+        for i, (lo, hi) in enumerate(chunks):
+            k = int(bo[hi] - bo[lo])
+            buf = bufs[i % 2][:k]
+            _ply_face_kernel(grid.magnitude, lo, hi, ro, bo, buf.view(np.uint8))
+            yield buf
+        if cat is not None:
+            for tri in boulder_face_chunks():
+                yield pack_faces(tri, dtype)
 
     def body_faces():
         for lo, hi in _band_chunks(grid):
@@ -99,7 +146,8 @@ def body_mesh_source(body) -> MeshSource:
     fields = [("height_m", "<f4")] + ([("boulder_id", "<i4")] if cat is not None else [])
     return MeshSource(n + nbv, t + nbt, vertex_chunks, face_groups, facet_chunks,
                       tuple(fields), "craterform lat/long body, metres", tuple(comments),
-                      f"craterform lat/long body, magnitude {grid.magnitude}, metres")
+                      f"craterform lat/long body, magnitude {grid.magnitude}, metres",
+                      vertex_records=vertex_records, face_records=face_records)
 
 
 def export_body(body, path, *, progress: bool = False) -> Path:

@@ -8,8 +8,11 @@ min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band stri
 to the patch and joined with degenerate triangles. Node extras and the JSON manifest
 give each patch's bounding sphere, bands, triangle count and the byte ranges of its
 data, so a renderer can cull and stream patches. Nothing holds the whole body's
-triangles: patches are generated and written one by one, normals come from a
-band-streaming kernel, and each level's binary data goes to a temporary file first.
+triangles: a first pass over the patches (numba, patches in parallel) finds each one's
+strip length, vertex count and bounds from float32 positions computed once per level,
+which fixes the whole JSON; the second pass generates the patches' data again, a group
+of patches at a time into one buffer, straight after the JSON (normals from a
+band-streaming kernel). Only the boulder meshes go through a temporary file.
 A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
 ``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
 glTF 2.0 allows.
@@ -25,6 +28,7 @@ so a renderer can switch by distance.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import shutil
@@ -34,11 +38,19 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, check_int, package_version, progress_bar
+from craters._shared import (
+    BackgroundWriter,
+    atomic_path,
+    check_int,
+    package_version,
+    progress_bar,
+)
 from craters.boulders import boulder_meshes, boulder_normals, catalog_shape, mesh_chunk
 
+from ._export_kernels import _glb_positions_kernel, _patch_kernel
+from ._grid_kernels import lon_table
 from .grid import LatLongGrid
-from .strips import join_strips, patch_tree, strip_triangles, triangle_strips
+from .strips import patch_tree, triangle_strips
 
 __all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
 
@@ -98,22 +110,24 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
     folder = path.parent if str(path.parent) else Path(".")
     temps = []
     try:
-        sizes = []
+        sizes, plans = [], []
         for level in range(lod + 1):
-            fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".lod{level}.bin",
-                                           dir=folder)
-            os.close(fd)
-            temps.append(tmp_bin)
-            with open(tmp_bin, "wb") as binf:
-                size = _write_level(body.lod(level), level, patch_k, gl, manifest, binf,
-                                    progress)
-                if body.boulders is not None and len(body.boulders):
-                    if level == 0:
+            plan = _plan_level(body.lod(level), level, patch_k, gl, manifest)
+            size = plan.size
+            if body.boulders is not None and len(body.boulders):
+                if level == 0:
+                    fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.",
+                                                   suffix=".boulders.bin", dir=folder)
+                    os.close(fd)
+                    temps.append(tmp_bin)
+                    plan.boulders = tmp_bin
+                    with open(tmp_bin, "wb") as binf:
                         size, boulder_first = _write_boulder_meshes(body.boulders, gl,
                                                                      manifest, binf, size)
-                    _boulder_nodes(body.boulders, level, boulder_first, gl, manifest)
-                sizes.append(size)
-        _finish(path, gl, manifest, temps, sizes)
+                _boulder_nodes(body.boulders, level, boulder_first, gl, manifest)
+            sizes.append(size)
+            plans.append(plan)
+        _finish(path, gl, manifest, plans, sizes, temps, progress)
     finally:
         for t in temps:
             if os.path.exists(t):
@@ -125,11 +139,14 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
 
 #: A GLB's length and chunk lengths are 32-bit: past this the levels go to .bin files.
 GLB_LIMIT = 2**32 - 1
+#: Bytes of patch data generated per group (one buffer) in the writing pass.
+_GROUP_BYTES = 1 << 26
 
 
-def _finish(path: Path, gl: dict, manifest: dict, temps: list, sizes: list) -> None:
-    """Embed the levels' binary data in the GLB, or - past 4 GiB, the format's limit -
-    reference one external ``<stem>.lod<k>.bin`` per level (glTF external buffers)."""
+def _finish(path: Path, gl: dict, manifest: dict, plans: list, sizes: list, temps: list,
+            progress: bool) -> None:
+    """Write the GLB with the levels' binary data embedded, or - past 4 GiB, the format's
+    limit - with one external ``<stem>.lod<k>.bin`` per level (glTF external buffers)."""
     starts = np.concatenate([[0], np.cumsum(sizes)]).astype(int)
     embedded = dict(gl, buffers=[{"byteLength": int(starts[-1])}],
                     bufferViews=[dict(v, buffer=0, byteOffset=v["byteOffset"]
@@ -147,18 +164,24 @@ def _finish(path: Path, gl: dict, manifest: dict, temps: list, sizes: list) -> N
             out.write(struct.pack("<I4s", len(js), b"JSON"))
             out.write(js)
             out.write(struct.pack("<I4s", int(starts[-1]), b"BIN\x00"))
-            for t in temps:
-                with open(t, "rb") as src:
-                    shutil.copyfileobj(src, out, length=16 << 20)
+            for plan in plans:
+                _write_level_data(plan, out, progress)
         return
-    names = [f"{path.stem}.lod{k}.bin" for k in range(len(temps))]
+    names = [f"{path.stem}.lod{k}.bin" for k in range(len(plans))]
     gl["buffers"] = [{"uri": n, "byteLength": int(sz)} for n, sz in zip(names, sizes,
                                                                        strict=True)]
     js = _json_chunk(gl)
     manifest["bin_chunk_offset"] = None
     manifest["buffers"] = names
-    for t, n in zip(temps, names, strict=True):
-        os.replace(t, path.parent / n)
+    folder = path.parent if str(path.parent) else Path(".")
+    for plan, n in zip(plans, names, strict=True):
+        fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".lod{plan.level}.bin",
+                                       dir=folder)
+        os.close(fd)
+        temps.append(tmp_bin)
+        with open(tmp_bin, "wb") as out:
+            _write_level_data(plan, out, progress)
+        os.replace(tmp_bin, path.parent / n)
     with atomic_path(path) as tmp, open(tmp, "wb") as out:
         out.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js)))
         out.write(struct.pack("<I4s", len(js), b"JSON"))
@@ -170,57 +193,112 @@ def _json_chunk(gl: dict) -> bytes:
     return js + b" " * _pad4(len(js))
 
 
-def _write_level(body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
-                 progress: bool) -> int:
-    """Write one level's patches to ``binf`` (buffer = the level); returns its size."""
-    offset = 0
+@dataclasses.dataclass
+class _LevelPlan:
+    """One level's patches after the first pass: what the second pass writes where."""
+
+    level: int
+    body: object
+    positions: np.ndarray
+    """float32 (N, 3) positions of the level's vertices."""
+    lon_table: np.ndarray
+    """The grid's longitude cosines and sines (shared by positions and normals)."""
+    leaves: tuple
+    """(band_lo, entry pointers, triangle range lo, hi) arrays of the patch tree leaves."""
+    at: np.ndarray
+    """(leaves, 3) byte offsets of each leaf's positions, normals, indices in the level
+    (-1: no patch, its strip has fewer than 3 vertices)."""
+    nbytes: np.ndarray
+    """Bytes of each leaf's data."""
+    size: int
+    """Bytes of the level's patch data."""
+    boulders: str | None = None
+    """Temporary file with the boulder meshes (after level 0's patches)."""
+
+
+def _leaf_table(grid: LatLongGrid, leaves: list) -> tuple:
+    """The leaves' bands and per-band triangle ranges as flat arrays
+    (``Patch.triangle_range`` of every band of every leaf)."""
+    band_lo = np.array([p.band_lo for p in leaves], dtype=np.int64)
+    counts = np.array([p.band_hi - p.band_lo for p in leaves], dtype=np.int64)
+    ptr = np.concatenate([[0], np.cumsum(counts)]).astype(np.int64)
+    band = np.repeat(band_lo, counts) + np.arange(ptr[-1]) - np.repeat(ptr[:-1], counts)
+    bo = grid.band_offsets()
+    n = (bo[band + 1] - bo[band]).astype(np.float64)
+    f_lo = np.repeat(np.array([p.frac_lo for p in leaves], dtype=np.float64), counts)
+    f_hi = np.repeat(np.array([p.frac_hi for p in leaves], dtype=np.float64), counts)
+    lo = np.floor(f_lo * n + 0.5).astype(np.int64)
+    hi = np.floor(f_hi * n + 0.5).astype(np.int64)
+    return band_lo, ptr, lo, hi
+
+
+def _patch_pass(grid, positions, normals, leaves, leaf_from, leaf_to, meta, bounds, at=None,
+                out=None) -> None:
+    """Run :func:`_patch_kernel`: metadata (``at`` None) or data into ``out`` (uint32
+    words; ``at`` = (leaves, 3) word offsets in it)."""
+    band_lo, ptr, lo, hi = leaves
+    write = at is not None
+    if not write:
+        at = np.zeros((1, 3), dtype=np.int64)
+        out = np.zeros(1, dtype=np.uint32)
+    _patch_kernel(grid.magnitude, grid.ring_offsets(), band_lo, ptr, lo, hi, positions,
+                  normals, leaf_from, leaf_to, write, meta, bounds,
+                  np.ascontiguousarray(at[:, 0]), np.ascontiguousarray(at[:, 1]),
+                  np.ascontiguousarray(at[:, 2]), out.view(np.float32), out)
+
+
+def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _LevelPlan:
+    """First pass over one level's patches: their JSON (buffer = the level; offsets
+    within it), manifest entries and where their data goes."""
     grid = body.grid
-    normals = body.vertex_normals()
-    radii = np.asarray(body.radii_m)
-    stretch = np.asarray(body.stretch)
-    root = patch_tree(grid, patch_k)
-    leaves = list(root.leaves())
+    positions = np.empty((grid.n_vertices, 3), dtype=np.float32)
+    table = lon_table(grid.magnitude, grid.ring_offsets())
+    _glb_positions_kernel(grid.magnitude, grid.ring_offsets(),
+                          np.ascontiguousarray(body.radii_m, dtype=np.float64),
+                          np.array(body.stretch, dtype=np.float64), table, positions)
+    leaves = list(patch_tree(grid, patch_k).leaves())
+    leaves_table = _leaf_table(grid, leaves)
+    nl = len(leaves)
+    meta = np.zeros((nl, 3), dtype=np.int64)
+    bounds = np.zeros((nl, 10), dtype=np.float64)
+    _patch_pass(grid, positions, positions, leaves_table, 0, nl, meta, bounds)
+    at = np.full((nl, 3), -1, dtype=np.int64)
+    nbytes = np.zeros(nl, dtype=np.int64)
+    offset = 0
     scene_nodes = []
     level_info = {"level": level, "magnitude": grid.magnitude, "n_vertices": grid.n_vertices,
                   "n_triangles": grid.n_triangles, "scene": level, "patches": []}
-    for leaf in progress_bar(leaves, enabled=progress, desc=f"LOD {level}"):
-        strip = join_strips(leaf.strips(grid))
-        if len(strip) < 3:
+    for i, leaf in enumerate(leaves):
+        length, nv, n_tri = (int(x) for x in meta[i])
+        if length < 3:
             continue
-        idx, local = np.unique(strip, return_inverse=True)
-        pos = (unit_vectors_of(grid, idx) * radii[idx, None] * stretch).astype(np.float32)
-        nrm = normals[idx]
-        ind = local.astype(np.uint32)
-        lo, hi = pos.min(axis=0), pos.max(axis=0)
-        centre = 0.5 * (lo.astype(np.float64) + hi)
-        radius = float(np.sqrt(((pos - centre) ** 2).sum(axis=1).max()))
-        n_tri = len(strip_triangles(strip))
+        lo, hi = bounds[i, 0:3].tolist(), bounds[i, 3:6].tolist()
+        centre, radius = bounds[i, 6:9].tolist(), float(bounds[i, 9])
         ranges = {}
-        for name, data, target in (("positions", pos, _ARRAY_BUFFER),
-                                   ("normals", nrm, _ARRAY_BUFFER),
-                                   ("indices", ind, _ELEMENT_ARRAY_BUFFER)):
-            raw = np.ascontiguousarray(data).tobytes()
-            binf.write(raw)
+        for k, (name, nbyte, target) in enumerate((
+                ("positions", 12 * nv, _ARRAY_BUFFER), ("normals", 12 * nv, _ARRAY_BUFFER),
+                ("indices", 4 * length, _ELEMENT_ARRAY_BUFFER))):
             gl["bufferViews"].append({"buffer": level, "byteOffset": offset,
-                                      "byteLength": len(raw), "target": target})
-            ranges[name] = [offset, len(raw)]
-            offset += len(raw)
+                                      "byteLength": nbyte, "target": target})
+            ranges[name] = [offset, nbyte]
+            at[i, k] = offset
+            offset += nbyte
+        nbytes[i] = 24 * nv + 4 * length
         v0 = len(gl["bufferViews"]) - 3
         a0 = len(gl["accessors"])
         gl["accessors"] += [
-            {"bufferView": v0, "componentType": _FLOAT, "count": len(pos), "type": "VEC3",
-             "min": [float(x) for x in lo], "max": [float(x) for x in hi]},
-            {"bufferView": v0 + 1, "componentType": _FLOAT, "count": len(pos), "type": "VEC3"},
-            {"bufferView": v0 + 2, "componentType": _UINT, "count": len(ind),
+            {"bufferView": v0, "componentType": _FLOAT, "count": nv, "type": "VEC3",
+             "min": lo, "max": hi},
+            {"bufferView": v0 + 1, "componentType": _FLOAT, "count": nv, "type": "VEC3"},
+            {"bufferView": v0 + 2, "componentType": _UINT, "count": length,
              "type": "SCALAR"}]
         gl["meshes"].append({"primitives": [{"attributes": {"POSITION": a0, "NORMAL": a0 + 1},
                                              "indices": a0 + 2, "mode": _TRIANGLE_STRIP}]})
         pid = len(level_info["patches"])
         info = {"id": pid, "bands": [leaf.band_lo, leaf.band_hi],
                 "fraction": [leaf.frac_lo, leaf.frac_hi], "depth": leaf.depth,
-                "centre_m": [float(x) for x in centre], "radius_m": radius,
-                "n_vertices": len(pos), "n_triangles": n_tri, "strip_length": len(ind),
-                "bytes": ranges}
+                "centre_m": centre, "radius_m": radius, "n_vertices": nv,
+                "n_triangles": n_tri, "strip_length": length, "bytes": ranges}
         gl["nodes"].append({"name": f"lod{level}/patch{pid}", "mesh": len(gl["meshes"]) - 1,
                             "extras": {"centre_m": info["centre_m"], "radius_m": radius,
                                        "n_triangles": n_tri}})
@@ -230,7 +308,46 @@ def _write_level(body, level: int, patch_k: int, gl: dict, manifest: dict, binf,
                         "extras": {"magnitude": grid.magnitude, "level": level}})
     gl["scenes"].append({"name": f"lod{level}", "nodes": [len(gl["nodes"]) - 1]})
     manifest["levels"].append(level_info)
-    return offset
+    return _LevelPlan(level, body, positions, table, leaves_table, at, nbytes, offset)
+
+
+def _write_level_data(plan: _LevelPlan, fh, progress: bool) -> None:
+    """Second pass: the level's patch data (groups of leaves generated in parallel into
+    one buffer, then written), then the boulder meshes after level 0."""
+    body = plan.body
+    grid = body.grid
+    normals = grid.vertex_normals(body.radii_m, body.stretch, lon_table=plan.lon_table)
+    plan.lon_table = None
+    nl = len(plan.nbytes)
+    ends = np.cumsum(plan.nbytes)
+    groups = []
+    first = 0
+    while first < nl:  # consecutive leaves, about _GROUP_BYTES each (at least one leaf)
+        last = int(np.searchsorted(ends, ends[first] - plan.nbytes[first] + _GROUP_BYTES,
+                                   side="right"))
+        last = min(max(last, first + 1), nl)
+        groups.append((first, last))
+        first = last
+    big = max((int(ends[b - 1] - ends[a] + plan.nbytes[a]) for a, b in groups), default=0)
+    bufs = [np.empty(big // 4, dtype=np.uint32) for _ in range(2)]
+    meta = np.zeros((1, 3), dtype=np.int64)
+    bounds = np.zeros((1, 10), dtype=np.float64)
+    with BackgroundWriter(fh) as out:  # group k + 1 is made while group k is written
+        for i, (a, b) in enumerate(progress_bar(groups, enabled=progress,
+                                                desc=f"LOD {plan.level}")):
+            start = int(ends[a] - plan.nbytes[a])
+            size = int(ends[b - 1]) - start
+            if size == 0:
+                continue
+            at = np.where(plan.at >= 0, (plan.at - start) // 4, 0)
+            buf = bufs[i % 2][:size // 4]
+            _patch_pass(grid, plan.positions, normals, plan.leaves, a, b, meta, bounds, at,
+                        buf)
+            out.write(buf.view(np.uint8))
+    plan.positions = None
+    if plan.boulders is not None:
+        with open(plan.boulders, "rb") as src:
+            shutil.copyfileobj(src, fh, length=16 << 20)
 
 
 def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):

@@ -17,7 +17,8 @@ from ._grid_kernels import (
     _unit_range_kernel,
     _unit_range_serial,
 )
-from ._slope_kernels import _normals_from_radii_kernel
+from ._grid_kernels import lon_table as make_lon_table
+from ._slope_kernels import _normalize_rows_kernel, _normals_from_radii_kernel
 
 __all__ = ["LatLongGrid", "MAX_MAGNITUDE"]
 
@@ -345,10 +346,13 @@ class LatLongGrid:
         """
         return self._sample(_surface_radius_kernel, "radii", radii, colatitudes, longitudes)
 
-    def vertex_normals(self, radii, stretch=(1.0, 1.0, 1.0)) -> np.ndarray:
+    def vertex_normals(self, radii, stretch=(1.0, 1.0, 1.0), *,
+                       lon_table: np.ndarray | None = None) -> np.ndarray:
         """Unit area-weighted vertex normals, float32 (N, 3), of the mesh whose vertex
         ``i`` is ``stretch * radii[i] * u_i``; accumulated band by band (12 B a vertex,
-        no triangle array) and normalised in chunks.
+        no triangle array, and 8 B a vertex of longitude cosines and sines while it
+        runs; pass ``lon_table`` - ``latlong._grid_kernels.lon_table(M, ring_offsets)`` -
+        to reuse one) and normalised in place.
 
         Examples
         --------
@@ -360,14 +364,15 @@ class LatLongGrid:
         radii = np.ascontiguousarray(radii, dtype=np.float64)
         if radii.shape != (self.n_vertices,):
             raise ValueError(f"`radii` must have shape ({self.n_vertices},); got {radii.shape}")
+        table = make_lon_table(self._m, self.ring_offsets()) if lon_table is None else lon_table
+        if table.shape != (3 * self._m * (self._m + 1), 2) or table.dtype != np.float64:
+            raise ValueError("`lon_table` must be the grid's longitude table "
+                             f"({3 * self._m * (self._m + 1)}, 2) float64")
         acc = np.zeros((self.n_vertices, 3), dtype=np.float32)
         _normals_from_radii_kernel(self._m, self.ring_offsets(), self.band_offsets(), radii,
-                                   np.ascontiguousarray(stretch, dtype=np.float64), acc)
-        step = 1 << 22
-        for s in range(0, self.n_vertices, step):  # normalise in place, in chunks
-            block = acc[s:s + step]
-            norm = np.sqrt((block.astype(np.float64) ** 2).sum(axis=1))
-            block /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
+                                   np.ascontiguousarray(stretch, dtype=np.float64),
+                                   table, acc)
+        _normalize_rows_kernel(acc)
         return acc
 
     def _sample(self, kernel, name: str, values, colatitudes, longitudes) -> np.ndarray:

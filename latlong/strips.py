@@ -119,9 +119,17 @@ class Patch:
     def n_strips(self) -> int:
         return self.band_hi - self.band_lo
 
+    def triangle_ranges(self, grid: LatLongGrid) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`triangle_range` of every band of the patch: (lo, hi) int64 arrays."""
+        bo = grid.band_offsets()
+        n = (bo[self.band_lo + 1:self.band_hi + 1] - bo[self.band_lo:self.band_hi])
+        n = n.astype(np.float64)
+        return (np.floor(self.frac_lo * n + 0.5).astype(np.int64),
+                np.floor(self.frac_hi * n + 0.5).astype(np.int64))
+
     def longest(self, grid: LatLongGrid) -> int:
-        return max(hi - lo for lo, hi in (self.triangle_range(grid, b)
-                                          for b in range(self.band_lo, self.band_hi)))
+        lo, hi = self.triangle_ranges(grid)
+        return int((hi - lo).max())
 
     def leaves(self):
         if not self.children:

@@ -9,6 +9,7 @@ importing a library never loads argparse.
 """
 
 from .files import (
+    BackgroundWriter,
     atomic_path,
     check_output_path,
     check_parent_folder,
@@ -33,7 +34,8 @@ from .validation import (
     parameter_of,
 )
 
-__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "area_slope_summary",
+__all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike", "about",
+           "area_slope_summary",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
            "load_toml",

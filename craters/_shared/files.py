@@ -1,4 +1,5 @@
-"""Files: output checks before any work, atomic writes, TOML scene files."""
+"""Files: output checks before any work, atomic writes, overlapped writes, TOML scene
+files."""
 
 from __future__ import annotations
 
@@ -7,9 +8,11 @@ import os
 import tempfile
 import tomllib
 from collections.abc import Iterator, Sequence
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
-__all__ = ["atomic_path", "check_output_path", "check_parent_folder", "check_suffix",
+__all__ = ["BackgroundWriter", "atomic_path", "check_output_path", "check_parent_folder",
+           "check_suffix",
            "load_toml"]
 
 
@@ -69,6 +72,56 @@ def atomic_path(path) -> Iterator[Path]:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()
         raise
+
+
+class BackgroundWriter:
+    """Write buffers to a binary file on one background thread, in order, at most one
+    write pending, so that the caller computes the next buffer while the last one is
+    written (the write call releases the GIL, numba kernels with ``nogil`` too).
+
+    A buffer handed to :meth:`write` must stay unchanged until the next-but-one
+    :meth:`write` (or :meth:`close`) returns: producers alternate two buffers. An error
+    of a write is raised by the next call. Use as a context manager.
+
+    Examples
+    --------
+    >>> import io
+    >>> sink = io.BytesIO()
+    >>> with BackgroundWriter(sink) as out:
+    ...     out.write(b"ab")
+    ...     out.write(b"cd")
+    >>> sink.getvalue()
+    b'abcd'
+    """
+
+    def __init__(self, fh):
+        self._fh = fh
+        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="craterform-write")
+        self._pending = None
+
+    def write(self, data) -> None:
+        """Queue ``data`` (bytes-like) after the writes before it."""
+        self.wait()
+        self._pending = self._pool.submit(self._fh.write, data)
+
+    def wait(self) -> None:
+        """Return when every queued write is done (raising its error, if any)."""
+        pending, self._pending = self._pending, None
+        if pending is not None:
+            pending.result()
+
+    def close(self) -> None:
+        """Finish the queued writes and stop the thread."""
+        try:
+            self.wait()
+        finally:
+            self._pool.shutdown(wait=True)
+
+    def __enter__(self) -> BackgroundWriter:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
 
 
 def load_toml(path) -> dict:

@@ -32,10 +32,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import atomic_path
+from .files import BackgroundWriter, atomic_path
 from .progress import progress_bar
 
-__all__ = ["MESH_SUFFIXES", "MESH_WRITERS", "MeshSource", "array_source", "write_mesh"]
+__all__ = ["MESH_SUFFIXES", "MESH_WRITERS", "MeshSource", "array_source", "pack_faces",
+           "pack_vertices", "ply_face_dtype", "ply_vertex_dtype", "write_mesh"]
 
 _PLY_TYPES = {"f4": "float", "f8": "double", "i4": "int", "u1": "uchar", "u4": "uint",
               "i2": "short", "u2": "ushort", "i1": "char"}
@@ -71,6 +72,16 @@ class MeshSource:
     """The OBJ comment line when it differs from ``title``."""
     progress_label: str = ""
     """Label of the progress bar over the face chunks."""
+    vertex_records: Callable[[np.dtype], Iterable[np.ndarray]] | None = None
+    """Optional fast path of the PLY writer: yields the vertices, in order, as packed
+    records of the given structured dtype (float32 ``x y z`` then the fields), the same
+    values :func:`pack_vertices` makes of ``vertex_chunks``. The chunks are written on a
+    background thread while the next ones are made, so a yielded array may only be
+    reused two yields later (alternate two buffers)."""
+    face_records: Callable[[np.dtype], Iterable[np.ndarray]] | None = None
+    """Optional fast path of the PLY writer: yields the faces, in order, as records of
+    the given dtype (``n`` = 3, ``v`` = the three indices), as :func:`pack_faces`
+    makes of ``faces``; buffers alternate as in ``vertex_records``."""
 
     def faces(self) -> Iterator[np.ndarray]:
         """Every face chunk, groups in order."""
@@ -107,9 +118,41 @@ def _index_type(n_vertices: int) -> tuple[str, str]:
     return ("int", "<i4") if n_vertices < 2**31 else ("uint", "<u4")
 
 
+def ply_vertex_dtype(src: MeshSource) -> np.dtype:
+    """The packed PLY vertex record of ``src``: float32 ``x y z`` then its fields."""
+    return np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+                     *((n, _dtype(t)) for n, t in src.fields)])
+
+
+def ply_face_dtype(n_vertices: int) -> np.dtype:
+    """The packed PLY face record: uchar count, three int (uint past 2^31) indices."""
+    return np.dtype([("n", "u1"), ("v", _index_type(n_vertices)[1], (3,))])
+
+
+def pack_vertices(xyz, values: dict, dtype: np.dtype, out: np.ndarray | None = None):
+    """Vertex records of ``dtype`` (:func:`ply_vertex_dtype`) from positions and fields."""
+    rec = np.empty(len(xyz), dtype=dtype) if out is None else out[:len(xyz)]
+    rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    for name in dtype.names[3:]:
+        rec[name] = values[name]
+    return rec
+
+
+def pack_faces(tri, dtype: np.dtype, out: np.ndarray | None = None):
+    """Face records of ``dtype`` (:func:`ply_face_dtype`) from (k, 3) indices."""
+    rec = np.empty(len(tri), dtype=dtype) if out is None else out[:len(tri)]
+    rec["n"] = 3
+    rec["v"] = tri
+    return rec
+
+
+def _bytes_of(rec: np.ndarray) -> np.ndarray:
+    return rec.reshape(-1).view(np.uint8)
+
+
 def write_ply(src: MeshSource, fh, progress: bool = False) -> None:
     """Binary little-endian PLY (module notes)."""
-    idx, idx_dt = _index_type(src.n_vertices)
+    idx = _index_type(src.n_vertices)[0]
     header = ["ply", "format binary_little_endian 1.0", f"comment {src.title}",
               *(f"comment {c}" for c in src.comments), f"element vertex {src.n_vertices}",
               "property float x", "property float y", "property float z",
@@ -117,20 +160,16 @@ def write_ply(src: MeshSource, fh, progress: bool = False) -> None:
               f"element face {src.n_faces}", f"property list uchar {idx} vertex_indices",
               "end_header"]
     fh.write(("\n".join(header) + "\n").encode("ascii"))
-    vdt = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
-                    *((n, _dtype(t)) for n, t in src.fields)])
-    for xyz, values in src.vertex_chunks():
-        rec = np.empty(len(xyz), dtype=vdt)
-        rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
-        for name, _ in src.fields:
-            rec[name] = values[name]
-        fh.write(rec.tobytes())
-    fdt = np.dtype([("n", "u1"), ("v", idx_dt, (3,))])
-    for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "PLY"):
-        rec = np.empty(len(tri), dtype=fdt)
-        rec["n"] = 3
-        rec["v"] = tri
-        fh.write(rec.tobytes())
+    vdt, fdt = ply_vertex_dtype(src), ply_face_dtype(src.n_vertices)
+    vertices = (src.vertex_records(vdt) if src.vertex_records is not None
+                else (pack_vertices(xyz, values, vdt) for xyz, values in src.vertex_chunks()))
+    faces = (src.face_records(fdt) if src.face_records is not None
+             else (pack_faces(tri, fdt) for tri in src.faces()))
+    with BackgroundWriter(fh) as out:
+        for rec in vertices:
+            out.write(_bytes_of(rec))
+        for rec in progress_bar(faces, enabled=progress, desc=src.progress_label or "PLY"):
+            out.write(_bytes_of(rec))
 
 
 def _text_blocks(rows: np.ndarray, fmt: str, step: int = 1 << 18):

@@ -8,7 +8,7 @@ from craters._shared import about, normalize_rng, progress_bar
 
 from ..core import crs_label
 from ..craterdensity import RESOLVED_CRATER_PX, crater_density, detect_craters, resolved_diameter_m
-from ..expansion import expand
+from ..expansion import expand_to_file
 from ..fractal import fractal_fit
 from ..frame import crater_target
 from ..gaps import fill_gaps
@@ -46,22 +46,24 @@ def _transform(s: Settings) -> int:
         target = crater_target(dem, s.get("body"), s.get("gravity_m_s2"))
         out = fill_gaps(dem, s["roughness"], fractal_dimension=s["fractal_dimension"],
                         craters=s["craters"], rng=seed, target=target)
-    else:
-        out = expand(dem, s["levels"], s["fractal_dimension"], s["roughness"], s["region"],
-                     rng=seed, progress=show)
-    bar.update()
-    bar.set_description(f"write {s['output']}")
-    write(out, s["output"])
+        bar.update()
+        bar.set_description(f"write {s['output']}")
+        write(out, s["output"])
+        shape, params = out.shape, out.history[-1]["parameters"]
+    else:  # tile by tile into the file: outputs bigger than memory
+        made = expand_to_file(dem, s["output"], s["levels"], s["fractal_dimension"],
+                              s["roughness"], s["region"], rng=seed, progress=show)
+        bar.update()
+        shape, params = made.shape, made.parameters
     bar.update()
     bar.close()
     if show:
-        params = out.history[-1]["parameters"]
         detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
                            else f"{k} {params[k]}" for k in params
                            if k in ("levels", "fractal_dimension", "roughness",
                                     "filled_pixels", "holes", "craters"))
-        print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {out.shape[0]} x "
-              f"{out.shape[1]} pixels, seed {seed}, {detail}")
+        print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {shape[0]} x "
+              f"{shape[1]} pixels, seed {seed}, {detail}")
         print(f"wrote {s['output']}")
     return 0
 

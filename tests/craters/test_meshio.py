@@ -73,3 +73,22 @@ def test_unknown_suffix_writes_nothing(tmp_path):
     with pytest.raises(ValueError, match="unknown mesh format.*allowed: .ply"):
         write_mesh(_tetra(False)[2], tmp_path / "t.xyz")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_background_writer_keeps_order_and_raises_write_errors(tmp_path):
+    from craters._shared import BackgroundWriter
+
+    with open(tmp_path / "x.bin", "wb") as fh, BackgroundWriter(fh) as out:
+        for k in range(50):
+            out.write(bytes([k]) * 1000)
+    assert (tmp_path / "x.bin").read_bytes() == b"".join(bytes([k]) * 1000 for k in range(50))
+
+    class Full:
+        def write(self, data):
+            raise OSError("No space left on device")
+
+    out = BackgroundWriter(Full())
+    out.write(b"abc")
+    with pytest.raises(OSError, match="No space"):
+        out.write(b"def")
+    out.close()

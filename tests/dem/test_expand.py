@@ -244,3 +244,53 @@ def test_fractal_dimension_of_a_17px_seed_expanded_7_levels(f, roughness):
         lags, gamma, _ = dem.variogram(e, 1)
         model = (roughness * 128.0) ** 2 * (1.0 / 128.0) ** (2 * (3 - f))
         assert abs(gamma.mean() / model - 1) <= VARIOGRAM_TOL
+
+
+@pytest.mark.parametrize("region,levels,roughness,tile_px", [
+    ((40, 60, 129), 3, None, 129),      # the local amplitude, 64 tiles of 17 input pixels
+    ((40, 60, 129), 3, 0.03, 257),      # a uniform one, 16 tiles
+    ((0, 0, 257), 1, None, 100),        # tiles of 33 pixels (97 once expanded)
+    ((7, 9, 33), 2, None, 5),           # the smallest tiles: 3 input pixels
+])
+def test_tiled_file_has_the_bytes_of_the_whole(tmp_path, lola_crop, region, levels,
+                                               roughness, tile_px):
+    whole = dem.expand(lola_crop, levels, roughness=roughness, region=region, rng=8)
+    a = dem.write(whole, tmp_path / "whole.tif")
+    made = dem.expand_to_file(lola_crop, tmp_path / "tiled.tif", levels, roughness=roughness,
+                              region=region, rng=8, tile_px=tile_px)
+    assert made.tiles > 1 and made.shape == whole.shape and made.seed == 8
+    assert made.parameters == whole.history[-1]["parameters"]
+    assert made.path.read_bytes() == a.read_bytes()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiled.tif", "whole.tif"]
+
+
+def test_tiled_file_without_crs_and_its_errors(tmp_path):
+    d = Dem(np.random.default_rng(2).normal(0, 3, (33, 33)), pixel_size_m=(2.0, 3.0),
+            tags={"SOURCE": "test"})
+    a = dem.write(dem.expand(d, 2, 2.2, 0.1, rng=1), tmp_path / "a.tif")
+    b = dem.expand_to_file(d, tmp_path / "b.tif", 2, 2.2, 0.1, rng=1, tile_px=33)
+    assert b.tiles == 16 and a.read_bytes() == b.path.read_bytes()
+    back = dem.read(b.path)
+    assert back.pixel_size_m == (0.5, 0.75) and back.tags["SOURCE"] == "test"
+    with pytest.raises(ValueError, match="`tile_px`"):
+        dem.expand_to_file(d, tmp_path / "c.tif", 1, tile_px=2)
+    with pytest.raises(ValueError, match="GeoTIFF"):
+        dem.expand_to_file(d, tmp_path / "c.png", 1)
+    z = d.heights.copy()
+    z[3, 3] = np.nan
+    with pytest.raises(ValueError, match="unknown"):
+        dem.expand_to_file(d.replace(heights=z), tmp_path / "c.tif", 1)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.tif", "b.tif"]
+
+
+def test_cli_expand_goes_tile_by_tile(tmp_path, lola_crop, monkeypatch, capsys):
+    import dem.expansion
+    from dem.cli import main
+
+    src = dem.write(lola_crop, tmp_path / "in.tif")
+    want = dem.write(dem.expand(lola_crop, 2, region=(0, 0, 129), rng=3), tmp_path / "w.tif")
+    monkeypatch.setattr(dem.expansion, "TILE_PX", 65)  # 16 tiles of 17 input pixels
+    assert main(["expand", str(src), "-o", str(tmp_path / "t.tif"), "--levels", "2",
+                 "--region", "0,0,129", "--seed", "3", "-q"]) == 0
+    assert (tmp_path / "t.tif").read_bytes() == want.read_bytes()
+    assert capsys.readouterr().out == ""

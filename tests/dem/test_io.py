@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import rasterio
 from affine import Affine
+from rasterio.windows import Window
 
 import dem
 from dem import Dem
@@ -30,8 +31,10 @@ def test_read_geotiff_nodata_crs_transform(tiny_geotiff):
     assert d.heights[2, 5] == 2 + 10
 
 
-@pytest.mark.parametrize("shape,tiled", [((33, 40), False), ((300, 257), True)])
-def test_write_round_trip(tmp_path, shape, tiled):
+@pytest.mark.parametrize("shape", [(33, 40), (300, 257), (600, 530)])
+def test_write_round_trip_as_cloud_optimised_geotiff(tmp_path, shape):
+    from rio_cogeo.cogeo import cog_validate
+
     rng = np.random.default_rng(1)
     z = rng.normal(0, 100, shape).astype(np.float32).astype(np.float64)
     z[5, 7] = np.nan
@@ -41,10 +44,18 @@ def test_write_round_trip(tmp_path, shape, tiled):
     with rasterio.open(out) as ds:
         prof = ds.profile
         assert prof["dtype"] == "float32" and np.isnan(prof["nodata"])
-        assert prof["compress"] == "deflate" and prof["tiled"] == tiled
-        if tiled:
-            assert (prof["blockxsize"], prof["blockysize"]) == (256, 256)
+        assert prof["compress"] == "deflate" and prof["tiled"]
+        assert (prof["blockxsize"], prof["blockysize"]) == (256, 256)
         assert ds.tags()["SOURCE"] == "test" and ds.units == ("metre",)
+        assert ds.descriptions == ("height",)
+        assert (len(ds.overviews(1)) > 0) == (max(shape) > 256)
+    if shape == (600, 530):  # the first overview: averages of the known pixels
+        with rasterio.open(out, overview_level=0) as ov:
+            coarse = ov.read(1)
+        want = np.nanmean(z.reshape(300, 2, 265, 2), axis=(1, 3))
+        np.testing.assert_allclose(coarse, want, rtol=1e-5, atol=1e-3)
+    valid, errors, warnings = cog_validate(out, strict=True)
+    assert valid and not errors and not warnings
     back = dem.read(out)
     assert np.array_equal(back.heights, z, equal_nan=True)
     assert back.transform == t and back.crs == d.crs
@@ -292,3 +303,52 @@ def test_parse_label_values():
     inner, parent = find_object(lab, "INNER")
     assert inner == {"X": -3} and parent is lab["OUTER"]
     assert find_object(lab, "NOPE") == (None, None)
+
+
+@pytest.mark.parametrize("source", ["geotiff", "pds", "nocrs"])
+def test_windowed_read_is_the_crop(tmp_path, lola_crop, source):
+    if source == "pds":
+        path, kw = os.path.join(DATA, "ldem4_crop.lbl"), {}
+        whole = lola_crop
+    elif source == "geotiff":
+        whole = dem.expand(lola_crop, 1, rng=1)  # level 1, origin (0, 0): tags travel
+        path, kw = dem.write(whole, tmp_path / "g.tif"), {}
+        whole = dem.read(path)
+    else:
+        whole = Dem(np.arange(35.0).reshape(5, 7), pixel_size_m=3.0)
+        path, kw = dem.write(whole, tmp_path / "n.tif"), {}
+        whole = dem.read(path)
+    for win in ((0, 0, 1, 1), (2, 3, 2, 4), Window(1, 2, 3, 3), (0, 0, *whole.shape)):
+        got = dem.read(path, window=win, **kw)
+        want = whole.crop(win if isinstance(win, Window) else Window(win[1], win[0], win[3],
+                                                                       win[2]))
+        assert np.array_equal(got.heights, want.heights, equal_nan=True)
+        assert got.transform == want.transform and got.crs == want.crs
+        assert (got.level, got.origin) == (want.level, want.origin)
+        assert got.pixel_size_m == want.pixel_size_m and dict(got.tags) == dict(want.tags)
+
+
+def test_windowed_read_errors(tmp_path):
+    d = Dem(np.arange(35.0).reshape(5, 7), pixel_size_m=3.0)
+    z = d.heights.copy()
+    z[:2, :2] = np.nan
+    path = dem.write(d.replace(heights=z), tmp_path / "n.tif")
+    for win, match in (((0, 0, 6, 1), "not inside"), ((-1, 0, 1, 1), "offsets >= 0"),
+                       ((0, 0, 0, 1), "sizes >= 1"), ((0.5, 0, 1, 1), "integer"),
+                       ((1, 2, 3), "rasterio Window"), ((0, 0, 2, 2), "every pixel of")):
+        with pytest.raises((ValueError, TypeError), match=match) as info:
+            dem.read(path, window=win)
+        assert "window" in str(info.value)
+
+
+def test_window_writer_leaves_nothing_on_error(tmp_path):
+    out = tmp_path / "w.tif"
+    out.write_bytes(b"old")
+    with pytest.raises(ValueError, match="not inside"):
+        with dem.WindowWriter(out, (4, 4), pixel_size_m=1.0) as w:
+            w.write(np.zeros((2, 2)), 0, 0)
+            w.write(np.zeros((2, 2)), 3, 3)
+    assert out.read_bytes() == b"old" and [p.name for p in tmp_path.iterdir()] == ["w.tif"]
+    with pytest.raises(ValueError, match="pixel_size_m"):
+        dem.WindowWriter(tmp_path / "x.tif", (4, 4))
+    assert [p.name for p in tmp_path.iterdir()] == ["w.tif"]

@@ -197,3 +197,115 @@ def test_export_cli(run_cli, tmp_path, body):
         assert proc.returncode == 2 and needle in proc.stderr
         assert len(proc.stderr.strip().splitlines()) == 1
     assert not (tmp_path / "x.glb").exists()
+
+
+def replay_a_steps(na, nb, steps):
+    """Reference: replay the zipper step by step (ring-a advances among ``steps``)."""
+    i = j = 0
+    for _ in range(steps):
+        if na > 1 and i < na and (j >= nb or (i + 1) * nb <= (j + 1) * na):
+            i += 1
+        else:
+            j += 1
+    return i
+
+
+@pytest.mark.parametrize("na,nb", [(1, 6), (6, 12), (12, 6), (18, 24), (600, 606),
+                                   (606, 600), (7, 7), (5, 13)])
+def test_zipper_state_in_closed_form(na, nb):
+    from latlong._grid_kernels import _zipper_a_steps
+
+    steps = na + nb if na > 1 else nb
+    assert [_zipper_a_steps(na, nb, s) for s in range(steps + 1)] == [
+        replay_a_steps(na, nb, s) for s in range(steps + 1)]
+
+
+def test_longitude_table_is_the_unit_vectors():
+    from latlong._grid_kernels import lon_table
+
+    g = LatLongGrid(7)
+    table = lon_table(7, g.ring_offsets())
+    u, off = g.unit_vectors(), g.ring_offsets()
+    for r in range(1, 2 * 7):  # cos(lat) * table = the unit vectors' x and y, exactly
+        row = off[min(r, 14 - r)] - 1
+        n = off[r + 1] - off[r]
+        lat = 0.5 * np.pi - r * (np.pi / 14)
+        assert np.array_equal(np.cos(lat) * table[row:row + n], u[off[r]:off[r + 1], :2])
+
+
+def reference_patches(body, patch_k):
+    """The glTF patch data the numpy way (the export before its kernels): per leaf the
+    joined strip, np.unique, float32 positions (u * r) * s, normals, bounds."""
+    grid, normals = body.grid, body.vertex_normals()
+    radii, stretch = np.asarray(body.radii_m), np.asarray(body.stretch)
+    for leaf in patch_tree(grid, patch_k).leaves():
+        strip = join_strips(leaf.strips(grid))
+        if len(strip) < 3:
+            continue
+        idx, local = np.unique(strip, return_inverse=True)
+        pos = (unit_vectors_of(grid, idx) * radii[idx, None] * stretch).astype(np.float32)
+        lo, hi = pos.min(axis=0), pos.max(axis=0)
+        centre = 0.5 * (lo.astype(np.float64) + hi)
+        radius = float(np.sqrt(((pos - centre) ** 2).sum(axis=1).max()))
+        yield pos, normals[idx], local.astype(np.uint32), centre, radius, len(
+            strip_triangles(strip))
+
+
+@pytest.mark.parametrize("m,k,stretch", [(1, 2, (1, 1, 1)), (5, 2, (1, 1, 1)),
+                                         (24, 3, (1.5, 1.0, 0.75)), (40, 16, (1, 2, 1))])
+def test_glb_patches_match_the_numpy_reference(tmp_path, m, k, stretch):
+    g = LatLongGrid(m)
+    body = Body.from_heights(g, 50.0, np.random.default_rng(m).normal(0, 2, g.n_vertices),
+                             stretch=stretch)
+    man = export_glb(body, tmp_path / "p.glb", patch_k=k)
+    raw = (tmp_path / "p.glb").read_bytes()
+    base = man["bin_chunk_offset"]
+    want = list(reference_patches(body, k))
+    got = man["levels"][0]["patches"]
+    assert len(got) == len(want)
+    for patch, (pos, nrm, ind, centre, radius, n_tri) in zip(got, want, strict=True):
+        for name, data in (("positions", pos), ("normals", nrm), ("indices", ind)):
+            off, n = patch["bytes"][name]
+            assert raw[base + off:base + off + n] == np.ascontiguousarray(data).tobytes()
+        assert patch["centre_m"] == centre.tolist() and patch["radius_m"] == radius
+        assert patch["n_triangles"] == n_tri and patch["strip_length"] == len(ind)
+
+
+@pytest.mark.parametrize("with_boulders", [False, True])
+def test_ply_fast_path_gives_the_generic_bytes(tmp_path, with_boulders):
+    import dataclasses
+
+    from craters._shared.meshio import write_mesh
+    from latlong import BoulderLayer, boulder_population, place_boulders
+    from latlong.export import body_mesh_source
+
+    g = LatLongGrid(24)
+    body = Body.from_heights(g, 400.0, perlin_fbm(g, 2.0, 4, 0.5, 2.0, 15.0, rng=1),
+                             stretch=(1.1, 1.0, 0.9))
+    if with_boulders:
+        cat = boulder_population(body, BoulderLayer(c=4e-4, k=-3, d_min_m=2, d_max_m=12),
+                                 rng=2)
+        body = body.replace(boulders=place_boulders(body, cat))
+    body.export(tmp_path / "fast.ply")
+    src = dataclasses.replace(body_mesh_source(body), vertex_records=None, face_records=None)
+    write_mesh(src, tmp_path / "generic.ply")
+    assert (tmp_path / "fast.ply").read_bytes() == (tmp_path / "generic.ply").read_bytes()
+
+
+def test_ply_fast_path_in_several_chunks(tmp_path, monkeypatch):
+    import latlong.export as export
+
+    body = Body.from_heights(LatLongGrid(30), 10.0, np.linspace(-1, 1, 5402))
+    body.export(tmp_path / "one.ply")
+    monkeypatch.setattr(export, "_CHUNK", 1000)  # several vertex and face chunks
+    body.export(tmp_path / "many.ply")
+    assert (tmp_path / "one.ply").read_bytes() == (tmp_path / "many.ply").read_bytes()
+
+
+def test_glb_in_several_groups(tmp_path, body, monkeypatch):
+    import latlong.gltf as gltf
+
+    export_glb(body, tmp_path / "one.glb", patch_k=8, lod=1)
+    monkeypatch.setattr(gltf, "_GROUP_BYTES", 5000)  # many groups of patches
+    export_glb(body, tmp_path / "many.glb", patch_k=8, lod=1)
+    assert (tmp_path / "one.glb").read_bytes() == (tmp_path / "many.glb").read_bytes()

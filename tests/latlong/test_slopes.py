@@ -21,6 +21,7 @@ from latlong import (
     slopes_and_areas,
     vertex_normals,
 )
+from latlong._grid_kernels import lon_table
 from latlong._slope_kernels import _normals_from_radii_kernel, _vertex_normals_kernel
 from latlong.shapes import ShapeModel
 from latlong.slopes import direction_cap_sums
@@ -171,7 +172,8 @@ def test_streamed_normals_match_the_vertex_array(rng, m):
     body = Body(grid, 50.0 + rng.uniform(0, 5, grid.n_vertices), stretch=(1.0, 1.3, 0.8))
     acc = np.zeros((grid.n_vertices, 3))
     _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), body.radii_m,
-                               np.asarray(body.stretch), acc)
+                               np.asarray(body.stretch), lon_table(m, grid.ring_offsets()),
+                               acc)
     want, _ = reference_vertex_normals(body.vertices(), grid.triangles())
     np.testing.assert_allclose(acc, want, rtol=1e-10, atol=1e-9)
 
@@ -235,3 +237,15 @@ def test_radius_spectrum_recovers_a_known_spectrum():
     assert np.abs(power[1:21] / want - 1).max() < 0.02
     assert power[21:].sum() < 1e-3 * want.sum()
     assert power[0] == pytest.approx(4 * np.pi * 1000.0**2, rel=1e-6)
+
+
+def test_normalised_rows_match_numpy(rng):
+    from latlong._slope_kernels import _normalize_rows_kernel
+
+    acc = (rng.normal(size=(5000, 3)) * 10.0 ** rng.uniform(-6, 6, (5000, 1))).astype(np.float32)
+    acc[:7] = 0.0
+    want = acc.copy()  # the numpy normalisation the kernel replaced
+    norm = np.sqrt((want.astype(np.float64) ** 2).sum(axis=1))
+    want /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
+    _normalize_rows_kernel(acc)
+    assert np.array_equal(acc, want)
