@@ -4,13 +4,19 @@ replaced."""
 
 from __future__ import annotations
 
+import hashlib
+
+import numba
 import numpy as np
 import pytest
 
+import craters
 import latlong.body as body_module
+import latlong.cratering as cratering
 import latlong.perlin as perlin
 import latlong.surface as surface
-from latlong import Body, LatLongGrid, perlin_fbm
+from latlong import Body, LatLongGrid, Scene, build, perlin_fbm, stamp_craters
+from latlong.cratering import WaveScheduleOutgrown
 from latlong.surface import band_areas
 
 
@@ -127,3 +133,69 @@ def test_band_areas_do_not_depend_on_the_step(monkeypatch, step):
     ref = band_areas(body)
     monkeypatch.setattr(surface, "_TRIANGLES_PER_STEP", step)
     np.testing.assert_array_equal(band_areas(body), ref)
+
+
+def _cratered_inputs():
+    radius = 500.0
+    body = Body.sphere(LatLongGrid(60), radius)
+    area = 4 * np.pi * radius**2
+    cat = craters.power_law_population(radius=radius, c=300 / (area * (10.0**-2 - 150.0**-2)),
+                                       k=-2.0, d_min=10.0, d_max=150.0, rng=5)
+    return body, cat
+
+
+def _digest(body):
+    h = hashlib.sha256(body.radii_m.tobytes())
+    for name in body.craters.dtype.names:
+        h.update(np.ascontiguousarray(body.craters[name]).tobytes())
+    return h.hexdigest()
+
+
+def test_stamping_into_the_body_gives_the_same_bytes():
+    body, cat = _cratered_inputs()
+    ref = _digest(stamp_craters(body, cat, rng=2))
+    assert body.radii_m.min() == body.radii_m.max() == 500.0  # untouched by default
+    mine = body.radii_m
+    out = stamp_craters(body, cat, rng=2, overwrite_body=True)
+    assert out.radii_m is mine and not mine.flags.writeable
+    assert _digest(out) == ref
+
+
+def test_stamping_into_a_read_only_buffer_falls_back_to_a_copy():
+    body, cat = _cratered_inputs()
+    ref = _digest(stamp_craters(body, cat, rng=2))
+    buf = np.frombuffer(body.radii_m.tobytes(), dtype=np.float64)  # cannot be made writeable
+    frozen = Body(body.grid, buf, radius_m=body.radius_m, copy=False)
+    out = stamp_craters(frozen, cat, rng=2, overwrite_body=True)
+    assert _digest(out) == ref and frozen.radii_m.max() == 500.0
+
+
+@pytest.fixture
+def two_threads():
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("one thread: no parallel waves")
+    old = numba.get_num_threads()
+    numba.set_num_threads(2)
+    yield
+    numba.set_num_threads(old)
+
+
+def test_outgrown_waves_in_place_raise(monkeypatch, two_threads):
+    body, cat = _cratered_inputs()
+    monkeypatch.setattr(cratering, "WAVE_RADIUS_SHARE", 4.0)  # a schedule far too tight
+    with pytest.raises(WaveScheduleOutgrown):
+        stamp_craters(body, cat, rng=2, overwrite_body=True)
+
+
+def _scene(**body):
+    return Scene.from_settings({"preset": "fbm-cratered", "magnitude": 40, "seed": 1,
+                                "radius_m": 60.0, **body})
+
+
+def test_build_redoes_an_outgrown_schedule_with_a_copy(monkeypatch, two_threads, caplog):
+    ref = build(_scene())
+    monkeypatch.setattr(cratering, "WAVE_RADIUS_SHARE", 4.0)
+    with caplog.at_level("INFO", logger="latlong.build"):
+        again = build(_scene())
+    assert "building again" in caplog.text
+    assert _digest(again) == _digest(ref) and again.metadata == ref.metadata
