@@ -43,6 +43,10 @@ class Body:
         The crater catalog that made the body (see :mod:`craters.catalog`), as stamped.
     boulders : structured array, optional
         The boulders placed on the body (see :mod:`latlong.boulders`).
+    copy : bool
+        False: take ``radii_m`` over without a copy when it is a C-contiguous float64
+        array already (for very large bodies: no second array); it becomes read-only and
+        must not be written to afterwards by other means.
 
     Examples
     --------
@@ -56,28 +60,30 @@ class Body:
 
     def __init__(self, grid: LatLongGrid, radii_m, *, radius_m: float | None = None,
                  stretch=(1.0, 1.0, 1.0), metadata: dict | None = None, craters=None,
-                 boulders=None):
+                 boulders=None, copy: bool = True):
         if not isinstance(grid, LatLongGrid):
             raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
-        radii = np.array(radii_m, dtype=np.float64, copy=True)
+        if copy:
+            radii = np.array(radii_m, dtype=np.float64, copy=True)
+        else:
+            radii = np.ascontiguousarray(radii_m, dtype=np.float64)
         if radii.shape != (grid.n_vertices,):
             raise ValueError(f"`radii_m` must have shape ({grid.n_vertices},); got {radii.shape}")
-        if not np.isfinite(radii).all():
-            raise ValueError("`radii_m` must be finite")
-        if (radii <= 0).any():
-            bad = int((radii <= 0).sum())
-            raise ValueError(
-                f"`radii_m` must be > 0 everywhere; {bad} vertices have radius <= 0 "
-                f"(min {radii.min():.6g} m): the base shape is too rough for this radius"
-            )
+        self._setup(grid, radii, radius_m, stretch, metadata, craters, boulders)
+
+    def _setup(self, grid, radii, radius_m, stretch, metadata, craters, boulders, *,
+               checked: bool = False):
+        """Validate and store (``radii``: this body's own float64 array, made read-only;
+        ``checked``: known finite and > 0 already)."""
+        if not checked:
+            _check_radii(radii)
         radii.setflags(write=False)
         stretch = np.array(stretch, dtype=np.float64).reshape(-1)
         if stretch.shape != (3,) or not np.isfinite(stretch).all() or (stretch <= 0).any():
             raise ValueError(f"`stretch` must be three finite factors > 0; got {stretch.tolist()}")
         stretch.setflags(write=False)
         if radius_m is None:
-            w = grid.vertex_areas()
-            radius_m = float(np.dot(w, radii) / w.sum())
+            radius_m = _area_mean(grid, radii)
         self._grid = grid
         self._radii = radii
         self._radius_m = check_positive("radius_m", radius_m)
@@ -107,21 +113,25 @@ class Body:
     def sphere(cls, grid: LatLongGrid, radius_m: float, **kwargs) -> Body:
         """A sphere of ``radius_m`` metres."""
         radius_m = check_positive("radius_m", radius_m)
-        return cls(grid, np.full(grid.n_vertices, radius_m), radius_m=radius_m, **kwargs)
+        return cls(grid, np.full(grid.n_vertices, radius_m), radius_m=radius_m, copy=False,
+                   **kwargs)
 
     @classmethod
     def from_heights(cls, grid: LatLongGrid, radius_m: float, heights_m, **kwargs) -> Body:
         """A body whose radii are ``radius_m + heights_m``."""
         radius_m = check_positive("radius_m", radius_m)
         return cls(grid, radius_m + np.asarray(heights_m, dtype=np.float64),
-                   radius_m=radius_m, **kwargs)
+                   radius_m=radius_m, copy=False, **kwargs)
 
-    def replace(self, **changes) -> Body:
+    def replace(self, *, copy: bool = True, **changes) -> Body:
         """A new body with some of ``radii_m, radius_m, stretch, metadata, craters,
         boulders`` replaced. Pure: nothing is recomputed. A body with boulders whose
         surface changes (``radii_m`` or ``stretch``) must be given its boulders again,
         placed on the new surface (``boulders=latlong.place_boulders(new, old.boulders)``
-        or ``boulders=None``): boulders are never left floating or buried silently."""
+        or ``boulders=None``): boulders are never left floating or buried silently.
+
+        Unchanged radii are shared with this body (read-only), not copied; new
+        ``radii_m`` are copied unless ``copy=False`` (see :class:`Body`)."""
         kw = {"radii_m": self._radii, "radius_m": self._radius_m,
               "stretch": self._stretch, "metadata": self._metadata,
               "craters": self._craters, "boulders": self._boulders}
@@ -136,7 +146,12 @@ class Body:
                 f"{len(self._boulders)} placed boulders: pass `boulders` too (None, or the "
                 "catalog placed again with latlong.place_boulders on the new body)")
         kw.update(changes)
-        return Body(self._grid, kw.pop("radii_m"), **kw)
+        radii = kw.pop("radii_m")
+        if "radii_m" not in changes:  # read-only and checked already: shared
+            new = Body.__new__(Body)
+            new._setup(self._grid, radii, checked=True, **kw)
+            return new
+        return Body(self._grid, radii, copy=copy, **kw)
 
     # ------------------------------------------------------------------ data
     @property
@@ -200,7 +215,7 @@ class Body:
         idx = self._grid.nested_indices(coarse)
         meta = {**self._metadata, "lod_level": level, "lod_of_magnitude": self.magnitude}
         return Body(coarse, self._radii[idx], radius_m=self._radius_m, stretch=self._stretch,
-                    metadata=meta)
+                    metadata=meta, copy=False)
 
     def vertices(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
         """Vertex positions in metres, (N, 3) float64 (or the rows ``lo:hi``)."""
@@ -271,6 +286,51 @@ class Body:
         return mesh
 
 
+_CHECK_CHUNK = 1 << 20  # vertices per block of the checks below (bounded temporaries)
+
+
+def _check_radii(radii: np.ndarray) -> None:
+    """Finite and > 0 everywhere, checked block by block (no whole-grid temporaries)."""
+    n = radii.shape[0]
+    for s in range(0, n, _CHECK_CHUNK):
+        if not np.isfinite(radii[s:s + _CHECK_CHUNK]).all():
+            raise ValueError("`radii_m` must be finite")
+    bad = sum(int(np.count_nonzero(radii[s:s + _CHECK_CHUNK] <= 0))
+              for s in range(0, n, _CHECK_CHUNK))
+    if bad:
+        raise ValueError(
+            f"`radii_m` must be > 0 everywhere; {bad} vertices have radius <= 0 "
+            f"(min {radii.min():.6g} m): the base shape is too rough for this radius"
+        )
+
+
+#: Vertices per block of the area-weighted mean: numpy's dot (OpenBLAS ddot) runs on one
+#: thread up to 10 000 elements and splits longer vectors between the BLAS threads, which
+#: changes its rounding with the thread count (measured: OpenBLAS 0.3.31, 1 vs 2 threads).
+_DOT_BLOCK = 10_000
+
+
+def _area_mean(grid: LatLongGrid, radii: np.ndarray) -> float:
+    """The area-weighted mean radius, ``dot(vertex_areas, radii) / sum(vertex_areas)``,
+    in blocks of :data:`_DOT_BLOCK` vertices summed in order.
+
+    The per-vertex areas of a block are made from the grid's :meth:`ring_areas` (no
+    whole-grid array). A grid of at most one block (M <= 40) gets the very bits of the
+    single ``np.dot`` used before; a larger one a result that no longer depends on the
+    BLAS thread count (the single dot's did).
+    """
+    areas, offs = grid.ring_areas(), grid.ring_offsets()
+    num = den = 0.0
+    for s in range(0, grid.n_vertices, _DOT_BLOCK):
+        e = min(s + _DOT_BLOCK, grid.n_vertices)
+        r0 = int(np.searchsorted(offs, s, side="right")) - 1
+        r1 = int(np.searchsorted(offs, e - 1, side="right")) - 1
+        w = np.repeat(areas[r0:r1 + 1], np.diff(np.clip(offs[r0:r1 + 2], s, e)))
+        num += float(np.dot(w, radii[s:e]))
+        den += float(w.sum())
+    return num / den
+
+
 def load(path) -> Body:
     """Read a body written by :meth:`Body.save`."""
     path = Path(path)
@@ -287,4 +347,4 @@ def load(path) -> Body:
     return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
                 radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
                 metadata=json.loads(str(fields["metadata_json"])),
-                craters=fields.get("craters"), boulders=fields.get("boulders"))
+                craters=fields.get("craters"), boulders=fields.get("boulders"), copy=False)

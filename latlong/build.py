@@ -12,6 +12,7 @@ fixed order, so the same scene gives the same bytes whatever the thread count.
 from __future__ import annotations
 
 import dataclasses
+import logging
 
 import numpy as np
 
@@ -19,7 +20,7 @@ from craters._shared import ParameterError, ParameterTypeError, package_version
 
 from .body import Body
 from .boulders import boulder_population, place_boulders
-from .cratering import body_population, stamp_craters
+from .cratering import WaveScheduleOutgrown, body_population, stamp_craters
 from .faulting import FaultingParams, two_phase_faulting
 from .grid import LatLongGrid
 from .perlin import FbmParams, perlin_fbm
@@ -30,11 +31,13 @@ from .shapes import from_shape_model
 __all__ = ["build", "mesh_spacing_m"]
 
 GENERATOR = "craterform latlong build"
+logger = logging.getLogger(__name__)
 
 
 def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
     """(heights above the reference radius in metres, reference radius, parameters for
-    the metadata) of the scene's base shape."""
+    the metadata) of the scene's base shape; the heights are a new float64 array of the
+    caller's (:func:`build` turns it into the radii in place)."""
     base, body = scene.base, scene.body
     if isinstance(base, SphereBase):
         return np.zeros(grid.n_vertices), body.radius_m, {}
@@ -58,7 +61,9 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
               "amplitude_m": base.detail_amplitude_m}
     detail = perlin_fbm(grid, *params.values(), rng=rng) if base.detail_amplitude_m else 0.0
     params["shape"] = shaped.metadata
-    return shaped.radii_m - shaped.radius_m + detail, shaped.radius_m, params
+    heights = shaped.radii_m - shaped.radius_m
+    heights += detail
+    return heights, shaped.radius_m, params
 
 
 def build(scene: Scene, *, progress: bool = False):
@@ -94,21 +99,35 @@ def build(scene: Scene, *, progress: bool = False):
         return _build_implicit(scene, progress)
     if isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh":
         return _build_mesh(scene, progress)
+    try:
+        return _build_latlong(scene, progress, overwrite=True)
+    except WaveScheduleOutgrown:
+        pass  # (rare) its radii are spent: build again, the stamp copying the radii
+    logger.info("crater wave schedule outgrown: building again with a copy of the radii")
+    return _build_latlong(scene, progress, overwrite=False)
+
+
+def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool) -> Body:
+    """The lat/long body. Memory: one float64 radius per vertex plus bounded buffers
+    (the base is made in place, the craters stamped into the body's own radii when
+    ``overwrite``; the same bytes either way)."""
     grid = LatLongGrid(scene.body.magnitude)
     rng = np.random.default_rng(scene.seed)
     heights, radius_m, params = _base_heights(scene, grid, rng, progress)
+    heights += radius_m  # the radii, in place (`heights` is this function's own array)
     craters, boulders = scene.craters, scene.boulders
     target = scene.target()
     metadata = _metadata(scene, params)
-    body = Body.from_heights(grid, radius_m, heights, stretch=scene.body.stretch,
-                             metadata=metadata)
+    body = Body(grid, heights, radius_m=radius_m, stretch=scene.body.stretch,
+                metadata=metadata, copy=False)
+    del heights
     if craters.layers:
         cat = body_population(body, craters.layers, rng=rng)
         body = stamp_craters(body, cat, roughness=craters.roughness, rng=rng,
                              progress=progress, max_extent_deg=craters.max_extent_deg,
                              target=target, too_large="skip",
                              slope_reference="gravity" if isinstance(scene.base, ShapeBase)
-                             else "body")
+                             else "body", overwrite_body=overwrite)
         body = body.replace(metadata={**body.metadata,
                                       "craters_skipped_too_large": len(cat) - len(body.craters)})
     if boulders.layers:

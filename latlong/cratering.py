@@ -19,13 +19,21 @@ from .body import Body
 from .mesh.cratering import down_directions
 from .surface import band_areas, sample_surface_points
 
-__all__ = ["body_population", "crater_extents_deg", "stamp_craters"]
+__all__ = ["WaveScheduleOutgrown", "body_population", "crater_extents_deg", "stamp_craters"]
 
 logger = logging.getLogger(__name__)
 _BATCH = 256  # craters per kernel call when a progress bar is shown
 #: The wave schedule allows each crater's local radius to fall to this share of its
 #: value before stamping (checked: beyond it the craters are stamped serially).
 WAVE_RADIUS_SHARE = 0.8
+_CHUNK = 1 << 20  # vertices per block of the whole-body checks (bounded temporaries)
+
+
+class WaveScheduleOutgrown(RuntimeError):
+    """:func:`stamp_craters` with ``overwrite_body=True`` found its parallel wave schedule
+    outgrown (a crater's cap grew past the bound it was scheduled with): the body's radii
+    are spent; stamp again from a fresh body without ``overwrite_body`` (that stamp then
+    falls back to the serial one)."""
 
 
 def _stamp_in_waves(body: Body, cat, rim_tabs, ejecta_edge: float, args, progress) -> bool:
@@ -114,7 +122,8 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
                   max_extent_deg: float = 60.0, irregularity: float = 0.02,
                   slope_erosion: bool = True, onset_deg: float = 20.0, full_deg: float = 45.0,
                   target: str | Target = "moon", ejecta_edge: float = DEFAULT_EJECTA_EDGE,
-                  too_large: str = "error", slope_reference: str = "body") -> Body:
+                  too_large: str = "error", slope_reference: str = "body",
+                  overwrite_body: bool = False) -> Body:
     """Stamp a crater catalog on a body, oldest first; returns a new :class:`Body`.
 
     For each crater (Martin 2014 V.A): the vertices of its region are gathered through
@@ -162,6 +171,13 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     irregularity, slope_erosion, onset_deg, full_deg, target, ejecta_edge
         As in :func:`craters.stamp_many` (``target``: the body whose crater morphology
         and diffusivity apply, e.g. :func:`craters.small_body` of this body's size).
+    overwrite_body : bool
+        Stamp into ``body``'s own radii array instead of a copy (8 B a vertex less, for
+        very large bodies): ``body`` (and any body sharing its radii, see
+        :meth:`Body.replace`) is consumed and must not be used afterwards. In the rare
+        case that the parallel wave schedule is outgrown (a crater moving the surface by
+        a fifth of the local radius) the radii cannot be restored: raises
+        :class:`WaveScheduleOutgrown`.
 
     Returns
     -------
@@ -208,7 +224,7 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     rng = normalize_rng(rng)
     rim_tabs = _craters.rim_perturbations(n, irr, rng=rng)
     seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
-    radii = np.array(body.radii_m, dtype=np.float64, copy=True)
+    radii, overwritten = _radii_to_stamp(body, overwrite_body)
     grid = body.grid
     names = cat.dtype.names
     prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
@@ -234,6 +250,9 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     done = False
     if numba.get_num_threads() > 1 and n > 1:
         done = _stamp_in_waves(body, cat, rim_tabs, ejecta_edge, args, progress)
+        if not done and overwritten:
+            raise WaveScheduleOutgrown(f"the parallel wave schedule of {n} craters was "
+                                       "outgrown and the body's radii were overwritten")
         if not done:  # a surface moved more than the schedule allowed: redo serially
             logger.info("wave schedule outgrown; stamping %d craters serially", n)
             radii[:] = body.radii_m
@@ -247,7 +266,7 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
                                onset, full, rough_arr, gain, scale[s:e], outs["slope"][s:e],
                                centre[s:e], outs["maxdh"][s:e], outs["nvert"][s:e],
                                outs["sp"][s:e], erased[s:e], up[s:e])
-    if n and (radii <= 0).any():
+    if n and any((radii[s:s + _CHUNK] <= 0).any() for s in range(0, len(radii), _CHUNK)):
         raise ValueError("craters pushed the surface through the body centre; lower the "
                          "largest diameter or max_extent_deg")
     cols = {k: cat[k] for k in names}
@@ -264,6 +283,19 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
             stamped = np.concatenate([body.craters, stamped.astype(body.craters.dtype)])
         except (TypeError, ValueError):
             logger.warning("previous crater catalog has other columns; keeping only the new")
-    return body.replace(radii_m=radii, craters=stamped)
+    return body.replace(radii_m=radii, craters=stamped, copy=False)
+
+
+def _radii_to_stamp(body: Body, overwrite: bool) -> tuple[np.ndarray, bool]:
+    """(writeable radii to stamp into, whether they are the body's own array)."""
+    if overwrite:
+        radii = body.radii_m
+        try:
+            radii.setflags(write=True)  # its own memory (not a read-only buffer's view)
+        except ValueError:
+            pass
+        else:
+            return radii, True
+    return np.array(body.radii_m, dtype=np.float64, copy=True), False
 
 

@@ -220,8 +220,8 @@ class LatLongGrid:
             _unit_index_kernel(self._m, self.ring_offsets(), flat, out)
         return out.reshape(idx.shape + (3,))
 
-    def vertex_areas(self) -> np.ndarray:
-        """Area represented by each vertex on the unit sphere (sum 4 pi), shape (N,).
+    def ring_areas(self) -> np.ndarray:
+        """Area represented by each vertex of each ring on the unit sphere, shape (2M+1,).
 
         Ring ``r`` owns the zone between colatitudes ``(r -+ 1/2) pi / (2M)`` (the pole
         caps end at the poles), shared evenly by its vertices.
@@ -233,9 +233,14 @@ class LatLongGrid:
             lo = np.clip(theta - d / 2, 0.0, np.pi)
             hi = np.clip(theta + d / 2, 0.0, np.pi)
             zone = 2 * np.pi * (np.cos(lo) - np.cos(hi))
-            return (zone / self.ring_sizes())[self.vertex_rings()]
+            return zone / self.ring_sizes()
 
-        return self._cached("areas", make)
+        return self._cached("ring_areas", make)
+
+    def vertex_areas(self) -> np.ndarray:
+        """Area represented by each vertex on the unit sphere (sum 4 pi), shape (N,):
+        its ring's :meth:`ring_areas` entry (cached; 8 B a vertex)."""
+        return self._cached("areas", lambda: np.repeat(self.ring_areas(), self.ring_sizes()))
 
     def spacing(self, radius_m: float = 1.0) -> float:
         """Nominal vertex spacing: the ring spacing ``pi R / (2M)`` in metres."""

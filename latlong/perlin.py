@@ -15,6 +15,8 @@ from .grid import LatLongGrid
 __all__ = ["FBM_PRESETS", "FbmParams", "fbm3", "perlin_fbm", "random_rotation"]
 
 _MAX_OCTAVES = 30
+#: Vertices per chunk of :func:`perlin_fbm` (~60 B each while it is computed).
+_CHUNK = 1 << 20
 
 
 def _check_noise_params(octaves, persistence, lacunarity, base):
@@ -138,12 +140,18 @@ FBM_PRESETS: dict[str, FbmParams] = {
 
 
 def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: float,
-               lacunarity: float, amplitude_m: float, *, rng=None) -> np.ndarray:
+               lacunarity: float, amplitude_m: float, *, rng=None, out=None) -> np.ndarray:
     """Heights (metres) from 3-D Perlin fBm sampled on the unit sphere.
 
     Each vertex direction ``u`` is rotated by a random rotation, scaled by
     ``frequency`` and shifted by a random offset in [0, 256)^3 (both from ``rng``), and
-    ``amplitude_m * fbm3(...)`` is its height.
+    ``amplitude_m * fbm3(...)`` is its height. Computed in bounded chunks of vertices
+    straight into the result: besides it, the memory used does not grow with the grid.
+
+    Parameters
+    ----------
+    out : (N,) float64 array, optional
+        Written in place and returned (C-contiguous, one value per vertex).
 
     Examples
     --------
@@ -157,20 +165,27 @@ def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: f
     amplitude_m = check_finite("amplitude_m", amplitude_m)
     octaves, persistence, lacunarity, _ = _check_noise_params(octaves, persistence,
                                                               lacunarity, 0)
+    if out is None:
+        out = np.empty(grid.n_vertices, dtype=np.float64)
+    elif not (isinstance(out, np.ndarray) and out.dtype == np.float64
+              and out.shape == (grid.n_vertices,) and out.flags.c_contiguous
+              and out.flags.writeable):
+        raise ValueError(f"`out` must be a writeable C-contiguous float64 array of shape "
+                         f"({grid.n_vertices},)")
     rng = normalize_rng(rng)
     rot = random_rotation(rng)
     offset = rng.uniform(0.0, 256.0, size=3)
-    out = np.empty(grid.n_vertices, dtype=np.float64)
-    # coordinates in float32 chunks to bound the memory of very large grids
-    chunk = 1 << 22
-    for s in range(0, grid.n_vertices, chunk):
+    # per vertex, so the chunking never changes a value: chunks bound the memory
+    for s in range(0, grid.n_vertices, _CHUNK):
         # explicit sums, not BLAS, so the rounding never depends on the thread count
-        uc = grid.unit_vectors_range(s, s + chunk)
+        uc = grid.unit_vectors_range(s, s + _CHUNK)
         xs, ys, zs = (
             ((uc[:, 0] * rot[a, 0] + uc[:, 1] * rot[a, 1] + uc[:, 2] * rot[a, 2]) * frequency
              + offset[a]).astype(np.float32)
             for a in range(3)
         )
-        _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, 0, out[s:s + chunk])
-    out *= amplitude_m
+        del uc
+        block = out[s:s + _CHUNK]
+        _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, 0, block)
+        block *= amplitude_m
     return out
