@@ -50,7 +50,10 @@ __all__ = ["Crater", "Roughness", "StampingProfiles", "resolve_roughness", "rim_
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
-WAVE_MIN = 64  # fewer craters than this (or one numba thread): the serial kernel
+# the serial kernel for fewer craters or crater-box pixels than these (or one thread): a
+# few ms of work per wave does not pay for its barrier, least of all on a busy machine
+WAVE_MIN = 64
+WAVE_MIN_PIXELS = 1_000_000
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -263,8 +266,13 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     gain = 2.0 ** (rough.fractal_dimension - 3.0)
     args = (h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds, ejecta_edge,
             bool(slope_erosion), onset, full, rough_arr, gain, scale, slope, erased)
-    if numba.get_num_threads() > 1 and n >= WAVE_MIN:
-        _stamp_in_waves(args, progress)
+    waves = numba.get_num_threads() > 1 and n >= WAVE_MIN
+    if waves:
+        reach = _crater_reach_px(pixel, diam, rim_tabs, ejecta_edge)
+        cost = _box_pixels(h.shape[0], cy, reach) * _box_pixels(h.shape[1], cx, reach)
+        waves = cost.sum() >= WAVE_MIN_PIXELS
+    if waves:
+        _stamp_in_waves(args, reach, cost, progress)
     else:
         step = _BATCH if progress else max(n, 1)
         for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
@@ -321,14 +329,13 @@ def _box_pixels(n: int, c: np.ndarray, reach: np.ndarray) -> np.ndarray:
     return np.maximum(hi - lo + 1.0, 0.0)
 
 
-def _stamp_in_waves(args, progress: bool) -> None:
+def _stamp_in_waves(args, reach, cost, progress: bool) -> None:
     """Stamp in parallel waves (:mod:`craters._wave_kernels`): the serial kernel's heights
-    and outputs, bit for bit. ``args``: the serial kernel's arguments (full arrays)."""
-    h, pixel, cx, cy, diam, _, _, rim_tabs, _, xe = args[:10]
+    and outputs, bit for bit. ``args``: the serial kernel's arguments (full arrays);
+    ``reach`` (:func:`_crater_reach_px`) and ``cost`` (box pixels) per crater."""
+    h, cx, cy = args[0], args[2], args[3]
     n = len(cx)
-    reach = _crater_reach_px(pixel, diam, rim_tabs, xe)
     wave, n_waves, cell = _wave_schedule(h.shape, cy, cx, reach)
-    cost = _box_pixels(h.shape[0], cy, reach) * _box_pixels(h.shape[1], cx, reach)
     alone = cost >= PARALLEL_MIN
     order = np.lexsort((-cost, wave))  # by wave, the costliest first
     starts = np.searchsorted(wave[order], np.arange(n_waves + 1))
