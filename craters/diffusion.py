@@ -242,7 +242,10 @@ def profile_tables(diameter_m, tau, target: str | Target = "moon", *,
         blended = np.empty((len(old), N_TABLE))
         _blend_tables(stack, a, b, j0, fd, ft,
                       fresh_morphometry(d[old], t)["depth_m"], blended)
-        out[old] = blended
+        if len(old) == len(d):
+            out = blended  # all diffused: no copy of the (n, N_TABLE) tables
+        else:
+            out[old] = blended
     return out
 
 

@@ -176,6 +176,20 @@ def fresh_profile(x, diameter_m, target: str | Target = "moon", *,
     d = _diameters(diameter_m)
     scalar = d.ndim == 0
     d = np.atleast_1d(d)
+    if d.size * x.size > _BLOCK:  # rows in blocks: the temporaries stay in cache (x4-10)
+        step = max(1, _BLOCK // max(x.size, 1))
+        h = np.concatenate([_fresh_rows(x, d[s:s + step], t, ejecta_edge)
+                            for s in range(0, d.size, step)])
+    else:
+        h = _fresh_rows(x, d, t, ejecta_edge)
+    return h[0] if scalar else h
+
+
+_BLOCK = 1 << 16  # elements per block of fresh_profile's (crater, x) temporaries
+
+
+def _fresh_rows(x: np.ndarray, d: np.ndarray, t: Target, ejecta_edge: float) -> np.ndarray:
+    """fresh_profile of the 1-D diameters ``d``: (len(d), len(x))."""
     m = fresh_morphometry(d, t)
     col = {k: v[:, None] for k, v in m.items()}
     xx = x[None, :]
@@ -200,5 +214,4 @@ def fresh_profile(x, diameter_m, target: str | Target = "moon", *,
     radius = 0.5 * d[:, None]
     e0 = np.minimum(0.14 * radius**0.74, rim)
     outer = _exterior(np.maximum(xx, 1.0), rim, e0, ejecta_edge)
-    h = np.where(xx <= 1.0, inner, np.where(xx < ejecta_edge, outer, 0.0))
-    return h[0] if scalar else h
+    return np.where(xx <= 1.0, inner, np.where(xx < ejecta_edge, outer, 0.0))

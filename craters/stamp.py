@@ -35,6 +35,7 @@ import logging
 import numba
 import numpy as np
 
+from ._diffusion_kernels import _rim_and_floor, _rim_spectra, _scale_rims
 from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
 from ._stamp_kernels import N_RIM, PARALLEL_MIN, _stamp_many_kernel
 from ._wave_kernels import WAVE_MARGIN, _stamp_waves_kernel, _wave_schedule_kernel
@@ -116,10 +117,11 @@ def rim_perturbations(n: int, irregularity, *, rng=None) -> np.ndarray:
     # sum_k a_k cos(k theta + phi_k) at theta = -pi + 2 pi j / 64, by an inverse real FFT:
     # the shift by -pi is the factor (-1)^k
     spec = np.zeros((n, N_RIM // 2 + 1), dtype=np.complex128)
-    spec[:, _HARMONICS] = (N_RIM / 2) * amps * np.exp(1j * phases) * (-1.0) ** _HARMONICS
+    _rim_spectra(phases, (N_RIM / 2) * amps, (-1.0) ** _HARMONICS, _HARMONICS, spec)
     rho = np.fft.irfft(spec, n=N_RIM, axis=1)
-    peak = np.abs(rho).max(axis=1, keepdims=True)
-    return np.ascontiguousarray(rho / np.where(peak > 0, peak, 1.0) * irr[:, None])
+    out = np.empty_like(rho)
+    _scale_rims(rho, np.ascontiguousarray(irr), out)
+    return out
 
 
 def _check_heights(heights) -> np.ndarray:
@@ -184,15 +186,17 @@ def stamping_profiles(catalog, target: str | Target = "moon", *,
     if (~from_age).any():
         tau[~from_age] = tau_from_degradation(d[~from_age], deg[~from_age], t,
                                               ejecta_edge=ejecta_edge)
-    tabs = profile_tables(d, tau, t, ejecta_edge=ejecta_edge)
-    inner = tabs[:, : int(np.ceil(1.2 / ejecta_edge * tabs.shape[1]))]
-    rim = tabs[:, : int(np.ceil(1.5 / ejecta_edge * tabs.shape[1]))].max(axis=1)
+    tabs = np.ascontiguousarray(profile_tables(d, tau, t, ejecta_edge=ejecta_edge))
+    rim, floor = np.empty(n), np.empty(n)
+    _rim_and_floor(tabs, min(int(np.ceil(1.5 / ejecta_edge * tabs.shape[1])), tabs.shape[1]),
+                   min(int(np.ceil(1.2 / ejecta_edge * tabs.shape[1])), tabs.shape[1]),
+                   rim, floor)
     fresh = fresh_morphometry(d, t)
     peak = np.where(fresh["complex"] > 0, fresh["peak_height_m"], 0.0)
     kappa_t = tau * (0.5 * d) ** 2
     extra = {"morphology": morphology_class(d, t), "floor_diameter_m": fresh["floor_diameter_m"],
              "peak_height_m": peak, "kappa_t_m2": kappa_t}
-    return StampingProfiles(np.ascontiguousarray(tabs), rim - inner.min(axis=1), rim,
+    return StampingProfiles(tabs, rim - floor, rim,
                             fresh["depth_m"], tau, extra)
 
 

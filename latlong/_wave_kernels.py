@@ -71,19 +71,50 @@ def _wave_schedule_kernel(colat, lon, ang, n_theta, out_wave):
     return n_waves
 
 
-@njit(cache=True, parallel=True)
-def _stamp_waves_kernel(order, starts, m, ring_offsets, radii, stretch, lat, lon, diam, tabs,
-                        depths, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
-                        gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,
-                        out_spacing, out_erased, up, ang_bound, n_threads, ok):
-    """Stamp the waves ``order[starts[w]:starts[w + 1]]`` one after the other, the craters
-    of a wave in parallel (a wave of one: its own writes in parallel; ``order`` puts a
-    wave's costliest craters first and thread t of ``n_threads`` takes every nt-th); ``ok[c]`` False
-    where crater ``c``'s cap outgrew ``ang_bound[c]`` (then the result is not valid)."""
-    unit = np.empty((0, 3))
+@njit(cache=True)
+def _balance_waves_kernel(order, starts, cost, n_threads, out_order, out_bounds):
+    """Share each wave's craters among ``n_threads`` threads, largest first to the least
+    loaded (LPT): ``out_order[out_bounds[w, t]:out_bounds[w, t + 1]]`` are thread t's
+    craters of wave w (``order[starts[w]:starts[w + 1]]``, costliest first, by ``cost``).
+    Round-robin dealing left the thread that took the largest crater of each wave with
+    the most work (ideal speed-up x1.82 instead of x1.97 on the M = 330 Moon benchmark)."""
+    load = np.empty(n_threads)
+    thread = np.empty(order.shape[0], np.int64)
     for w in range(starts.shape[0] - 1):
         s = starts[w]
         e = starts[w + 1]
+        load[:] = 0.0
+        for k in range(s, e):
+            best = 0
+            for t in range(1, n_threads):
+                if load[t] < load[best]:
+                    best = t
+            thread[k] = best
+            load[best] += cost[order[k]]
+        at = s
+        for t in range(n_threads):
+            out_bounds[w, t] = at
+            for k in range(s, e):
+                if thread[k] == t:
+                    out_order[at] = order[k]
+                    at += 1
+        out_bounds[w, n_threads] = at
+
+
+@njit(cache=True, parallel=True)
+def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon, diam, tabs,
+                        depths, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
+                        gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,
+                        out_spacing, out_erased, up, ang_bound, ok):
+    """Stamp the waves one after the other, the craters of a wave in parallel: thread t
+    takes ``order[bounds[w, t]:bounds[w, t + 1]]`` of wave w (:func:`_balance_waves_kernel`;
+    a wave of one crater: its own writes in parallel); ``ok[c]`` False where crater
+    ``c``'s cap outgrew ``ang_bound[c]`` (then the result is not valid)."""
+    unit = np.empty((0, 3))
+    nt = bounds.shape[1] - 1
+    for w in range(bounds.shape[0]):
+        s = bounds[w, 0]
+        e = bounds[w, nt]
         if e - s == 1:
             c = order[s]
             ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs,
@@ -92,9 +123,8 @@ def _stamp_waves_kernel(order, starts, m, ring_offsets, radii, stretch, lat, lon
                                out_maxdh, out_nvert, out_spacing, out_erased, up, False, 0,
                                True, ang_bound[c])
             continue
-        nt = min(n_threads, e - s)
-        for t in prange(nt):  # thread t takes every nt-th crater (costliest first)
-            for k in range(s + t, e, nt):
+        for t in prange(nt):
+            for k in range(bounds[w, t], bounds[w, t + 1]):
                 c = order[k]
                 ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam,
                                    tabs, depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,

@@ -14,7 +14,7 @@ from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
 from craters.targets import Target
 
 from ._crater_kernels import _stamp_body_kernel
-from ._wave_kernels import _stamp_waves_kernel, _wave_schedule_kernel
+from ._wave_kernels import _balance_waves_kernel, _stamp_waves_kernel, _wave_schedule_kernel
 from .body import Body
 from .mesh.cratering import down_directions
 from .surface import band_areas, sample_surface_points
@@ -26,6 +26,7 @@ _BATCH = 256  # craters per kernel call when a progress bar is shown
 #: The wave schedule allows each crater's local radius to fall to this share of its
 #: value before stamping (checked: beyond it the craters are stamped serially).
 WAVE_RADIUS_SHARE = 0.8
+WAVE_FIXED_COST = 200.0  # a crater's fixed work (local grid, fits), in gathered vertices
 _CHUNK = 1 << 20  # vertices per block of the whole-body checks (bounded temporaries)
 
 
@@ -49,21 +50,27 @@ def _stamp_in_waves(body: Body, cat, rim_tabs, ejecta_edge: float, args, progres
         * (1.0 + rim_tabs.max(axis=1))
     # the cap each crater will gather, for a local radius down to WAVE_RADIUS_SHARE of
     # today's: earlier craters would have to move the surface by more than that
-    rloc = WAVE_RADIUS_SHARE * _local_radii(body, cat["lat_deg"], cat["lon_deg"])
+    rnow = _local_radii(body, cat["lat_deg"], cat["lon_deg"])
+    rloc = WAVE_RADIUS_SHARE * rnow
     bound = np.minimum(np.pi, (reach / rloc + np.pi / m) * stretch.max() / stretch.min())
     bound = np.ascontiguousarray(bound * (1.0 + 1e-9))
+    # work per crater: the vertices of its gather cap today, plus a fixed share
+    cap = np.minimum(np.pi, (reach / rnow + np.pi / m) * stretch.max() / stretch.min())
+    cost = 0.5 * (1.0 - np.cos(cap)) * body.grid.n_vertices + WAVE_FIXED_COST
     n_theta = int(np.clip(np.pi / (2.0 * np.median(bound)), 4, 4096))
     wave = np.empty(n, dtype=np.int64)
     n_waves = _wave_schedule_kernel(np.pi / 2 - lat, lon, bound, n_theta, wave)
-    order = np.lexsort((-reach / rloc, wave))  # by wave, the largest caps first
+    order = np.lexsort((-cost, wave))  # by wave, the costliest first
     starts = np.searchsorted(wave[order], np.arange(n_waves + 1))
+    n_threads = numba.get_num_threads()
+    bounds = np.empty((n_waves, n_threads + 1), dtype=np.int64)
+    _balance_waves_kernel(order.copy(), starts, cost, n_threads, order, bounds)
     ok = np.ones(n, dtype=np.bool_)
     chunks = np.linspace(0, n_waves, min(n_waves, 100 if progress else 1) + 1).astype(int)
     bar = progress_bar(total=n, enabled=progress, desc="craters")
     try:
         for w0, w1 in zip(chunks[:-1], chunks[1:], strict=True):
-            _stamp_waves_kernel(order, starts[w0:w1 + 1], *args, bound,
-                                numba.get_num_threads(), ok)
+            _stamp_waves_kernel(order, bounds[w0:w1], *args, bound, ok)
             bar.update(int(starts[w1] - starts[w0]))
     finally:
         bar.close()

@@ -258,3 +258,23 @@ def test_systems_lookup():
     assert get_chronology_system("moon").d_range_m == (10.0, 300000.0)
     with pytest.raises(ValueError, match="`npf` must be one of moon"):
         get_chronology_system("pluto")
+
+
+def test_expected_survivors_equal_scipy_stats_poisson():
+    """The Poisson tails from scipy.special (no scipy.stats import) give the same numbers
+    as scipy.stats.poisson, caps below 2 and lambda = 0 included."""
+    from scipy.stats import poisson
+
+    from craters.chronology.sampling import expected_survivors
+
+    rng = np.random.default_rng(1)
+    lam = np.concatenate([rng.uniform(0, 50, 300), [0.0, 1e-9, 1e4, 3.0]])
+    want = np.concatenate([rng.uniform(0, 60, 300), [0.0, 2.5, 3e3, 0.4]])
+    lo = np.floor(want)
+    f = want - lo
+
+    def e_min(c):
+        return lam * poisson.cdf(c - 2, lam) + c * poisson.sf(c - 1, lam)
+
+    np.testing.assert_array_equal(expected_survivors(lam, want),
+                                  (1 - f) * e_min(lo) + f * e_min(lo + 1))

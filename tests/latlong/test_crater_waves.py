@@ -126,3 +126,30 @@ def test_fill_rim_cells_gives_the_rim_offsets_of_the_whole_fill():
     rim_offsets(full, float(nh), float(nh), sp, radius, rim, 0.0, 0.0, 0.0, a)
     rim_offsets(part, float(nh), float(nh), sp, radius, rim, 0.0, 0.0, 0.0, b)
     np.testing.assert_array_equal(a, b)
+
+
+def test_balanced_waves_keep_each_crater_in_its_wave_once():
+    """LPT sharing of each wave among threads: a permutation that keeps every wave's
+    craters together, and the heaviest thread's load no worse than round-robin dealing."""
+    from latlong._wave_kernels import _balance_waves_kernel
+
+    rng = np.random.default_rng(4)
+    n, n_threads = 400, 3
+    wave = np.sort(rng.integers(0, 25, n))
+    cost = rng.pareto(1.5, n) + 1.0
+    order = np.lexsort((-cost, wave))
+    starts = np.searchsorted(wave[order], np.arange(wave.max() + 2))
+    out = np.empty(n, np.int64)
+    bounds = np.empty((len(starts) - 1, n_threads + 1), np.int64)
+    _balance_waves_kernel(order, starts, cost, n_threads, out, bounds)
+    assert np.array_equal(np.sort(out), np.arange(n))
+    lpt = rr = 0.0
+    for w in range(len(starts) - 1):
+        assert bounds[w, 0] == starts[w] and bounds[w, -1] == starts[w + 1]
+        assert set(out[starts[w]:starts[w + 1]]) == set(order[starts[w]:starts[w + 1]])
+        loads = [cost[out[bounds[w, t]:bounds[w, t + 1]]].sum() for t in range(n_threads)]
+        lpt += max(loads)
+        dealt = order[starts[w]:starts[w + 1]]
+        rr += max(cost[dealt[t::n_threads]].sum() for t in range(n_threads))
+    assert lpt <= rr
+    assert lpt < 0.95 * rr  # heavy-tailed costs: dealing in turn leaves real imbalance
