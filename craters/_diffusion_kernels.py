@@ -13,19 +13,21 @@ from numba import njit, prange
 
 
 @njit(cache=True, parallel=True)
-def _blend_tables(stack, a, b, j0, fd, ft, depth, out):
-    """``out[c] = ((1 - fd)((1 - ft) S[a, j0] + ft S[a, j0 + 1])
-    + fd ((1 - ft) S[b, j0] + ft S[b, j0 + 1])) depth[c]`` for every crater c (rows of ``out``),
-    with S = ``stack`` (nodes, tau nodes, table) in float32."""
-    n, m = out.shape
-    for c in prange(n):
+def _blend_tables(stack, a, b, j0, fd, ft, depth, rows, out):
+    """``out[rows[c]] = ((1 - fd)((1 - ft) S[a, j0] + ft S[a, j0 + 1])
+    + fd ((1 - ft) S[b, j0] + ft S[b, j0 + 1])) depth[c]`` for every crater c, with S =
+    ``stack`` (nodes, tau nodes, table) in float32 (straight into the caller's rows: no
+    (n, table) temporary and copy, 0.23 s of a 50 000-crater stamp)."""
+    m = out.shape[1]
+    for c in prange(a.shape[0]):
         ia, ib, j = a[c], b[c], j0[c]
         wd, wt = fd[c], ft[c]
         s = depth[c]
+        r = rows[c]
         for k in range(m):  # the numpy expression's order of operations, for the same bits
             lo = (1.0 - wt) * stack[ia, j, k] + wt * stack[ia, j + 1, k]
             hi = (1.0 - wt) * stack[ib, j, k] + wt * stack[ib, j + 1, k]
-            out[c, k] = ((1.0 - wd) * lo + wd * hi) * s
+            out[r, k] = ((1.0 - wd) * lo + wd * hi) * s
 
 
 @njit(cache=True, parallel=True)

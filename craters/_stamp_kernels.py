@@ -67,7 +67,7 @@ def _corner(seed, ix, iy, fx, fy):
     return _GRAD[g, 0] * fx + _GRAD[g, 1] * fy
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _noise2(seed, x, y):
     """2-D gradient noise in about [-0.8, 0.8], zero at integer lattice points."""
     x0 = np.floor(x)
@@ -87,7 +87,7 @@ def _noise2(seed, x, y):
     return a + v * (b - a)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _fbm2(seed, x, y, wavelength, octaves, gain):
     """fBm of ``octaves`` octaves from ``wavelength`` (metres) halving each octave."""
     total = 0.0

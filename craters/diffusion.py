@@ -239,13 +239,8 @@ def profile_tables(diameter_m, tau, target: str | Target = "moon", *,
         upto = np.minimum(j0 + 2, len(cache.tau_nodes))
         stack, pos = cache.stack(np.concatenate([i0, i0 + 1]), np.concatenate([upto, upto]))
         a, b = pos[:len(old)], pos[len(old):]
-        blended = np.empty((len(old), N_TABLE))
-        _blend_tables(stack, a, b, j0, fd, ft,
-                      fresh_morphometry(d[old], t)["depth_m"], blended)
-        if len(old) == len(d):
-            out = blended  # all diffused: no copy of the (n, N_TABLE) tables
-        else:
-            out[old] = blended
+        _blend_tables(stack, a, b, j0, fd, ft, fresh_morphometry(d[old], t)["depth_m"], old,
+                      out)
     return out
 
 

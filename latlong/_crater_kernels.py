@@ -166,7 +166,16 @@ def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, s
                  rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves, gain,
                  dh_out):
     """New radii for gathered vertices lo..hi-1 (each vertex written once)."""
+    # beyond the ejecta edge of the widest rim nothing changes: no rim lookup there (nor
+    # an azimuth: _local_coordinates leaves it 0 beyond this same bound)
+    far = 0.0
+    for k in range(rim_tab.shape[0]):
+        far = max(far, rim_tab[k])
+    far = xe * radius * (1.0 + far) * (1.0 + 1e-12)  # margin over rounding
     for q in range(lo, hi):
+        if dist[q] > far:
+            dh_out[q] = 0.0
+            continue
         x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
         dh = 0.0
         if x < xe:

@@ -119,9 +119,11 @@ def _local_coordinates(cand, m, ring_offsets, radii, stretch, a0, a1, a2, e0v, e
     has unit normal ``a`` and east/north axes ``e``, ``n`` at local radius ``rloc``:
     the candidates within arc ``limit`` (metres) are written, in order, to ``idx``
     (vertex), ``pmag`` (|position|), ``dist`` (arc ``rloc`` x angle to the centre),
-    ``az`` (azimuth from east), ``xl, yl`` (dist x (cos, sin) az) and ``hgt`` (pmag -
-    rloc). Returns (count written, count within ``reach``)."""
+    ``az`` (azimuth from east; 0 beyond ``reach`` (1 + 1e-12), where the stamp does not
+    read it: an arctangent less for a third of the vertices), ``xl, yl`` (dist x (cos,
+    sin) az) and ``hgt`` (pmag - rloc). Returns (count written, count within ``reach``)."""
     keep = 0
+    az_reach = reach * (1.0 + 1e-12)  # the same bound as _write_range's
     # candidates whose direction is farther than limit / rloc (with a margin far above
     # rounding) are dropped on the dot product alone, before the arctangents
     cos_reject = np.cos(limit / rloc) - 1e-9 if limit / rloc < 3.0 else -2.0
@@ -187,7 +189,7 @@ def _local_coordinates(cand, m, ring_offsets, radii, stretch, a0, a1, a2, e0v, e
         idx[keep] = i
         pmag[keep] = pm
         dist[keep] = d
-        az[keep] = np.arctan2(yn, xe_)
+        az[keep] = np.arctan2(yn, xe_) if d <= az_reach else 0.0
         # d (cos, sin) of the azimuth from its components, not from the angle
         if rho > 0.0:
             xl[keep] = d * (xe_ / rho)

@@ -16,11 +16,13 @@ def test_blend_tables_matches_numpy_bit_for_bit():
     a, b = rng.integers(0, 7, n), rng.integers(0, 7, n)
     j0 = rng.integers(0, 8, n)
     fd, ft, depth = rng.random(n), rng.random(n), rng.uniform(1, 1e3, n)
-    out = np.empty((n, 33))
-    _blend_tables(stack, a, b, j0, fd, ft, depth, out)
+    rows = rng.permutation(n + 5)[:n]  # into given rows of a bigger table
+    out = np.full((n + 5, 33), -7.0)
+    _blend_tables(stack, a, b, j0, fd, ft, depth, rows, out)
     f, t = fd[:, None], ft[:, None]
-    want = ((1 - f) * ((1 - t) * stack[a, j0] + t * stack[a, j0 + 1])
-            + f * ((1 - t) * stack[b, j0] + t * stack[b, j0 + 1])) * depth[:, None]
+    want = np.full((n + 5, 33), -7.0)
+    want[rows] = ((1 - f) * ((1 - t) * stack[a, j0] + t * stack[a, j0 + 1])
+                  + f * ((1 - t) * stack[b, j0] + t * stack[b, j0 + 1])) * depth[:, None]
     np.testing.assert_array_equal(out, want)
 
 

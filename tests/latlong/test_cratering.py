@@ -309,7 +309,9 @@ def test_local_coordinates_match_numpy(rng, lat, lon, stretch):
     assert np.array_equal(idx, cand[sel])
     assert np.allclose(pmag, pm[sel], rtol=1e-14, atol=0)
     assert np.allclose(dist, d[sel], rtol=0, atol=1e-9)
-    assert np.allclose(azk[dist > 1e-6], az[sel][dist > 1e-6], rtol=0, atol=1e-9)
+    near = (dist > 1e-6) & (dist <= reach)  # beyond reach the stamp reads no azimuth
+    assert np.allclose(azk[near], az[sel][near], rtol=0, atol=1e-9)
+    assert (azk[dist > reach * (1 + 1e-12)] == 0).all()
     assert np.allclose(xl, d[sel] * np.cos(az[sel]), rtol=0, atol=1e-9)
     assert np.allclose(yl, d[sel] * np.sin(az[sel]), rtol=0, atol=1e-9)
     assert np.allclose(hgt, pm[sel] - rloc, rtol=0, atol=1e-9)
