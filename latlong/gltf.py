@@ -12,7 +12,10 @@ triangles: a first pass over the patches (numba, patches in parallel) finds each
 strip length, vertex count and bounds from float32 positions computed once per level,
 which fixes the whole JSON; the second pass generates the patches' data again, a group
 of patches at a time into one buffer, straight after the JSON (normals from a
-band-streaming kernel). Only the boulder meshes go through a temporary file.
+band-streaming kernel). Only the boulder meshes go through a temporary file. Memory:
+the float32 positions (12 B a vertex) and longitude table (8 B a vertex) of every level
+between the passes, the normals (12 B a vertex) of the level being written, two 64 MB
+buffers.
 A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
 ``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
 glTF 2.0 allows.
