@@ -2,7 +2,9 @@
 
 Every value is computed as the numpy code it replaces computed it (same operations in
 the same order, float64 rounded once to float32), so the files keep their bytes; the
-kernels only skip the intermediate arrays and the per-patch Python work.
+kernels only skip the intermediate arrays and the per-patch Python work. The chunk
+kernels run on one thread without the GIL: the exports make several chunks at once on
+worker threads (``craters._shared.ordered_chunks``).
 """
 
 from __future__ import annotations
@@ -13,16 +15,16 @@ from numba import njit, prange
 from ._grid_kernels import _band_strip_kernel, _band_triangles_kernel, _lon_row, _ring_size
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _ply_vertex_kernel(m, ring_offsets, radii, radius_m, stretch, lon_table, lo, hi, out):
     """PLY vertex records of vertices ``lo .. hi - 1`` into ``out`` ((hi - lo, w) float32
     view of the records): x y z = float32(u * (radius * stretch)) (``Body.vertices``)
-    and height = float32(radius - radius_m); columns past 3 are left alone. Rings in
-    parallel; the latitude's cosine and sine once per ring and the longitudes' from
-    ``lon_table`` (``_unit_of``'s values)."""
+    and height = float32(radius - radius_m); columns past 3 are left alone. The
+    latitude's cosine and sine once per ring and the longitudes' from ``lon_table``
+    (``_unit_of``'s values)."""
     r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
     r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
-    for r in prange(r_first, r_last + 1):
+    for r in range(r_first, r_last + 1):
         o = ring_offsets[r]
         n = ring_offsets[r + 1] - o
         j0 = max(lo - o, 0)
@@ -44,16 +46,19 @@ def _ply_vertex_kernel(m, ring_offsets, radii, radius_m, stretch, lon_table, lo,
             out[q, 3] = np.float32(rad - radius_m)
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _ply_face_kernel(m, band_lo, band_hi, ring_offsets, band_offsets, out):
     """PLY face records (uchar 3, three little-endian 32-bit indices: 13 bytes) of the
-    bands ``band_lo .. band_hi - 1`` into the bytes ``out``; bands in parallel, each
-    triangulated by :func:`_band_triangles_kernel` into a small buffer first."""
+    bands ``band_lo .. band_hi - 1`` into the bytes ``out``, each band triangulated by
+    :func:`_band_triangles_kernel` into a small buffer first."""
     base = band_offsets[band_lo]
-    for band in prange(band_lo, band_hi):
+    most = 0
+    for band in range(band_lo, band_hi):
+        most = max(most, band_offsets[band + 1] - band_offsets[band])
+    tri = np.empty((most, 3), dtype=np.int64)
+    for band in range(band_lo, band_hi):
         t0 = band_offsets[band]
         nt = band_offsets[band + 1] - t0
-        tri = np.empty((nt, 3), dtype=np.int64)
         if band < m:
             ra, rb, south = band, band + 1, False
         else:
@@ -168,12 +173,11 @@ def _patch_local(ring_offsets, strip, length, r_lo, r_hi, vertices, local):
     return count
 
 
-@njit(cache=True, nogil=True, parallel=True)
+@njit(cache=True, nogil=True)
 def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, positions,
                   normals, leaf_from, leaf_to, write, meta, bounds, pos_at, nrm_at, ind_at,
                   out_f32, out_u32):
-    """The glTF data of leaves ``leaf_from .. leaf_to - 1`` of a patch tree, leaves in
-    parallel.
+    """The glTF data of leaves ``leaf_from .. leaf_to - 1`` of a patch tree.
 
     Leaf ``leaf`` covers bands ``leaf_band_lo[leaf] ..`` with the triangle ranges
     ``rng_lo/rng_hi[leaf_ptr[leaf] .. leaf_ptr[leaf + 1] - 1]``. Without ``write`` it fills
@@ -184,7 +188,7 @@ def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, posit
     its sorted vertices) and uint32 local strip indices at the 4-byte word offsets
     ``pos_at/nrm_at/ind_at[leaf]`` of ``out_f32``/``out_u32`` (two views of one buffer).
     """
-    for leaf in prange(leaf_from, leaf_to):
+    for leaf in range(leaf_from, leaf_to):
         p0 = leaf_ptr[leaf]
         nb = leaf_ptr[leaf + 1] - p0
         cap = 0

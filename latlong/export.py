@@ -4,15 +4,16 @@ for the shared writers (PLY, OBJ, STL, VTP, VTK), and the patched-strip glTF for
 Nothing holds the whole triangle array: triangles are generated a few latitude bands at a
 time (``LatLongGrid.band_triangles``), so a 24 M-vertex body exports in a few hundred MB
 beyond the body itself. PLY takes a fast path (``MeshSource.vertex_records`` /
-``face_records``): numba kernels write the packed records of 2 M vertices or triangles
-straight into one of two alternating buffers while the other is written on a background
-thread (the longitudes' cosines and sines, 8 B a vertex, are found once per pair of
-mirror rings); the bytes are those of the generic packing. Every vertex has ``height_m``
-(radius minus the reference radius). Placed boulders (``body.boulders``) are merged in at
-their finest level after the body's vertices and triangles, with a per-vertex
-``boulder_id`` (-1 on the body, else the boulder's row in the catalog: ground truth for
-hazard detection) and, in OBJ, the face groups ``body`` and ``boulders``. ``.glb`` is
-the renderer export of :func:`latlong.export_glb` (patched triangle strips, manifest).
+``face_records``): numba kernels write the packed records of 1 M vertices or triangles
+straight into buffers, several chunks at once on worker threads, while the chunks before
+are written on a background thread (the longitudes' cosines and sines, 8 B a vertex,
+are found once per pair of mirror rings); the bytes are those of the generic packing.
+Every vertex has ``height_m`` (radius minus the reference radius). Placed boulders
+(``body.boulders``) are merged in at their finest level after the body's vertices and
+triangles, with a per-vertex ``boulder_id`` (-1 on the body, else the boulder's row in
+the catalog: ground truth for hazard detection) and, in OBJ, the face groups ``body`` and
+``boulders``. ``.glb`` is the renderer export of :func:`latlong.export_glb` (patched
+triangle strips, manifest).
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from craters._shared import ordered_chunks
 from craters._shared.meshio import (
     MESH_SUFFIXES,
     MeshSource,
@@ -39,7 +41,7 @@ __all__ = ["EXPORT_SUFFIXES", "body_mesh_source", "export_body"]
 #: Suffixes :meth:`latlong.Body.export` writes.
 EXPORT_SUFFIXES = MESH_SUFFIXES
 # triangles (and vertices) per streamed chunk
-_CHUNK = 1 << 21
+_CHUNK = 1 << 20
 
 
 def _band_chunks(grid):
@@ -83,19 +85,21 @@ def body_mesh_source(body) -> MeshSource:
             yield from boulder_vertex_chunks()
 
     def vertex_records(dtype):
-        # the body's records straight from a kernel into two alternating buffers
-        bufs = [np.empty(min(n, _CHUNK), dtype=dtype) for _ in range(2)]
+        # the body's records straight from a kernel, chunks made on worker threads
         radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
         table = lon_table(grid.magnitude, grid.ring_offsets())
-        for k, s in enumerate(range(0, n, _CHUNK)):
+
+        def make(s, buf):
             e = min(s + _CHUNK, n)
-            buf = bufs[k % 2]
             _ply_vertex_kernel(grid.magnitude, grid.ring_offsets(), radii, body.radius_m,
                                stretch, table, s, e, buf.view(np.float32).reshape(len(buf), -1))
             rec = buf[:e - s]
             if cat is not None:
                 rec["boulder_id"] = -1
-            yield rec
+            return rec
+
+        yield from ordered_chunks(make, range(0, n, _CHUNK),
+                                  lambda: np.empty(min(n, _CHUNK), dtype=dtype))
         if cat is not None:
             for v, values in boulder_vertex_chunks():
                 yield pack_vertices(v, values, dtype)
@@ -104,12 +108,14 @@ def body_mesh_source(body) -> MeshSource:
         ro, bo = grid.ring_offsets(), grid.band_offsets()
         chunks = list(_band_chunks(grid))
         size = max((int(bo[hi] - bo[lo]) for lo, hi in chunks), default=0)
-        bufs = [np.empty(size, dtype=dtype) for _ in range(2)]
-        for i, (lo, hi) in enumerate(chunks):
-            k = int(bo[hi] - bo[lo])
-            buf = bufs[i % 2][:k]
-            _ply_face_kernel(grid.magnitude, lo, hi, ro, bo, buf.view(np.uint8))
-            yield buf
+
+        def make(chunk, buf):
+            lo, hi = chunk
+            rec = buf[:int(bo[hi] - bo[lo])]
+            _ply_face_kernel(grid.magnitude, lo, hi, ro, bo, rec.view(np.uint8))
+            return rec
+
+        yield from ordered_chunks(make, chunks, lambda: np.empty(size, dtype=dtype))
         if cat is not None:
             for tri in boulder_face_chunks():
                 yield pack_faces(tri, dtype)

@@ -8,11 +8,14 @@ min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band stri
 to the patch and joined with degenerate triangles. Node extras and the JSON manifest
 give each patch's bounding sphere, bands, triangle count and the byte ranges of its
 data, so a renderer can cull and stream patches. Nothing holds the whole body's
-triangles: a first pass over the patches (numba, patches in parallel) finds each one's
-strip length, vertex count and bounds from float32 positions computed once per level,
-which fixes the whole JSON; the second pass generates the patches' data again, a group
-of patches at a time into one buffer, straight after the JSON (normals from a
-band-streaming kernel). Only the boulder meshes go through a temporary file.
+triangles: a first pass over the patches (numba, chunks of patches on worker threads)
+finds each one's strip length, vertex count and bounds from float32 positions computed
+once per level, which fixes the whole JSON; the second pass generates the patches' data
+again, groups of patches on worker threads into buffers written in order straight after
+the JSON (normals from a band-streaming kernel). Only the boulder meshes go through a
+temporary file. Memory: the float32 positions (12 B a vertex) and longitude table (8 B a
+vertex) of every level between the passes, the normals (12 B a vertex) of the level
+being written, 32 MB buffers (two per thread, and two).
 A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
 ``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
 glTF 2.0 allows.
@@ -42,6 +45,7 @@ from craters._shared import (
     BackgroundWriter,
     atomic_path,
     check_int,
+    ordered_chunks,
     package_version,
     progress_bar,
 )
@@ -140,7 +144,9 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
 #: A GLB's length and chunk lengths are 32-bit: past this the levels go to .bin files.
 GLB_LIMIT = 2**32 - 1
 #: Bytes of patch data generated per group (one buffer) in the writing pass.
-_GROUP_BYTES = 1 << 26
+_GROUP_BYTES = 1 << 25
+# leaves per task of the first pass
+_LEAVES_PER_TASK = 64
 
 
 def _finish(path: Path, gl: dict, manifest: dict, plans: list, sizes: list, temps: list,
@@ -261,7 +267,12 @@ def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _Le
     nl = len(leaves)
     meta = np.zeros((nl, 3), dtype=np.int64)
     bounds = np.zeros((nl, 10), dtype=np.float64)
-    _patch_pass(grid, positions, positions, leaves_table, 0, nl, meta, bounds)
+    # leaves in chunks on worker threads (the kernel runs without the GIL)
+    chunks = [(a, min(a + _LEAVES_PER_TASK, nl)) for a in range(0, nl, _LEAVES_PER_TASK)]
+    for _ in ordered_chunks(lambda ab, _: _patch_pass(grid, positions, positions,
+                                                      leaves_table, *ab, meta, bounds),
+                            chunks, lambda: None):
+        pass
     at = np.full((nl, 3), -1, dtype=np.int64)
     nbytes = np.zeros(nl, dtype=np.int64)
     offset = 0
@@ -329,21 +340,24 @@ def _write_level_data(plan: _LevelPlan, fh, progress: bool) -> None:
         groups.append((first, last))
         first = last
     big = max((int(ends[b - 1] - ends[a] + plan.nbytes[a]) for a, b in groups), default=0)
-    bufs = [np.empty(big // 4, dtype=np.uint32) for _ in range(2)]
     meta = np.zeros((1, 3), dtype=np.int64)
     bounds = np.zeros((1, 10), dtype=np.float64)
-    with BackgroundWriter(fh) as out:  # group k + 1 is made while group k is written
-        for i, (a, b) in enumerate(progress_bar(groups, enabled=progress,
-                                                desc=f"LOD {plan.level}")):
-            start = int(ends[a] - plan.nbytes[a])
-            size = int(ends[b - 1]) - start
-            if size == 0:
-                continue
-            at = np.where(plan.at >= 0, (plan.at - start) // 4, 0)
-            buf = bufs[i % 2][:size // 4]
-            _patch_pass(grid, plan.positions, normals, plan.leaves, a, b, meta, bounds, at,
-                        buf)
-            out.write(buf.view(np.uint8))
+
+    def make(group, buf):
+        a, b = group
+        start = int(ends[a] - plan.nbytes[a])
+        words = buf[:(int(ends[b - 1]) - start) // 4]
+        at = np.where(plan.at >= 0, (plan.at - start) // 4, 0)
+        _patch_pass(grid, plan.positions, normals, plan.leaves, a, b, meta, bounds, at, words)
+        return words.view(np.uint8)
+
+    # groups made on worker threads, written in order on a background thread
+    with BackgroundWriter(fh) as out:
+        for data in progress_bar(ordered_chunks(make, groups,
+                                                lambda: np.empty(big // 4, dtype=np.uint32)),
+                                 total=len(groups), enabled=progress,
+                                 desc=f"LOD {plan.level}"):
+            out.write(data)
     plan.positions = None
     if plan.boulders is not None:
         with open(plan.boulders, "rb") as src:

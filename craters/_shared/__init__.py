@@ -15,6 +15,7 @@ from .files import (
     check_parent_folder,
     check_suffix,
     load_toml,
+    ordered_chunks,
 )
 from .progress import progress_bar
 from .spec import parse_spec
@@ -38,7 +39,7 @@ __all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike"
            "area_slope_summary",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
-           "load_toml",
-           "normalize_rng", "package_version", "parameter_of", "parse_spec",
+           "load_toml", "normalize_rng", "ordered_chunks", "package_version", "parameter_of",
+           "parse_spec",
            "physical_memory_bytes",
            "progress_bar"]

@@ -3,7 +3,7 @@
 Speeds are reported as absolute times on this machine plus a ratio against a reference
 measured in the same run (a plain-numpy version of the same diamond-square doubling;
 GDAL's inverse-distance ``fillnodata`` for gap filling). Usage:
-``python tests/benchmarks/bench_dem.py [--quick] [--only enhance]``. Uses
+``python tests/benchmarks/bench_dem.py [--quick] [--only enhance|expand_file|...]``. Uses
 ``../shared/data`` (LOLA LDEM_4, 720 x 1440 = 1.04 Mpx) when present, else the
 257 x 257 crop in tests/data. The ``dem enhance`` / ``dem mesh`` figures run the real
 command line in a child process and report its wall time and peak RSS (GNU time), the
@@ -286,18 +286,49 @@ def bench_enhance(quick):
         assert doc["info"]["seed"] == 2014
 
 
+def bench_expand_file(quick):
+    """`dem expand` bigger than memory: a 1025^2 base by 4 levels (16385^2 pixels) tile by
+    tile; peak RSS, the file (COG validation) and windows against separate expansions."""
+    from rio_cogeo.cogeo import cog_validate
+
+    crop = dem.read(CROP)
+    base = crop if quick else dem.expand(crop, 2, rng=5)  # 257^2 or 1025^2
+    with tempfile.TemporaryDirectory(dir=ROOT.parent) as tmp:
+        tmp = Path(tmp)
+        dem.write(base, tmp / "base.tif")
+        load = os.getloadavg()[0]
+        wall, rss = timed_child(["dem", "expand", str(tmp / "base.tif"), "-o",
+                                 str(tmp / "big.tif"), "--levels", "4", "--seed", "2", "-q"])
+        side = (base.shape[0] - 1) * 16 + 1
+        size = (tmp / "big.tif").stat().st_size
+        valid, errors, warnings = cog_validate(tmp / "big.tif", strict=True)
+        print(f"dem expand {base.shape[0]}^2 by 4 levels -> {side}^2 ({side**2 / 1e6:.0f} "
+              f"Mpx, {size / 1e9:.2f} GB file): {wall:.1f} s wall, peak RSS {rss:.0f} MiB "
+              f"(load average before: {load:.2f}); cog_validate: {valid} {errors} {warnings}")
+        same = []
+        for r0, c0 in ((0, 0), (base.shape[0] // 2, base.shape[0] // 4)):
+            part = dem.expand(base, 4, region=(r0, c0, 129), rng=2)
+            win = dem.read(tmp / "big.tif", window=(16 * r0, 16 * c0, *part.shape))
+            same.append(np.array_equal(win.heights, part.heights.astype(np.float32)))
+        print(f"  windows of the file equal separate region expansions: {all(same)}")
+        if quick:  # the whole raster fits: the same bytes in one piece
+            whole = dem.write(dem.expand(base, 4, rng=2), tmp / "whole.tif")
+            print(f"  tiled file == whole-raster file, byte for byte: "
+                  f"{whole.read_bytes() == (tmp / 'big.tif').read_bytes()}")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="smaller sizes")
     parser.add_argument("--only", choices=["expand", "fill", "fill_spectra", "figures",
-                                           "enhance"],
+                                           "enhance", "expand_file"],
                         help="run one part")
     args = parser.parse_args()
     quick = args.quick
     print(f"machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
           f"numba threads {os.environ.get('NUMBA_NUM_THREADS', 'default')}")
     parts = {"expand": bench_expand, "fill": bench_fill, "fill_spectra": fill_spectra,
-             "figures": figures, "enhance": bench_enhance}
+             "figures": figures, "enhance": bench_enhance, "expand_file": bench_expand_file}
     for name, func in parts.items():
         if args.only in (None, name):
             func(quick)

@@ -92,3 +92,40 @@ def test_background_writer_keeps_order_and_raises_write_errors(tmp_path):
     with pytest.raises(OSError, match="No space"):
         out.write(b"def")
     out.close()
+
+
+@pytest.mark.parametrize("threads", [1, 2, 4])
+def test_ordered_chunks_keeps_order_and_bounds_the_buffers(threads):
+    import threading
+    import time
+
+    from craters._shared import ordered_chunks
+
+    made = []
+    lock = threading.Lock()
+
+    def buffer():
+        with lock:
+            made.append(1)
+        return np.zeros(1)
+
+    def make(i, buf):
+        time.sleep(0.001 * ((7 * i) % 5))  # finish out of order
+        buf[0] = i
+        return buf
+
+    seen, prev = [], None
+    for k, buf in enumerate(ordered_chunks(make, range(60), buffer, threads=threads)):
+        seen.append(int(buf[0]))
+        assert buf[0] == k
+        assert prev is None or prev[0] == k - 1  # the one before is intact too (written)
+        prev = buf
+    assert seen == list(range(60)) and len(made) <= 2 * threads + 2
+
+    def fails(i, buf):
+        if i == 5:
+            raise OSError("disk full")
+        return i
+
+    with pytest.raises(OSError, match="disk full"):
+        list(ordered_chunks(fails, range(20), lambda: None, threads=threads))
