@@ -27,12 +27,12 @@ __all__ = ["BUILD_BASE_BYTES", "BUILD_BYTES_PER_VERTEX", "BUILD_BYTES_PER_VERTEX
 MAX_MAGNITUDE = 1_000_000
 #: Peak memory of ``latlong build ... -o body.npz`` per grid vertex: the float64 radii.
 BUILD_BYTES_PER_VERTEX = 8.0
-#: ... plus, per stamping thread, the kernel's arrays for the crater it stamps (~80 B per
-#: vertex of the crater's cap, a cap being ~0.6 (D/R)^2 of the body). Measured (issue 18,
-#: /usr/bin/time -v, fbm-cratered: D up to 15 m on R = 100 m, 2 threads): peak RSS
-#: 0.70 GB at M = 2048, 1.49 GB at M = 4096, a slope of 10.8 B a vertex = 8 + 2 x 1.4;
-#: rounded up here. Bodies whose largest craters are a larger share of the radius need
-#: more.
+#: ... plus, per stamping thread, the kernel's arrays for the crater it stamps (~95 B per
+#: vertex of the crater's cap, a cap being ~0.6 (D/R)^2 of the body). Measured (issue 18):
+#: fbm-cratered (D up to 15 m on R = 100 m) on 2 threads peaked (/usr/bin/time -v) at
+#: 0.70 GB at M = 2048 and 1.49 GB at M = 4096, a slope of 10.8 B a vertex; eight 15 m
+#: craters on a 100 m sphere at M = 4096 raised the peak by 1.50 B a vertex on 1 thread,
+#: 2.58 on 2. Bodies whose largest craters are a larger share of the radius need more.
 BUILD_BYTES_PER_VERTEX_THREAD = 1.5
 #: ... and what does not grow with the grid: interpreter, libraries, numba and its
 #: compiler (a first run without a kernel cache), bounded buffers, ~70 000 craters'
