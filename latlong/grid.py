@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from craters._shared import check_int
@@ -20,10 +21,32 @@ from ._grid_kernels import (
 from ._grid_kernels import lon_table as make_lon_table
 from ._slope_kernels import _normalize_rows_kernel, _normals_from_radii_kernel
 
-__all__ = ["LatLongGrid", "MAX_MAGNITUDE"]
+__all__ = ["BUILD_BASE_BYTES", "BUILD_BYTES_PER_VERTEX", "BUILD_BYTES_PER_VERTEX_THREAD",
+           "LatLongGrid", "MAX_MAGNITUDE", "build_bytes_per_vertex"]
 
 #: Largest magnitude whose vertex indices fit the int64 arrays used everywhere.
 MAX_MAGNITUDE = 1_000_000
+#: Peak memory of ``latlong build ... -o body.npz`` per grid vertex: the float64 radii.
+BUILD_BYTES_PER_VERTEX = 8.0
+#: ... plus, per stamping thread, the kernel's arrays for the crater it stamps (~95 B per
+#: vertex of the crater's cap, a cap being ~0.6 (D/R)^2 of the body). Measured (issue 18):
+#: fbm-cratered (D up to 15 m on R = 100 m) on 2 threads peaked (/usr/bin/time -v) at
+#: 0.70 GB at M = 2048 and 1.49 GB at M = 4096, a slope of 10.8 B a vertex; eight 15 m
+#: craters on a 100 m sphere at M = 4096 raised the peak by 1.50 B a vertex on 1 thread,
+#: 2.58 on 2. Bodies whose largest craters are a larger share of the radius need more.
+BUILD_BYTES_PER_VERTEX_THREAD = 1.5
+#: ... and what does not grow with the grid: interpreter, libraries, numba and its
+#: compiler (a first run without a kernel cache), bounded buffers, ~70 000 craters'
+#: profile tables. The same fit's intercept is 0.45 GB (kernels cached); rounded up.
+BUILD_BASE_BYTES = 0.6e9
+
+
+def build_bytes_per_vertex(threads: int | None = None) -> float:
+    """Peak memory of a build per grid vertex with ``threads`` stamping threads (default
+    numba's current count): :data:`BUILD_BYTES_PER_VERTEX` + ``threads`` x
+    :data:`BUILD_BYTES_PER_VERTEX_THREAD` (11 B with 2 threads)."""
+    threads = numba.get_num_threads() if threads is None else int(threads)
+    return BUILD_BYTES_PER_VERTEX + threads * BUILD_BYTES_PER_VERTEX_THREAD
 
 
 def _readonly(a: np.ndarray) -> np.ndarray:
@@ -111,14 +134,24 @@ class LatLongGrid:
         return value
 
     @staticmethod
-    def estimate_bytes(magnitude: int, bytes_per_vertex: int = 160) -> int:
-        """Rough memory needed to build and export a body of this magnitude.
+    def estimate_bytes(magnitude: int, bytes_per_vertex: float | None = None,
+                       base_bytes: float | None = None) -> int:
+        """Memory (peak resident set) needed to build a body of this magnitude and write
+        it as .npz: ``base_bytes + (6 M^2 + 2) * bytes_per_vertex``.
 
-        The default of 160 bytes per vertex covers radii, unit vectors, vertices and a
-        streamed export; the CLI refuses requests above the machine's memory.
+        Defaults (measured, see the module's constants): :data:`BUILD_BASE_BYTES` and
+        :func:`build_bytes_per_vertex` for numba's current thread count. Mesh exports
+        may need more.
+
+        Examples
+        --------
+        >>> LatLongGrid.estimate_bytes(10, 8, 0)
+        4816
         """
         m = int(magnitude)
-        return (6 * m * m + 2) * int(bytes_per_vertex)
+        bpv = build_bytes_per_vertex() if bytes_per_vertex is None else bytes_per_vertex
+        base = BUILD_BASE_BYTES if base_bytes is None else base_bytes
+        return int(base + (6 * m * m + 2) * bpv)
 
     # ------------------------------------------------------------------ rings
     def ring_sizes(self) -> np.ndarray:

@@ -52,7 +52,7 @@ __all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
 # flat setting -> (part, field) of the scene; a part's error is shown under the setting
 _BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch",
          "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3",
-         "crater_depth_ratio": "crater_depth_ratio"}
+         "crater_depth_ratio": "crater_depth_ratio", "max_memory_gb": "max_memory_gb"}
 _FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
              "smooth_width_m": "smooth_width_m", "smooth_passes": "smooth_passes",
              "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
@@ -309,7 +309,7 @@ def _latlong_scene(cls, given: dict) -> Scene:
 
 
 def _implicit_scene(cls, given: dict) -> Scene:
-    allowed = {*_IMPLICIT, *_EXAMPLE, *_PREVIEW, "magnitude", "seed"}
+    allowed = {*_IMPLICIT, *_EXAMPLE, *_PREVIEW, "magnitude", "max_memory_gb", "seed"}
     for key in given:
         if key not in allowed:
             raise ParameterError(key, "does not apply to {} implicit", see=("backend",))

@@ -20,34 +20,43 @@ from craters._shared import (
     check_int,
     check_positive,
     check_range,
-    human_bytes,
     physical_memory_bytes,
 )
 
-from .grid import LatLongGrid
+from .grid import BUILD_BASE_BYTES, LatLongGrid, build_bytes_per_vertex
 from .shapes import ShapeModel, read_shape_model
 
-__all__ = ["BASES", "BYTES_PER_VERTEX", "BodySettings", "BoulderSettings", "CraterSettings",
-           "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase", "check_memory"]
+__all__ = ["BASES", "MEMORY_SHARE", "BodySettings", "BoulderSettings",
+           "CraterSettings", "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase",
+           "check_memory"]
 
 #: Names of the base shapes (``shape`` takes a model file).
 BASES = ("sphere", "faulting", "fbm", "shape")
-#: Memory per vertex of a build with export (radii, unit vectors, vertices, caches).
-BYTES_PER_VERTEX = 160
+#: The share of this machine's memory a build may use unless ``max_memory_gb`` is given.
+MEMORY_SHARE = 0.8
 CROSSINGS = ("error", "outermost", "innermost")
 #: Where a shape base is cratered: the lat/long grid or the model's own mesh.
 SURFACES = ("latlong", "mesh")
 
 
-def check_memory(magnitude: int) -> None:
-    """Refuse up front a grid that cannot fit in this machine's memory (the estimate)."""
-    need = LatLongGrid.estimate_bytes(magnitude, BYTES_PER_VERTEX)
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
+def check_memory(magnitude: int, max_memory_gb: float | None = None) -> None:
+    """Refuse up front a grid whose build would need more than ``max_memory_gb`` GB
+    (1e9 bytes; default :data:`MEMORY_SHARE` of this machine's memory), with the
+    estimate (:meth:`LatLongGrid.estimate_bytes`)."""
+    bpv = build_bytes_per_vertex()
+    need = LatLongGrid.estimate_bytes(magnitude, bpv)
+    if max_memory_gb is None:
+        have = physical_memory_bytes()
+        limit = MEMORY_SHARE * have
+        whose = f" (the default: {MEMORY_SHARE:g} x this machine's {have / 1e9:.3g} GB)"
+    else:
+        limit, whose = max_memory_gb * 1e9, ""
+    if need > limit:
         n = 6 * magnitude * magnitude + 2
-        raise ParameterError("magnitude", f"{magnitude} needs about {human_bytes(need)} of "
-                             f"memory ({n:.3g} vertices x {BYTES_PER_VERTEX} B); this machine "
-                             f"has {human_bytes(have)}")
+        raise ParameterError(
+            "magnitude", f"{magnitude} needs about {need / 1e9:.3g} GB of memory ({n:.3g} "
+            f"vertices x {bpv:g} B + {BUILD_BASE_BYTES / 1e9:.3g} GB), more than "
+            f"{{}} = {limit / 1e9:.3g} GB{whose}", see=("max_memory_gb",))
 
 
 def _set(obj, name, value) -> None:
@@ -89,6 +98,10 @@ class BodySettings:
     crater_depth_ratio: float | None = None
     """Fresh crater depth/diameter of a small body, [0.01, 0.5]; default 0.2 (Marchi et
     al. 2015); e.g. Bennu 0.10 (Daly et al. 2020)."""
+    max_memory_gb: float | None = None
+    """Memory the build may use, GB (1e9 bytes); a magnitude whose estimate
+    (:func:`check_memory`) is larger is refused up front. Default: :data:`MEMORY_SHARE`
+    of this machine's memory."""
 
     def __post_init__(self):
         _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
@@ -103,7 +116,9 @@ class BodySettings:
                                      f"{self.target}'s crater depths follow its published laws)")
             _set(self, "crater_depth_ratio", check_range("crater_depth_ratio",
                                                          self.crater_depth_ratio, 0.01, 0.5))
-        check_memory(self.magnitude)
+        if self.max_memory_gb is not None:
+            _set(self, "max_memory_gb", check_positive("max_memory_gb", self.max_memory_gb))
+        check_memory(self.magnitude, self.max_memory_gb)
         if self.radius_m is not None:
             _set(self, "radius_m", check_positive("radius_m", self.radius_m))
         if self.stretch is not None:

@@ -12,9 +12,10 @@ import argparse
 from dataclasses import dataclass
 from typing import Any
 
-from craters._shared import ParameterError, ParameterTypeError, load_toml
+from craters._shared import ParameterError, ParameterTypeError, load_toml, physical_memory_bytes
 from craters._shared.cli import CliError, parse_seed
 from latlong import SETTING_DEFAULTS
+from latlong.settings import MEMORY_SHARE
 
 __all__ = ["BUILD_OPTIONS", "OUTPUT_KEYS", "RENDER_OPTIONS", "Opt", "add_options",
            "flag_of", "given_options", "read_config", "shown"]
@@ -72,6 +73,9 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
         "named scene (see `latlong presets`): sets the base and its parameters, the body "
         "and crater layers"),
     Opt(("--magnitude",), "magnitude", int, "grid magnitude M >= 1 (6M^2+2 vertices)"),
+    Opt(("--max-memory-gb",), "max_memory_gb", float,
+        "memory the build may use, GB (1e9 bytes): a --magnitude whose estimate (radii and "
+        "bounded buffers, written as .npz) is larger is refused up front"),
     Opt(("--radius-m",), "radius_m", float, "reference radius in metres"),
     Opt(("--stretch",), "stretch", _stretch,
         "scale factors X,Y,Z applied to the body (e.g. 2,1,1; the faulting presets "
@@ -238,6 +242,10 @@ def _default_text(opt: Opt) -> str:
     if value is None:
         if opt.key == "spacing_m":
             return "the lat/long spacing at --magnitude, (pi/2) R / M"
+        if opt.key == "max_memory_gb":
+            have = physical_memory_bytes()
+            return (f"{MEMORY_SHARE:g} x this machine's memory, "
+                    f"{MEMORY_SHARE * have / 1e9:.3g} GB")
         return "the preset's / base's" if opt.group in ("faulting", "fbm", "body") else "none"
     if isinstance(value, tuple):
         return ",".join(f"{v:g}" if isinstance(v, float) else str(v) for v in value) or "none"

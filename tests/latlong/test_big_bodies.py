@@ -1,6 +1,6 @@
 """Bodies far bigger than memory used to allow (issue 18): the build keeps one float64
 radius per vertex plus bounded buffers, with the same bytes as the whole-grid code it
-replaced."""
+replaced; a build that would not fit is refused up front."""
 
 from __future__ import annotations
 
@@ -15,8 +15,19 @@ import latlong.body as body_module
 import latlong.cratering as cratering
 import latlong.perlin as perlin
 import latlong.surface as surface
-from latlong import Body, LatLongGrid, Scene, build, perlin_fbm, stamp_craters
+from latlong import (
+    Body,
+    BodySettings,
+    FbmParams,
+    LatLongGrid,
+    Scene,
+    build,
+    perlin_fbm,
+    stamp_craters,
+)
 from latlong.cratering import WaveScheduleOutgrown
+from latlong.grid import build_bytes_per_vertex
+from latlong.settings import check_memory
 from latlong.surface import band_areas
 
 
@@ -199,3 +210,38 @@ def test_build_redoes_an_outgrown_schedule_with_a_copy(monkeypatch, two_threads,
         again = build(_scene())
     assert "building again" in caplog.text
     assert _digest(again) == _digest(ref) and again.metadata == ref.metadata
+
+
+def test_memory_estimate_and_limit():
+    # issue 18 on its 2-core machine: M = 8192 within 8 GB, M = 13 000 within 16 GB
+    two = build_bytes_per_vertex(2)
+    assert two == 11.0 and build_bytes_per_vertex(1) < two < build_bytes_per_vertex(8)
+    assert LatLongGrid.estimate_bytes(100, two) < LatLongGrid.estimate_bytes(8192, two) < 8e9
+    assert LatLongGrid.estimate_bytes(13_000, two) < 16e9
+    assert LatLongGrid.estimate_bytes(13_000) == LatLongGrid.estimate_bytes(
+        13_000, build_bytes_per_vertex(numba.get_num_threads()))
+    check_memory(13_000, max_memory_gb=1000.0)
+    with pytest.raises(ValueError, match=r"`magnitude` 13000 needs about .* GB .* more than "
+                                         r"`max_memory_gb` = 1 GB"):
+        check_memory(13_000, max_memory_gb=1.0)
+    # a scene is only described, never allocated: a large one is accepted when allowed
+    assert Scene(BodySettings(magnitude=20_000, max_memory_gb=1e4),
+                 FbmParams()).body.magnitude == 20_000
+    with pytest.raises(ValueError, match="`max_memory_gb`"):
+        BodySettings(magnitude=10, max_memory_gb=0.0)
+
+
+def test_cli_refuses_a_build_over_max_memory(run_cli, tmp_path, one_line_error):
+    out = tmp_path / "b.npz"
+    proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "3000",
+                   "--max-memory-gb", "1", "-o", str(out), "-q")
+    one_line_error(proc, "--magnitude 3000 needs about", "GB", "--max-memory-gb = 1 GB")
+    assert not out.exists()
+    (tmp_path / "scene.toml").write_text('preset = "fbm-cratered"\nmagnitude = 3000\n'
+                                         "max_memory_gb = 1.0\n")
+    proc = run_cli("latlong", "build", "--config", str(tmp_path / "scene.toml"),
+                   "-o", str(out), "-q")
+    one_line_error(proc, "magnitude", "'max_memory_gb' = 1 GB")
+    proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "12",
+                   "--max-memory-gb", "1", "--seed", "1", "-o", str(out), "-q")
+    assert proc.returncode == 0, proc.stderr

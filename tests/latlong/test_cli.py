@@ -73,7 +73,7 @@ def test_same_seed_same_bytes_any_thread_count(run_cli, tmp_path):
 @pytest.mark.parametrize("args,needles", [
     (["--magnitude", "0"], ["--magnitude", "[1,"]),
     (["--magnitude", "-3"], ["--magnitude"]),
-    (["--magnitude", "100000000"], ["--magnitude 100000000", "memory", "GiB"]),
+    (["--magnitude", "100000000"], ["--magnitude 100000000", "memory", "GB", "--max-memory-gb"]),
     (["--magnitude", "abc"], ["--magnitude"]),
     (["--base", "cube"], ["--base", "sphere, faulting, fbm"]),
     (["--seed", "1.5"], ["--seed"]),
