@@ -175,7 +175,7 @@ def _patch_local(ring_offsets, strip, length, r_lo, r_hi, vertices, local):
 
 @njit(cache=True, nogil=True)
 def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, positions,
-                  normals, leaf_from, leaf_to, write, meta, bounds, pos_at, nrm_at, ind_at,
+                  normals, base, leaf_from, leaf_to, write, meta, bounds, pos_at, nrm_at, ind_at,
                   out_f32, out_u32):
     """The glTF data of leaves ``leaf_from .. leaf_to - 1`` of a patch tree.
 
@@ -183,10 +183,12 @@ def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, posit
     ``rng_lo/rng_hi[leaf_ptr[leaf] .. leaf_ptr[leaf + 1] - 1]``. Without ``write`` it fills
     ``meta[leaf]`` = (strip length, vertices, non-degenerate triangles) and ``bounds[leaf]`` =
     (min xyz, max xyz, centre xyz, radius) of its float32 positions (centre in float64
-    from the float32 bounds, radius = the largest distance to it). With ``write`` it
-    writes the patch's positions, normals (float32 rows of ``positions``/``normals`` of
-    its sorted vertices) and uint32 local strip indices at the 4-byte word offsets
-    ``pos_at/nrm_at/ind_at[leaf]`` of ``out_f32``/``out_u32`` (two views of one buffer).
+    from the float32 bounds, radius = the largest distance to it); row ``v - base`` of
+    ``positions``/``normals`` is vertex v's (they may hold a window of rings only). With
+    ``write`` it writes the patch's positions, normals (float32 rows of
+    ``positions``/``normals`` of its sorted vertices) and uint32 local strip indices at
+    the 4-byte word offsets ``pos_at/nrm_at/ind_at[leaf]`` of ``out_f32``/``out_u32``
+    (two views of one buffer).
     """
     for leaf in range(leaf_from, leaf_to):
         p0 = leaf_ptr[leaf]
@@ -213,8 +215,8 @@ def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, posit
             for q in range(nv):
                 v = vertices[q]
                 for c in range(3):
-                    out_f32[pa + 3 * q + c] = positions[v, c]
-                    out_f32[na + 3 * q + c] = normals[v, c]
+                    out_f32[pa + 3 * q + c] = positions[v - base, c]
+                    out_f32[na + 3 * q + c] = normals[v - base, c]
             ia = ind_at[leaf]
             for k in range(length):
                 out_u32[ia + k] = local[k]
@@ -229,11 +231,11 @@ def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, posit
         meta[leaf, 0] = length
         meta[leaf, 1] = nv
         meta[leaf, 2] = n_tri
-        lo = positions[vertices[0]].copy()
-        hi = positions[vertices[0]].copy()
+        lo = positions[vertices[0] - base].copy()
+        hi = positions[vertices[0] - base].copy()
         for q in range(1, nv):
             for c in range(3):
-                x = positions[vertices[q], c]
+                x = positions[vertices[q] - base, c]
                 if x < lo[c]:
                     lo[c] = x
                 if x > hi[c]:
@@ -247,9 +249,9 @@ def _patch_kernel(m, ring_offsets, leaf_band_lo, leaf_ptr, rng_lo, rng_hi, posit
         far = 0.0
         for q in range(nv):
             v = vertices[q]
-            dx = np.float64(positions[v, 0]) - centre[0]
-            dy = np.float64(positions[v, 1]) - centre[1]
-            dz = np.float64(positions[v, 2]) - centre[2]
+            dx = np.float64(positions[v - base, 0]) - centre[0]
+            dy = np.float64(positions[v - base, 1]) - centre[1]
+            dz = np.float64(positions[v - base, 2]) - centre[2]
             d2 = dx * dx + dy * dy + dz * dz
             if d2 > far or q == 0:
                 far = d2

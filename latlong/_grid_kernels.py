@@ -238,7 +238,8 @@ def lon_table(m: int, ring_offsets) -> np.ndarray:
 def _ring_positions(m, r, o, radii, stretch, table, t0, out):
     """Positions of ring r's vertices (radii times unit vectors, stretched) into out,
     ``stretch * radius * sin(colatitude) * cos(longitude)`` ..., the longitudes'
-    cosines and sines from ``table`` rows ``t0 ..`` (:func:`lon_table`)."""
+    cosines and sines from ``table`` rows ``t0 ..`` (:func:`lon_table`), or - ``table``
+    empty - computed as :func:`_lon_table_kernel` computes them (the same values)."""
     n = _ring_size(r, m)
     colat = r * (np.pi / (2 * m))
     if n == 1:
@@ -249,6 +250,13 @@ def _ring_positions(m, r, o, radii, stretch, table, t0, out):
         return
     s = np.sin(colat)
     c = np.cos(colat)
+    if table.shape[0] == 0:
+        for j in range(n):
+            lon = 2.0 * np.pi * j / n
+            out[j, 0] = stretch[0] * radii[o + j] * s * np.cos(lon)
+            out[j, 1] = stretch[1] * radii[o + j] * s * np.sin(lon)
+            out[j, 2] = stretch[2] * radii[o + j] * c
+        return
     for j in range(n):
         out[j, 0] = stretch[0] * radii[o + j] * s * table[t0 + j, 0]
         out[j, 1] = stretch[1] * radii[o + j] * s * table[t0 + j, 1]

@@ -83,6 +83,28 @@ def _band_normals(pos, oa, na, ob, nb, south, out):
             _add_triangle_normal(pos, p, q, r, out)
 
 
+@njit(cache=True, inline="always")
+def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, base):
+    """Band ``band``'s two rings positioned locally (:func:`_ring_positions`; longitudes
+    from ``lon_table``, or computed when it is empty) and its triangles' area vectors
+    added to ``acc`` (row ``v - base`` is vertex v's)."""
+    if band < m:
+        ra, rb, south = band, band + 1, False
+    else:
+        ra, rb, south = band + 1, band, True
+    na = _ring_size(ra, m)
+    nb = _ring_size(rb, m)
+    oa = ring_offsets[ra]
+    ob = ring_offsets[rb]
+    lo = min(oa, ob)
+    pos = np.empty((na + nb, 3))
+    ta = _lon_row(m, ra, ring_offsets) if lon_table.shape[0] else 0
+    tb = _lon_row(m, rb, ring_offsets) if lon_table.shape[0] else 0
+    _ring_positions(m, ra, oa, radii, stretch, lon_table, ta, pos[oa - lo:oa - lo + na])
+    _ring_positions(m, rb, ob, radii, stretch, lon_table, tb, pos[ob - lo:ob - lo + nb])
+    _band_normals(pos, oa - lo, na, ob - lo, nb, south, acc[lo - base:lo - base + na + nb])
+
+
 @njit(cache=True, parallel=True)
 def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc):
     """Area-weighted vertex normals of the body into ``acc``, streamed band by band (no
@@ -99,21 +121,7 @@ def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lo
             band = 2 * hb + parity
             if band >= n_bands:
                 continue
-            if band < m:
-                ra, rb, south = band, band + 1, False
-            else:
-                ra, rb, south = band + 1, band, True
-            na = _ring_size(ra, m)
-            nb = _ring_size(rb, m)
-            oa = ring_offsets[ra]
-            ob = ring_offsets[rb]
-            lo = min(oa, ob)
-            pos = np.empty((na + nb, 3))
-            _ring_positions(m, ra, oa, radii, stretch, lon_table,
-                            _lon_row(m, ra, ring_offsets), pos[oa - lo:oa - lo + na])
-            _ring_positions(m, rb, ob, radii, stretch, lon_table,
-                            _lon_row(m, rb, ring_offsets), pos[ob - lo:ob - lo + nb])
-            _band_normals(pos, oa - lo, na, ob - lo, nb, south, acc[lo:lo + na + nb])
+            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, 0)
 
 
 @njit(cache=True, parallel=True)

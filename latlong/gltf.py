@@ -8,14 +8,13 @@ min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band stri
 to the patch and joined with degenerate triangles. Node extras and the JSON manifest
 give each patch's bounding sphere, bands, triangle count and the byte ranges of its
 data, so a renderer can cull and stream patches. Nothing holds the whole body's
-triangles: a first pass over the patches (numba, chunks of patches on worker threads)
-finds each one's strip length, vertex count and bounds from float32 positions computed
-once per level, which fixes the whole JSON; the second pass generates the patches' data
-again, groups of patches on worker threads into buffers written in order straight after
-the JSON (normals from a band-streaming kernel). Only the boulder meshes go through a
-temporary file. Memory: the float32 positions (12 B a vertex) and longitude table (8 B a
-vertex) of every level between the passes, the normals (12 B a vertex) of the level
-being written, 32 MB buffers (two per thread, and two).
+triangles, positions or normals: a first pass over the patches finds each one's strip
+length, vertex count and bounds, which fixes the whole JSON; the second pass generates
+the patches' data again and writes each at its offset. Both make the float32 positions
+(and normals) of a window of rings at a time (:mod:`latlong.patchdata`), the patches on
+worker threads. Only the boulder meshes go through a temporary file. Memory beyond the
+body's radii: the windows (~100 MB), 32 MB buffers (two per thread, and two) and the
+JSON.
 A GLB is limited to 4 GiB (32-bit lengths); larger exports keep the JSON in the
 ``.glb`` and reference one external buffer file ``<stem>.lod<k>.bin`` per level, as
 glTF 2.0 allows.
@@ -42,18 +41,14 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import (
-    BackgroundWriter,
     atomic_path,
     check_int,
-    ordered_chunks,
     package_version,
-    progress_bar,
 )
 from craters.boulders import boulder_meshes, boulder_normals, catalog_shape, mesh_chunk
 
-from ._export_kernels import _glb_positions_kernel, _patch_kernel
-from ._grid_kernels import lon_table
 from .grid import LatLongGrid
+from .patchdata import leaf_metadata, write_leaf_data
 from .strips import patch_tree, triangle_strips
 
 __all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
@@ -143,10 +138,6 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
 
 #: A GLB's length and chunk lengths are 32-bit: past this the levels go to .bin files.
 GLB_LIMIT = 2**32 - 1
-#: Bytes of patch data generated per group (one buffer) in the writing pass.
-_GROUP_BYTES = 1 << 25
-# leaves per task of the first pass
-_LEAVES_PER_TASK = 64
 
 
 def _finish(path: Path, gl: dict, manifest: dict, plans: list, sizes: list, temps: list,
@@ -205,10 +196,6 @@ class _LevelPlan:
 
     level: int
     body: object
-    positions: np.ndarray
-    """float32 (N, 3) positions of the level's vertices."""
-    lon_table: np.ndarray
-    """The grid's longitude cosines and sines (shared by positions and normals)."""
     leaves: tuple
     """(band_lo, entry pointers, triangle range lo, hi) arrays of the patch tree leaves."""
     at: np.ndarray
@@ -238,41 +225,15 @@ def _leaf_table(grid: LatLongGrid, leaves: list) -> tuple:
     return band_lo, ptr, lo, hi
 
 
-def _patch_pass(grid, positions, normals, leaves, leaf_from, leaf_to, meta, bounds, at=None,
-                out=None) -> None:
-    """Run :func:`_patch_kernel`: metadata (``at`` None) or data into ``out`` (uint32
-    words; ``at`` = (leaves, 3) word offsets in it)."""
-    band_lo, ptr, lo, hi = leaves
-    write = at is not None
-    if not write:
-        at = np.zeros((1, 3), dtype=np.int64)
-        out = np.zeros(1, dtype=np.uint32)
-    _patch_kernel(grid.magnitude, grid.ring_offsets(), band_lo, ptr, lo, hi, positions,
-                  normals, leaf_from, leaf_to, write, meta, bounds,
-                  np.ascontiguousarray(at[:, 0]), np.ascontiguousarray(at[:, 1]),
-                  np.ascontiguousarray(at[:, 2]), out.view(np.float32), out)
-
-
 def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _LevelPlan:
     """First pass over one level's patches: their JSON (buffer = the level; offsets
-    within it), manifest entries and where their data goes."""
+    within it), manifest entries and where their data goes (positions made ring window
+    by ring window: :mod:`latlong.patchdata`)."""
     grid = body.grid
-    positions = np.empty((grid.n_vertices, 3), dtype=np.float32)
-    table = lon_table(grid.magnitude, grid.ring_offsets())
-    _glb_positions_kernel(grid.magnitude, grid.ring_offsets(),
-                          np.ascontiguousarray(body.radii_m, dtype=np.float64),
-                          np.array(body.stretch, dtype=np.float64), table, positions)
     leaves = list(patch_tree(grid, patch_k).leaves())
     leaves_table = _leaf_table(grid, leaves)
     nl = len(leaves)
-    meta = np.zeros((nl, 3), dtype=np.int64)
-    bounds = np.zeros((nl, 10), dtype=np.float64)
-    # leaves in chunks on worker threads (the kernel runs without the GIL)
-    chunks = [(a, min(a + _LEAVES_PER_TASK, nl)) for a in range(0, nl, _LEAVES_PER_TASK)]
-    for _ in ordered_chunks(lambda ab, _: _patch_pass(grid, positions, positions,
-                                                      leaves_table, *ab, meta, bounds),
-                            chunks, lambda: None):
-        pass
+    meta, bounds = leaf_metadata(grid, body.radii_m, body.stretch, leaves_table)
     at = np.full((nl, 3), -1, dtype=np.int64)
     nbytes = np.zeros(nl, dtype=np.int64)
     offset = 0
@@ -319,46 +280,16 @@ def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _Le
                         "extras": {"magnitude": grid.magnitude, "level": level}})
     gl["scenes"].append({"name": f"lod{level}", "nodes": [len(gl["nodes"]) - 1]})
     manifest["levels"].append(level_info)
-    return _LevelPlan(level, body, positions, table, leaves_table, at, nbytes, offset)
+    return _LevelPlan(level, body, leaves_table, at, nbytes, offset)
 
 
 def _write_level_data(plan: _LevelPlan, fh, progress: bool) -> None:
-    """Second pass: the level's patch data (groups of leaves generated in parallel into
-    one buffer, then written), then the boulder meshes after level 0."""
+    """Second pass: the level's patch data (:func:`latlong.patchdata.write_leaf_data`:
+    ring window by ring window, each leaf at its offset), then the boulder meshes after
+    level 0."""
     body = plan.body
-    grid = body.grid
-    normals = grid.vertex_normals(body.radii_m, body.stretch, lon_table=plan.lon_table)
-    plan.lon_table = None
-    nl = len(plan.nbytes)
-    ends = np.cumsum(plan.nbytes)
-    groups = []
-    first = 0
-    while first < nl:  # consecutive leaves, about _GROUP_BYTES each (at least one leaf)
-        last = int(np.searchsorted(ends, ends[first] - plan.nbytes[first] + _GROUP_BYTES,
-                                   side="right"))
-        last = min(max(last, first + 1), nl)
-        groups.append((first, last))
-        first = last
-    big = max((int(ends[b - 1] - ends[a] + plan.nbytes[a]) for a, b in groups), default=0)
-    meta = np.zeros((1, 3), dtype=np.int64)
-    bounds = np.zeros((1, 10), dtype=np.float64)
-
-    def make(group, buf):
-        a, b = group
-        start = int(ends[a] - plan.nbytes[a])
-        words = buf[:(int(ends[b - 1]) - start) // 4]
-        at = np.where(plan.at >= 0, (plan.at - start) // 4, 0)
-        _patch_pass(grid, plan.positions, normals, plan.leaves, a, b, meta, bounds, at, words)
-        return words.view(np.uint8)
-
-    # groups made on worker threads, written in order on a background thread
-    with BackgroundWriter(fh) as out:
-        for data in progress_bar(ordered_chunks(make, groups,
-                                                lambda: np.empty(big // 4, dtype=np.uint32)),
-                                 total=len(groups), enabled=progress,
-                                 desc=f"LOD {plan.level}"):
-            out.write(data)
-    plan.positions = None
+    write_leaf_data(body.grid, body.radii_m, body.stretch, plan.leaves, plan.at, plan.nbytes,
+                    fh, progress=progress, desc=f"LOD {plan.level}")
     if plan.boulders is not None:
         with open(plan.boulders, "rb") as src:
             shutil.copyfileobj(src, fh, length=16 << 20)

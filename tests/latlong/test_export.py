@@ -303,9 +303,9 @@ def test_ply_fast_path_in_several_chunks(tmp_path, monkeypatch):
 
 
 def test_glb_in_several_groups(tmp_path, body, monkeypatch):
-    import latlong.gltf as gltf
+    import latlong.patchdata as patchdata
 
     export_glb(body, tmp_path / "one.glb", patch_k=8, lod=1)
-    monkeypatch.setattr(gltf, "_GROUP_BYTES", 5000)  # many groups of patches
+    monkeypatch.setattr(patchdata, "GROUP_BYTES", 5000)  # many groups of patches
     export_glb(body, tmp_path / "many.glb", patch_k=8, lod=1)
     assert (tmp_path / "one.glb").read_bytes() == (tmp_path / "many.glb").read_bytes()

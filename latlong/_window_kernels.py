@@ -1,0 +1,77 @@
+"""Numba kernels of the glTF export's ring windows (issue 18: exports without whole-body
+arrays).
+
+The glTF export needs every vertex's float32 position and unit normal. Holding them for
+the whole body costs 24 B a vertex (plus 8 B of longitude table): 16 GB at M = 8192.
+These kernels make them for a window of consecutive rings only, with the same values,
+bit for bit, as the whole-body kernels (:func:`~latlong._export_kernels._glb_positions_kernel`,
+:func:`~latlong._slope_kernels._normals_from_radii_kernel`): the longitudes' cosines and
+sines are computed with the same expression as the table's, and a ring's normal receives
+the area vectors of its two bands in the same order (the even band first, each band's
+triangles in zipper order), so the export's bytes do not change.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ._slope_kernels import _band_area_vectors
+
+
+@njit(cache=True, parallel=True)
+def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out):
+    """Unit area-weighted normals (float32) of the vertices of rings ``r_lo .. r_hi`` into
+    ``out`` (their count, 3): those of ``grid.vertex_normals``, bit for bit. The bands
+    touching those rings (``r_lo - 1 .. r_hi``) are streamed as the whole-body kernel
+    streams them, even bands first, into an accumulator over rings ``r_lo - 1 .. r_hi + 1``
+    (the outer two rings only receive part of their bands and are dropped)."""
+    two_m = 2 * m
+    a = max(r_lo - 1, 0)
+    b = min(r_hi + 1, two_m)
+    base = ring_offsets[a]
+    acc = np.zeros((ring_offsets[b + 1] - base, 3), dtype=np.float32)
+    no_table = np.empty((0, 2))  # longitudes computed, the table's values
+    band_lo = max(r_lo - 1, 0)
+    band_hi = min(r_hi, two_m - 1)
+    for parity in range(2):
+        first = band_lo + ((parity - band_lo) % 2)
+        for hb in prange((band_hi - first) // 2 + 1 if band_hi >= first else 0):
+            _band_area_vectors(m, ring_offsets, radii, stretch, no_table, first + 2 * hb, acc,
+                               base)
+    skip = ring_offsets[r_lo] - base
+    for i in prange(out.shape[0]):
+        x = np.float64(acc[skip + i, 0])
+        y = np.float64(acc[skip + i, 1])
+        z = np.float64(acc[skip + i, 2])
+        norm = np.sqrt((x * x + y * y) + z * z)
+        for c in range(3):
+            out[i, c] = acc[skip + i, c]
+        if norm > 0:  # as _normalize_rows_kernel
+            d = np.float32(norm)
+            for c in range(3):
+                out[i, c] = out[i, c] / d
+
+
+@njit(cache=True, parallel=True)
+def _window_positions_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out):
+    """float32 glTF positions of the vertices of rings ``r_lo .. r_hi`` into ``out``:
+    :func:`~latlong._export_kernels._glb_positions_kernel`'s values (``(u * r) * s``
+    rounded once), the longitudes' cosines and sines computed as the table's are."""
+    base = ring_offsets[r_lo]
+    for r in prange(r_lo, r_hi + 1):
+        o = ring_offsets[r]
+        n = ring_offsets[r + 1] - o
+        lat = 0.5 * np.pi - r * (np.pi / (2 * m))
+        c = np.cos(lat)
+        sz = np.sin(lat)
+        for j in range(n):
+            rad = radii[o + j]
+            if r == 0 or r == 2 * m:
+                x, y, z = 0.0, 0.0, 1.0 if r == 0 else -1.0
+            else:
+                lon = 2.0 * np.pi * j / n
+                x, y, z = c * np.cos(lon), c * np.sin(lon), sz
+            out[o - base + j, 0] = np.float32(x * rad * stretch[0])
+            out[o - base + j, 1] = np.float32(y * rad * stretch[1])
+            out[o - base + j, 2] = np.float32(z * rad * stretch[2])
