@@ -21,7 +21,7 @@ def _ply_vertex_kernel(m, ring_offsets, radii, radius_m, stretch, lon_table, lo,
     view of the records): x y z = float32(u * (radius * stretch)) (``Body.vertices``)
     and height = float32(radius - radius_m); columns past 3 are left alone. The
     latitude's cosine and sine once per ring and the longitudes' from ``lon_table``
-    (``_unit_of``'s values)."""
+    (``_unit_of``'s values), or computed as the table's are when it is empty."""
     r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
     r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
     for r in range(r_first, r_last + 1):
@@ -38,6 +38,9 @@ def _ply_vertex_kernel(m, ring_offsets, radii, radius_m, stretch, lon_table, lo,
             rad = radii[o + j]
             if r == 0 or r == 2 * m:
                 x, y, z = 0.0, 0.0, 1.0 if r == 0 else -1.0
+            elif lon_table.shape[0] == 0:
+                lon = 2.0 * np.pi * j / n
+                x, y, z = c * np.cos(lon), c * np.sin(lon), sz
             else:
                 x, y, z = c * lon_table[t0 + j, 0], c * lon_table[t0 + j, 1], sz
             out[q, 0] = np.float32(x * (rad * stretch[0]))

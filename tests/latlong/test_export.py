@@ -309,3 +309,16 @@ def test_glb_in_several_groups(tmp_path, body, monkeypatch):
     monkeypatch.setattr(patchdata, "GROUP_BYTES", 5000)  # many groups of patches
     export_glb(body, tmp_path / "many.glb", patch_k=8, lod=1)
     assert (tmp_path / "one.glb").read_bytes() == (tmp_path / "many.glb").read_bytes()
+
+
+def test_ply_without_the_longitude_table_gives_the_same_bytes(tmp_path, monkeypatch):
+    """Past _TABLE_BYTES the PLY kernel computes the longitudes' cosines and sines itself
+    (no 8 B a vertex table for huge bodies): the same records."""
+    import latlong.export as export
+
+    body = Body.from_heights(LatLongGrid(30), 10.0, np.linspace(-1, 1, 5402),
+                             stretch=(1.2, 1.0, 0.9))
+    body.export(tmp_path / "table.ply")
+    monkeypatch.setattr(export, "_TABLE_BYTES", 0)
+    body.export(tmp_path / "computed.ply")
+    assert (tmp_path / "table.ply").read_bytes() == (tmp_path / "computed.ply").read_bytes()
