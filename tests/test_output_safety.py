@@ -104,11 +104,20 @@ def test_glb_companion_is_checked_up_front(capsys, tmp_path, companion, kind):
     assert snapshot(tmp_path) == before
 
 
-def test_glb_companion_replaced_with_force(capsys, tmp_path):
-    (tmp_path / "o.json").write_text("MINE\n")
+@pytest.mark.parametrize("kind", ["file", "symlink"])
+def test_glb_companion_replaced_with_force(capsys, tmp_path, kind):
+    """With --force the companion is replaced; a symlink is replaced, never followed."""
+    mine = tmp_path / "mine.txt"
+    mine.write_text("MINE\n")
+    if kind == "file":
+        shutil.copy(mine, tmp_path / "o.json")
+    else:
+        (tmp_path / "o.json").symlink_to(mine)
     code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "o.glb", "--force")
     assert code == 0, err
+    assert not (tmp_path / "o.json").is_symlink()
     assert (tmp_path / "o.json").read_text().startswith("{")
+    assert mine.read_text() == "MINE\n"
     assert temporaries(tmp_path) == []
 
 
@@ -266,6 +275,37 @@ def test_a_failed_plot_takes_back_the_csv(capsys, tmp_path, monkeypatch, prog):
                        tmp_path / "s.png", "-q")
     assert_refused(code, err, "No space left")
     assert snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize("what", ["file", "folder"])
+@pytest.mark.parametrize("existing", [False, True])
+def test_output_group_takes_back_files_and_folders(tmp_path, what, existing):
+    from craters._shared import output_group, replace_output, temp_file, temp_folder
+
+    target = tmp_path / "out"
+    if existing:
+        if what == "file":
+            target.write_text("old")
+        else:
+            target.mkdir()
+            (target / "a").write_text("old")
+    before = snapshot(tmp_path)
+    with pytest.raises(KeyboardInterrupt), output_group():
+        with output_group():  # nested: handed to the outer group on success
+            if what == "file":
+                tmp = temp_file(target)
+                tmp.write_text("new")
+            else:
+                tmp = temp_folder(target)
+                (tmp / "b").write_text("new")
+            replace_output(tmp, target)
+        assert (target / "b").exists() if what == "folder" else target.read_text() == "new"
+        raise KeyboardInterrupt
+    assert snapshot(tmp_path) == before
+    with output_group():  # success: the new output stays, no backup left
+        tmp = temp_file(tmp_path / "x")
+        replace_output(tmp, target if what == "file" else tmp_path / "x")
+    assert temporaries(tmp_path) == []
 
 
 # --------------------------------------------------------------- temporaries of killed runs
