@@ -224,6 +224,24 @@ def test_enhance_replaces_its_own_stack_with_force(capsys, tmp_path, site):
     assert temporaries(tmp_path) == []
 
 
+@pytest.mark.parametrize("command", ["camera", "lidar"])
+@pytest.mark.parametrize("which", ["model", "poses"])
+def test_sensor_output_folder_never_holds_an_input(capsys, tmp_path, command, which):
+    out = tmp_path / "out"
+    out.mkdir()
+    model = (out if which == "model" else tmp_path) / "m.npz"
+    model.write_bytes(b"model")
+    poses = (out if which == "poses" else tmp_path) / "poses.csv"
+    poses.write_text("mine\n")
+    argv = [command, model, "-o", out, "--force", "--poses", poses]
+    if command == "camera":
+        argv += ["--size", "8x8", "--sun-direction", "1,0,0"]
+    before = snapshot(tmp_path)
+    code, _, err = run(capsys, "latlong", *argv)
+    assert_refused(code, err, "-o/--output", which)
+    assert snapshot(tmp_path) == before
+
+
 # --------------------------------------------------------------- a failed run writes nothing
 def _enospc(*args, **kwargs):
     raise OSError(errno.ENOSPC, "No space left on device")

@@ -268,4 +268,5 @@ def check_outside_folder(folder, inputs: Iterable, *, flag: str = "-o/--output")
         where = Path(inp).resolve()
         if where == root or where.is_relative_to(root):
             raise ValueError(f"{flag} {str(folder)!r} holds the input {what} {str(inp)!r}; "
-                             f"replacing the folder would delete it".lstrip())
+                             f"choose another output folder: inputs are never "
+                             f"overwritten".lstrip())
