@@ -21,7 +21,8 @@ import numpy as np
 from affine import Affine
 from rasterio.crs import CRS
 
-__all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "find_file", "find_object",
+__all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "data_file", "find_file",
+           "find_object",
            "georeference", "label_number", "label_text", "parse_label", "sample_constant"]
 
 logger = logging.getLogger(__name__)
@@ -202,6 +203,26 @@ def find_file(folder: Path, name: str) -> Path | None:
         if p.name.lower() == lower and p.is_file():
             return p
     return None
+
+
+def data_file(label_path: Path, name: str) -> Path | None:
+    """The data file a label's pointer names: only a file beside the label or below its
+    folder (a relative name without ``..`` that stays inside it through symlinks too),
+    matched case-insensitively; None if it is missing. A pointer naming any other file (an
+    absolute path, ``../../etc/passwd``) is a one-line ValueError: a label never makes us
+    read a file the user did not give."""
+    folder = label_path.parent
+    parts = Path(name).parts
+    bad = not name or Path(name).is_absolute() or "\\" in name or ".." in parts
+    if not bad:
+        found = find_file(folder, name) if len(parts) == 1 else \
+            (folder / name if (folder / name).is_file() else None)
+        if found is None:
+            return None
+        if found.resolve().is_relative_to(folder.resolve()):
+            return found
+    raise ValueError(f"{str(label_path)!r}: the image pointer names {name!r}, which is not a "
+                     f"file beside the label or below its folder; refusing to read it")
 
 
 def label_text(path: Path) -> tuple[str, Path]:

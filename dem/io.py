@@ -11,8 +11,6 @@ from __future__ import annotations
 
 import contextlib
 import logging
-import os
-import tempfile
 import warnings
 from pathlib import Path
 
@@ -24,12 +22,12 @@ from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.windows import Window
 
 from craters import get_target
-from craters._shared import about, atomic_path, check_int, parameter_of
+from craters._shared import about, atomic_path, check_int, parameter_of, temp_file
 
 from ._pds import (
     SAMPLE_TYPES,
     Quantity,
-    find_file,
+    data_file,
     find_object,
     georeference,
     label_number,
@@ -272,7 +270,7 @@ def _read_pds(path: Path, band: int, win=None):
     if data_name is None:
         data_path = label_path
     else:
-        data_path = find_file(label_path.parent, data_name)
+        data_path = data_file(label_path, data_name)
         if data_path is None:
             raise ValueError(f"{where!r}: the image file {data_name!r} it points to is missing")
     offset += (band - 1) * lines * stride
@@ -427,11 +425,7 @@ class WindowWriter:
                     raise ValueError("a DEM without CRS needs `pixel_size_m`")
             pair = np.broadcast_to(np.asarray(pixel_size_m, dtype=np.float64), (2,))
             pixel_size_m = tuple(float(v) for v in pair)
-        folder = self.path.parent if str(self.path.parent) else Path(".")
-        fd, tmp = tempfile.mkstemp(prefix=f".{self.path.name}.", suffix=".part.tif",
-                                   dir=folder)
-        os.close(fd)
-        self._tmp = Path(tmp)
+        self._tmp = temp_file(self.path, ".part.tif")
         self._env = rasterio.Env(GDAL_CACHEMAX=int(cache_mb))
         self._env.__enter__()
         try:

@@ -22,8 +22,8 @@ from __future__ import annotations
 import contextlib
 import json
 import os
+import re
 import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +36,17 @@ from craters import (
     write_geojson,
     write_scc,
 )
-from craters._shared import about, check_int, check_parent_folder, package_version, progress_bar
+from craters._shared import (
+    about,
+    check_int,
+    check_outside_folder,
+    check_parent_folder,
+    package_version,
+    progress_bar,
+    replace_output,
+    sweep_temporaries,
+    temp_folder,
+)
 
 from .core import Dem, crs_label
 from .frame import LocalFrame, body_axes_m, grid_pixel_size, pixel_affine, world_to_lonlat
@@ -340,10 +350,19 @@ def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
         arrays[j][r0:r0 + w, c0:c0 + w] = arrays[j + 1][::2, ::2]
 
 
-def check_stack_folder(folder, *, force: bool) -> Path:
-    """Validate an output stack folder before any work (see :meth:`Stack.write`)."""
+#: The names of the files a stack writes (:func:`write_stack`): only a folder holding
+#: nothing else is replaced.
+STACK_FILE = re.compile(r"^(manifest\.json|layer_\d{2,}\.tif|(craters|boulders)_\d{2,}"
+                        r"\.(csv|geojson)|craters_\d{2,}\.scc)$")
+
+
+def check_stack_folder(folder, *, force: bool, inputs=()) -> Path:
+    """Validate an output stack folder before any work (see :meth:`Stack.write`): a
+    folder replaced with ``force`` must be a stack folder holding only the files a stack
+    writes, and none of ``inputs`` (pairs of (what, path)) may lie inside it."""
     folder = Path(folder)
     check_parent_folder(folder)
+    check_outside_folder(folder, inputs, flag="output")
     if folder.exists():
         if not folder.is_dir():
             raise ValueError(f"output {str(folder)!r} exists and is not a folder")
@@ -354,6 +373,14 @@ def check_stack_folder(folder, *, force: bool) -> Path:
             if not (folder / MANIFEST).is_file():
                 raise ValueError(f"output {str(folder)!r} is not a stack folder (no {MANIFEST}); "
                                  f"refusing to replace it")
+            foreign = sorted(p.name for p in folder.iterdir()
+                             if not (STACK_FILE.match(p.name) and p.is_file()
+                                     and not p.is_symlink()))
+            if foreign:
+                more = f" and {len(foreign) - 1} more" if len(foreign) > 1 else ""
+                raise ValueError(f"output {str(folder)!r} holds {foreign[0]!r}{more}, which a "
+                                 f"stack does not write; refusing to replace it")
+    sweep_temporaries(folder.parent if str(folder.parent) else Path("."))
     return folder
 
 
@@ -407,18 +434,11 @@ def _write_count(stack: Stack, k: int, folder: Path) -> None:
 @contextlib.contextmanager
 def _atomic_folder(folder: Path):
     """Yield a temporary folder next to ``folder``; swap it into place on success."""
-    parent = folder.parent if str(folder.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".tmp", dir=parent))
+    tmp = temp_folder(folder)
     try:
         yield tmp
         os.chmod(tmp, 0o755)
-        if folder.exists():
-            old = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", suffix=".old", dir=parent))
-            os.replace(folder, old / "stack")
-            os.replace(tmp, folder)
-            shutil.rmtree(old, ignore_errors=True)
-        else:
-            os.replace(tmp, folder)
+        replace_output(tmp, folder)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise

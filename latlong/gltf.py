@@ -35,7 +35,6 @@ import json
 import os
 import shutil
 import struct
-import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -43,7 +42,10 @@ import numpy as np
 from craters._shared import (
     atomic_path,
     check_int,
+    output_group,
     package_version,
+    replace_output,
+    temp_file,
 )
 from craters.boulders import boulder_meshes, boulder_normals, catalog_shape, mesh_chunk
 
@@ -106,7 +108,6 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
           "bufferViews": [], "buffers": []}
     manifest = {"format": "craterform.patches/1", "glb": path.name, "patch_k": patch_k,
                 "levels": []}
-    folder = path.parent if str(path.parent) else Path(".")
     temps = []
     try:
         sizes, plans = [], []
@@ -115,9 +116,7 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
             size = plan.size
             if body.boulders is not None and len(body.boulders):
                 if level == 0:
-                    fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.",
-                                                   suffix=".boulders.bin", dir=folder)
-                    os.close(fd)
+                    tmp_bin = str(temp_file(path, ".boulders.bin"))
                     temps.append(tmp_bin)
                     plan.boulders = tmp_bin
                     with open(tmp_bin, "wb") as binf:
@@ -126,13 +125,15 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
                 _boulder_nodes(body.boulders, level, boulder_first, gl, manifest)
             sizes.append(size)
             plans.append(plan)
-        _finish(path, gl, manifest, plans, sizes, temps, progress)
+        with output_group():  # the .glb, its .json and .bin files: together or not at all
+            _finish(path, gl, manifest, plans, sizes, temps, progress)
+            with atomic_path(path.with_suffix(".json")) as tmp:
+                tmp.write_text(json.dumps(manifest, indent=1, sort_keys=True),
+                               encoding="utf-8")
     finally:
         for t in temps:
             if os.path.exists(t):
                 os.unlink(t)
-    with atomic_path(path.with_suffix(".json")) as tmp:
-        tmp.write_text(json.dumps(manifest, indent=1, sort_keys=True), encoding="utf-8")
     return manifest
 
 
@@ -170,15 +171,12 @@ def _finish(path: Path, gl: dict, manifest: dict, plans: list, sizes: list, temp
     js = _json_chunk(gl)
     manifest["bin_chunk_offset"] = None
     manifest["buffers"] = names
-    folder = path.parent if str(path.parent) else Path(".")
     for plan, n in zip(plans, names, strict=True):
-        fd, tmp_bin = tempfile.mkstemp(prefix=f".{path.name}.", suffix=f".lod{plan.level}.bin",
-                                       dir=folder)
-        os.close(fd)
+        tmp_bin = str(temp_file(path, f".lod{plan.level}.bin"))
         temps.append(tmp_bin)
         with open(tmp_bin, "wb") as out:
             _write_level_data(plan, out, progress)
-        os.replace(tmp_bin, path.parent / n)
+        replace_output(tmp_bin, path.parent / n)
     with atomic_path(path) as tmp, open(tmp, "wb") as out:
         out.write(struct.pack("<4sII", b"glTF", 2, 12 + 8 + len(js)))
         out.write(struct.pack("<I4s", len(js), b"JSON"))

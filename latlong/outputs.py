@@ -11,6 +11,7 @@ writes a built body, mesh surface or implicit surface, every file atomically.
 from __future__ import annotations
 
 import dataclasses
+import os
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,7 @@ from craters._shared import (
     ParameterTypeError,
     check_output_path,
     check_suffix,
+    same_file,
 )
 
 from .body import EXPORT_SUFFIXES
@@ -30,7 +32,8 @@ from .scene import Scene
 from .settings import ShapeBase
 from .surface import band_areas
 
-__all__ = ["OUTPUT_SETTINGS", "Outputs", "output_kind", "write_outputs"]
+__all__ = ["OUTPUT_SETTINGS", "Outputs", "companions", "output_kind", "scene_inputs",
+           "write_outputs"]
 
 #: The keys of a scene file that say what to write (not what to make).
 OUTPUT_SETTINGS = ("output", "catalog", "boulder_catalog", "preview", "catalog_columns")
@@ -100,10 +103,13 @@ class Outputs:
             **{k: rename(getattr(self, k)) for k in ("catalog", "boulder_catalog", "preview")
                if getattr(self, k)})
 
-    def check(self, scene: Scene, *, force: bool = False, paths: bool = True) -> None:
+    def check(self, scene: Scene, *, force: bool = False, paths: bool = True,
+              inputs=()) -> None:
         """Raise before any work if the scene cannot write these outputs: known suffixes for
-        its kind, catalogs only of layers it has, no file twice and (``paths``) folders
-        that exist, nothing overwritten without ``force``."""
+        its kind, catalogs only of layers it has, no file twice, no output that is an input
+        (the scene's shape files and ``inputs``, pairs of (what, path)) and (``paths``)
+        folders that exist, nothing overwritten without ``force`` - a .glb's manifest
+        ``.json`` and external ``.lod0.bin`` included."""
         kind = output_kind(scene)
         if scene.backend == "implicit" and self.boulder_catalog:
             raise ParameterError("boulder_catalog", "does not apply to {} implicit",
@@ -124,13 +130,45 @@ class Outputs:
             if key in seen:
                 raise ValueError(f"output {x!r} is given twice")
             seen.add(key)
-        named = [(o, _SUFFIXES[kind]) for o in self.output]
-        named += [(getattr(self, k), s) for k, s in _EXTRA_SUFFIXES.items() if getattr(self, k)]
-        for path, suffixes in named:
+        named = [("output", o, _SUFFIXES[kind]) for o in self.output]
+        named += [(k, getattr(self, k), s) for k, s in _EXTRA_SUFFIXES.items()
+                  if getattr(self, k)]
+        inputs = [*scene_inputs(scene), *inputs]
+        for key, path, suffixes in named:
             if paths:
                 check_output_path(path, force=force, suffixes=suffixes)
             else:
                 check_suffix(path, suffixes)
+            for out in (path, *companions(path)):
+                for what, inp in inputs:
+                    if same_file(out, inp):
+                        raise ParameterError(key, f"{str(path)!r} would overwrite the "
+                                             f"input {what} {str(inp)!r}; inputs are never "
+                                             f"modified")
+            for extra in companions(path) if paths else ():
+                if extra.is_dir() or (os.path.lexists(extra) and not force):
+                    raise ParameterError(key, f"{str(path)!r} also writes {str(extra)!r}, "
+                                         f"which exists; use --force to overwrite")
+
+
+def companions(path) -> list[Path]:
+    """The files a body export writes next to ``path`` besides it: a .glb's manifest
+    ``<stem>.json`` and, past 4 GiB, its external buffer ``<stem>.lod0.bin``."""
+    path = Path(path)
+    if path.suffix.lower() != ".glb":
+        return []
+    return [path.with_suffix(".json"), path.with_name(f"{path.stem}.lod0.bin")]
+
+
+def scene_inputs(scene: Scene) -> list[tuple[str, str]]:
+    """The files a scene reads (its shape models), as (what, path) pairs."""
+    found = []
+    if isinstance(scene.base, ShapeBase):
+        found.append(("shape model", getattr(scene.base.model, "source", scene.base.model)))
+    if scene.implicit is not None:
+        found.append(("shape model", getattr(scene.implicit.shape, "source",
+                                             scene.implicit.shape)))
+    return [(what, str(p)) for what, p in found if p and not str(p).startswith("latlong/data/")]
 
 
 def write_outputs(made, scene: Scene, outputs: Outputs, *, progress: bool = False,

@@ -17,6 +17,16 @@ from .files import (
     load_toml,
     ordered_chunks,
 )
+from .outputs import (
+    check_not_input,
+    check_outside_folder,
+    output_group,
+    replace_output,
+    same_file,
+    sweep_temporaries,
+    temp_file,
+    temp_folder,
+)
 from .progress import progress_bar
 from .spec import parse_spec
 from .stats import area_slope_summary
@@ -38,8 +48,10 @@ from .validation import (
 __all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike", "about",
            "area_slope_summary",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
+           "check_not_input", "check_outside_folder",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
            "load_toml", "normalize_rng", "ordered_chunks", "package_version", "parameter_of",
            "parse_spec",
-           "physical_memory_bytes",
-           "progress_bar"]
+           "output_group", "physical_memory_bytes",
+           "progress_bar", "replace_output", "same_file", "sweep_temporaries", "temp_file",
+           "temp_folder"]

@@ -7,12 +7,16 @@ code 2, the ``--seed`` type, and the report options of the analysis commands.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
+import signal
 import sys
-from collections.abc import Callable, Collection, Mapping
+import threading
+from collections.abc import Callable, Collection, Iterator, Mapping
 
 from .files import check_output_path
+from .outputs import check_not_input, output_group
 from .validation import ParameterError, ParameterTypeError, parameter_of
 
 __all__ = ["BATCH_FLAGS", "CliError", "OneLineParser", "add_batch_arguments",
@@ -43,8 +47,35 @@ class OneLineParser(argparse.ArgumentParser):
         sys.exit(2)
 
 
-def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None = None) -> int:
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, raised like Ctrl-C so that the same cleanup runs."""
+
+
+def _terminate(signum, frame):
+    raise Terminated
+
+
+@contextlib.contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """SIGTERM raises :class:`Terminated` (a KeyboardInterrupt) while inside: temporaries
+    are removed and the run's outputs taken back as for Ctrl-C."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    old = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, old)
+
+
+def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None = None,
+            atomic: bool = True) -> int:
     """Run a CLI body; user errors become one line on stderr and exit code 2.
+
+    With ``atomic`` (every command but batches, whose finished variants must stay) the
+    run's outputs appear together or not at all: a failed, interrupted (Ctrl-C) or
+    terminated (SIGTERM) run takes back the files it wrote and restores those it replaced.
 
     ``flags`` maps library parameters / setting keys to the command's flags: an error
     about one of them (:class:`~craters._shared.ParameterError`) is shown under its flag.
@@ -52,7 +83,8 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
     """
     logging.basicConfig(format="%(levelname)s: %(message)s", level=logging.WARNING)
     try:
-        return int(func() or 0)
+        with _sigterm_raises(), (output_group() if atomic else contextlib.nullcontext()):
+            return int(func() or 0)
     except (CliError, ValueError, TypeError, OSError, MemoryError) as exc:
         if os.environ.get("CRATERFORM_DEBUG"):
             raise
@@ -62,7 +94,10 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
             msg = str(exc) if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"error: {msg}\n".replace("\n", " ").rstrip() + "\n")
         return 2
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as exc:
+        if isinstance(exc, Terminated):
+            sys.stderr.write("error: terminated (SIGTERM); nothing written\n")
+            return 143
         sys.stderr.write("error: interrupted\n")
         return 130
 
@@ -79,13 +114,16 @@ def add_report_arguments(parser) -> None:
                         "(default: off)")
 
 
-def check_report_outputs(args) -> None:
-    """``--csv``/``--plot``: something to do, the right suffixes, no silent overwrite."""
+def check_report_outputs(args, inputs=()) -> None:
+    """``--csv``/``--plot``: something to do, the right suffixes, no silent overwrite, not
+    one of ``inputs`` (pairs of (what, path))."""
     if args.csv is None and args.plot is None and args.quiet:
         raise CliError("nothing to do: give --csv, --plot or drop --quiet for the table")
     if args.csv:
+        check_not_input(args.csv, inputs, flag="--csv")
         check_output_path(args.csv, force=args.force, suffixes=(".csv",))
     if args.plot:
+        check_not_input(args.plot, inputs, flag="--plot")
         check_output_path(args.plot, force=args.force, suffixes=(".png",))
 
 

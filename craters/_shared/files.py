@@ -7,11 +7,12 @@ import collections
 import contextlib
 import os
 import queue
-import tempfile
 import tomllib
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+
+from .outputs import replace_output, sweep_temporaries, temp_file
 
 __all__ = ["BackgroundWriter", "atomic_path", "check_output_path", "check_parent_folder",
            "check_suffix", "load_toml", "ordered_chunks"]
@@ -48,8 +49,9 @@ def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = Non
     check_parent_folder(path)
     if path.is_dir():
         raise ValueError(f"output {str(path)!r} is a folder")
-    if path.exists() and not force:
+    if os.path.lexists(path) and not force:  # a dangling symlink too
         raise ValueError(f"output {str(path)!r} exists; use --force to overwrite")
+    sweep_temporaries(path.parent if str(path.parent) else Path("."))
     return path
 
 
@@ -57,18 +59,16 @@ def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = Non
 def atomic_path(path) -> Iterator[Path]:
     """Yield a temporary path in the target folder; move it onto ``path`` on success.
 
-    On any exception the temporary file is removed and ``path`` is left untouched.
+    On any exception the temporary file is removed and ``path`` is left untouched. Inside
+    an output group (:func:`~craters._shared.outputs.output_group`) the move can be taken
+    back if a later output of the group fails.
     """
     path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp" + path.suffix,
-                               dir=folder)
-    os.close(fd)
-    tmp = Path(tmp)
+    tmp = temp_file(path, path.suffix)
     try:
         yield tmp
         os.chmod(tmp, 0o644)
-        os.replace(tmp, path)
+        replace_output(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             tmp.unlink()

@@ -39,7 +39,7 @@ def build_parser() -> OneLineParser:
 def main(argv: list[str] | None = None) -> int:
     """Run ``dem`` with ``argv`` (default: the process's arguments); the exit code."""
     args = build_parser().parse_args(argv)
-    return run_cli(lambda: args.func(args))
+    return run_cli(lambda: args.func(args), atomic=args.command != "batch")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -38,7 +38,8 @@ def _inputs(s: Settings) -> list[tuple[str, object]]:
 
 def _slopes(s: Settings) -> int:
     args = SimpleNamespace(**s)
-    check_report_outputs(args)
+    check_report_outputs(args, [("input", p) for p in (s["input"], *(s["compare"] or []),
+                                                     s.config)])
     results = [(label, slope_distribution(d, args.bin_deg, args.method))
                for label, d in _inputs(s)]
     if args.csv:
@@ -56,7 +57,8 @@ def _slopes(s: Settings) -> int:
 
 def _spectrum(s: Settings) -> int:
     args = SimpleNamespace(**s)
-    check_report_outputs(args)
+    check_report_outputs(args, [("input", p) for p in (s["input"], *(s["compare"] or []),
+                                                     s.config)])
     results = []
     for label, d in _inputs(s):
         if not d.known.all():

@@ -27,6 +27,7 @@ from typing import Any
 from craters._shared import (
     ParameterError,
     ParameterTypeError,
+    check_not_input,
     check_output_path,
     load_toml,
     parameter_of,
@@ -317,8 +318,7 @@ def check_output(s: Settings, suffixes) -> Path:
     if not s["output"]:
         raise CliError("nothing to write: give -o/--output")
     out = Path(s["output"])
-    if Path(s["input"]).resolve() == out.resolve():
-        raise CliError(f"output {str(out)!r} is the input; inputs are never modified")
+    check_not_input(out, (("DEM", s["input"]), ("config", s.config)))
     return check_output_path(out, force=s["force"], suffixes=suffixes)
 
 

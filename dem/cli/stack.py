@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from craters._shared import about
 from craters._shared.cli import CliError
 
 from ..config import EnhanceConfig
@@ -19,7 +20,9 @@ def _enhance(s: Settings) -> int:
     if not s["output"]:
         raise CliError("nothing to write: give -o/--output")
     cfg = EnhanceConfig.from_mapping({key: s[key] for key in EnhanceConfig.keys()})
-    folder = check_stack_folder(s["output"], force=s["force"])
+    with about("output"):
+        folder = check_stack_folder(s["output"], force=s["force"],
+                                    inputs=(("DEM", s["input"]), ("config", s.config)))
     show = not s["quiet"]
     stack = enhance(cfg, progress=show)
     manifest = write_stack(stack, folder, progress=show)

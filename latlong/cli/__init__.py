@@ -58,7 +58,7 @@ def main(argv: list[str] | None = None) -> int:
     flags = {o.key: flag_of(o.key) for o in BUILD_OPTIONS}
     if args.command == "lidar":
         flags = LIDAR_FLAGS
-    return run_cli(lambda: args.func(args), flags=flags)
+    return run_cli(lambda: args.func(args), flags=flags, atomic=args.command != "batch")
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -92,7 +92,7 @@ def cmd_slopes(args) -> int:
     if not 0 <= args.radius_deg <= 90 or not np.isfinite(args.radius_deg):
         raise CliError(f"--radius-deg must be in [0, 90]; got {args.radius_deg}")
     grav = _gravity_args(args)
-    check_report_outputs(args)
+    check_report_outputs(args, [("input", p) for p in inputs])
     objs = [_load_input(p, args.shape_units) for p in inputs]
     results, baselines = [], []
     for label, obj in zip(labels, objs, strict=True):
@@ -145,7 +145,7 @@ def cmd_spectrum(args) -> int:
         raise CliError(f"--magnitude must be in [1, 4000]; got {args.magnitude}")
     if args.l_max is not None and args.l_max < 1:
         raise CliError(f"--l-max must be >= 1; got {args.l_max}")
-    check_report_outputs(args)
+    check_report_outputs(args, [("input", p) for p in inputs])
     bodies = [_as_body(_load_input(p, args.shape_units), args.magnitude) for p in inputs]
     results = []
     for label, body in zip(labels, bodies, strict=True):

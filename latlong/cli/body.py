@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from craters._shared import check_output_path, human_bytes
+from craters._shared import check_not_input, check_output_path, human_bytes
 from craters._shared.cli import CliError
 from latlong import PreviewSettings, export_glb, export_vtp_strips, load, render_preview
 from latlong.presets import preset_table
@@ -48,6 +48,7 @@ def cmd_presets(args) -> int:
 
 def cmd_render(args) -> int:
     settings = PreviewSettings(**given_options(args, RENDER_OPTIONS))
+    check_not_input(args.output, [("MODEL", args.model)])
     check_output_path(args.output, force=args.force, suffixes=(".png",))
     body = load(args.model)
     render_preview(body, args.output, settings)
@@ -70,6 +71,8 @@ def cmd_export(args) -> int:
         check_output_path(out.with_suffix(".json"), force=args.force, suffixes=(".json",))
         for level in range(args.lod + 1):  # external buffers of exports past 4 GiB
             check_output_path(out.with_name(f"{out.stem}.lod{level}.bin"), force=args.force)
+    for written in (out, out.with_suffix(".json")):
+        check_not_input(written, [("MODEL", args.model)])
     body = load(args.model)
     if body.magnitude % (2**args.lod):
         raise CliError(f"--lod {args.lod} needs a magnitude divisible by {2**args.lod}; "

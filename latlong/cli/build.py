@@ -29,13 +29,14 @@ def _settings(args) -> tuple[dict, dict, set]:
     return given, run, file_keys
 
 
-def _outputs(scene: Scene, run: dict) -> Outputs:
+def _outputs(scene: Scene, run: dict, config=None) -> Outputs:
     """The run's outputs, checked against the scene before any work (something to write,
     known suffixes, folders writable, nothing overwritten without --force)."""
     outputs = Outputs.from_settings({k: run.get(k) for k in OUTPUT_SETTINGS})
     if not outputs.files():
         raise CliError("nothing to write: give -o/--output, --catalog or --preview")
-    outputs.check(scene, force=bool(run.get("force")))
+    outputs.check(scene, force=bool(run.get("force")),
+                  inputs=[("config", config)] if config else ())
     return outputs
 
 
@@ -68,7 +69,7 @@ def cmd_build(args) -> int:
         scene = Scene.from_settings(settings)
     except (ValueError, TypeError) as exc:
         raise CliError(shown(exc, from_file, args.config)) from None
-    outputs = _outputs(scene, run)
+    outputs = _outputs(scene, run, args.config)
     files = outputs.files()
     show = not run.get("quiet")
     bar = progress_bar(total=1 + len(files), enabled=show, desc="build")

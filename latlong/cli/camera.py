@@ -11,13 +11,17 @@ into FOLDER at the end, ``frames.json`` last.
 from __future__ import annotations
 
 import contextlib
-import os
 import shutil
-import tempfile
 import time
 from pathlib import Path
 
-from craters._shared import ParameterError, ParameterTypeError, progress_bar
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    progress_bar,
+    replace_output,
+    temp_folder,
+)
 from craters._shared.cli import CliError, parse_seed
 
 from .sensor_options import (
@@ -76,12 +80,12 @@ def _camera(args):
 def _move_into(tmp: Path, out: Path) -> None:
     """Move the rendered files into ``out`` (``frames.json`` last)."""
     if not out.exists():
-        os.replace(tmp, out)
+        replace_output(tmp, out)
         return
     names = sorted(p.name for p in tmp.iterdir())
     names.sort(key=lambda n: n == "frames.json")
     for name in names:
-        os.replace(tmp / name, out / name)
+        replace_output(tmp / name, out / name)
     tmp.rmdir()
 
 
@@ -135,8 +139,7 @@ def cmd_camera(args) -> int:
     if not args.quiet:
         print(f"model {args.model}: {len(mesh.faces)} triangles, BVH built in "
               f"{t_bvh:.1f} s")
-    parent = out.parent if str(out.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=parent))
+    tmp = temp_folder(out)
     try:
         entries = []
         for k in progress_bar(range(len(poses)), enabled=not args.quiet, desc="frames"):

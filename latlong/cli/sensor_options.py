@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import ParameterError, ParameterTypeError
+from craters._shared import ParameterError, ParameterTypeError, check_outside_folder
 from craters._shared.cli import CliError
 
 __all__ = ["POSE_FLAGS", "add_pose_options", "allow_negative_lists", "numbers",
@@ -158,10 +158,13 @@ def refuse_inside(mesh, poses, args, sensor: str) -> None:
 
 def output_folder(args) -> Path:
     """``-o/--output`` checked: a real folder, its parent writable, empty unless
-    ``--force``."""
+    ``--force``, holding no input (MODEL, --poses, --catalog)."""
     from latlong.sensors.lidar_files import check_output_folder
 
     try:
+        check_outside_folder(args.output, [
+            ("model", args.model), ("poses", getattr(args, "poses", None)),
+            ("catalog", getattr(args, "catalog", None))], flag="")
         return check_output_folder(args.output, force=args.force)
     except ValueError as exc:
         raise CliError(f"-o/--output: {exc}") from None

@@ -25,12 +25,19 @@ import datetime
 import json
 import os
 import shutil
-import tempfile
 from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, normalize_rng, package_version, progress_bar
+from craters._shared import (
+    atomic_path,
+    normalize_rng,
+    package_version,
+    progress_bar,
+    replace_output,
+    sweep_temporaries,
+    temp_folder,
+)
 
 from .engine import RayMesh
 from .lidar import LidarFrame, LidarSettings, lidar_frame
@@ -100,6 +107,7 @@ def check_output_folder(folder, *, force: bool) -> Path:
     if folder.exists() and any(folder.iterdir()) and not force:
         raise ValueError(f"output folder {str(folder)!r} exists and is not empty; use "
                          "--force to write into it")
+    sweep_temporaries(parent)
     return folder
 
 
@@ -133,8 +141,7 @@ def lidar_run(geometry: SceneGeometry, settings: LidarSettings, poses: Poses, fo
     folder = check_output_folder(folder, force=force)
     seed = _seed_of(rng)
     mesh = mesh if mesh is not None else RayMesh(geometry.vertices, geometry.faces)
-    parent = folder.parent if str(folder.parent) else Path(".")
-    tmp = Path(tempfile.mkdtemp(prefix=f".{folder.name}.", dir=parent))
+    tmp = temp_folder(folder)
     try:
         frames = []
         for k in progress_bar(range(len(poses)), enabled=progress, desc="lidar frames"):
@@ -168,9 +175,9 @@ def _move_into(tmp: Path, folder: Path) -> None:
         os.chmod(p, 0o644)
     if not folder.exists():
         os.chmod(tmp, 0o755)
-        os.replace(tmp, folder)
+        replace_output(tmp, folder)
         return
     names = sorted(p.name for p in tmp.iterdir())
     names.remove("lidar.json")
     for name in [*names, "lidar.json"]:
-        os.replace(tmp / name, folder / name)
+        replace_output(tmp / name, folder / name)
