@@ -1,4 +1,4 @@
-"""The ``dem`` command line: ``dem info``, ``fill``, ``expand`` (:mod:`.raster`),
+"""The ``dem`` command line: ``dem info``, ``convert``, ``fill``, ``expand`` (:mod:`.raster`),
 ``enhance``, ``mesh`` (:mod:`.stack`), ``batch`` (:mod:`.batch`), ``slopes`` and ``spectrum``
 (:mod:`.analysis`).
 

@@ -123,10 +123,10 @@ class Opt:
 
 _E = {f.name: f.default for f in dataclasses.fields(EnhanceConfig) if f.init}
 _INFO, _FILL, _EXPAND, _ENHANCE, _MESH = "info", "fill", "expand", "enhance", "mesh"
-_SLOPES, _SPECTRUM = "slopes", "spectrum"
-_DEM_IN = (_INFO, _FILL, _EXPAND, _ENHANCE)
+_SLOPES, _SPECTRUM, _CONVERT = "slopes", "spectrum", "convert"
+_DEM_IN = (_INFO, _FILL, _EXPAND, _ENHANCE, _CONVERT)
 _READ = (*_DEM_IN, _MESH, _SLOPES, _SPECTRUM)
-_WRITE = (_FILL, _EXPAND, _ENHANCE, _MESH, _SLOPES, _SPECTRUM)
+_WRITE = (_FILL, _EXPAND, _ENHANCE, _MESH, _SLOPES, _SPECTRUM, _CONVERT)
 _REPORT = (_SLOPES, _SPECTRUM)
 _NO_INPUT = "none: the config file's `input`"
 
@@ -137,8 +137,8 @@ OPTIONS: tuple[Opt, ...] = (
         _NO_INPUT, toml=str),
     Opt(("input",), "input", str, None, "a DEM (GeoTIFF, PDS .lbl/.img) or a stack manifest "
         "(.json: every layer is one input)", _REPORT, _NO_INPUT, toml=str),
-    Opt(("-o", "--output"), "output", str, None, "output GeoTIFF (.tif)", (_FILL, _EXPAND),
-        "none: required", toml=str, metavar="OUT"),
+    Opt(("-o", "--output"), "output", str, None, "output GeoTIFF (.tif)",
+        (_FILL, _EXPAND, _CONVERT), "none: required", toml=str, metavar="OUT"),
     Opt(("-o", "--output"), "output", str, None,
         "output folder of the stack (layer GeoTIFFs, crater catalogs, manifest.json)",
         (_ENHANCE,), "none: required", toml=str, metavar="DIR"),

@@ -1,4 +1,5 @@
-"""``dem info``, ``dem fill`` and ``dem expand``: one DEM in, one DEM (or a description) out."""
+"""``dem info``, ``dem convert``, ``dem fill`` and ``dem expand``: one DEM in, one DEM (or
+a description) out."""
 
 from __future__ import annotations
 
@@ -64,6 +65,18 @@ def _transform(s: Settings) -> int:
                                     "filled_pixels", "holes", "craters"))
         print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {shape[0]} x "
               f"{shape[1]} pixels, seed {seed}, {detail}")
+        print(f"wrote {s['output']}")
+    return 0
+
+
+def _convert(s: Settings) -> int:
+    """``dem convert``: any DEM :func:`dem.read` reads (PDS3, GeoTIFF, ...) -> GeoTIFF."""
+    check_output(s, GEOTIFF_SUFFIXES)
+    dem = read_input(s)
+    write(dem, s["output"])
+    if not s["quiet"]:
+        print(f"dem convert: {dem.shape[0]} x {dem.shape[1]} pixels, {crs_label(dem.crs)}, "
+              f"{100 * dem.nan_fraction:.3g} % unknown")
         print(f"wrote {s['output']}")
     return 0
 
@@ -148,9 +161,12 @@ def _crater_rows(dem) -> list[tuple[str, str]]:
 
 
 def register(sub) -> None:
-    """Add ``info``, ``fill`` and ``expand`` to the sub-command parser."""
+    """Add ``info``, ``convert``, ``fill`` and ``expand`` to the sub-command parser."""
     add_command(sub, "info", _info,
                 "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)")
+    add_command(sub, "convert", _convert,
+                "convert a DEM (PDS3 .lbl/.img, GeoTIFF, any raster GDAL reads) to a "
+                "cloud-optimised GeoTIFF")
     add_command(sub, "fill", _transform,
                 "fill the unknown pixels of a DEM with fractal terrain, outside in")
     add_command(sub, "expand", _transform,
