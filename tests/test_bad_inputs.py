@@ -316,6 +316,19 @@ def test_ctrl_c_during_start_up(tmp_path, delay_s):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_closed_pipe_is_no_error(tmp_path):
+    """``latlong info body.npz | head``: no "Broken pipe" error when the reader leaves."""
+    from latlong import Body, LatLongGrid
+
+    Body.sphere(LatLongGrid(4), 10.0).save(tmp_path / "b.npz")
+    proc = subprocess.Popen([sys.executable, "-m", "latlong", "info", "b.npz"], cwd=tmp_path,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    proc.stdout.close()  # the reader is gone before the first line
+    with proc.stderr:
+        err = proc.stderr.read()
+    assert proc.wait(timeout=300) == 141 and err == "", err
+
+
 def test_noise_is_not_a_dependency():
     """``pip install .`` needs no compiler: ``noise`` (an sdist) is an extra."""
     import tomllib
