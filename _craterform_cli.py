@@ -32,7 +32,7 @@ def _check_environment() -> str | None:
     return None
 
 
-def _run(package: str) -> int:
+def _run(package: str, argv: list[str] | None) -> int:
     problem = _check_environment()
     if problem is not None:
         sys.stderr.write(f"error: {problem}\n")
@@ -48,22 +48,22 @@ def _run(package: str) -> int:
     try:
         if interrupted:
             raise KeyboardInterrupt
-        return main()
+        return main(argv)
     except KeyboardInterrupt:
         sys.stderr.write("error: interrupted\n")
         return 130
 
 
-def latlong() -> int:
-    """The ``latlong`` command."""
-    return _run("latlong")
+def latlong(argv: list[str] | None = None) -> int:
+    """The ``latlong`` command (``argv``: default the process's arguments)."""
+    return _run("latlong", argv)
 
 
-def dem() -> int:
-    """The ``dem`` command."""
-    return _run("dem")
+def dem(argv: list[str] | None = None) -> int:
+    """The ``dem`` command (``argv``: default the process's arguments)."""
+    return _run("dem", argv)
 
 
-def craters() -> int:
-    """The ``craters`` command."""
-    return _run("craters")
+def craters(argv: list[str] | None = None) -> int:
+    """The ``craters`` command (``argv``: default the process's arguments)."""
+    return _run("craters", argv)
