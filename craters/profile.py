@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._shared import ParameterError, check_positive, check_range
+from ._shared import ParameterError, check_range
 from .diffusion import (
     TAU_FRESH,
     diffuse_profiles,
@@ -23,8 +23,12 @@ from .diffusion import (
 from .morphology import EJECTA_EDGE, fresh_morphometry, fresh_profile, morphology_class
 from .targets import Target, get_target
 
-__all__ = ["DEFAULT_EJECTA_EDGE", "crater_morphometry", "crater_tau", "radial_profile",
-           "slope_erosion"]
+__all__ = ["DEFAULT_EJECTA_EDGE", "DIAMETER_RANGE_M", "crater_morphometry", "crater_tau",
+           "radial_profile", "slope_erosion"]
+
+#: Diameters of one crater's profile, metres (a 1 mm pit to a 10 000 km basin): depths,
+#: rims and the diffusion time D^-2 stay finite and non-zero.
+DIAMETER_RANGE_M = (1e-3, 1e7)
 
 #: Default ejecta edge in crater radii: r = 1.5 D, one diameter beyond the rim.
 DEFAULT_EJECTA_EDGE = EJECTA_EDGE
@@ -35,7 +39,7 @@ def crater_tau(diameter_m: float, *, age_gyr: float | None = None,
     """The dimensionless diffusion time kappa t / R^2 of a crater of that age, or of the
     one that has lost ``degradation`` of its fresh depth (give one of them, or neither
     for a fresh crater)."""
-    d = check_positive("diameter_m", diameter_m)
+    d = check_range("diameter_m", diameter_m, *DIAMETER_RANGE_M)
     if age_gyr is not None and degradation is not None:
         raise ParameterError("age_gyr", "and {} cannot both be given", see=("degradation",))
     if age_gyr is not None:

@@ -21,6 +21,8 @@ import numpy as np
 from affine import Affine
 from rasterio.crs import CRS
 
+from craters._shared.files import check_regular_file
+
 __all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "data_file", "find_file",
            "find_object",
            "georeference", "label_number", "label_text", "parse_label", "sample_constant"]
@@ -35,6 +37,10 @@ _TOKEN = re.compile(
     r"|(?P<word>[^\s=(){},<>\"']+)",
     re.S,
 )
+#: Deepest nesting of OBJECT/GROUP blocks and lists (real labels: 3 or 4 levels).
+MAX_NESTING = 64
+#: Largest detached label read, bytes (real ones: a few kilobytes).
+MAX_LABEL_BYTES = 16 << 20
 _COMMENT = re.compile(r"/\*.*?\*/", re.S)
 _INT = re.compile(r"[+-]?\d+")
 _FLOAT = re.compile(r"[+-]?(\d+\.\d*|\.\d+|\d+)([eE][+-]?\d+)?")
@@ -73,6 +79,7 @@ class _Parser:
                 value = " ".join(value.split())
             self.tokens.append((kind, value))
         self.pos = 0
+        self.depth = 0
 
     def peek(self):
         return self.tokens[self.pos] if self.pos < len(self.tokens) else (None, None)
@@ -86,6 +93,12 @@ class _Parser:
         kind, got = self.take()
         if got != value:
             raise ValueError(f"PDS label: expected {value!r}, got {got!r}")
+
+    def nest(self):
+        self.depth += 1
+        if self.depth > MAX_NESTING:
+            raise ValueError(f"PDS label: OBJECT/GROUP blocks or lists nested deeper than "
+                             f"{MAX_NESTING} levels")
 
     def block(self, end: str | None) -> dict:
         out: dict = {}
@@ -108,7 +121,9 @@ class _Parser:
             self.expect("=")
             if key in ("OBJECT", "GROUP"):
                 _, name = self.take()
+                self.nest()
                 inner = self.block("END_" + key)
+                self.depth -= 1
                 out.setdefault(str(name).upper(), inner)
             else:
                 out.setdefault(key, self.value())
@@ -117,6 +132,7 @@ class _Parser:
         kind, tok = self.take()
         if tok in ("(", "{"):
             close = ")" if tok == "(" else "}"
+            self.nest()
             items = []
             while self.peek()[1] != close:
                 if self.peek()[0] is None:
@@ -125,6 +141,7 @@ class _Parser:
                 if self.peek()[1] == ",":
                     self.take()
             self.take()
+            self.depth -= 1
             return items
         if kind in ("str", "lit"):
             return tok
@@ -228,7 +245,8 @@ def data_file(label_path: Path, name: str) -> Path | None:
 def label_text(path: Path) -> tuple[str, Path]:
     """The label text and the file it came from (detached ``.lbl`` or attached)."""
     if path.suffix.lower() == ".lbl":
-        return path.read_text(encoding="latin-1"), path
+        return check_regular_file(path, "PDS label", MAX_LABEL_BYTES).read_text(
+            encoding="latin-1"), path
     with open(path, "rb") as fh:
         head = fh.read(1 << 20)
     if head.startswith(b"PDS_VERSION_ID"):
@@ -238,6 +256,7 @@ def label_text(path: Path) -> tuple[str, Path]:
     for suffix in (".lbl", ".LBL", ".Lbl"):
         label = find_file(path.parent, path.stem + suffix)
         if label is not None:
+            check_regular_file(label, "PDS label", MAX_LABEL_BYTES)
             return label.read_text(encoding="latin-1"), label
     raise ValueError(f"{str(path)!r}: no PDS label found (neither attached nor a .LBL "
                      f"file next to it)")
@@ -284,6 +303,8 @@ def georeference(proj: dict, label: dict, where: str):
     radius_m = label_number(proj, "A_AXIS_RADIUS", where, unit_scale=km)
     if not isinstance(proj["A_AXIS_RADIUS"], Quantity):
         radius_m *= 1000.0  # PDS3 gives axis radii in km
+    if not (math.isfinite(radius_m) and radius_m > 0):
+        raise ValueError(f"{where!r}: A_AXIS_RADIUS must be finite and > 0; got {radius_m!r}")
     deg = {"deg": 1.0, "degree": 1.0, "degrees": 1.0}
     center_lat = label_number(proj, "CENTER_LATITUDE", where, 0.0, deg)
     if center_lat != 0.0:
@@ -299,9 +320,11 @@ def georeference(proj: dict, label: dict, where: str):
         scale_m = label_number(proj, "MAP_SCALE", where, unit_scale={
             "m/pix": 1.0, "m/pixel": 1.0, "meters/pixel": 1.0, "metres/pixel": 1.0,
             "km/pix": 1000.0, "km/pixel": 1000.0})
+        if not (math.isfinite(scale_m) and scale_m > 0):
+            raise ValueError(f"{where!r}: MAP_SCALE must be finite and > 0; got {scale_m!r}")
         res = radius_m * math.pi / 180.0 / scale_m
-    if not res > 0:
-        raise ValueError(f"{where!r}: MAP_RESOLUTION must be > 0; got {res!r}")
+    if not (math.isfinite(res) and res > 0):
+        raise ValueError(f"{where!r}: MAP_RESOLUTION must be finite and > 0; got {res!r}")
     center_lon = label_number(proj, "CENTER_LONGITUDE", where, 0.0, deg)
     pix = {"pix": 1.0, "pixel": 1.0, "pixels": 1.0}
     if "SAMPLE_PROJECTION_OFFSET" in proj and "LINE_PROJECTION_OFFSET" in proj:

@@ -33,6 +33,8 @@ from craters._shared import (
     parse_spec,
 )
 
+from .fractal import MAX_ROUGHNESS
+
 __all__ = ["EnhanceConfig", "SourceCraterLayer", "parse_source_spec"]
 
 
@@ -236,7 +238,7 @@ class EnhanceConfig:
                 check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)
         if self.roughness is not None:
             with about("roughness"):
-                check_positive("roughness", self.roughness, allow_zero=True)
+                check_range("roughness", self.roughness, 0.0, MAX_ROUGHNESS)
         if self.seed is not None:
             with about("seed"):
                 check_int("seed", self.seed, 0, 2**63 - 1)

@@ -15,7 +15,14 @@ from rasterio.crs import CRS
 from rasterio.errors import CRSError
 from rasterio.windows import Window
 
-from craters._shared import about, check_int, check_positive, package_version
+from craters._shared import (
+    ParameterTypeError,
+    about,
+    check_int,
+    check_positive,
+    check_range,
+    package_version,
+)
 
 __all__ = ["Dem", "HISTORY_TAG", "crs_label", "parse_region"]
 
@@ -25,6 +32,9 @@ HISTORY_TAG = "CRATERFORM_HISTORY"
 LEVEL_TAG = "CRATERFORM_LEVEL"
 #: Tag holding the body radius (metres) of a DEM craterform wrote.
 RADIUS_TAG = "CRATERFORM_BODY_RADIUS_M"
+#: Body radii a DEM may have, metres (a boulder to a gas giant): pixel sizes in metres
+#: stay finite and non-zero.
+BODY_RADIUS_RANGE_M = (1e-3, 1e9)
 #: Tag holding the pixel size "x,y" (metres) of a DEM without CRS that craterform wrote.
 PIXEL_SIZE_TAG = "CRATERFORM_PIXEL_SIZE_M"
 ORIGIN_TAG = "CRATERFORM_ORIGIN"
@@ -169,6 +179,8 @@ class Dem:
     def __init__(self, heights, transform: Affine | None = None, crs=None, *,
                  pixel_size_m=None, body_radius_m: float | None = None, tags=None,
                  level: int = 0, origin=(0, 0)):
+        if np.iscomplexobj(heights):
+            raise ParameterTypeError("heights", "must be real numbers; got complex values")
         h = np.array(heights, dtype=np.float64, copy=True)
         self._init(h, transform, crs, pixel_size_m, body_radius_m, tags, level, origin)
 
@@ -197,8 +209,8 @@ class Dem:
             except CRSError as exc:
                 raise ValueError(f"`crs` is not a CRS rasterio understands: {exc}") from None
         with about("body_radius_m"):
-            radius = None if body_radius_m is None else check_positive("body_radius_m",
-                                                                       body_radius_m)
+            radius = None if body_radius_m is None else check_range(
+                "body_radius_m", body_radius_m, *BODY_RADIUS_RANGE_M)
         self._h = _readonly(h)
         self._transform = transform
         self._crs = crs

@@ -93,7 +93,7 @@ from craters._shared import (
 from ._expand_kernels import _expand_kernel
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .fractal import expansion_fit, local_msd
+from .fractal import MAX_ROUGHNESS, expansion_fit, local_msd
 
 __all__ = ["CONTEXT_PX", "TILE_PX", "ExpandedFile", "displacement_scales", "expand",
            "expand_to_file", "expansion_sizes", "midpoint_factor"]
@@ -368,7 +368,7 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
             fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
     if roughness is not None:
         with about("roughness"):
-            roughness = check_positive("roughness", roughness, allow_zero=True)
+            roughness = check_range("roughness", roughness, 0.0, MAX_ROUGHNESS)
     params: dict = {"levels": levels, "region": [r0, c0, width],
                     "input_resolution_m": dem.resolution_m}
     fit = None

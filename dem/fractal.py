@@ -70,8 +70,13 @@ from craters._shared import check_int
 
 from .core import Dem
 
-__all__ = ["FractalFit", "SpectralFit", "dimension_warning", "expansion_fit", "fractal_dimension",
-           "fractal_fit", "local_msd", "local_roughness", "variogram", "window_mean"]
+#: Largest roughness a user may ask for, m/m (an RMS slope of 89.94 degrees between
+#: neighbours): beyond it heights soon leave float32, the type of the GeoTIFFs written.
+MAX_ROUGHNESS = 1000.0
+
+__all__ = ["MAX_ROUGHNESS", "FractalFit", "SpectralFit", "dimension_warning", "expansion_fit",
+           "fractal_dimension", "fractal_fit", "local_msd", "local_roughness", "variogram",
+           "window_mean"]
 
 #: Lags (pixels) of the fractal-dimension estimate: the finest scales above the pixel.
 DEFAULT_MIN_LAG_PX = 2

@@ -44,7 +44,7 @@ import math
 
 import numpy as np
 
-from craters._shared import about, check_positive, check_range
+from craters._shared import about, check_range
 
 from ._fill_kernels import (
     _noise_box_kernel,
@@ -56,7 +56,7 @@ from ._fill_kernels import (
 )
 from ._rng_kernels import key_from_rng
 from .core import Dem
-from .fractal import NORMALISER_WINDOW_PX, fractal_fit, local_msd, window_mean
+from .fractal import MAX_ROUGHNESS, NORMALISER_WINDOW_PX, fractal_fit, local_msd, window_mean
 from .gapcraters import gap_crater_layer, stamp_gap_craters
 
 __all__ = ["fbm_noise", "fill_gaps", "harmonic_fill"]
@@ -137,7 +137,7 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
         raise ValueError("`dem` has no known pixel (all NaN): there is nothing to fill from")
     if roughness is not None:
         with about("roughness"):
-            roughness = check_positive("roughness", roughness, allow_zero=True)
+            roughness = check_range("roughness", roughness, 0.0, MAX_ROUGHNESS)
     if fractal_dimension is not None:
         with about("fractal_dimension"):
             fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)

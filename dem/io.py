@@ -146,7 +146,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
     except (ValueError, TypeError) as exc:
         with about(parameter_of(exc)):  # the file named, the parameter kept
-            raise type(exc)(f"{str(path)!r}: {exc}") from None
+            kind = ValueError if isinstance(exc, ValueError) else TypeError  # plain kinds:
+            raise kind(f"{str(path)!r}: {exc}") from None  # a ParameterError needs a rule
 
 
 def _check_window(window) -> tuple[int, int, int, int]:
@@ -192,6 +193,9 @@ def _read_gdal(path: Path, band: int, win=None):
                     with about("band"):
                         raise ValueError(f"`band` must be in [1, {ds.count}] for "
                                          f"{str(path)!r}; got {band}")
+                if np.dtype(ds.dtypes[band - 1]).kind == "c":
+                    raise ValueError(f"{str(path)!r}: band {band} holds complex numbers "
+                                     f"({ds.dtypes[band - 1]}); heights must be real")
                 if win is None:
                     data = ds.read(band, masked=True)
                 else:
@@ -338,6 +342,10 @@ def write(dem: Dem, path) -> Path:
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
     path = _check_geotiff_path(path)
     rows, cols = dem.shape
+    top = float(np.nanmax(np.abs(dem.heights))) if dem.known.any() else 0.0
+    if top > np.finfo(np.float32).max:
+        raise ValueError(f"output {str(path)!r}: heights up to {top:.6g} m do not fit the "
+                         f"GeoTIFF's float32 (at most {np.finfo(np.float32).max:.6g})")
     data = dem.heights.astype(np.float32)
     with atomic_path(path) as tmp:
         with warnings.catch_warnings():

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from craters import validate_catalog
-from craters._shared import atomic_path, check_int, check_positive
+from craters._shared import ParameterTypeError, atomic_path, check_int, check_positive
 
 from .export import EXPORT_SUFFIXES, export_body
 from .grid import LatLongGrid
@@ -17,6 +17,8 @@ from .grid import LatLongGrid
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
 
 FORMAT = "craterform.body/1"
+#: The arrays every saved body holds (craters and boulders are optional).
+_SAVED = ("format", "magnitude", "radius_m", "stretch", "radii_m", "metadata_json")
 # a fixed zip timestamp so that the same body always gives the same bytes
 _ZIP_DATE = (1980, 1, 1, 0, 0, 0)
 
@@ -63,6 +65,8 @@ class Body:
                  boulders=None, copy: bool = True):
         if not isinstance(grid, LatLongGrid):
             raise TypeError(f"`grid` must be a LatLongGrid; got {type(grid).__name__}")
+        if np.iscomplexobj(radii_m):
+            raise ParameterTypeError("radii_m", "must be real numbers; got complex values")
         if copy:
             radii = np.array(radii_m, dtype=np.float64, copy=True)
         else:
@@ -344,7 +348,20 @@ def load(path) -> Body:
     fmt = str(fields["format"]) if "format" in fields else ""
     if fmt != FORMAT:
         raise ValueError(f"{str(path)!r} is not a craterform body (format {fmt!r})")
-    return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
-                radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
-                metadata=json.loads(str(fields["metadata_json"])),
-                craters=fields.get("craters"), boulders=fields.get("boulders"), copy=False)
+    missing = [k for k in _SAVED if k not in fields]
+    if missing:
+        raise ValueError(f"body {str(path)!r} is incomplete: no {', '.join(missing)}")
+    for key in ("magnitude", "radius_m", "stretch", "radii_m"):
+        if fields[key].dtype.kind not in "iuf":
+            raise ValueError(f"body {str(path)!r}: {key} must hold real numbers; got dtype "
+                             f"{fields[key].dtype}")
+    if fields["magnitude"].shape != () or fields["radius_m"].shape != ():
+        raise ValueError(f"body {str(path)!r}: magnitude and radius_m must be single numbers")
+    try:  # the file's values, not the caller's arguments: no parameter names in errors
+        return Body(LatLongGrid(int(fields["magnitude"])), fields["radii_m"],
+                    radius_m=float(fields["radius_m"]), stretch=fields["stretch"],
+                    metadata=json.loads(str(fields["metadata_json"])),
+                    craters=fields.get("craters"), boulders=fields.get("boulders"),
+                    copy=False)
+    except (ValueError, TypeError, OverflowError) as exc:
+        raise ValueError(f"body {str(path)!r} is invalid: {exc}") from None

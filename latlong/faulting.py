@@ -12,7 +12,7 @@ from craters._shared import ParameterError, check_int, check_positive, normalize
 
 from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid
-from .smoothing import smooth
+from .smoothing import check_smooth_width, smooth
 
 __all__ = [
     "FAULTING_PRESETS",
@@ -219,6 +219,9 @@ def two_phase_faulting(grid: LatLongGrid, radius_m: float, params: FaultingParam
     params = FAULTING_PRESETS["paper"] if params is None else params
     if not isinstance(params, FaultingParams):
         raise TypeError(f"`params` must be a FaultingParams; got {type(params).__name__}")
+    if params.smooth_passes:
+        check_smooth_width(params.smooth_width_m, radius_m, params.smooth_passes,
+                           "smooth_width_m")
     rng = normalize_rng(rng)
     h = poisson_faulting(grid, params.n_faults_1, params.max_fault_1_m, rng=rng,
                          progress=progress)

@@ -18,6 +18,7 @@ underscores (``magnitude``, ``radius_m``, ``faults_1``, ``craters`` ...; the lis
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -44,6 +45,8 @@ from .settings import (
     ImplicitSettings,
     ShapeBase,
     SphereBase,
+    check_memory,
+    expected_counts,
 )
 from .shapes import read_shape_model
 
@@ -186,6 +189,15 @@ class Scene:
             self.boulders.check_fits(smallest)
         except ParameterError as exc:
             raise exc.renamed("boulders") from None
+        if isinstance(base, ShapeBase):
+            area = base.model.area_m2
+        else:  # the ellipsoid's area (Knud Thomsen's formula, within 1.1 %)
+            a, b, c = (body.radius_m * f for f in body.stretch)
+            p = 1.6075
+            area = 4 * math.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
+        n_craters, n_boulders = expected_counts(self.craters, self.boulders, area)
+        check_memory(body.magnitude, body.max_memory_gb, n_craters=n_craters,
+                     n_boulders=n_boulders)
 
     def target(self) -> _craters.Target:
         """The craters' target (:func:`craters.get_target`): a named body, or a small body

@@ -24,25 +24,40 @@ from craters._shared import (
 )
 
 from .grid import BUILD_BASE_BYTES, LatLongGrid, build_bytes_per_vertex
-from .shapes import ShapeModel, read_shape_model
+from .shapes import SIZE_RANGE_M, ShapeModel, read_shape_model
 
 __all__ = ["BASES", "MEMORY_SHARE", "BodySettings", "BoulderSettings",
            "CraterSettings", "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase",
-           "check_memory"]
+           "check_memory", "expected_counts"]
 
+#: Peak memory of a build per crater of its catalog (the catalog, the stamping profile
+#: tables, the wave schedule), bytes. Measured (/usr/bin/time -v, 2 threads): M = 100,
+#: R = 50 m, c=0.5,k=-2,d_max_m=15: 0.71 GB with 8.9e4 craters, 3.54 GB with 8.9e5,
+#: 3.5 kB a crater; rounded up.
+BUILD_BYTES_PER_CRATER = 4.0e3
+#: ... per boulder (catalog, rock meshes' bookkeeping), bytes. Measured the same way:
+#: M = 40, R = 50 m sphere, c=0.5,k=-2,d_max_m=2: 0.71 GB with 8.9e4 boulders, 0.97 GB
+#: with 8.9e5, 0.33 kB a boulder; rounded up.
+BUILD_BYTES_PER_BOULDER = 0.4e3
 #: Names of the base shapes (``shape`` takes a model file).
 BASES = ("sphere", "faulting", "fbm", "shape")
 #: The share of this machine's memory a build may use unless ``max_memory_gb`` is given.
 MEMORY_SHARE = 0.8
+#: Mean radius a body may have, metres: the range of shape models (a boulder to a gas
+#: giant), so radii, areas and volumes stay finite in float64.
+RADIUS_RANGE_M = SIZE_RANGE_M
 CROSSINGS = ("error", "outermost", "innermost")
 #: Where a shape base is cratered: the lat/long grid or the model's own mesh.
 SURFACES = ("latlong", "mesh")
 
 
-def check_memory(magnitude: int, max_memory_gb: float | None = None) -> None:
-    """Refuse up front a grid whose build would need more than ``max_memory_gb`` GB
-    (1e9 bytes; default :data:`MEMORY_SHARE` of this machine's memory), with the
-    estimate (:meth:`LatLongGrid.estimate_bytes`)."""
+def check_memory(magnitude: int, max_memory_gb: float | None = None, *,
+                 n_craters: float = 0.0, n_boulders: float = 0.0) -> None:
+    """Refuse up front a build that would need more than ``max_memory_gb`` GB (1e9
+    bytes; default :data:`MEMORY_SHARE` of this machine's memory), with the estimate:
+    the grid's (:meth:`LatLongGrid.estimate_bytes`), then with the expected numbers of
+    craters and boulders (:data:`BUILD_BYTES_PER_CRATER`, :data:`BUILD_BYTES_PER_BOULDER`)
+    refused under ``craters`` / ``boulders``."""
     bpv = build_bytes_per_vertex()
     need = LatLongGrid.estimate_bytes(magnitude, bpv)
     if max_memory_gb is None:
@@ -57,6 +72,25 @@ def check_memory(magnitude: int, max_memory_gb: float | None = None) -> None:
             "magnitude", f"{magnitude} needs about {need / 1e9:.3g} GB of memory ({n:.3g} "
             f"vertices x {bpv:g} B + {BUILD_BASE_BYTES / 1e9:.3g} GB), more than "
             f"{{}} = {limit / 1e9:.3g} GB{whose}", see=("max_memory_gb",))
+    for name, count, each in (("craters", n_craters, BUILD_BYTES_PER_CRATER),
+                              ("boulders", n_boulders, BUILD_BYTES_PER_BOULDER)):
+        if need + count * each > limit:
+            raise ParameterError(
+                name, f": about {count:.3g} {name} need about {count * each / 1e9:.3g} GB of "
+                f"memory ({each / 1e3:g} kB each) besides the {need / 1e9:.3g} GB of "
+                f"magnitude {magnitude} and what comes before: more than {{}} = "
+                f"{limit / 1e9:.3g} GB{whose}; raise d_min_m or lower c",
+                see=("max_memory_gb",))
+        need += count * each
+
+
+def expected_counts(craters: CraterSettings, boulders: BoulderSettings,
+                    area_m2: float) -> tuple[float, float]:
+    """The mean numbers of craters and boulders the layers draw on ``area_m2``."""
+    n_craters = sum(float(la.expected_count(area_m2)) for la in craters.layers)
+    n_boulders = sum(area_m2 * la.c * (la.d_min_m ** la.k - la.d_max_m ** la.k)
+                     for la in boulders.layers)
+    return n_craters, n_boulders
 
 
 def _set(obj, name, value) -> None:
@@ -120,7 +154,7 @@ class BodySettings:
             _set(self, "max_memory_gb", check_positive("max_memory_gb", self.max_memory_gb))
         check_memory(self.magnitude, self.max_memory_gb)
         if self.radius_m is not None:
-            _set(self, "radius_m", check_positive("radius_m", self.radius_m))
+            _set(self, "radius_m", check_range("radius_m", self.radius_m, *RADIUS_RANGE_M))
         if self.stretch is not None:
             _set(self, "stretch", parse_stretch(self.stretch))
 

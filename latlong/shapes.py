@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int
+from craters._shared.meshfiles import check_mesh_file
 
 from ._shape_kernels import _brute_force_kernel, _raycast_kernel
 from .body import Body
@@ -42,6 +43,9 @@ UNITS = {"km": 1000.0, "m": 1.0}
 #: grid vertex in 10^4 (a Eros plate model's 2 vertices of 2.9e5) is a pinhole in the
 #: model, not a shape that is not star-shaped.
 NON_STAR_TOLERANCE = 1e-4
+#: Extent a shape model may span, metres (a boulder to a gas giant): the geometry
+#: (volumes ~ extent^3, edge lengths) stays within float64 and divides safely.
+SIZE_RANGE_M = (1e-3, 1e9)
 _PYVISTA_SUFFIXES = (".ply", ".stl", ".vtk", ".vtp")
 _TEXT_SUFFIXES = (".obj", ".tab", ".plt", ".txt")
 
@@ -179,6 +183,10 @@ def _check_and_orient(verts: np.ndarray, faces: np.ndarray, source: str) -> Shap
         raise ValueError(f"shape model {source!r} is empty (no vertices or no faces)")
     if not np.isfinite(verts).all():
         raise ValueError(f"shape model {source!r} has non-finite vertex coordinates")
+    extent = float(np.ptp(verts, axis=0).max())
+    if not SIZE_RANGE_M[0] <= extent <= SIZE_RANGE_M[1]:
+        raise ValueError(f"shape model {source!r} spans {extent:.6g} m; allowed "
+                         f"{SIZE_RANGE_M[0]:g} m to {SIZE_RANGE_M[1]:g} m (check its units)")
     # merge coincident vertices (STL facets, duplicated seams); lexicographic order as
     # np.unique(axis=0) gives, by lexsort (np.unique(axis=0) takes ~40 s on 1 M vertices)
     order = np.lexsort((verts[:, 2], verts[:, 1], verts[:, 0]))
@@ -237,6 +245,7 @@ def read_shape_model(path, *, units: str) -> ShapeModel:
     if suffix in _PYVISTA_SUFFIXES:
         import pyvista as pv
 
+        check_mesh_file(path, "shape model")
         try:
             mesh = pv.read(path)
         except Exception as exc:  # noqa: BLE001 - VTK raises many kinds
@@ -247,11 +256,17 @@ def read_shape_model(path, *, units: str) -> ShapeModel:
         verts = np.asarray(mesh.points, dtype=np.float64)
         faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if (
             mesh.n_cells) else np.zeros((0, 3), np.int64)
+        if faces.size and (faces.min() < 0 or faces.max() >= len(verts)):
+            raise ValueError(f"shape model {str(path)!r}: facet indices out of range "
+                             f"[{faces.min()}, {faces.max()}] for {len(verts)} vertices")
     elif suffix in _TEXT_SUFFIXES:
         try:
             verts, faces, fmt = _read_text_mesh(path)
         except (ValueError, IndexError) as exc:
             raise ValueError(f"cannot parse shape model {str(path)!r}: {exc}") from None
+        except OverflowError:
+            raise ValueError(f"cannot parse shape model {str(path)!r}: a count or facet "
+                             f"index is not a finite integer below 2**63") from None
         if verts.ndim != 2 or (len(verts) and verts.shape[1] != 3):
             raise ValueError(f"shape model {str(path)!r}: vertices need three coordinates")
         faces = _zero_based(faces, len(verts), fmt, path)

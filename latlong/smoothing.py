@@ -18,11 +18,11 @@ import math
 
 import numpy as np
 
-from craters._shared import check_int, check_positive
+from craters._shared import ParameterError, check_int, check_positive, check_range
 
 from .grid import LatLongGrid
 
-__all__ = ["fwhm_to_sigma", "heat_smooth", "smooth"]
+__all__ = ["MAX_SIGMA_RAD", "check_smooth_width", "fwhm_to_sigma", "heat_smooth", "smooth"]
 
 _FWHM_PER_SIGMA = 2.0 * math.sqrt(2.0 * math.log(2.0))
 # pyramid settings (relative to grid spacings h): stop coarsening once the next level's
@@ -30,6 +30,10 @@ _FWHM_PER_SIGMA = 2.0 * math.sqrt(2.0 * math.log(2.0))
 _COARSEST = 3.0
 _PRE = 0.7
 _POST = 0.5
+#: Widest smoothing, geodesic sigma in radians: at pi (half the circumference) the
+#: degree-1 harmonic is already down to exp(-pi^2) = 5e-5 and a wider Gaussian only
+#: costs time (~ sigma^2 diffusion steps on the coarsest grid: hours at sigma = 1e6).
+MAX_SIGMA_RAD = math.pi
 
 
 def fwhm_to_sigma(width: float) -> float:
@@ -102,7 +106,7 @@ def heat_smooth(grid: LatLongGrid, values, sigma_rad: float) -> np.ndarray:
         raise ValueError(f"`values` must have shape ({grid.n_vertices},); got {f0.shape}")
     if not np.isfinite(f0).all():
         raise ValueError("`values` must be finite")
-    sigma = check_positive("sigma_rad", sigma_rad, allow_zero=True)
+    sigma = check_range("sigma_rad", sigma_rad, 0.0, MAX_SIGMA_RAD)
     if sigma == 0:
         return f0.copy()
     var = sigma * sigma
@@ -130,6 +134,29 @@ def heat_smooth(grid: LatLongGrid, values, sigma_rad: float) -> np.ndarray:
     w = grid.vertex_areas()
     f += (np.dot(w, f0) - np.dot(w, f)) / w.sum()
     return f
+
+
+def check_smooth_width(width_m, radius_m: float, passes: int = 1,
+                       name: str = "width_m") -> float:
+    """``width_m`` (FWHM, metres; parameter ``name``) as a float: finite, >= 0, and with
+    ``passes`` passes no wider than :data:`MAX_SIGMA_RAD` on a body of ``radius_m``.
+
+    Examples
+    --------
+    >>> check_smooth_width(1e9, 50.0)
+    Traceback (most recent call last):
+    ...
+    craters._shared.validation.ParameterError: `width_m` must be in [0, 369.9] m (a \
+Gaussian of sigma pi radians on a body of radius 50 m, 1 pass); got 1000000000.0
+    """
+    width_m = check_positive(name, width_m, allow_zero=True)
+    radius_m = check_positive("radius_m", radius_m)
+    top = MAX_SIGMA_RAD * _FWHM_PER_SIGMA * radius_m / math.sqrt(max(passes, 1))
+    if width_m > top:
+        raise ParameterError(name, f"must be in [0, {top:.4g}] m (a Gaussian of sigma pi "
+                             f"radians on a body of radius {radius_m:g} m, {passes} "
+                             f"pass{'es' if passes != 1 else ''}); got {width_m!r}")
+    return width_m
 
 
 def smooth(grid: LatLongGrid, values, width_m: float, *, radius_m: float,
@@ -162,8 +189,7 @@ def smooth(grid: LatLongGrid, values, width_m: float, *, radius_m: float,
     >>> bool(abs(s[0] / z[0] - np.exp(-2 * fwhm_to_sigma(1.0) ** 2 / 2)) < 0.02)
     True
     """
-    width_m = check_positive("width_m", width_m, allow_zero=True)
-    radius_m = check_positive("radius_m", radius_m)
     passes = check_int("passes", passes, 0, 10_000)
+    width_m = check_smooth_width(width_m, radius_m, passes)
     sigma = fwhm_to_sigma(width_m) * math.sqrt(passes) / radius_m
     return heat_smooth(grid, values, sigma)

@@ -195,6 +195,9 @@ def test_resume_redoes_only_missing_and_corrupt(tmp_path, scene, scheduler):
 
 
 def test_failed_variant_is_recorded_and_the_others_kept(tmp_path, scene, scheduler):
+    # a memory allowance far above the up-front estimate of TOO_MANY (4e9 GB), so the
+    # variant is accepted and fails while it runs (the population's count limit)
+    scene.write_text(SCENE + "max_memory_gb = 1e12\n")
     out = tmp_path / "batch"
     proc = _cli("latlong", "batch", str(scene), "--seeds", "1-2", "--scheduler", scheduler,
                 "--vary", f"craters=c=0.5,k=-2,d_min_m=8,d_max_m=15;{TOO_MANY}", "-o", str(out))
@@ -220,7 +223,7 @@ def test_failed_variant_is_recorded_and_the_others_kept(tmp_path, scene, schedul
     (["--seeds", "1", "--vary", "seed=1,2"], "--vary seed: give the seeds with --seeds"),
     (["--seeds", "1", "--vary", "magnitude=16,x"], "--vary magnitude=x:"),
     (["--seeds", "1", "--vary", "radius-m=100,-5"],
-     "--vary radius_m=-5: `radius_m` must be finite and > 0"),
+     "--vary radius_m=-5: `radius_m` must be in [0.001, 1e+09]"),
     (["--seeds", "1", "--vary", "radius_m=100,100.0"], "--vary radius_m: value '100' is given"),
     (["--seeds", "1", "--scheduler", "nowhere"], "--scheduler must be a dask scheduler"),
     (["--seeds", "1", "--scheduler", "tcp://127.0.0.1:9", "--workers", "2"],

@@ -84,7 +84,12 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
     logging.basicConfig(format="%(levelname)s: %(message)s", level=logging.WARNING)
     try:
         with _sigterm_raises(), (output_group() if atomic else contextlib.nullcontext()):
-            return int(func() or 0)
+            code = int(func() or 0)
+            sys.stdout.flush()  # a closed pipe shows here, not at exit
+        return code
+    except BrokenPipeError:  # `latlong info x | head`: the reader has what it wanted
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 128 + 13  # as a process killed by SIGPIPE, without a message
     except (CliError, ValueError, TypeError, OSError, MemoryError) as exc:
         if os.environ.get("CRATERFORM_DEBUG"):
             raise

@@ -7,6 +7,7 @@ import collections
 import contextlib
 import os
 import queue
+import stat
 import tomllib
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import ThreadPoolExecutor
@@ -15,7 +16,7 @@ from pathlib import Path
 from .outputs import replace_output, sweep_temporaries, temp_file
 
 __all__ = ["BackgroundWriter", "atomic_path", "check_output_path", "check_parent_folder",
-           "check_suffix", "load_toml", "ordered_chunks"]
+           "check_regular_file", "check_suffix", "load_toml", "ordered_chunks"]
 
 
 def check_parent_folder(path) -> None:
@@ -189,9 +190,40 @@ def ordered_chunks(make: Callable, items: Iterable, buffer: Callable[[], object]
 _END = object()
 
 
+def check_regular_file(path, what: str, max_bytes: int | None = None) -> Path:
+    """``path`` names an existing regular file (not a FIFO, device or folder) of at
+    most ``max_bytes``; returns it as a Path, else a one-line ``ValueError``.
+
+    Examples
+    --------
+    >>> check_regular_file("/dev/null", "config file")
+    Traceback (most recent call last):
+    ...
+    ValueError: config file '/dev/null' is not a regular file (a device, FIFO or folder)
+    """
+    path = Path(path)
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ValueError(f"{what} {str(path)!r} does not exist") from None
+    except OSError as exc:
+        raise ValueError(f"cannot read {what} {str(path)!r}: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(st.st_mode):
+        raise ValueError(f"{what} {str(path)!r} is not a regular file (a device, FIFO or "
+                         f"folder)")
+    if max_bytes is not None and st.st_size > max_bytes:
+        raise ValueError(f"{what} {str(path)!r} has {st.st_size} bytes; at most {max_bytes} "
+                         f"are read")
+    return path
+
+
+#: Largest TOML scene or config file read, bytes (a scene is a few kilobytes).
+MAX_TOML_BYTES = 16 << 20
+
+
 def load_toml(path) -> dict:
     """Read a TOML scene file; errors become ValueError naming the file."""
-    path = Path(path)
+    path = check_regular_file(path, "config file", MAX_TOML_BYTES)
     try:
         with open(path, "rb") as fh:
             return tomllib.load(fh)
@@ -199,3 +231,5 @@ def load_toml(path) -> dict:
         raise ValueError(f"config file {str(path)!r} does not exist") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ValueError(f"config file {str(path)!r} nests arrays or tables too deeply") from None

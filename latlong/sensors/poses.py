@@ -14,12 +14,15 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import ParameterError, check_finite, check_int, check_positive, check_range
+from craters._shared.files import check_regular_file
 
 from .camera import Pose, unit_quaternions
 
 __all__ = ["POSE_COLUMNS", "Poses", "approach", "read_poses", "read_poses_toml", "surface_point"]
 
 #: The header of a trajectory CSV (issue 17's interface).
+#: Largest trajectory file read, bytes (~10 million poses as CSV).
+MAX_POSES_BYTES = 1 << 30
 POSE_COLUMNS = ("time_s", "x_m", "y_m", "z_m", "qw", "qx", "qy", "qz")
 @dataclass(frozen=True, slots=True)
 class Poses:
@@ -81,6 +84,7 @@ def read_poses(path) -> Poses:
     path = Path(path)
     if path.suffix.lower() == ".toml":
         return read_poses_toml(path)
+    check_regular_file(path, "poses file", MAX_POSES_BYTES)
     try:
         with open(path, newline="") as fh:
             rows = list(csv.reader(fh))
@@ -111,11 +115,11 @@ def read_poses_toml(path) -> Poses:
     z]`` and ``quaternion_wxyz = [w, x, y, z]`` (unknown keys are errors)."""
     import tomllib
 
-    path = Path(path)
+    path = check_regular_file(path, "poses file", MAX_POSES_BYTES)
     try:
         with open(path, "rb") as fh:
             doc = tomllib.load(fh)
-    except (OSError, tomllib.TOMLDecodeError) as exc:
+    except (OSError, tomllib.TOMLDecodeError, RecursionError) as exc:
         raise ValueError(f"cannot read poses {str(path)!r}: {exc}") from None
     frames = doc.get("frame")
     if set(doc) != {"frame"} or not isinstance(frames, list) or not frames:

@@ -469,7 +469,9 @@ def test_cli_boulders_from_config_and_export(run_cli, tmp_path):
     (["--boulders", "c=1e-3,k=-3,d_min_m=1,d_max_m=5", "--boulder-roughness", "3"],
      ["roughness"]),
     (["--boulder-catalog", "r.csv"], ["--boulder-catalog", "--boulders"]),
-    (["--boulders", "c=100,k=-3,d_min_m=0.001,d_max_m=5"], ["boulders", "2e7"]),
+    # the count limit (past the memory estimate, which test_bad_inputs covers)
+    (["--boulders", "c=100,k=-3,d_min_m=0.001,d_max_m=5", "--max-memory-gb", "1e12"],
+     ["boulders", "2e7"]),
 ])
 def test_cli_bad_boulder_input(run_cli, tmp_path, args, needles, one_line_error):
     proc = run_cli("latlong", "build", "--magnitude", "20", "--radius-m", "1000", *args,

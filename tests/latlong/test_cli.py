@@ -79,7 +79,7 @@ def test_same_seed_same_bytes_any_thread_count(run_cli, tmp_path):
     (["--seed", "1.5"], ["--seed"]),
     (["--seed", "-1"], ["--seed"]),
     (["--radius-m", "nan"], ["--radius-m", "finite"]),
-    (["--radius-m", "-5"], ["--radius-m", "> 0"]),
+    (["--radius-m", "-5"], ["--radius-m", "[0.001, 1e+09]"]),
     (["--base", "fbm", "--octaves", "0"], ["--octaves"]),
     (["--base", "fbm", "--frequency", "inf"], ["--frequency"]),
     (["--base", "fbm", "--faults-1", "10"], ["--faults-1", "faulting"]),

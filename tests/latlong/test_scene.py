@@ -90,7 +90,7 @@ def test_shape_base_reads_the_model_once_and_sets_the_body():
 
 @pytest.mark.parametrize("settings,name,text", [
     ({"magnitude": 0}, "magnitude", "[1, 1000000000]"),
-    ({"radius_m": -1}, "radius_m", "> 0"),
+    ({"radius_m": -1}, "radius_m", "[0.001, 1e+09]"),
     ({"base": "fbm", "faults_1": 10}, "faults_1", "faulting"),
     ({"preset": "paper", "base": "fbm"}, "preset", "faulting"),
     ({"craters": ["c=0.1,k=-2,d_min_m=5,d_max_m=150"], "radius_m": 100}, "craters",
