@@ -365,7 +365,10 @@ def test_sweep_removes_week_old_temporaries_of_live_pids(tmp_path):
 
 # --------------------------------------------------------------- kills
 _SLOW_EXPORT = r"""
-import sys, time
+import signal, sys, time
+# Python keeps SIGINT ignored when its parent ignored it (a pytest-xdist worker may):
+# take Ctrl-C as a user's shell delivers it
+signal.signal(signal.SIGINT, signal.default_int_handler)
 import latlong.gltf as g
 real = g._write_level_data
 def slow(*a, **k):

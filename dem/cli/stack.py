@@ -30,15 +30,19 @@ def _enhance(s: Settings) -> int:
         info = stack.info
         c = info["craters"]
         sizes = stack.pixel_sizes_m()
+        small = int(c.get("rejected_below_finest", 0))
         print(f"dem enhance: {len(stack)} layers of {cfg.size} x {cfg.size} pixels, "
-              f"{sizes[0]:.4g} m -> {sizes[-1]:.4g} m per pixel, seed {info['seed']}; craters "
-              f"stamped {sum(c['stamped'])}, erased on steep ground "
-              f"{sum(c['erased_on_steep_ground'])}, rejected {c['rejected']} of {c['drawn']}")
+              f"{sizes[0]:.4g} m -> {sizes[-1]:.4g} m per pixel, seed {info['seed']}; "
+              f"{sum(c['stamped']):,} craters stamped, {sum(c['erased_on_steep_ground']):,} "
+              f"erased on steep ground; of the {c['drawn']:,} craters the layers put over "
+              f"layer 0's area, {small:,} are too small for the finest layer's pixels and "
+              f"{int(c['rejected']) - small:,} fall outside the finer layers or cross "
+              "their borders (not stamped)")
         b = info.get("boulders")
         if b:
-            print(f"boulders stamped {sum(b['stamped'])}, rejected {b['rejected']} of "
-                  f"{b['drawn']} (below {cfg.min_boulder_px:g} px of the finest layer or "
-                  f"crossing a layer's border)")
+            print(f"{sum(b['stamped']):,} boulders stamped; of the {b['drawn']:,} drawn, "
+                  f"{int(b['rejected']):,} not stamped (below {cfg.min_boulder_px:g} px of "
+                  "the finest layer or crossing a layer's border)")
         print(f"wrote {manifest}")
     return 0
 

@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import numpy as np
+
 from craters._shared import human_bytes, progress_bar
 from craters._shared.cli import CliError
 from latlong import Scene, build
@@ -56,11 +58,24 @@ def _summary(made, scene: Scene) -> str:
         return (f"mesh surface: {made.n_vertices} vertices, {len(made.faces)} triangles (mean "
                 f"edge {meta['mean_edge_m']:.3g} m), {n_craters} craters ({skipped} left out "
                 f"on folds), {n_boulders} boulders, seed {scene.seed}")
-    r = made.radii_m
+    lo, hi = _distance_range(made)
     n_craters = 0 if made.craters is None else len(made.craters)
     return (f"body: magnitude {made.magnitude}, {made.n_vertices} vertices, base "
             f"{scene.base.name} ({scene.preset or '-'}), {n_craters} craters, seed "
-            f"{scene.seed}, radius {r.min():.4g}..{r.max():.4g} m")
+            f"{scene.seed}, surface {lo:.4g}..{hi:.4g} m from the centre")
+
+
+def _distance_range(body) -> tuple[float, float]:
+    """Nearest and farthest surface points from the centre: the radii when unstretched,
+    else |stretch * r * u| (a stretched body's radii are not its size), in 1 M-vertex
+    blocks."""
+    if tuple(body.stretch) == (1.0, 1.0, 1.0):
+        return float(body.radii_m.min()), float(body.radii_m.max())
+    lo, hi = np.inf, 0.0
+    for s in range(0, body.n_vertices, 1 << 20):
+        d = np.linalg.norm(body.vertices(s, min(s + (1 << 20), body.n_vertices)), axis=1)
+        lo, hi = min(lo, float(d.min())), max(hi, float(d.max()))
+    return lo, hi
 
 
 def cmd_build(args) -> int:

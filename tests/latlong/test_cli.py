@@ -396,3 +396,15 @@ def test_gravitational_slopes_command(run_cli, tmp_path):
         assert_one_line_error(run_cli("latlong", "slopes", eros, "--shape-units", "km",
                                       *args, "--csv", str(tmp_path / "x.csv")), flag)
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_build_summary_gives_a_stretched_body_its_true_size():
+    """Issue 19 item 8: a stretched body's summary gives its distances from the centre,
+    not its radii (which printed 127 m for a body reaching 239 m)."""
+    from latlong import Body, LatLongGrid
+    from latlong.cli.build import _distance_range
+
+    body = Body.sphere(LatLongGrid(12), 100.0).replace(stretch=(2.0, 1.0, 0.5))
+    lo, hi = _distance_range(body)
+    assert abs(hi - 200.0) < 1e-9 and abs(lo - 50.0) < 1e-9
+    assert _distance_range(Body.sphere(LatLongGrid(4), 7.0)) == (7.0, 7.0)
