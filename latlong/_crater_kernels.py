@@ -353,7 +353,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
                        rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                        out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,

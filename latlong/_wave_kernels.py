@@ -101,7 +101,7 @@ def _balance_waves_kernel(order, starts, cost, n_threads, out_order, out_bounds)
         out_bounds[w, n_threads] = at
 
 
-@njit(cache=True, parallel=True)
+@njit(cache=True, parallel=True, nogil=True)
 def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon, diam, tabs,
                         depths, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
                         gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,

@@ -14,6 +14,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 
+import numba
 import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError, package_version
@@ -25,6 +26,7 @@ from .faulting import FaultingParams, two_phase_faulting
 from .grid import LatLongGrid
 from .perlin import FbmParams, perlin_fbm
 from .scene import Scene
+from .scratch import disk_radii
 from .settings import ShapeBase, SphereBase
 from .shapes import from_shape_model
 
@@ -34,13 +36,17 @@ GENERATOR = "craterform latlong build"
 logger = logging.getLogger(__name__)
 
 
-def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
+def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool, out=None):
     """(heights above the reference radius in metres, reference radius, parameters for
     the metadata) of the scene's base shape; the heights are a new float64 array of the
-    caller's (:func:`build` turns it into the radii in place)."""
+    caller's (:func:`build` turns it into the radii in place), or ``out`` (sphere and fbm
+    bases) filled."""
     base, body = scene.base, scene.body
     if isinstance(base, SphereBase):
-        return np.zeros(grid.n_vertices), body.radius_m, {}
+        if out is None:
+            return np.zeros(grid.n_vertices), body.radius_m, {}
+        out.fill(0.0)
+        return out, body.radius_m, {}
     if isinstance(base, FaultingParams):  # its stretch is the body's (the scene made it so)
         heights = two_phase_faulting(grid, body.radius_m, base, rng=rng, progress=progress)
         return heights, body.radius_m, dataclasses.asdict(base)
@@ -48,7 +54,8 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
         params = {"frequency": base.frequency, "octaves": base.octaves,
                   "persistence": base.persistence, "lacunarity": base.lacunarity,
                   "amplitude_m": base.amplitude_m}
-        return perlin_fbm(grid, *params.values(), rng=rng), body.radius_m, params
+        return (perlin_fbm(grid, *params.values(), rng=rng, out=out, progress=progress),
+                body.radius_m, params)
     assert isinstance(base, ShapeBase)
     try:
         shaped = from_shape_model(base.model, grid.magnitude, center=base.center,
@@ -66,7 +73,7 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool):
     return heights, shaped.radius_m, params
 
 
-def build(scene: Scene, *, progress: bool = False):
+def build(scene: Scene, *, progress: bool = False, scratch_dir=None):
     """Make the body a scene describes; writes nothing.
 
     Parameters
@@ -74,6 +81,10 @@ def build(scene: Scene, *, progress: bool = False):
     scene : Scene
     progress : bool
         Progress bars on a terminal for the long steps.
+    scratch_dir : path, optional
+        Where the radii's scratch file goes when :meth:`Scene.radii_on_disk` (a body bigger
+        than ``max_memory_gb``; :mod:`latlong.scratch`); default the system's temporary
+        folder. The body's radii are then that file, mapped (same bytes as in memory).
 
     Returns
     -------
@@ -99,21 +110,32 @@ def build(scene: Scene, *, progress: bool = False):
         return _build_implicit(scene, progress)
     if isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh":
         return _build_mesh(scene, progress)
+    on_disk = scene.radii_on_disk()
+    radii = disk_radii(6 * scene.body.magnitude ** 2 + 2, scratch_dir) if on_disk else None
     try:
-        return _build_latlong(scene, progress, overwrite=True)
+        return _build_latlong(scene, progress, overwrite=True, out=radii)
     except WaveScheduleOutgrown:
         pass  # (rare) its radii are spent: build again, the stamp copying the radii
+    if on_disk:  # a copy would be a second body in memory: stamp serially into the file
+        logger.info("crater wave schedule outgrown: building again, stamping serially")
+        threads = numba.get_num_threads()
+        numba.set_num_threads(1)
+        try:
+            return _build_latlong(scene, progress, overwrite=True, out=radii)
+        finally:
+            numba.set_num_threads(threads)
     logger.info("crater wave schedule outgrown: building again with a copy of the radii")
     return _build_latlong(scene, progress, overwrite=False)
 
 
-def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool) -> Body:
+def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -> Body:
     """The lat/long body. Memory: one float64 radius per vertex plus bounded buffers
     (the base is made in place, the craters stamped into the body's own radii when
-    ``overwrite``; the same bytes either way)."""
+    ``overwrite``; the same bytes either way); none of it with ``out``, the radii's
+    scratch file (:func:`latlong.scratch.disk_radii`)."""
     grid = LatLongGrid(scene.body.magnitude)
     rng = np.random.default_rng(scene.seed)
-    heights, radius_m, params = _base_heights(scene, grid, rng, progress)
+    heights, radius_m, params = _base_heights(scene, grid, rng, progress, out)
     heights += radius_m  # the radii, in place (`heights` is this function's own array)
     craters, boulders = scene.craters, scene.boulders
     target = scene.target()

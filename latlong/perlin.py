@@ -15,6 +15,7 @@ from craters._shared import (
     check_positive,
     check_range,
     normalize_rng,
+    progress_bar,
 )
 
 from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
@@ -148,7 +149,8 @@ FBM_PRESETS: dict[str, FbmParams] = {
 
 
 def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: float,
-               lacunarity: float, amplitude_m: float, *, rng=None, out=None) -> np.ndarray:
+               lacunarity: float, amplitude_m: float, *, rng=None, out=None,
+               progress: bool = False) -> np.ndarray:
     """Heights (metres) from 3-D Perlin fBm sampled on the unit sphere.
 
     Each vertex direction ``u`` is rotated by a random rotation, scaled by
@@ -160,6 +162,8 @@ def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: f
     ----------
     out : (N,) float64 array, optional
         Written in place and returned (C-contiguous, one value per vertex).
+    progress : bool
+        A progress bar (log lines off a terminal) over the chunks.
 
     Examples
     --------
@@ -184,7 +188,8 @@ def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: f
     rot = random_rotation(rng)
     offset = rng.uniform(0.0, 256.0, size=3)
     # per vertex, so the chunking never changes a value: chunks bound the memory
-    for s in range(0, grid.n_vertices, _CHUNK):
+    for s in progress_bar(range(0, grid.n_vertices, _CHUNK), enabled=progress,
+                          desc="base fbm"):
         # explicit sums, not BLAS, so the rounding never depends on the thread count
         uc = grid.unit_vectors_range(s, s + _CHUNK)
         xs, ys, zs = (

@@ -55,7 +55,8 @@ __all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
 # flat setting -> (part, field) of the scene; a part's error is shown under the setting
 _BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch",
          "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3",
-         "crater_depth_ratio": "crater_depth_ratio", "max_memory_gb": "max_memory_gb"}
+         "crater_depth_ratio": "crater_depth_ratio", "max_memory_gb": "max_memory_gb",
+         "radii_on_disk": "radii_on_disk"}
 _FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
              "smooth_width_m": "smooth_width_m", "smooth_passes": "smooth_passes",
              "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
@@ -104,6 +105,13 @@ SETTING_DEFAULTS: dict[str, object] = {
     **_field_defaults(_craters.BoulderShape, _BOULDER_SHAPE), "backend": "latlong",
     **_field_defaults(ImplicitSettings, _IMPLICIT), **_field_defaults(PreviewSettings, _PREVIEW),
 }
+
+
+def _ellipsoid_area(body: BodySettings) -> float:
+    """The stretched sphere's area (Knud Thomsen's formula, within 1.1 %)."""
+    a, b, c = (body.radius_m * f for f in body.stretch)
+    p = 1.6075
+    return 4 * math.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
 
 
 @dataclass(frozen=True, slots=True)
@@ -191,13 +199,26 @@ class Scene:
             raise exc.renamed("boulders") from None
         if isinstance(base, ShapeBase):
             area = base.model.area_m2
-        else:  # the ellipsoid's area (Knud Thomsen's formula, within 1.1 %)
-            a, b, c = (body.radius_m * f for f in body.stretch)
-            p = 1.6075
-            area = 4 * math.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
-        n_craters, n_boulders = expected_counts(self.craters, self.boulders, area)
-        check_memory(body.magnitude, body.max_memory_gb, n_craters=n_craters,
-                     n_boulders=n_boulders)
+        else:
+            area = _ellipsoid_area(body)
+        self._check_memory(area)
+
+    def _check_memory(self, area_m2: float) -> bool:
+        """:func:`check_memory` of this scene; whether its radii go on disk."""
+        body, base = self.body, self.base
+        n_craters, n_boulders = expected_counts(self.craters, self.boulders, area_m2)
+        disk_ok = self.implicit is None and isinstance(base, SphereBase | FbmParams)
+        return check_memory(body.magnitude, body.max_memory_gb, n_craters=n_craters,
+                            n_boulders=n_boulders, radii_on_disk=body.radii_on_disk,
+                            disk_ok=disk_ok)
+
+    def radii_on_disk(self) -> bool:
+        """Whether :func:`latlong.build` keeps this scene's radii in a scratch file
+        (``body.radii_on_disk``: ``yes``, or ``auto`` and the in-memory estimate exceeds
+        ``max_memory_gb``; :mod:`latlong.scratch`)."""
+        if self.implicit is not None or not isinstance(self.base, SphereBase | FbmParams):
+            return False
+        return self._check_memory(_ellipsoid_area(self.body))
 
     def target(self) -> _craters.Target:
         """The craters' target (:func:`craters.get_target`): a named body, or a small body

@@ -26,7 +26,7 @@ from craters._shared import (
 from .grid import BUILD_BASE_BYTES, LatLongGrid, build_bytes_per_vertex
 from .shapes import SIZE_RANGE_M, ShapeModel, read_shape_model
 
-__all__ = ["BASES", "MEMORY_SHARE", "BodySettings", "BoulderSettings",
+__all__ = ["BASES", "MEMORY_SHARE", "RADII_ON_DISK", "BodySettings", "BoulderSettings",
            "CraterSettings", "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase",
            "check_memory", "expected_counts"]
 
@@ -43,6 +43,10 @@ BUILD_BYTES_PER_BOULDER = 0.4e3
 BASES = ("sphere", "faulting", "fbm", "shape")
 #: The share of this machine's memory a build may use unless ``max_memory_gb`` is given.
 MEMORY_SHARE = 0.8
+#: Where a lat/long build keeps its radii (:func:`check_memory`, :mod:`latlong.scratch`).
+RADII_ON_DISK = ("auto", "yes", "no")
+#: The radii's share of :func:`~latlong.grid.build_bytes_per_vertex` (one float64).
+RADII_BYTES_PER_VERTEX = 8.0
 #: Mean radius a body may have, metres: the range of shape models (a boulder to a gas
 #: giant), so radii, areas and volumes stay finite in float64.
 RADIUS_RANGE_M = SIZE_RANGE_M
@@ -52,25 +56,42 @@ SURFACES = ("latlong", "mesh")
 
 
 def check_memory(magnitude: int, max_memory_gb: float | None = None, *,
-                 n_craters: float = 0.0, n_boulders: float = 0.0) -> None:
+                 n_craters: float = 0.0, n_boulders: float = 0.0,
+                 radii_on_disk: str = "auto", disk_ok: bool = True) -> bool:
     """Refuse up front a build that would need more than ``max_memory_gb`` GB (1e9
     bytes; default :data:`MEMORY_SHARE` of this machine's memory), with the estimate:
     the grid's (:meth:`LatLongGrid.estimate_bytes`), then with the expected numbers of
     craters and boulders (:data:`BUILD_BYTES_PER_CRATER`, :data:`BUILD_BYTES_PER_BOULDER`)
-    refused under ``craters`` / ``boulders``."""
+    refused under ``craters`` / ``boulders``.
+
+    ``radii_on_disk`` (:data:`RADII_ON_DISK`): ``"yes"`` counts the radii (8 B a vertex)
+    as kept in a scratch file (:mod:`latlong.scratch`), ``"no"`` in memory, ``"auto"`` in
+    memory when that fits, else on disk if ``disk_ok`` (the base can be made on disk).
+    Returns whether the radii go on disk."""
+    check_choice("radii_on_disk", radii_on_disk, RADII_ON_DISK)
+    if radii_on_disk == "yes" and not disk_ok:
+        raise ParameterError("radii_on_disk", "= yes needs a sphere or fbm base on the "
+                             "lat/long grid")
     bpv = build_bytes_per_vertex()
-    need = LatLongGrid.estimate_bytes(magnitude, bpv)
     if max_memory_gb is None:
         have = physical_memory_bytes()
         limit = MEMORY_SHARE * have
         whose = f" (the default: {MEMORY_SHARE:g} x this machine's {have / 1e9:.3g} GB)"
     else:
         limit, whose = max_memory_gb * 1e9, ""
+    counts = n_craters * BUILD_BYTES_PER_CRATER + n_boulders * BUILD_BYTES_PER_BOULDER
+    on_disk = radii_on_disk == "yes"
+    if radii_on_disk == "auto" and disk_ok:
+        on_disk = LatLongGrid.estimate_bytes(magnitude, bpv) + counts > limit
+    if on_disk:
+        bpv -= RADII_BYTES_PER_VERTEX
+    need = LatLongGrid.estimate_bytes(magnitude, bpv)
     if need > limit:
         n = 6 * magnitude * magnitude + 2
+        where = " with the radii on disk" if on_disk else ""
         raise ParameterError(
-            "magnitude", f"{magnitude} needs about {need / 1e9:.3g} GB of memory ({n:.3g} "
-            f"vertices x {bpv:g} B + {BUILD_BASE_BYTES / 1e9:.3g} GB), more than "
+            "magnitude", f"{magnitude} needs about {need / 1e9:.3g} GB of memory{where} "
+            f"({n:.3g} vertices x {bpv:g} B + {BUILD_BASE_BYTES / 1e9:.3g} GB), more than "
             f"{{}} = {limit / 1e9:.3g} GB{whose}", see=("max_memory_gb",))
     for name, count, each in (("craters", n_craters, BUILD_BYTES_PER_CRATER),
                               ("boulders", n_boulders, BUILD_BYTES_PER_BOULDER)):
@@ -82,6 +103,7 @@ def check_memory(magnitude: int, max_memory_gb: float | None = None, *,
                 f"{limit / 1e9:.3g} GB{whose}; raise d_min_m or lower c",
                 see=("max_memory_gb",))
         need += count * each
+    return on_disk
 
 
 def expected_counts(craters: CraterSettings, boulders: BoulderSettings,
@@ -136,6 +158,10 @@ class BodySettings:
     """Memory the build may use, GB (1e9 bytes); a magnitude whose estimate
     (:func:`check_memory`) is larger is refused up front. Default: :data:`MEMORY_SHARE`
     of this machine's memory."""
+    radii_on_disk: str = "auto"
+    """Keep the radii in a memory-mapped scratch file (:mod:`latlong.scratch`; bodies
+    bigger than memory, the same bytes): ``auto`` when the in-memory estimate exceeds
+    ``max_memory_gb`` (sphere and fbm bases), ``yes``, ``no``."""
 
     def __post_init__(self):
         _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
@@ -152,7 +178,7 @@ class BodySettings:
                                                          self.crater_depth_ratio, 0.01, 0.5))
         if self.max_memory_gb is not None:
             _set(self, "max_memory_gb", check_positive("max_memory_gb", self.max_memory_gb))
-        check_memory(self.magnitude, self.max_memory_gb)
+        check_memory(self.magnitude, self.max_memory_gb, radii_on_disk=self.radii_on_disk)
         if self.radius_m is not None:
             _set(self, "radius_m", check_range("radius_m", self.radius_m, *RADIUS_RANGE_M))
         if self.stretch is not None:

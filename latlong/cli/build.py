@@ -8,6 +8,7 @@ checked before any work; outputs are written atomically.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -89,7 +90,14 @@ def cmd_build(args) -> int:
     show = not run.get("quiet")
     bar = progress_bar(total=1 + len(files), enabled=show, desc="build")
     bar.set_description("body")
-    made = build(scene, progress=show)
+    scratch = None
+    if scene.radii_on_disk():
+        scratch = Path(files[0]).parent
+        if show:
+            print(f"keeping the {6 * scene.body.magnitude ** 2 + 2:.3g} radii "
+                  f"({(6 * scene.body.magnitude ** 2 + 2) * 8 / 1e9:.3g} GB) in a scratch file "
+                  f"in {str(scratch)!r} (--radii-on-disk)", file=sys.stderr)
+    made = build(scene, progress=show, scratch_dir=scratch)
     bar.update()
     write_outputs(made, scene, outputs, progress=show, done=bar.update)
     bar.close()

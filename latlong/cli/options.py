@@ -75,7 +75,12 @@ BUILD_OPTIONS: tuple[Opt, ...] = (
     Opt(("--magnitude",), "magnitude", int, "grid magnitude M >= 1 (6M^2+2 vertices)"),
     Opt(("--max-memory-gb",), "max_memory_gb", float,
         "memory the build may use, GB (1e9 bytes): a --magnitude whose estimate (radii and "
-        "bounded buffers, written as .npz) is larger is refused up front"),
+        "bounded buffers, written as .npz) is larger is refused up front, or built with "
+        "its radii on disk (--radii-on-disk auto)"),
+    Opt(("--radii-on-disk",), "radii_on_disk", str,
+        "keep the body's radii in a memory-mapped scratch file beside the first output "
+        "(bodies bigger than memory; the same bytes): auto = when the in-memory estimate "
+        "exceeds --max-memory-gb (sphere and fbm bases), yes, no"),
     Opt(("--radius-m",), "radius_m", float, "reference radius in metres"),
     Opt(("--stretch",), "stretch", _stretch,
         "scale factors X,Y,Z applied to the body (e.g. 2,1,1; the faulting presets "

@@ -234,11 +234,15 @@ def test_memory_estimate_and_limit():
 def test_cli_refuses_a_build_over_max_memory(run_cli, tmp_path, one_line_error):
     out = tmp_path / "b.npz"
     proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "3000",
-                   "--max-memory-gb", "1", "-o", str(out), "-q")
+                   "--max-memory-gb", "1", "--radii-on-disk", "no", "-o", str(out), "-q")
     one_line_error(proc, "--magnitude 3000 needs about", "GB", "--max-memory-gb = 1 GB")
+    proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "3000",
+                   "--max-memory-gb", "1", "-o", str(out), "-q")  # radii on disk, craters not
+    one_line_error(proc, "--craters: about", "besides the 0.762 GB of magnitude 3000",
+                   "--max-memory-gb = 1 GB")
     assert not out.exists()
     (tmp_path / "scene.toml").write_text('preset = "fbm-cratered"\nmagnitude = 3000\n'
-                                         "max_memory_gb = 1.0\n")
+                                         'max_memory_gb = 1.0\nradii_on_disk = "no"\n')
     proc = run_cli("latlong", "build", "--config", str(tmp_path / "scene.toml"),
                    "-o", str(out), "-q")
     one_line_error(proc, "magnitude", "'max_memory_gb' = 1 GB")
