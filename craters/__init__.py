@@ -27,78 +27,82 @@ command line ``craters.cli``; neither is crater science.
 """
 
 import logging
+from typing import TYPE_CHECKING
 
-from .boulders import (
-    BoulderLayer,
-    BoulderNode,
-    BoulderShape,
-    boulder,
-    boulder_meshes,
-    boulder_normals,
-    parse_boulder_spec,
-)
-from .catalog import (
-    CATALOG_COLUMNS,
-    make_catalog,
-    read_catalog,
-    read_scc,
-    sort_oldest_first,
-    validate_catalog,
-    write_catalog,
-    write_geojson,
-    write_scc,
-)
-from .chronology import (
-    CHRONOLOGY_SYSTEMS,
-    EQUILIBRIUM_FUNCTIONS,
-    ChronologySystem,
-    cap_at_equilibrium,
-    cumulative_density,
-    formation_ages,
-    get_chronology_system,
-    sample_pf_diameters,
-    saturation_diameter_m,
-)
-from .diffusion import kappa_m2_yr, profile_tables, tau_from_age, tau_from_degradation
-from .layers import LAYER_TYPES, ModelAgeLayer, as_crater_layer
-from .lcsn import (
-    LCSN_PRESETS,
-    LcsnParams,
-    lcsn_degrade,
-    lcsn_kernel,
-    lcsn_morphometry,
-    lcsn_raw,
-    lcsn_scaled,
-)
-from .morphology import fresh_morphometry, fresh_profile, morphology_class
-from .population import (
-    CraterLayer,
-    expected_count,
-    fit_power_law_exponent,
-    parse_layer_spec,
-    population,
-    power_law_population,
-    sample_power_law_diameters,
-    uniform_sphere_directions,
-)
-from .profile import (
-    DEFAULT_EJECTA_EDGE,
-    crater_morphometry,
-    crater_tau,
-    radial_profile,
-    slope_erosion,
-)
-from .stamp import (
-    Crater,
-    Roughness,
-    StampingProfiles,
-    as_stamped,
-    rim_perturbations,
-    stamp,
-    stamp_many,
-    stamping_profiles,
-)
-from .targets import TARGETS, Target, get_target, small_body
+from ._shared.lazy import lazy_package
+
+if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
+    from .boulders import (
+        BoulderLayer,
+        BoulderNode,
+        BoulderShape,
+        boulder,
+        boulder_meshes,
+        boulder_normals,
+        parse_boulder_spec,
+    )
+    from .catalog import (
+        CATALOG_COLUMNS,
+        make_catalog,
+        read_catalog,
+        read_scc,
+        sort_oldest_first,
+        validate_catalog,
+        write_catalog,
+        write_geojson,
+        write_scc,
+    )
+    from .chronology import (
+        CHRONOLOGY_SYSTEMS,
+        EQUILIBRIUM_FUNCTIONS,
+        ChronologySystem,
+        cap_at_equilibrium,
+        cumulative_density,
+        formation_ages,
+        get_chronology_system,
+        sample_pf_diameters,
+        saturation_diameter_m,
+    )
+    from .diffusion import kappa_m2_yr, profile_tables, tau_from_age, tau_from_degradation
+    from .layers import LAYER_TYPES, ModelAgeLayer, as_crater_layer
+    from .lcsn import (
+        LCSN_PRESETS,
+        LcsnParams,
+        lcsn_degrade,
+        lcsn_kernel,
+        lcsn_morphometry,
+        lcsn_raw,
+        lcsn_scaled,
+    )
+    from .morphology import fresh_morphometry, fresh_profile, morphology_class
+    from .population import (
+        CraterLayer,
+        expected_count,
+        fit_power_law_exponent,
+        parse_layer_spec,
+        population,
+        power_law_population,
+        sample_power_law_diameters,
+        uniform_sphere_directions,
+    )
+    from .profile import (
+        DEFAULT_EJECTA_EDGE,
+        crater_morphometry,
+        crater_tau,
+        radial_profile,
+        slope_erosion,
+    )
+    from .stamp import (
+        Crater,
+        Roughness,
+        StampingProfiles,
+        as_stamped,
+        rim_perturbations,
+        stamp,
+        stamp_many,
+        stamping_profiles,
+    )
+    from .targets import TARGETS, Target, get_target, small_body
 
 __all__ = [
     "BoulderLayer",
@@ -169,5 +173,7 @@ __all__ = [
     "write_geojson",
     "write_scc",
 ]
+
+lazy_package(__name__)
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -24,40 +24,50 @@ craters and boulders per layer (:func:`enhance`) and their stitched meshes
 """
 
 import logging
+from typing import TYPE_CHECKING
 
-from .analysis import band_power, laplacian
-from .batch import batch
-from .boulders import boulder_population, stamp_boulders
-from .config import EnhanceConfig, SourceCraterLayer
-from .core import Dem
-from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
-from .craterfill import fill_crater_gaps, replace_crater
-from .enhance import enhance
-from .expansion import ExpandedFile, displacement_scales, expand, expand_to_file, expansion_sizes
-from .fractal import (
-    FractalFit,
-    SpectralFit,
-    dimension_warning,
-    expansion_fit,
-    fractal_dimension,
-    fractal_fit,
-    local_roughness,
-    variogram,
-)
-from .frame import LocalFrame, local_frame
-from .gaps import fill_gaps
-from .io import WindowWriter, read, write
-from .mesh import to_mesh
-from .stack import Stack, read_stack
-from .terrain import (
-    pixel_sizes_by_row,
-    power_spectrum,
-    roughness,
-    slope,
-    slope_distribution,
-    spectral_exponent,
-    spectral_fit,
-)
+from craters._shared.lazy import lazy_package
+
+if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
+    from .analysis import band_power, laplacian
+    from .batch import batch
+    from .boulders import boulder_population, stamp_boulders
+    from .config import EnhanceConfig, SourceCraterLayer
+    from .core import Dem
+    from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
+    from .craterfill import fill_crater_gaps, replace_crater
+    from .enhance import enhance
+    from .expansion import (
+        ExpandedFile,
+        displacement_scales,
+        expand,
+        expand_to_file,
+        expansion_sizes,
+    )
+    from .fractal import (
+        FractalFit,
+        SpectralFit,
+        dimension_warning,
+        expansion_fit,
+        fractal_dimension,
+        fractal_fit,
+        local_roughness,
+        variogram,
+    )
+    from .frame import LocalFrame, local_frame
+    from .gaps import fill_gaps
+    from .io import WindowWriter, read, write
+    from .mesh import to_mesh
+    from .stack import Stack, read_stack
+    from .terrain import (
+        pixel_sizes_by_row,
+        power_spectrum,
+        roughness,
+        slope,
+        slope_distribution,
+        spectral_exponent,
+        spectral_fit,
+    )
 
 __all__ = [
     "CraterDensity",
@@ -105,5 +115,7 @@ __all__ = [
     "variogram",
     "write",
 ]
+
+lazy_package(__name__)
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -24,68 +24,72 @@ Imports point down that picture and into ``craters`` (never ``dem``). ``latlong 
 """
 
 import logging
+from typing import TYPE_CHECKING
 
-from .batch import batch
-from .body import EXPORT_SUFFIXES, Body, load
-from .boulders import (
-    BoulderLayer,
-    BoulderNode,
-    BoulderShape,
-    boulder,
-    boulder_meshes,
-    boulder_population,
-    boulder_world_meshes,
-    place_boulders,
-)
-from .build import build
-from .cratering import body_population, crater_extents_deg, stamp_craters
-from .faulting import (
-    FAULTING_PRESETS,
-    FaultingParams,
-    apply_faults,
-    area_mean,
-    poisson_faulting,
-    random_faults,
-    two_phase_faulting,
-)
-from .gltf import export_glb, export_vtp_strips
-from .gravity import GravityField, gravity
-from .grid import LatLongGrid
-from .implicit import (
-    GaborNoise,
-    GaborPatch,
-    ImplicitSurface,
-    LcsnLayer,
-    fit_gabor,
-    fit_metaballs,
-    implicit_surface,
-    sphere_packing,
-)
-from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
-from .presets import PRESETS
-from .preview import PreviewSettings, render_preview
-from .scene import SETTING_DEFAULTS, SETTINGS, Scene
-from .sensors import render
-from .settings import (
-    BodySettings,
-    BoulderSettings,
-    CraterSettings,
-    ImplicitSettings,
-    ShapeBase,
-    SphereBase,
-)
-from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
-from .slopes import (
-    facet_slopes,
-    mesh_slopes,
-    radius_spectrum,
-    slope_summary,
-    slopes,
-    slopes_and_areas,
-    vertex_normals,
-)
-from .smoothing import fwhm_to_sigma, heat_smooth, smooth
-from .surface import surface_positions
+from craters._shared.lazy import lazy_package
+
+if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
+    from .batch import batch
+    from .body import EXPORT_SUFFIXES, Body, load
+    from .boulders import (
+        BoulderLayer,
+        BoulderNode,
+        BoulderShape,
+        boulder,
+        boulder_meshes,
+        boulder_population,
+        boulder_world_meshes,
+        place_boulders,
+    )
+    from .build import build
+    from .cratering import body_population, crater_extents_deg, stamp_craters
+    from .faulting import (
+        FAULTING_PRESETS,
+        FaultingParams,
+        apply_faults,
+        area_mean,
+        poisson_faulting,
+        random_faults,
+        two_phase_faulting,
+    )
+    from .gltf import export_glb, export_vtp_strips
+    from .gravity import GravityField, gravity
+    from .grid import LatLongGrid
+    from .implicit import (
+        GaborNoise,
+        GaborPatch,
+        ImplicitSurface,
+        LcsnLayer,
+        fit_gabor,
+        fit_metaballs,
+        implicit_surface,
+        sphere_packing,
+    )
+    from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
+    from .presets import PRESETS
+    from .preview import PreviewSettings, render_preview
+    from .scene import SETTING_DEFAULTS, SETTINGS, Scene
+    from .sensors import render
+    from .settings import (
+        BodySettings,
+        BoulderSettings,
+        CraterSettings,
+        ImplicitSettings,
+        ShapeBase,
+        SphereBase,
+    )
+    from .shapes import ShapeModel, cast_radii, from_shape_model, read_shape_model
+    from .slopes import (
+        facet_slopes,
+        mesh_slopes,
+        radius_spectrum,
+        slope_summary,
+        slopes,
+        slopes_and_areas,
+        vertex_normals,
+    )
+    from .smoothing import fwhm_to_sigma, heat_smooth, smooth
+    from .surface import surface_positions
 
 __all__ = [
     "EXPORT_SUFFIXES",
@@ -157,5 +161,7 @@ __all__ = [
     "vertex_normals",
     "two_phase_faulting",
 ]
+
+lazy_package(__name__)
 
 logging.getLogger(__name__).addHandler(logging.NullHandler())

@@ -1,8 +1,16 @@
-"""``python -m latlong`` runs the ``latlong`` command line."""
+"""The ``latlong`` command, as its console script and as ``python -m latlong``: started by
+:mod:`craters._shared.start` (a Ctrl-C or a bad ``NUMBA_NUM_THREADS`` while the libraries
+load is one error line)."""
 
 import sys
 
-from .cli import main
+from craters._shared.start import start_command
+
+
+def main(argv: list[str] | None = None) -> int:
+    """The ``latlong`` command (``argv``: default the process's arguments)."""
+    return start_command("latlong.cli", argv)
+
 
 if __name__ == "__main__":
     sys.exit(main())

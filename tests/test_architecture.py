@@ -8,12 +8,17 @@
   ``craters._shared.cli``, argparse), and importing them does not load argparse;
 * no module reads another module's private (``_``-prefixed) name, except the numba
   kernels of its own package (``_*kernels`` modules);
-* no module over 500 lines.
+* no module over 500 lines;
+* the top level holds only the packages, tests, examples, README, licence, pyproject and
+  dotfiles (.ci/, .gitignore): no top-level module;
+* importing the packages loads neither numba nor numpy (lazy ``__init__``, PEP 562), so
+  the commands can start without tracebacks (craters._shared.start).
 """
 
 from __future__ import annotations
 
 import ast
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -23,6 +28,7 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("craters", "latlong", "dem")
 MAX_LINES = 500
+TOP_LEVEL = {*PACKAGES, "tests", "examples", "pyproject.toml", "README.md", "LICENSE"}
 
 
 def _module_name(path: Path) -> str:
@@ -197,6 +203,31 @@ def test_no_module_over_500_lines():
     long = {m: n for m, p in SOURCES.items()
             if (n := len(p.read_text().splitlines())) > MAX_LINES}
     assert not long, long
+
+
+def test_no_top_level_module():
+    assert not sorted(p.name for p in ROOT.glob("*.py"))
+
+
+def test_top_level_holds_only_the_layout():
+    """What git tracks or would add (ignored files aside: caches, egg-info, out/)."""
+    if shutil.which("git") is None or not (ROOT / ".git").exists():
+        pytest.skip("not a git checkout")
+    listed = subprocess.run(["git", "ls-files", "--cached", "--others", "--exclude-standard"],
+                            capture_output=True, text=True, cwd=ROOT, check=True).stdout
+    top = {line.split("/")[0] for line in listed.splitlines()}
+    assert top >= TOP_LEVEL
+    assert not sorted(n for n in top - TOP_LEVEL if not n.startswith("."))
+
+
+def test_importing_the_packages_loads_no_numba():
+    heavy = ("numba", "numpy", "scipy", "pyvista", "vtk", "rasterio", "matplotlib", "dask")
+    code = ("import sys, latlong, dem, craters, craters._shared, latlong.__main__, "
+            "dem.__main__, craters.__main__; "
+            f"print([m for m in {heavy!r} if m in sys.modules])")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, check=True)
+    assert proc.stdout.strip() == "[]"
 
 
 @pytest.mark.parametrize("package", PACKAGES)

@@ -280,11 +280,14 @@ def test_ply_header_beyond_the_file_is_refused_before_vtk(tmp_path, argv, texts)
     assert_refused(proc.returncode, proc.stderr, texts, before, tmp_path)
 
 
-def console_script(name: str) -> str:
+def console_script(name: str, launcher: str = "script") -> list[str]:
+    """The command ``name`` as its console script or as ``python -m name``."""
+    if launcher == "-m":
+        return [sys.executable, "-m", name]
     path = Path(sys.executable).parent / name
     if not path.exists():
         pytest.skip(f"the {name} console script is not installed beside {sys.executable}")
-    return str(path)
+    return [str(path)]
 
 
 @pytest.mark.parametrize("command,argv", [
@@ -293,18 +296,21 @@ def console_script(name: str) -> str:
     ("craters", ["profile", "--diameter-m", "100"]),
 ])
 @pytest.mark.parametrize("value", ["0", "two"])
-def test_bad_numba_num_threads(tmp_path, command, argv, value):
-    proc = subprocess.run([console_script(command), *argv], capture_output=True, text=True,
-                          cwd=tmp_path, env={**os.environ, "NUMBA_NUM_THREADS": value},
-                          timeout=300)
+@pytest.mark.parametrize("launcher", ["script", "-m"])
+def test_bad_numba_num_threads(tmp_path, command, argv, value, launcher):
+    proc = subprocess.run([*console_script(command, launcher), *argv], capture_output=True,
+                          text=True, cwd=tmp_path,
+                          env={**os.environ, "NUMBA_NUM_THREADS": value}, timeout=300)
     assert_refused(proc.returncode, proc.stderr, ["NUMBA_NUM_THREADS", ">= 1", repr(value)],
                    {}, tmp_path)
 
 
 @pytest.mark.parametrize("delay_s", [0.3, 1.0])
-def test_ctrl_c_during_start_up(tmp_path, delay_s):
+@pytest.mark.parametrize("launcher", ["script", "-m"])
+def test_ctrl_c_during_start_up(tmp_path, delay_s, launcher):
     """One line and exit code 130, as a Ctrl-C later in a run (run_cli)."""
-    proc = subprocess.Popen([console_script("latlong"), "build", "--magnitude", "8", *OUT],
+    proc = subprocess.Popen([*console_script("latlong", launcher), "build", "--magnitude", "8",
+                             *OUT],
                             cwd=tmp_path, stderr=subprocess.PIPE, text=True)
     time.sleep(delay_s)
     proc.send_signal(signal.SIGINT)

@@ -8,42 +8,47 @@ The command-line helpers are in :mod:`craters._shared.cli`; nothing here imports
 importing a library never loads argparse.
 """
 
-from .files import (
-    BackgroundWriter,
-    atomic_path,
-    check_output_path,
-    check_parent_folder,
-    check_suffix,
-    load_toml,
-    ordered_chunks,
-)
-from .outputs import (
-    check_not_input,
-    check_outside_folder,
-    output_group,
-    replace_output,
-    same_file,
-    sweep_temporaries,
-    temp_file,
-    temp_folder,
-)
-from .progress import progress_bar
-from .spec import parse_spec
-from .stats import area_slope_summary
-from .system import human_bytes, package_version, physical_memory_bytes
-from .validation import (
-    ParameterError,
-    ParameterTypeError,
-    RngLike,
-    about,
-    check_choice,
-    check_finite,
-    check_int,
-    check_positive,
-    check_range,
-    normalize_rng,
-    parameter_of,
-)
+from typing import TYPE_CHECKING
+
+from .lazy import lazy_package
+
+if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
+    from .files import (
+        BackgroundWriter,
+        atomic_path,
+        check_output_path,
+        check_parent_folder,
+        check_suffix,
+        load_toml,
+        ordered_chunks,
+    )
+    from .outputs import (
+        check_not_input,
+        check_outside_folder,
+        output_group,
+        replace_output,
+        same_file,
+        sweep_temporaries,
+        temp_file,
+        temp_folder,
+    )
+    from .progress import progress_bar
+    from .spec import parse_spec
+    from .stats import area_slope_summary
+    from .system import human_bytes, package_version, physical_memory_bytes
+    from .validation import (
+        ParameterError,
+        ParameterTypeError,
+        RngLike,
+        about,
+        check_choice,
+        check_finite,
+        check_int,
+        check_positive,
+        check_range,
+        normalize_rng,
+        parameter_of,
+    )
 
 __all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike", "about",
            "area_slope_summary",
@@ -55,3 +60,5 @@ __all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike"
            "output_group", "physical_memory_bytes",
            "progress_bar", "replace_output", "same_file", "sweep_temporaries", "temp_file",
            "temp_folder"]
+
+lazy_package(__name__)

@@ -5,6 +5,7 @@ any thread count."""
 from __future__ import annotations
 
 import hashlib
+import importlib
 import os
 import subprocess
 import sys
@@ -18,7 +19,7 @@ import craters
 from craters._stamp_kernels import PARALLEL_MIN
 from craters._wave_kernels import WAVE_MARGIN, _wave_schedule_kernel
 
-stamp_module = sys.modules["craters.stamp"]  # ``craters.stamp`` is also the function
+stamp_module = importlib.import_module("craters.stamp")  # craters.stamp is its function
 
 PIXEL = 2.0
 SHAPE = (300, 360)

@@ -1,11 +1,12 @@
-"""The console scripts ``latlong``, ``dem`` and ``craters``: start-up without tracebacks.
+"""The start of the commands ``latlong``, ``dem`` and ``craters`` (their console scripts
+and ``python -m``, the packages' ``__main__``): start-up without tracebacks.
 
-A console script imports its ``main`` before calling it, and importing a package loads
-numpy, numba, pyvista and rasterio (a second or more). Problems of that start-up would
-show a traceback, so each script starts here, in a module that imports nothing heavy:
-a Ctrl-C while the libraries load is ``error: interrupted`` and exit code 130 (as a
-Ctrl-C later in a run, :func:`craters._shared.cli.run_cli`), and a ``NUMBA_NUM_THREADS``
-numba would refuse at import is one ``error:`` line and exit code 2.
+Loading a command line loads numpy, numba, pyvista and rasterio (a second or more), and
+problems of that start-up would show a traceback. This module and the packages' lazy
+``__init__`` (:mod:`craters._shared.lazy`) import nothing heavy, so a command starts here
+before any of it loads: a Ctrl-C while the libraries load is ``error: interrupted`` and
+exit code 130 (as a Ctrl-C later in a run, :func:`craters._shared.cli.run_cli`), and a
+``NUMBA_NUM_THREADS`` numba would refuse at import is one ``error:`` line and exit code 2.
 """
 
 from __future__ import annotations
@@ -15,10 +16,10 @@ import os
 import signal
 import sys
 
-__all__ = ["craters", "dem", "latlong"]
+__all__ = ["environment_problem", "start_command"]
 
 
-def _check_environment() -> str | None:
+def environment_problem() -> str | None:
     """The problem with the environment, or None."""
     text = os.environ.get("NUMBA_NUM_THREADS")
     if text is not None and text.strip():
@@ -32,8 +33,10 @@ def _check_environment() -> str | None:
     return None
 
 
-def _run(package: str, argv: list[str] | None) -> int:
-    problem = _check_environment()
+def start_command(cli_module: str, argv: list[str] | None) -> int:
+    """Import the command line ``cli_module`` (``"latlong.cli"``) and run its ``main`` with
+    ``argv`` (default the process's arguments); the exit code."""
+    problem = environment_problem()
     if problem is not None:
         sys.stderr.write(f"error: {problem}\n")
         return 2
@@ -42,7 +45,7 @@ def _run(package: str, argv: list[str] | None) -> int:
     interrupted: list[int] = []
     previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
     try:
-        main = importlib.import_module(f"{package}.cli").main
+        main = importlib.import_module(cli_module).main
     finally:
         signal.signal(signal.SIGINT, previous)
     try:
@@ -56,18 +59,3 @@ def _run(package: str, argv: list[str] | None) -> int:
     # shuts down must not turn it into a traceback or a death by SIGINT
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     return code
-
-
-def latlong(argv: list[str] | None = None) -> int:
-    """The ``latlong`` command (``argv``: default the process's arguments)."""
-    return _run("latlong", argv)
-
-
-def dem(argv: list[str] | None = None) -> int:
-    """The ``dem`` command (``argv``: default the process's arguments)."""
-    return _run("dem", argv)
-
-
-def craters(argv: list[str] | None = None) -> int:
-    """The ``craters`` command (``argv``: default the process's arguments)."""
-    return _run("craters", argv)
