@@ -55,7 +55,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     ``.img`` suffix, detached or attached label) are read through GDAL's PDS driver
     behind craterform's label checks (:mod:`dem.pdsimage`: the ``^IMAGE`` pointer may
     only name a file beside the label or below its folder): heights are ``DN *
-    SCALING_FACTOR``, ``MISSING_CONSTANT`` pixels are NaN; a simple-cylindrical map
+    SCALING_FACTOR`` (metres; kilometres if the image's ``UNIT`` says so, as in LOLA's
+    floating-point polar products), ``MISSING_CONSTANT`` pixels are NaN; a simple-cylindrical map
     centred on the equator gives a geographic CRS on a sphere of the label's
     ``A_AXIS_RADIUS``, any other projection GDAL knows (polar stereographic, ...) its
     projected CRS; ``A_AXIS_RADIUS`` is then also the body radius. A label ``OFFSET``

@@ -57,6 +57,7 @@ _GDAL_TYPES = {("i", "<"): "LSB_INTEGER", ("i", ">"): "MSB_INTEGER",
                ("f", "<"): "PC_REAL", ("f", ">"): "IEEE_REAL"}
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*|\d+#[0-9A-Fa-f]+#")
 _KEY = re.compile(r"[A-Z][A-Z0-9_]*")  # keywords passed on (no pointers: no other files)
+_KM = ("KM", "KILOMETER", "KILOMETERS", "KILOMETRE", "KILOMETRES")
 # the names of the files in the private folder GDAL opens
 _LABEL, _DATA = "LABEL.LBL", "DATA.IMG"
 
@@ -126,7 +127,10 @@ def read_pds(path: Path, band: int, win=None):
     missing = sample_constant(image.get("MISSING_CONSTANT"), kind, nbytes)
     if missing is not None:
         heights[raw == missing] = np.nan
-    heights *= label_number(image, "SCALING_FACTOR", where, 1.0)
+    # heights in kilometres (UNIT = KILOMETER, as LOLA's floating-point polar products
+    # give them, with OFFSET = 1737.4): metres, the OFFSET too
+    unit_m = 1000.0 if str(image.get("UNIT", "")).upper() in _KM else 1.0
+    heights *= label_number(image, "SCALING_FACTOR", where, 1.0) * unit_m
 
     tags = {"PDS_LABEL": label_path.name}
     for key in ("PRODUCT_ID", "TARGET_NAME", "DATA_SET_ID"):
@@ -139,7 +143,7 @@ def read_pds(path: Path, band: int, win=None):
         else:
             transform, crs, radius_m = _gdal_georeference(proj, gdal_transform, gdal_crs,
                                                           where)
-    pds_offset = float(image.get("OFFSET", 0.0) or 0.0)
+    pds_offset = label_number(image, "OFFSET", where, 0.0) * unit_m
     if pds_offset:
         if radius_m is not None and abs(pds_offset - radius_m) <= 0.1 * radius_m:
             tags["PDS_REFERENCE_RADIUS_M"] = repr(pds_offset)

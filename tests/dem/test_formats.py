@@ -332,6 +332,21 @@ END_OBJECT = IMAGE_MAP_PROJECTION"""
     assert np.array_equal(d.heights, data)
 
 
+def test_heights_in_kilometres_and_the_lola_offset(tmp_path):
+    """A floating-point product in km with OFFSET = 1737.4 (km, the reference radius), as
+    LOLA's polar float products: metres, and the offset recorded, not added."""
+    proj = ("OBJECT = IMAGE_MAP_PROJECTION\n  " + "\n  ".join(POLAR)
+            + "\nEND_OBJECT = IMAGE_MAP_PROJECTION")
+    data = np.array([[-1.25, 0.0], [0.5, 2.0]], dtype="<f4")
+    d = dem.read(write_product(tmp_path, data, "PC_REAL", proj,
+                               "UNIT = KILOMETER\n  SCALING_FACTOR = 1\n  OFFSET = 1737.4"))
+    assert np.array_equal(d.heights, data * 1000.0)
+    assert d.tags["PDS_REFERENCE_RADIUS_M"] == "1737400.0"
+    other = dem.read(write_product(tmp_path, data, "PC_REAL", proj,
+                                   "UNIT = METER\n  SCALING_FACTOR = 2\n  OFFSET = 10"))
+    assert np.array_equal(other.heights, data * 2.0 + 10.0)  # an OFFSET of 10 m: added
+
+
 POLAR = ('MAP_PROJECTION_TYPE = "POLAR STEREOGRAPHIC"', "A_AXIS_RADIUS = 1737.4 <KM>",
          "C_AXIS_RADIUS = 1737.4 <KM>", "CENTER_LATITUDE = -90.0",
          "MAP_SCALE = 5 <METERS/PIXEL>")
