@@ -112,6 +112,17 @@ def test_every_geotiff_dem_writes_is_a_valid_cog(capsys, tmp_path, case, tiny_ge
             assert bool(ds.overviews(1)) == (max(ds.shape) > 256), (path.name, ds.shape)
 
 
+@pytest.mark.parametrize("shape", [(1, 1), (257, 3), (3, 1000), (1025, 2), (256, 256)])
+def test_odd_shapes_are_valid_cogs(tmp_path, shape):
+    from rio_cogeo.cogeo import cog_validate
+
+    z = np.random.default_rng(0).normal(size=shape)
+    path = dem.write(dem.Dem(z, pixel_size_m=1.0), tmp_path / "odd.tif")
+    valid, errors, warnings = cog_validate(path, strict=True)
+    assert valid and not errors and not warnings, (errors, warnings)
+    assert np.array_equal(dem.read(path).heights, z.astype(np.float32))
+
+
 # --------------------------------------------------------------------------- IAU codes
 def iau_input(tmp: Path, code: str, lola) -> tuple[Path, tuple[float, float]]:
     """The LOLA crop's heights as a GeoTIFF in the IAU CRS ``code`` (written by dem)."""
