@@ -1,5 +1,5 @@
-"""A small PDS3 (ODL) label parser and reader of its facts: enough for simple-cylindrical
-DEM products.
+"""A small PDS3 (ODL) label parser and reader of its facts: the checks made before GDAL
+reads a product (:mod:`dem.pdsimage`) and the georeference of simple-cylindrical maps.
 
 Label text handling and what the label says (sample types, constants, georeference);
 the image's bytes are read in :mod:`dem.io`. The label becomes nested dictionaries:
@@ -23,9 +23,9 @@ from rasterio.crs import CRS
 
 from craters._shared.files import check_regular_file
 
-__all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "data_file", "find_file",
-           "find_object",
-           "georeference", "label_number", "label_text", "parse_label", "sample_constant"]
+__all__ = ["SAMPLE_TYPES", "SIMPLE_CYLINDRICAL", "Quantity", "axis_radius_m", "data_file",
+           "find_file", "find_object", "georeference", "label_number", "label_text",
+           "parse_label", "sample_constant"]
 
 logger = logging.getLogger(__name__)
 
@@ -292,12 +292,8 @@ def sample_constant(value, kind: str, nbytes: int):
     return raw
 
 
-def georeference(proj: dict, label: dict, where: str):
-    """Transform (degrees), geographic CRS and radius (m) of a simple-cylindrical map."""
-    ptype = " ".join(str(proj.get("MAP_PROJECTION_TYPE", "")).upper().split())
-    if ptype not in SIMPLE_CYLINDRICAL:
-        raise ValueError(f"{where!r}: unsupported MAP_PROJECTION_TYPE {ptype or '(none)'!r}; "
-                         f"only simple cylindrical DEMs are read")
+def axis_radius_m(proj: dict, where: str) -> float:
+    """The map projection's ``A_AXIS_RADIUS`` in metres (km without a unit), checked."""
     km = {"km": 1000.0, "kilometers": 1000.0, "kilometres": 1000.0, "m": 1.0, "meters": 1.0,
           "metres": 1.0, "meter": 1.0, "metre": 1.0}
     radius_m = label_number(proj, "A_AXIS_RADIUS", where, unit_scale=km)
@@ -305,6 +301,16 @@ def georeference(proj: dict, label: dict, where: str):
         radius_m *= 1000.0  # PDS3 gives axis radii in km
     if not (math.isfinite(radius_m) and radius_m > 0):
         raise ValueError(f"{where!r}: A_AXIS_RADIUS must be finite and > 0; got {radius_m!r}")
+    return radius_m
+
+
+def georeference(proj: dict, label: dict, where: str):
+    """Transform (degrees), geographic CRS and radius (m) of a simple-cylindrical map."""
+    ptype = " ".join(str(proj.get("MAP_PROJECTION_TYPE", "")).upper().split())
+    if ptype not in SIMPLE_CYLINDRICAL:
+        raise ValueError(f"{where!r}: unsupported MAP_PROJECTION_TYPE {ptype or '(none)'!r}; "
+                         f"only simple cylindrical DEMs are read")
+    radius_m = axis_radius_m(proj, where)
     deg = {"deg": 1.0, "degree": 1.0, "degrees": 1.0}
     center_lat = label_number(proj, "CENTER_LATITUDE", where, 0.0, deg)
     if center_lat != 0.0:

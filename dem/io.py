@@ -24,18 +24,9 @@ from rasterio.windows import Window
 from craters import get_target
 from craters._shared import about, atomic_path, check_int, parameter_of, temp_file
 
-from ._pds import (
-    SAMPLE_TYPES,
-    Quantity,
-    data_file,
-    find_object,
-    georeference,
-    label_number,
-    label_text,
-    parse_label,
-    sample_constant,
-)
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
+from .crscode import CRS_TAG, crs_tags, restore_crs
+from .pdsimage import read_pds
 
 __all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "read", "write"]
 
@@ -43,7 +34,7 @@ logger = logging.getLogger(__name__)
 
 #: Suffixes :func:`write` accepts.
 GEOTIFF_SUFFIXES = (".tif", ".tiff")
-#: Suffixes :func:`read` hands to the PDS3 reader instead of GDAL.
+#: Suffixes :func:`read` hands to the PDS3 reader (label checks, then GDAL's PDS driver).
 PDS_SUFFIXES = (".img", ".lbl")
 # tile size of the written cloud-optimised GeoTIFFs, pixels
 _BLOCK = 256
@@ -58,12 +49,18 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
          body: str | None = None, *, window=None) -> Dem:
     """Read a DEM: a GeoTIFF (or any raster GDAL reads) or a PDS3 ``.IMG``/``.LBL`` pair.
 
-    NoData pixels become NaN; the band's scale and offset are applied; the CRS,
-    transform and tags are kept. PDS3 products (``.lbl`` or ``.img`` suffix, detached or
-    attached label) are read by craterform itself: heights are ``DN * SCALING_FACTOR``,
-    ``MISSING_CONSTANT`` pixels are NaN, and a simple-cylindrical map projection gives
-    a geographic CRS on a sphere of the label's ``A_AXIS_RADIUS`` (which is then also
-    the body radius). A label ``OFFSET`` within 10 % of that radius is the reference
+    NoData pixels become NaN; the band's scale and offset are applied; the CRS (with
+    its IAU or other authority code, also where the GeoTIFF keys lose it:
+    :mod:`dem.crscode`), transform and tags are kept. PDS3 products (``.lbl`` or
+    ``.img`` suffix, detached or attached label) are read through GDAL's PDS driver
+    behind craterform's label checks (:mod:`dem.pdsimage`: the ``^IMAGE`` pointer may
+    only name a file beside the label or below its folder): heights are ``DN *
+    SCALING_FACTOR`` (metres; kilometres if the image's ``UNIT`` says so, as in LOLA's
+    floating-point polar products), ``MISSING_CONSTANT`` pixels are NaN; a simple-cylindrical map
+    centred on the equator gives a geographic CRS on a sphere of the label's
+    ``A_AXIS_RADIUS``, any other projection GDAL knows (polar stereographic, ...) its
+    projected CRS; ``A_AXIS_RADIUS`` is then also the body radius. A label ``OFFSET``
+    within 10 % of that radius is the reference
     radius of the heights (as in LOLA's GDR products: radius = height + OFFSET), so it
     is recorded in the tag ``PDS_REFERENCE_RADIUS_M`` and not added; any other
     ``OFFSET`` is added as the PDS standard says.
@@ -109,7 +106,7 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
     if path.suffix.lower() in PDS_SUFFIXES:
-        heights, transform, crs, tags, label_radius = _read_pds(path, band, win)
+        heights, transform, crs, tags, label_radius = read_pds(path, band, win)
         if body_radius_m is None:
             body_radius_m = label_radius
     else:
@@ -208,112 +205,14 @@ def _read_gdal(path: Path, band: int, win=None):
     except RasterioIOError as exc:
         reason = str(exc).replace(str(path), "").strip(" :'")
         raise ValueError(f"{str(path)!r} is not a raster file GDAL can read ({reason})") from None
+    tags = {str(k): str(v) for k, v in tags.items()}
+    crs = restore_crs(crs, tags, str(path))  # an IAU code the GeoTIFF keys lost
     heights = np.ma.filled(data.astype(np.float64), np.nan)
     if scale not in (None, 1.0):
         heights *= scale
     if offset not in (None, 0.0):
         heights += offset
-    return heights, transform, crs, {str(k): str(v) for k, v in tags.items()}
-
-
-# --------------------------------------------------------------------------- PDS3
-def _read_pds(path: Path, band: int, win=None):
-    text, label_path = label_text(path)
-    where = str(label_path)
-    try:
-        label = parse_label(text)
-    except ValueError as exc:
-        raise ValueError(f"{where!r}: cannot parse the PDS label ({exc})") from None
-    image, parent = find_object(label, "IMAGE")
-    if image is None:
-        raise ValueError(f"{where!r}: the PDS label has no IMAGE object")
-    lines = int(label_number(image, "LINES", where))
-    samples = int(label_number(image, "LINE_SAMPLES", where))
-    bands = int(label_number(image, "BANDS", where, 1))
-    bits = int(label_number(image, "SAMPLE_BITS", where))
-    stype = str(image.get("SAMPLE_TYPE", "")).upper().replace(" ", "_")
-    if stype not in SAMPLE_TYPES:
-        raise ValueError(f"{where!r}: unsupported SAMPLE_TYPE {stype or '(none)'!r}")
-    kind, order = SAMPLE_TYPES[stype]
-    if bits not in (8, 16, 32, 64) or (kind == "f" and bits < 32):
-        raise ValueError(f"{where!r}: unsupported SAMPLE_BITS {bits} for {stype}")
-    nbytes = bits // 8
-    dtype = np.dtype(f"{order if nbytes > 1 else '|'}{kind}{nbytes}")
-    if band > bands:
-        with about("band"):
-            raise ValueError(f"`band` must be in [1, {bands}] for {where!r}; got {band}")
-    if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
-            "BAND_SEQUENTIAL":
-        raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
-    prefix = int(label_number(image, "LINE_PREFIX_BYTES", where, 0))
-    suffix = int(label_number(image, "LINE_SUFFIX_BYTES", where, 0))
-    stride = prefix + samples * nbytes + suffix
-
-    # where the samples are: ^IMAGE = "F.IMG" | ("F.IMG", record) | record | n <BYTES>
-    pointer = parent.get("^IMAGE", label.get("^IMAGE"))
-    record_bytes = parent.get("RECORD_BYTES", label.get("RECORD_BYTES"))
-    data_name, start = None, 1
-    if isinstance(pointer, list) and pointer:
-        data_name = str(pointer[0])
-        start = pointer[1] if len(pointer) > 1 else 1
-    elif isinstance(pointer, str):
-        data_name = pointer
-    elif isinstance(pointer, int | float):
-        start = pointer
-    else:
-        raise ValueError(f"{where!r}: the PDS label has no usable ^IMAGE pointer")
-    if isinstance(start, Quantity) and start.unit.upper() == "BYTES":
-        offset = int(start) - 1
-    elif int(start) == 1:
-        offset = 0
-    elif record_bytes is None:
-        raise ValueError(f"{where!r}: ^IMAGE points to record {int(start)} but the label has "
-                         f"no RECORD_BYTES")
-    else:
-        offset = (int(start) - 1) * int(record_bytes)
-    if data_name is None:
-        data_path = label_path
-    else:
-        data_path = data_file(label_path, data_name)
-        if data_path is None:
-            raise ValueError(f"{where!r}: the image file {data_name!r} it points to is missing")
-    offset += (band - 1) * lines * stride
-    r0, c0, n_lines, n_samples = (0, 0, lines, samples) if win is None else win
-    if win is not None:
-        _check_inside(win, lines, samples, path)
-    need = n_lines * stride
-    with open(data_path, "rb") as fh:
-        fh.seek(offset + r0 * stride)
-        buf = fh.read(need)
-    if len(buf) < need:
-        raise ValueError(f"{str(data_path)!r} is truncated: {lines} x {samples} samples of "
-                         f"{nbytes} bytes need {lines * stride} bytes from offset {offset}")
-    rows = np.frombuffer(buf, dtype=np.uint8).reshape(n_lines, stride)
-    first = prefix + c0 * nbytes
-    raw = np.ascontiguousarray(rows[:, first:first + n_samples * nbytes]).view(dtype)
-    raw = raw.reshape(n_lines, n_samples)
-    heights = raw.astype(np.float64)
-    missing = sample_constant(image.get("MISSING_CONSTANT"), kind, nbytes)
-    if missing is not None:
-        heights[raw == missing] = np.nan
-    scale = label_number(image, "SCALING_FACTOR", where, 1.0)
-    heights *= scale
-
-    proj, _ = find_object(label, "IMAGE_MAP_PROJECTION")
-    tags = {"PDS_LABEL": label_path.name}
-    for key in ("PRODUCT_ID", "TARGET_NAME", "DATA_SET_ID"):
-        if isinstance(label.get(key), str):
-            tags[f"PDS_{key}"] = label[key]
-    transform, crs, radius_m = Affine.identity(), None, None
-    if proj is not None:
-        transform, crs, radius_m = georeference(proj, label, where)
-    pds_offset = float(image.get("OFFSET", 0.0) or 0.0)
-    if pds_offset:
-        if radius_m is not None and abs(pds_offset - radius_m) <= 0.1 * radius_m:
-            tags["PDS_REFERENCE_RADIUS_M"] = repr(pds_offset)
-        else:
-            heights += pds_offset
-    return heights, transform, crs, tags, radius_m
+    return heights, transform, crs, tags
 
 
 # --------------------------------------------------------------------------- write
@@ -325,8 +224,9 @@ def write(dem: Dem, path) -> Path:
     the floating-point predictor, 256 x 256 tiles, overviews (averages) down to one
     tile, BigTIFF when needed. The CRS, transform and tags (including how the layer was
     made: ``CRATERFORM_GENERATOR``, ``_VERSION``, ``_SEED``, ``_PARAMETERS``,
-    ``_HISTORY``, the body radius if known, ``CRATERFORM_BODY_RADIUS_M``, and without a
-    CRS the pixel size, ``CRATERFORM_PIXEL_SIZE_M``) are written. An existing file is
+    ``_HISTORY``, the body radius if known, ``CRATERFORM_BODY_RADIUS_M``, without a
+    CRS the pixel size, ``CRATERFORM_PIXEL_SIZE_M``, and a CRS code the GeoTIFF keys
+    cannot hold, e.g. ``IAU_2015:30135``, ``CRATERFORM_CRS``) are written. An existing file is
     replaced.
 
     Examples
@@ -368,8 +268,10 @@ def _check_geotiff_path(path) -> Path:
 
 
 def _file_tags(tags, crs, body_radius_m, pixel_size_m) -> dict:
-    """The tags written with a DEM: its own, the body radius, the pixel size (no CRS)."""
-    tags = dict(tags)
+    """The tags written with a DEM: its own, the body radius, the pixel size (no CRS),
+    the CRS's code where the GeoTIFF keys lose it."""
+    tags = {k: v for k, v in tags.items() if k != CRS_TAG}
+    tags.update(crs_tags(crs))
     if body_radius_m is not None:
         tags[RADIUS_TAG] = repr(body_radius_m)
     if crs is None:
@@ -444,7 +346,7 @@ class WindowWriter:
                                          nodata=np.nan, crs=crs, transform=transform,
                                          tiled=True, blockxsize=_BLOCK, blockysize=_BLOCK,
                                          bigtiff="IF_SAFER", sparse_ok=True)
-                _set_metadata(self._ds, _file_tags(tags or {}, self._ds.crs, body_radius_m,
+                _set_metadata(self._ds, _file_tags(tags or {}, crs, body_radius_m,
                                                    pixel_size_m))
         except BaseException:
             self._discard()

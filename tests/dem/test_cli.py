@@ -454,29 +454,3 @@ def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_pa
     assert proc.returncode == 0, proc.stderr
     info = dem.read_stack(tmp_path / "other").info
     assert info["parameters"]["input"] == str(copy) and info["parameters"]["layers"] == 2
-
-
-def test_outputs_are_valid_cloud_optimised_geotiffs(capsys, tmp_path, lola_tif):
-    from rio_cogeo.cogeo import cog_validate
-
-    run = InProcess(capsys)
-    holes = dem.read(lola_tif, body_radius_m=1737400.0)
-    z = holes.heights.copy()
-    z[100:130, 40:90] = np.nan
-    gappy = dem.write(holes.replace(heights=z), tmp_path / "gappy.tif")
-    made = []
-    for command, args in (("fill", [str(gappy), "-o", str(tmp_path / "fill.tif")]),
-                          ("expand", [str(lola_tif), "-o", str(tmp_path / "expand.tif"),
-                                      "--levels", "1", *MOON])):
-        assert run("dem", command, *args, "--seed", "3", "-q").returncode == 0
-        made.append(tmp_path / f"{command}.tif")
-    scene = write_scene(tmp_path / "scene.toml",
-                        **scene_keys(tmp_path, lola_tif, layers=3, size=257))
-    assert run("dem", "enhance", "--config", str(scene), "--seed", "3", "-q").returncode == 0
-    made += sorted((tmp_path / "stack").glob("*.tif"))
-    assert len(made) == 2 + 3
-    for path in [gappy, *made]:
-        valid, errors, warnings = cog_validate(path, strict=True)
-        assert valid and not errors and not warnings, (path.name, errors, warnings)
-        with rasterio.open(path) as ds:
-            assert ds.overviews(1) and ds.block_shapes == [(256, 256)]
