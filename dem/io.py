@@ -22,7 +22,16 @@ from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.windows import Window
 
 from craters import get_target
-from craters._shared import about, atomic_path, check_int, parameter_of, temp_file
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    about,
+    atomic_path,
+    check_int,
+    parameter_of,
+    temp_file,
+)
+from craters._shared.files import check_regular_file
 
 from ._pds import (
     SAMPLE_TYPES,
@@ -103,8 +112,7 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         pixel; the message is one line naming the file.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"DEM file {str(path)!r} does not exist")
+    check_regular_file(path, "DEM file")
     with about("band"):
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
@@ -145,6 +153,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         return Dem._own(heights, transform, crs, pixel_size_m=pixel_size_m,
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
     except (ValueError, TypeError) as exc:
+        if isinstance(exc, ParameterError | ParameterTypeError):  # the file named, the rule
+            shown = str(path).replace("{", "{{").replace("}", "}}") if exc.see else str(path)
+            raise type(exc)(exc.name, f"{exc.rule} (reading {shown!r})", see=exc.see) from None
         with about(parameter_of(exc)):  # the file named, the parameter kept
             kind = ValueError if isinstance(exc, ValueError) else TypeError  # plain kinds:
             raise kind(f"{str(path)!r}: {exc}") from None  # a ParameterError needs a rule
@@ -179,8 +190,7 @@ def _window_text(win) -> str:
 def _check_inside(win, rows: int, cols: int, path: Path) -> None:
     r0, c0, h, w = win
     if r0 + h > rows or c0 + w > cols:
-        with about("window"):
-            raise ValueError(f"`window` {_window_text(win)} is not inside {str(path)!r} "
+        raise ParameterError("window", f"{_window_text(win)} is not inside {str(path)!r} "
                              f"({rows} x {cols} pixels)")
 
 
@@ -190,8 +200,7 @@ def _read_gdal(path: Path, band: int, win=None):
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as ds:
                 if band > ds.count:
-                    with about("band"):
-                        raise ValueError(f"`band` must be in [1, {ds.count}] for "
+                    raise ParameterError("band", f"must be in [1, {ds.count}] for "
                                          f"{str(path)!r}; got {band}")
                 if np.dtype(ds.dtypes[band - 1]).kind == "c":
                     raise ValueError(f"{str(path)!r}: band {band} holds complex numbers "
@@ -240,8 +249,7 @@ def _read_pds(path: Path, band: int, win=None):
     nbytes = bits // 8
     dtype = np.dtype(f"{order if nbytes > 1 else '|'}{kind}{nbytes}")
     if band > bands:
-        with about("band"):
-            raise ValueError(f"`band` must be in [1, {bands}] for {where!r}; got {band}")
+        raise ParameterError("band", f"must be in [1, {bands}] for {where!r}; got {band}")
     if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
             "BAND_SEQUENTIAL":
         raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
@@ -276,7 +284,7 @@ def _read_pds(path: Path, band: int, win=None):
     else:
         data_path = data_file(label_path, data_name)
         if data_path is None:
-            raise ValueError(f"{where!r}: the image file {data_name!r} it points to is missing")
+            raise FileNotFoundError(f"{where!r}: its image file {data_name!r} is missing")
     offset += (band - 1) * lines * stride
     r0, c0, n_lines, n_samples = (0, 0, lines, samples) if win is None else win
     if win is not None:
@@ -429,8 +437,7 @@ class WindowWriter:
         transform = Affine.identity() if transform is None else transform
         if crs is None:  # the pixel size tag, as a Dem without CRS writes it
             if pixel_size_m is None:
-                with about("pixel_size_m"):
-                    raise ValueError("a DEM without CRS needs `pixel_size_m`")
+                raise ParameterError("pixel_size_m", "is needed for a DEM without CRS")
             pair = np.broadcast_to(np.asarray(pixel_size_m, dtype=np.float64), (2,))
             pixel_size_m = tuple(float(v) for v in pair)
         self._tmp = temp_file(self.path, ".part.tif")
