@@ -33,13 +33,20 @@ from pathlib import Path
 import numpy as np
 
 from ._shared import ParameterError, atomic_path, check_choice
+from ._shared.files import check_regular_file
 from .scc import read_scc, write_scc
 
-__all__ = ["CATALOG_COLUMNS", "CATALOG_FORMAT", "catalog_dtype", "make_catalog",
-           "read_catalog", "read_scc", "sort_oldest_first", "write_catalog", "write_geojson",
-           "write_scc"]
+__all__ = ["BOULDER_FORMAT", "CATALOG_COLUMNS", "CATALOG_FORMAT", "catalog_dtype",
+           "is_boulder_catalog", "make_catalog", "read_catalog", "read_scc", "sort_oldest_first",
+           "write_catalog", "write_geojson", "write_scc"]
 
 CATALOG_FORMAT = "craterform crater catalog v1"
+#: First line of a boulder catalog's CSV (a catalog with ``burial_frac``: the boulders of
+#: :mod:`craters.boulders`, placed on a body or a DEM).
+BOULDER_FORMAT = "craterform boulder catalog v1"
+#: Columns a boulder catalog holds in memory (a crater catalog's) that mean nothing for a
+#: boulder (always 0): left out of its CSV, put back by :func:`read_catalog`.
+_CRATER_ONLY = ("age_gyr", "degradation")
 _KIND_LEN = 16
 _INT_COLUMNS = {"seed": np.uint64, "layer": np.int64, "level": np.int64, "index": np.int64,
                 "n_vertices": np.int64}
@@ -139,13 +146,22 @@ def _format(value) -> str:
     return str(value)
 
 
+def is_boulder_catalog(cat: np.ndarray) -> bool:
+    """Whether ``cat`` holds boulders (it has their ``burial_frac`` column)."""
+    return "burial_frac" in (cat.dtype.names or ())
+
+
 def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path:
     """Write a catalog as CSV (atomic).
 
     ``columns="craterform"``: line 1 is a ``#`` comment with format and units, then the
-    column names. ``columns="robbins"`` (catalogs on a body, with ``lat_deg, lon_deg``):
-    the Robbins (2019) database names (module notes) and no comment line, so that
-    readers of that database (``pandas.read_csv``) take it as it is: ``CRATER_ID``
+    column names. A boulder catalog (:func:`is_boulder_catalog`) says so on line 1 and
+    has no crater-only columns (``age_gyr``, ``degradation``): its columns are the
+    position, ``diameter_m``, ``kind``, ``burial_frac``, ``height_m`` and the placement's
+    others (centre, normal, orientation, shape parameters). ``columns="robbins"``
+    (catalogs on a body, with ``lat_deg, lon_deg``): the Robbins (2019) database names
+    (module notes) and no comment line, so that readers of that database
+    (``pandas.read_csv``) take it as it is: ``CRATER_ID``
     (``CF-`` and the row number), ``LAT_CIRC_IMG``, ``LON_CIRC_IMG`` (degrees east,
     0-360), ``DIAM_CIRC_IMG`` (km), then the other columns under their own names.
     :func:`read_catalog` reads both.
@@ -153,6 +169,9 @@ def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path
     validate_catalog(cat)
     check_choice("columns", columns, CATALOG_COLUMNS)
     path = Path(path)
+    boulders = is_boulder_catalog(cat)
+    if boulders:
+        cat = cat[[n for n in cat.dtype.names if n not in _CRATER_ONLY]]
     names = list(cat.dtype.names)
     rows = [[_format(v) for v in row] for row in cat.tolist()]
     if columns == "robbins":
@@ -167,10 +186,15 @@ def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path
         keep = [names.index(n) for n in rest]
         rows = [h + [r[j] for j in keep] for h, r in zip(head, rows, strict=True)]
         names = [_ROBBINS_ID, *_ROBBINS, *rest]
-    units = "metres (_m), degrees (_deg), Gyr (_gyr); degradation 0 = fresh, 1 = gone"
+    if boulders:
+        head = (f"{BOULDER_FORMAT}; units: metres (_m), degrees (_deg); diameter_m = "
+                "size across, height_m = height above the surface, burial_frac = buried share")
+    else:
+        head = (f"{CATALOG_FORMAT}; units: metres (_m), degrees (_deg), Gyr (_gyr); "
+                "degradation 0 = fresh, 1 = gone")
     with atomic_path(path) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
         if columns == "craterform":
-            fh.write(f"# {CATALOG_FORMAT}; units: {units}\n")
+            fh.write(f"# {head}\n")
         w = csv.writer(fh, lineterminator="\n")
         w.writerow(names)
         w.writerows(rows)
@@ -180,8 +204,7 @@ def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path
 def read_catalog(path) -> np.ndarray:
     """Read a catalog written by :func:`write_catalog` (either column style)."""
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"catalog {str(path)!r} does not exist")
+    check_regular_file(path, "catalog")
     with open(path, newline="", encoding="utf-8") as fh:
         lines = [ln for ln in fh if not ln.startswith("#")]
     rows = list(csv.reader(lines))
@@ -204,6 +227,8 @@ def read_catalog(path) -> np.ndarray:
             raise ValueError(f"catalog {str(path)!r}: bad column {name!r}: {exc}") from None
     if robbins:
         cat["diameter_m"] *= 1000.0
+    if is_boulder_catalog(cat) and not any(n in names for n in _CRATER_ONLY):
+        cat = make_catalog(**{n: cat[n] for n in names})  # the crater-only columns back, 0
     return validate_catalog(cat)
 
 
@@ -217,6 +242,8 @@ def write_geojson(cat: np.ndarray, path, *, to_world=None, crs: str | None = Non
     if "x_m" not in cat.dtype.names:
         raise ValueError("GeoJSON output needs a planar catalog (x_m, y_m)")
     xs, ys = cat["x_m"], cat["y_m"]
+    if is_boulder_catalog(cat):  # as its CSV: no crater-only columns
+        cat = cat[[n for n in cat.dtype.names if n not in _CRATER_ONLY]]
     if to_world is not None:
         xs, ys = to_world(xs, ys)
     feats = []

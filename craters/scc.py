@@ -35,6 +35,7 @@ from pathlib import Path
 import numpy as np
 
 from ._shared import ParameterError, atomic_path, check_positive
+from ._shared.files import check_regular_file
 
 __all__ = ["read_scc", "write_scc"]
 
@@ -138,8 +139,7 @@ def read_scc(path) -> dict:
     none).
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"crater count {str(path)!r} does not exist")
+    check_regular_file(path, "crater count")
     text = path.read_text(encoding="utf-8-sig")
     values, tables, table, rows = {}, {}, None, []
     for raw in text.splitlines():

@@ -33,6 +33,7 @@ from craters._shared.batch import (
     variants,
     vary_error,
 )
+from craters._shared.files import check_regular_file
 
 from .config import EnhanceConfig
 from .enhance import enhance
@@ -109,8 +110,7 @@ def _combo_config(settings: dict, values: tuple, seed: int) -> EnhanceConfig:
         cfg = EnhanceConfig.from_mapping({**settings, **dict(values), "seed": seed})
         if cfg.input is None:
             raise ParameterError("input", "is required: the base DEM file")
-        if not Path(cfg.input).is_file():
-            raise ParameterError("input", f"{cfg.input!r} does not exist")
+        check_regular_file(cfg.input, "input DEM")
         return cfg
     except (TypeError, ValueError) as exc:
         if not values:

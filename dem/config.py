@@ -25,6 +25,7 @@ from craters import (
 )
 from craters._shared import (
     ParameterError,
+    ParameterTypeError,
     about,
     check_choice,
     check_int,
@@ -113,10 +114,10 @@ class EnhanceConfig:
     >>> cfg = EnhanceConfig(layers=3, size=17, craters=["c=0.05,k=-2,d_min_m=20,d_max_m=800"])
     >>> cfg.crater_layers[0].d_max_m, cfg.to_dict()["craters"]
     (800.0, ['c=0.05,k=-2,d_min_m=20,d_max_m=800'])
-    >>> EnhanceConfig(size=100)
+    >>> EnhanceConfig(size=100)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    ValueError: `size` must be 2^n + 1 pixels, 5..16385 (5, 9, 17, ..., 1025, 2049, ...); got 100
+    craters._shared.validation.ParameterError: `size` must be 2^n + 1 pixels, 5..16385 (5, ...
     """
 
     input: str | None = None
@@ -180,25 +181,25 @@ class EnhanceConfig:
 
         with about("input"):
             if self.input is not None and (not isinstance(self.input, str) or not self.input):
-                raise TypeError(f"`input` must be a file name; got {self.input!r}")
+                raise ParameterTypeError("input", f"must be a file name; got {self.input!r}")
         with about("target"):
             t = self.target
             if t is not None:
                 if (isinstance(t, str) or not hasattr(t, "__len__") or len(t) != 2
                         or not all(isinstance(v, numbers.Real) and not isinstance(v, bool)
                                    for v in t)):
-                    raise TypeError(f"`target` must be [x, y] in world coordinates (CRS "
-                                    f"units); got {t!r}")
+                    raise ParameterTypeError("target", f"must be [x, y] in world coordinates "
+                                             f"(CRS units); got {t!r}")
                 if not all(math.isfinite(v) for v in t):
-                    raise ValueError(f"`target` must be finite; got {t!r}")
+                    raise ParameterError("target", f"must be finite; got {t!r}")
                 put("target", (float(t[0]), float(t[1])))
         with about("layers"):
             put("layers", check_int("layers", self.layers, 1, 24))
         with about("size"):
             size = check_int("size", self.size)
             if size < 5 or size > 16385 or (size - 1) & (size - 2):
-                raise ValueError(f"`size` must be 2^n + 1 pixels, 5..16385 (5, 9, 17, ..., "
-                                 f"1025, 2049, ...); got {size}")
+                raise ParameterError("size", f"must be 2^n + 1 pixels, 5..16385 (5, 9, 17, "
+                                     f"..., 1025, 2049, ...); got {size}")
             put("size", size)
         for name, parse, kind, example in (
                 ("craters", _parse_crater_spec, (*LAYER_TYPES, SourceCraterLayer),
@@ -208,15 +209,16 @@ class EnhanceConfig:
             with about(name):
                 specs = getattr(self, name)
                 if isinstance(specs, str) or not isinstance(specs, list | tuple):
-                    raise TypeError(f"`{name}` must be a list of {name[:-1]} layer specs like "
-                                    f"'{example}'; got {specs!r}")
+                    raise ParameterTypeError(name, f"must be a list of {name[:-1]} layer specs "
+                                             f"like '{example}'; got {specs!r}")
                 parsed = []
                 for spec in specs:
                     if not isinstance(spec, (str, *kind)):
                         records = " or ".join(f"{k.__module__.split('.')[0]}.{k.__name__}"
                                               for k in kind)
-                        raise TypeError(f"`{name}` must hold {name[:-1]} layer specs like "
-                                        f"'{example}' or {records}; got {spec!r}")
+                        raise ParameterTypeError(name, f"must hold {name[:-1]} layer specs "
+                                                 f"like '{example}' or {records}; got "
+                                                 f"{spec!r}")
                     parsed.append(spec if isinstance(spec, kind) else parse(spec))
                 put(name, tuple(specs))
                 put(f"{name[:-1]}_layers", tuple(parsed))
@@ -231,8 +233,8 @@ class EnhanceConfig:
                                                     self.source_crater_px, 1.0, 1e6))
         with about("smooth_craters"):
             if not isinstance(self.smooth_craters, bool):
-                raise TypeError(f"`smooth_craters` must be true or false; got "
-                                f"{self.smooth_craters!r}")
+                raise ParameterTypeError("smooth_craters", f"must be true or false; got "
+                                         f"{self.smooth_craters!r}")
         if self.fractal_dimension is not None:
             with about("fractal_dimension"):
                 check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)

@@ -16,6 +16,7 @@ from rasterio.errors import CRSError
 from rasterio.windows import Window
 
 from craters._shared import (
+    ParameterError,
     ParameterTypeError,
     about,
     check_int,
@@ -24,7 +25,7 @@ from craters._shared import (
     package_version,
 )
 
-__all__ = ["Dem", "HISTORY_TAG", "crs_label", "parse_region"]
+__all__ = ["Dem", "HISTORY_TAG", "crs_label", "crs_sphere_radius_m", "parse_region"]
 
 #: GeoTIFF tag holding the JSON list of craterform steps that made a layer.
 HISTORY_TAG = "CRATERFORM_HISTORY"
@@ -66,7 +67,11 @@ def crs_label(crs: CRS | None) -> str:
     if auth:
         return ":".join(auth)
     m = re.match(r'\s*\w+\["([^"]*)"', crs.to_wkt())
-    return m.group(1) if m else crs.to_string()
+    if m and m.group(1) != "unknown":
+        return m.group(1)
+    params = crs.to_dict()  # unnamed: "+proj=longlat +R=1737400"
+    return " ".join(f"+{k}" if v is True else f"+{k}={v}" for k, v in params.items()
+                    if k != "no_defs") or crs.to_string()
 
 
 def parse_region(region) -> Window | BoundingBox:
@@ -104,9 +109,9 @@ def parse_region(region) -> Window | BoundingBox:
     elif isinstance(region, tuple | list):
         parts = list(region)
     else:
-        raise TypeError(f"`region` must be (row, col, size) in pixels, (left, bottom, right, "
-                        f"top) in CRS units, the same as text, a rasterio Window or "
-                        f"BoundingBox; got {type(region).__name__}")
+        raise ParameterTypeError("region", f"must be (row, col, size) in pixels, (left, bottom, "
+                                 f"right, top) in CRS units, the same as text, a rasterio "
+                                 f"Window or BoundingBox; got {type(region).__name__}")
     integral = all(isinstance(v, numbers.Integral) and not isinstance(v, bool) for v in parts)
     if len(parts) == 3 and integral:
         row, col, size = (int(v) for v in parts)
@@ -114,8 +119,25 @@ def parse_region(region) -> Window | BoundingBox:
     if (len(parts) == 4 and all(isinstance(v, numbers.Real) and not isinstance(v, bool)
                                 and math.isfinite(v) for v in parts)):
         return BoundingBox(*(float(v) for v in parts))
-    raise ValueError(f"`region` must be ROW,COL,SIZE (integer pixels) or "
-                     f"LEFT,BOTTOM,RIGHT,TOP (finite, CRS units); got {region!r}")
+    raise ParameterError("region", f"must be ROW,COL,SIZE (integer pixels) or "
+                         f"LEFT,BOTTOM,RIGHT,TOP (finite, CRS units); got {region!r}")
+
+
+def crs_sphere_radius_m(crs: CRS | None) -> float | None:
+    """The radius of a CRS whose body is a sphere (``+R=``, equal axes, the IAU codes of
+    spherical bodies such as ``IAU_2015:30100``, the Moon), in metres; else None.
+
+    Examples
+    --------
+    >>> crs_sphere_radius_m(CRS.from_proj4("+proj=longlat +R=1737400 +no_defs"))
+    1737400.0
+    >>> crs_sphere_radius_m(CRS.from_epsg(4326)) is None  # an ellipsoid: no one radius
+    True
+    """
+    if crs is None:
+        return None
+    radius = crs.to_dict().get("R")
+    return None if radius is None else float(radius)
 
 
 def _crs_radius_text(crs: CRS) -> str:
@@ -156,7 +178,8 @@ class Dem:
     pixel_size_m : float or (float, float), optional
         Pixel size (x, y) in metres; only for DEMs without CRS, where it is required.
     body_radius_m : float, optional
-        Radius of the body in metres; required with a geographic CRS.
+        Radius of the body in metres; required with a geographic CRS, unless the CRS is
+        on a sphere (``+R=``, e.g. ``IAU_2015:30100``): then that sphere's radius.
     tags : mapping of str to str, optional
         Metadata tags (kept through operations, written to GeoTIFF).
     level : int
@@ -211,6 +234,8 @@ class Dem:
         with about("body_radius_m"):
             radius = None if body_radius_m is None else check_range(
                 "body_radius_m", body_radius_m, *BODY_RADIUS_RANGE_M)
+        if radius is None and crs is not None and crs.is_geographic:
+            radius = crs_sphere_radius_m(crs)  # a sphere's CRS gives the radius itself
         self._h = _readonly(h)
         self._transform = transform
         self._crs = crs
@@ -238,21 +263,18 @@ class Dem:
         crs = self._crs
         if crs is None:
             if self._own_px is None:
-                with about("pixel_size_m"):
-                    raise ValueError("the DEM has no CRS: give its pixel size in metres with "
-                                     "`pixel_size_m`")
+                raise ParameterError("pixel_size_m", "is needed: the DEM has no CRS; give "
+                                     "its pixel size in metres")
             return self._own_px
         if self._own_px is not None:
-            with about("pixel_size_m"):
-                raise ValueError(f"`pixel_size_m` is only for DEMs without a CRS; this DEM's "
+            raise ParameterError("pixel_size_m", f"is only for DEMs without a CRS; this DEM's "
                                  f"CRS ({crs_label(crs)}) gives the pixel size")
         if crs.is_geographic:
             if self._radius is None:
-                with about("body_radius_m"):
-                    raise ValueError(
-                        f"the DEM has a geographic CRS ({crs_label(crs)})"
-                        f"{_crs_radius_text(crs)}: give the body radius in metres with "
-                        f"`body_radius_m` to convert degrees to metres")
+                raise ParameterError(
+                    "body_radius_m", f"is needed: the DEM has a geographic CRS "
+                    f"({crs_label(crs)}){_crs_radius_text(crs)}; give the body radius in "
+                    f"metres to convert degrees to metres")
             rad = crs.units_factor[1]  # radians per angular unit
             rows, cols = self._h.shape
             lat_c = t.d * cols / 2.0 + t.e * rows / 2.0 + t.f
@@ -419,28 +441,28 @@ class Dem:
         if isinstance(region, Window):
             vals = (region.row_off, region.col_off, region.height, region.width)
             if any(not float(v).is_integer() for v in vals):
-                raise ValueError(f"`region` window must have integer offsets and sizes; "
-                                 f"got {region!r}")
+                raise ParameterError("region", f"window must have integer offsets and sizes; "
+                                     f"got {region!r}")
             r0, c0, h, w = (int(v) for v in vals)
         else:
             r0, c0, h, w = self._bounds_window(region)
         if h < 1 or w < 1:
-            raise ValueError(f"`region` selects no pixels (rows {r0}..{r0 + h - 1}, cols "
-                             f"{c0}..{c0 + w - 1}); the DEM has {rows} x {cols} pixels")
+            raise ParameterError("region", f"selects no pixels (rows {r0}..{r0 + h - 1}, cols "
+                                 f"{c0}..{c0 + w - 1}); the DEM has {rows} x {cols} pixels")
         if r0 < 0 or c0 < 0 or r0 + h > rows or c0 + w > cols:
-            raise ValueError(
-                f"`region` (rows {r0}..{r0 + h - 1}, cols {c0}..{c0 + w - 1}) is not inside "
+            raise ParameterError(
+                "region", f"(rows {r0}..{r0 + h - 1}, cols {c0}..{c0 + w - 1}) is not inside "
                 f"the DEM (rows 0..{rows - 1}, cols 0..{cols - 1})")
         return Window(c0, r0, w, h)
 
     def _bounds_window(self, box: BoundingBox) -> tuple[int, int, int, int]:
         t = self._transform
         if t.b != 0 or t.d != 0:
-            raise ValueError("`region` bounds need a north-up (unrotated) transform; "
-                             "give a pixel Window instead")
+            raise ParameterError("region", "bounds need a north-up (unrotated) transform; "
+                                 "give a pixel Window instead")
         if not (box.left <= box.right and box.bottom <= box.top):
-            raise ValueError(f"`region` bounds must have left <= right and bottom <= top; "
-                             f"got {tuple(box)}")
+            raise ParameterError("region", f"bounds must have left <= right and bottom <= "
+                                 f"top; got {tuple(box)}")
         # the box corners in pixel index units (north-up: each axis on its own)
         c_a, c_b = (box.left - t.c) / t.a, (box.right - t.c) / t.a
         r_a, r_b = (box.top - t.f) / t.e, (box.bottom - t.f) / t.e

@@ -81,6 +81,7 @@ import numpy as np
 from affine import Affine
 
 from craters._shared import (
+    ParameterError,
     about,
     check_int,
     check_positive,
@@ -157,16 +158,14 @@ def _region(dem: Dem, region) -> tuple[int, int, int]:
     if region is None:
         rows, cols = dem.shape
         if rows != cols or rows < 3 or (rows - 1) & (rows - 2):
-            with about("region"):
-                raise ValueError(
-                    f"`dem` is {rows} x {cols} pixels; expansion needs a square region of "
-                    f"W = 2^n + 1 pixels ({allowed}): give `region` or crop the DEM")
+            raise ParameterError(
+                "region", f"is needed (or a cropped DEM): the DEM is {rows} x {cols} pixels "
+                f"and expansion needs a square region of W = 2^n + 1 pixels ({allowed})")
         return 0, 0, rows
     win = dem.window(region)
     h, w = int(win.height), int(win.width)
     if h != w or h < 3 or (h - 1) & (h - 2):
-        with about("region"):
-            raise ValueError(f"`region` is {h} x {w} pixels; expansion needs a square of "
+        raise ParameterError("region", f"is {h} x {w} pixels; expansion needs a square of "
                              f"W = 2^n + 1 pixels ({allowed})")
     return int(win.row_off), int(win.col_off), h
 

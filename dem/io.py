@@ -22,7 +22,16 @@ from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.windows import Window
 
 from craters import get_target
-from craters._shared import about, atomic_path, check_int, parameter_of, temp_file
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    about,
+    atomic_path,
+    check_int,
+    parameter_of,
+    temp_file,
+)
+from craters._shared.files import check_regular_file
 
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
 from .crscode import CRS_TAG, crs_tags, restore_crs
@@ -100,8 +109,7 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         pixel; the message is one line naming the file.
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"DEM file {str(path)!r} does not exist")
+    check_regular_file(path, "DEM file")
     with about("band"):
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
@@ -142,6 +150,9 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         return Dem._own(heights, transform, crs, pixel_size_m=pixel_size_m,
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
     except (ValueError, TypeError) as exc:
+        if isinstance(exc, ParameterError | ParameterTypeError):  # the file named, the rule
+            shown = str(path).replace("{", "{{").replace("}", "}}") if exc.see else str(path)
+            raise type(exc)(exc.name, f"{exc.rule} (reading {shown!r})", see=exc.see) from None
         with about(parameter_of(exc)):  # the file named, the parameter kept
             kind = ValueError if isinstance(exc, ValueError) else TypeError  # plain kinds:
             raise kind(f"{str(path)!r}: {exc}") from None  # a ParameterError needs a rule
@@ -176,8 +187,7 @@ def _window_text(win) -> str:
 def _check_inside(win, rows: int, cols: int, path: Path) -> None:
     r0, c0, h, w = win
     if r0 + h > rows or c0 + w > cols:
-        with about("window"):
-            raise ValueError(f"`window` {_window_text(win)} is not inside {str(path)!r} "
+        raise ParameterError("window", f"{_window_text(win)} is not inside {str(path)!r} "
                              f"({rows} x {cols} pixels)")
 
 
@@ -187,8 +197,7 @@ def _read_gdal(path: Path, band: int, win=None):
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
             with rasterio.open(path) as ds:
                 if band > ds.count:
-                    with about("band"):
-                        raise ValueError(f"`band` must be in [1, {ds.count}] for "
+                    raise ParameterError("band", f"must be in [1, {ds.count}] for "
                                          f"{str(path)!r}; got {band}")
                 if np.dtype(ds.dtypes[band - 1]).kind == "c":
                     raise ValueError(f"{str(path)!r}: band {band} holds complex numbers "
@@ -331,8 +340,7 @@ class WindowWriter:
         transform = Affine.identity() if transform is None else transform
         if crs is None:  # the pixel size tag, as a Dem without CRS writes it
             if pixel_size_m is None:
-                with about("pixel_size_m"):
-                    raise ValueError("a DEM without CRS needs `pixel_size_m`")
+                raise ParameterError("pixel_size_m", "is needed for a DEM without CRS")
             pair = np.broadcast_to(np.asarray(pixel_size_m, dtype=np.float64), (2,))
             pixel_size_m = tuple(float(v) for v in pair)
         self._tmp = temp_file(self.path, ".part.tif")

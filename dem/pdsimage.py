@@ -33,7 +33,7 @@ from rasterio.crs import CRS
 from rasterio.errors import NotGeoreferencedWarning, RasterioIOError
 from rasterio.windows import Window
 
-from craters._shared import about
+from craters._shared import ParameterError, about
 
 from ._pds import (
     SAMPLE_TYPES,
@@ -93,7 +93,7 @@ def read_pds(path: Path, band: int, win=None):
     nbytes = bits // 8
     if band > bands:
         with about("band"):
-            raise ValueError(f"`band` must be in [1, {bands}] for {where!r}; got {band}")
+            raise ParameterError("band", f"must be in [1, {bands}] for {where!r}; got {band}")
     if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
             "BAND_SEQUENTIAL":
         raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
@@ -183,7 +183,8 @@ def _image_start(label: dict, parent: dict, label_path: Path, where: str):
         return label_path, offset
     found = data_file(label_path, data_name)  # refuses a file outside the label's folder
     if found is None:
-        raise ValueError(f"{where!r}: the image file {data_name!r} it points to is missing")
+        raise FileNotFoundError(f"{where!r}: the image file {data_name!r} it points to is "
+                                f"missing")
     return found, offset
 
 

@@ -50,6 +50,7 @@ import numpy as np
 from rasterio.windows import Window
 
 import craters
+from craters._shared import ParameterError
 
 from .boulders import BOULDER_REACH, draw_boulders
 from .core import Dem
@@ -115,15 +116,15 @@ def layer_windows(base: Dem, target, size: int, n_layers: int):
     in the base)``; ``target`` is (X, Y) in world coordinates or None (the centre)."""
     rows, cols = base.shape
     if rows < size or cols < size:
-        raise ValueError(f"the base DEM is {rows} x {cols} pixels; layers of `size` {size} need "
-                         f"at least {size} x {size}")
+        raise ParameterError("size", f"{size} needs a base DEM of at least {size} x {size} "
+                             f"pixels; it has {rows} x {cols}")
     if target is None:
         r_t, c_t = rows // 2, cols // 2
     else:
         col_f, row_f = ~base.transform @ target
         if not (0 <= row_f < rows and 0 <= col_f < cols):
             b = base.bounds
-            raise ValueError(f"`target` {list(target)} is outside the base DEM (bounds "
+            raise ParameterError("target", f"{list(target)} is outside the base DEM (bounds "
                              f"left {b.left:.10g}, bottom {b.bottom:.10g}, right {b.right:.10g}, "
                              f"top {b.top:.10g})")
         r_t, c_t = int(math.floor(row_f)), int(math.floor(col_f))

@@ -37,7 +37,7 @@ from craters import (
     write_scc,
 )
 from craters._shared import (
-    about,
+    ParameterError,
     check_int,
     check_outside_folder,
     check_parent_folder,
@@ -47,6 +47,7 @@ from craters._shared import (
     sweep_temporaries,
     temp_folder,
 )
+from craters._shared.files import check_regular_file
 
 from .core import Dem, crs_label
 from .frame import LocalFrame, body_axes_m, grid_pixel_size, pixel_affine, world_to_lonlat
@@ -368,8 +369,7 @@ def check_stack_folder(folder, *, force: bool, inputs=()) -> Path:
             raise ValueError(f"output {str(folder)!r} exists and is not a folder")
         if any(folder.iterdir()):
             if not force:
-                with about("force"):
-                    raise ValueError(f"output {str(folder)!r} exists; replace it with `force`")
+                raise ParameterError("force", f"is needed: output {str(folder)!r} exists")
             if not (folder / MANIFEST).is_file():
                 raise ValueError(f"output {str(folder)!r} is not a stack folder (no {MANIFEST}); "
                                  f"refusing to replace it")
@@ -448,8 +448,7 @@ def read_stack(path, *, progress: bool = False) -> Stack:
     """Read a stack written by :meth:`Stack.write` (its manifest, or the folder)."""
     path = Path(path)
     manifest = path / MANIFEST if path.is_dir() else path
-    if not manifest.is_file():
-        raise ValueError(f"stack manifest {str(manifest)!r} does not exist")
+    check_regular_file(manifest, "stack manifest")
     try:
         doc = json.loads(manifest.read_text(encoding="utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as exc:

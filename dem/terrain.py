@@ -21,7 +21,14 @@ import math
 
 import numpy as np
 
-from craters._shared import about, area_slope_summary, check_choice, check_int, check_range
+from craters._shared import (
+    ParameterError,
+    about,
+    area_slope_summary,
+    check_choice,
+    check_int,
+    check_range,
+)
 
 from .core import Dem
 from .fractal import FractalFit, SpectralFit, fractal_fit
@@ -143,7 +150,7 @@ def power_spectrum(dem: Dem, n_bins: int | None = None) -> tuple[np.ndarray, np.
     z = dem.heights
     rows, cols = z.shape
     if min(rows, cols) < 8:
-        raise ValueError(f"`dem` must be at least 8 x 8 pixels; got {rows} x {cols}")
+        raise ParameterError("dem", f"must be at least 8 x 8 pixels; got {rows} x {cols}")
     width, dy = pixel_sizes_by_row(dem)
     dx = float(width.mean())
     yy, xx = np.mgrid[0:rows, 0:cols]

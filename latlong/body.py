@@ -9,7 +9,14 @@ from pathlib import Path
 import numpy as np
 
 from craters import validate_catalog
-from craters._shared import ParameterTypeError, atomic_path, check_int, check_positive
+from craters._shared import (
+    ParameterError,
+    ParameterTypeError,
+    atomic_path,
+    check_int,
+    check_positive,
+)
+from craters._shared.files import check_regular_file
 
 from .export import EXPORT_SUFFIXES, export_body
 from .grid import LatLongGrid
@@ -298,14 +305,13 @@ def _check_radii(radii: np.ndarray) -> None:
     n = radii.shape[0]
     for s in range(0, n, _CHECK_CHUNK):
         if not np.isfinite(radii[s:s + _CHECK_CHUNK]).all():
-            raise ValueError("`radii_m` must be finite")
+            raise ParameterError("radii_m", "must be finite")
     bad = sum(int(np.count_nonzero(radii[s:s + _CHECK_CHUNK] <= 0))
               for s in range(0, n, _CHECK_CHUNK))
     if bad:
-        raise ValueError(
-            f"`radii_m` must be > 0 everywhere; {bad} vertices have radius <= 0 "
-            f"(min {radii.min():.6g} m): the base shape is too rough for this radius"
-        )
+        raise ParameterError(
+            "radii_m", f"must be > 0 everywhere; {bad} vertices have radius <= 0 "
+            f"(min {radii.min():.6g} m)")
 
 
 #: Vertices per block of the area-weighted mean: numpy's dot (OpenBLAS ddot) runs on one
@@ -338,12 +344,22 @@ def _area_mean(grid: LatLongGrid, radii: np.ndarray) -> float:
 def load(path) -> Body:
     """Read a body written by :meth:`Body.save`."""
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"model file {str(path)!r} does not exist")
+    check_regular_file(path, "model file")
+    need = (f"{str(path)!r} is not a body .npz (as Body.save and `latlong build -o NAME.npz` "
+            "write)")
+    if not zipfile.is_zipfile(path):  # a mesh (.ply ...), a single .npy, anything else
+        mesh = path.suffix.lower() in (*EXPORT_SUFFIXES, ".tab", ".plt", ".gltf")
+        raise ValueError(need + (f": a {path.suffix} file is a mesh, which holds no lat/long "
+                                 "body" if mesh else ": it is not a .npz (zip) archive"))
     try:
         with np.load(path, allow_pickle=False) as z:
             fields = {k: z[k] for k in z.files}
-    except (zipfile.BadZipFile, OSError, ValueError, EOFError) as exc:
+    except ValueError as exc:
+        if "allow_pickle" in str(exc):  # numpy's words for Python objects in the archive
+            raise ValueError(need + ": it holds Python objects (pickles), which a body "
+                             "never does, and they are not read") from None
+        raise ValueError(f"cannot read body {str(path)!r}: {exc}") from None
+    except (zipfile.BadZipFile, OSError, EOFError) as exc:
         raise ValueError(f"cannot read body {str(path)!r}: {exc}") from None
     fmt = str(fields["format"]) if "format" in fields else ""
     if fmt != FORMAT:

@@ -140,8 +140,13 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
     craters, boulders = scene.craters, scene.boulders
     target = scene.target()
     metadata = _metadata(scene, params)
-    body = Body(grid, heights, radius_m=radius_m, stretch=scene.body.stretch,
-                metadata=metadata, copy=False)
+    try:
+        body = Body(grid, heights, radius_m=radius_m, stretch=scene.body.stretch,
+                    metadata=metadata, copy=False)
+    except ParameterError as exc:
+        if exc.name != "radii_m":
+            raise
+        raise _too_rough(scene, radius_m, exc) from None
     del heights
     if craters.layers:
         cat = body_population(body, craters.layers, rng=rng)
@@ -156,6 +161,20 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
         found = boulder_population(body, boulders.layers, rng=rng)
         body = body.replace(boulders=place_boulders(body, found, shape=boulders.shape))
     return body
+
+
+def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterError:
+    """A base whose heights make radii <= 0 (or not finite): the error of the settings
+    that made them (the scene's names), not of the body's radii."""
+    if isinstance(scene.base, FaultingParams):
+        name, see, what = "max_fault_1_m", ("max_fault_2_m",), "and {} are"
+    else:  # fBm, or a shape model's fBm detail
+        name, see, what = "amplitude_m", (), "is"
+    if isinstance(scene.base, ShapeBase):
+        return ParameterError(name, f"{what} too large for the shape model (mean radius "
+                              f"{radius_m:.6g} m): the radii {exc.rule}", see=see)
+    return ParameterError(name, f"{what} too large for {{}} = {radius_m:g} m: the "
+                          f"radii {exc.rule}", see=(*see, "radius_m"))
 
 
 def _metadata(scene: Scene, params: dict) -> dict:

@@ -184,7 +184,15 @@ def write_outputs(made, scene: Scene, outputs: Outputs, *, progress: bool = Fals
             try:
                 body = made.to_body(scene.body.magnitude, crossings=scene.implicit.crossings)
             except ValueError as exc:
-                raise ValueError(f".npz output (lat/long projection): {exc}") from None
+                if not (isinstance(exc, ParameterError) and exc.name == "crossings"):
+                    raise ValueError(f".npz output (lat/long projection): {exc}") from None
+                # the scene's name; the advice of a shape base (another centre, --surface
+                # mesh) does not apply: the implicit surface is cast from its origin
+                why = exc.rule.partition(": ")[2].partition("; crater it")[0]
+                raise ParameterError("shape_crossings", "must be outermost or innermost for "
+                                     f"a .npz output (the surface cast onto the lat/long "
+                                     f"grid from its origin): {why}; or write only meshes "
+                                     "(.ply .obj .stl .vtp .vtk .glb)") from None
         for out in outputs.output:
             (body.save if out.lower().endswith(".npz") else made.save)(out)
             done()

@@ -39,6 +39,11 @@ def _check_noise_params(octaves, persistence, lacunarity, base):
             "lacunarity", f"** ({{}} - 1) * 1024 must stay below 2**31 (the noise tiling "
             f"period): lacunarity < {top:.6g} with {octaves} octaves; got {lacunarity!r}",
             see=("octaves",))
+    if (octaves - 1) * math.log10(persistence) >= 38:  # the amplitudes' float32 sum
+        raise ParameterError(
+            "persistence", f"** ({{}} - 1) must stay below 1e38 (the octaves' amplitudes are "
+            f"summed in single precision): persistence < {10 ** (38 / (octaves - 1)):.6g} "
+            f"with {octaves} octaves; got {persistence!r}", see=("octaves",))
     return octaves, persistence, lacunarity, base
 
 
@@ -177,6 +182,13 @@ def perlin_fbm(grid: LatLongGrid, frequency: float, octaves: int, persistence: f
     amplitude_m = check_finite("amplitude_m", amplitude_m)
     octaves, persistence, lacunarity, _ = _check_noise_params(octaves, persistence,
                                                               lacunarity, 0)
+    if math.log2(frequency + 256) + (octaves - 1) * math.log2(lacunarity) >= 31:
+        top = 2.0 ** 31 / lacunarity ** (octaves - 1) - 256
+        raise ParameterError(
+            "frequency", f"(+ 256, the random offset) * {{}} ** ({{}} - 1) must stay below "
+            f"2**31 (the noise tiling period): frequency < {top:.6g} with lacunarity "
+            f"{lacunarity:g} and {octaves} octaves; got "
+            f"{frequency!r}", see=("lacunarity", "octaves"))
     if out is None:
         out = np.empty(grid.n_vertices, dtype=np.float64)
     elif not (isinstance(out, np.ndarray) and out.dtype == np.float64

@@ -271,6 +271,10 @@ def _part(factory, names: dict, values: dict, **fixed):
     except (ParameterError, ParameterTypeError) as exc:
         key = next((k for k, f in names.items() if f == exc.name), exc.name)
         raise exc.renamed(key) from None
+    except FileNotFoundError as exc:  # a file setting's: kept, its tag renamed
+        tag = getattr(exc, "parameter", None)
+        exc.parameter = next((k for k, f in names.items() if f == tag), tag)
+        raise
 
 
 def _preview(given: dict) -> PreviewSettings:
@@ -385,6 +389,9 @@ def _fit_example(given: dict):
                                  "give {}", see=("gabor_amplitude_m",))
         return fit_gabor(image, pixel, amplitude_m=amplitude)
     except ParameterError:
+        raise
+    except FileNotFoundError as exc:  # kept (Python), tagged (the command's flag)
+        exc.parameter = "gabor_example"
         raise
     except ValueError as exc:
         raise ParameterError("gabor_example", f"{given['gabor_example']}: {exc}") from None

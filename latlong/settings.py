@@ -251,6 +251,9 @@ class ShapeBase:
                                      f"got {self.units!r}")
             try:
                 _set(self, "model", read_shape_model(self.model, units=self.units))
+            except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
+                exc.parameter = "model"
+                raise
             except ValueError as exc:
                 raise ParameterError("model", f"{self.model}: {exc}") from None
         check_choice("crossings", self.crossings, CROSSINGS)
@@ -432,6 +435,9 @@ class ImplicitSettings:
                                      f"got {self.units!r}")
             try:
                 _set(self, "shape", read_shape_model(self.shape, units=self.units))
+            except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
+                exc.parameter = "shape"
+                raise
             except ValueError as exc:
                 raise ParameterError("shape", f"{self.shape}: {exc}") from None
         _set(self, "layers", _layers(self.layers, LcsnLayer, parse_lcsn_spec, "layers"))

@@ -27,6 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int
+from craters._shared.files import check_regular_file
 from craters._shared.meshfiles import check_mesh_file
 
 from ._shape_kernels import _brute_force_kernel, _raycast_kernel
@@ -239,8 +240,7 @@ def read_shape_model(path, *, units: str) -> ShapeModel:
     """
     units = check_choice("units", units, tuple(UNITS))
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"shape model {str(path)!r} does not exist")
+    check_regular_file(path, "shape model")
     suffix = path.suffix.lower()
     if suffix in _PYVISTA_SUFFIXES:
         import pyvista as pv
@@ -381,8 +381,8 @@ def from_shape_model(model, magnitude: int, *, units: str | None = None,
     areas = grid.vertex_areas()
     if (count == 0).any():
         missed = float(areas[count == 0].sum() / areas.sum())
-        raise ValueError(f"{missed:.2%} of the directions from the centre miss the surface: "
-                         "the centre is outside the model (choose another `center`)")
+        raise ParameterError("center", f"is outside the model: {missed:.2%} of the directions "
+                             "from it miss the surface; choose another")
     multi = count > 1
     fraction = float(areas[multi].sum() / areas.sum())
     n_multi = int(multi.sum())

@@ -160,6 +160,10 @@ def test_readme_bash_blocks_run_in_order(tmp_path):
                 f"README bash block {number}: {line!r}\nran as: {command!r}\n"
                 f"after {times[-1][0]:.1f} s, "
                 f"exit {done.returncode}\n{done.stderr[-3000:]}")
+            # no Python warning line (RuntimeWarning, ComplexWarning ...) reaches the user
+            assert not re.search(r"\b\w*Warning\b", done.stderr), (
+                f"README bash block {number}: {command!r} printed a warning:\n"
+                f"{done.stderr[-3000:]}")
             ran += 1
     assert ran >= 40
 

@@ -95,6 +95,8 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
             raise
         if isinstance(exc, ParameterError | ParameterTypeError) and exc.name in (flags or {}):
             msg = exc.shown_as(flags[exc.name], lambda k: flags.get(k, f"`{k}`"))
+        elif isinstance(exc, OSError) and parameter_of(exc) in (flags or {}):
+            msg = f"{flags[parameter_of(exc)]}: {exc}"  # a missing file of a setting
         else:
             msg = str(exc) if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"error: {msg}\n".replace("\n", " ").rstrip() + "\n")

@@ -192,7 +192,8 @@ _END = object()
 
 def check_regular_file(path, what: str, max_bytes: int | None = None) -> Path:
     """``path`` names an existing regular file (not a FIFO, device or folder) of at
-    most ``max_bytes``; returns it as a Path, else a one-line ``ValueError``.
+    most ``max_bytes``; returns it as a Path, else a one-line ``FileNotFoundError`` (no
+    such file) or ``ValueError``.
 
     Examples
     --------
@@ -205,7 +206,7 @@ def check_regular_file(path, what: str, max_bytes: int | None = None) -> Path:
     try:
         st = os.stat(path)
     except FileNotFoundError:
-        raise ValueError(f"{what} {str(path)!r} does not exist") from None
+        raise FileNotFoundError(f"{what} {str(path)!r} does not exist") from None
     except OSError as exc:
         raise ValueError(f"cannot read {what} {str(path)!r}: {exc.strerror or exc}") from None
     if not stat.S_ISREG(st.st_mode):
@@ -227,8 +228,8 @@ def load_toml(path) -> dict:
     try:
         with open(path, "rb") as fh:
             return tomllib.load(fh)
-    except FileNotFoundError:
-        raise ValueError(f"config file {str(path)!r} does not exist") from None
+    except FileNotFoundError:  # removed since the check
+        raise FileNotFoundError(f"config file {str(path)!r} does not exist") from None
     except tomllib.TOMLDecodeError as exc:
         raise ValueError(f"config file {str(path)!r} is not valid TOML: {exc}") from None
     except RecursionError:

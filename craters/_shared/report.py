@@ -13,7 +13,8 @@ import numpy as np
 
 from .files import atomic_path
 
-__all__ = ["plot_slopes", "save_figure", "slope_csv", "slope_table", "write_csv"]
+__all__ = ["plot_slopes", "save_figure", "series_colors", "slope_csv", "slope_table",
+           "write_csv"]
 
 
 def write_csv(path, comment: str, columns, rows) -> None:
@@ -31,6 +32,17 @@ def save_figure(fig, path) -> None:
     """Write a matplotlib figure as PNG (110 dpi), atomically."""
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
+
+
+def series_colors(n: int) -> list:
+    """``n`` colours that do not repeat: matplotlib's ten-colour cycle up to ten series,
+    else a colormap (viridis) sampled once per series (an 11-layer stack's layer 0 and
+    layer 10 were both blue with the cycle)."""
+    import matplotlib
+
+    if n <= 10:
+        return [matplotlib.colormaps["tab10"](k) for k in range(n)]
+    return [matplotlib.colormaps["viridis"](k / (n - 1)) for k in range(n)]
 
 
 def _common_bins(results):
@@ -55,7 +67,9 @@ def slope_csv(path, comment: str, results) -> None:
 
 def plot_slopes(path, results, *, xlabel: str, ylabel: str, title: str,
                 full_range: bool = False) -> None:
-    """Histogram and cumulative slope-frequency panels of every input, side by side."""
+    """Histogram and cumulative slope-frequency panels of every input, side by side
+    (``results``: (legend label, slope summary) pairs; colours from
+    :func:`series_colors`)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -64,11 +78,12 @@ def plot_slopes(path, results, *, xlabel: str, ylabel: str, title: str,
     edges, n_bins = _common_bins(results)
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(12, 4.8))
     centres = 0.5 * (edges[:n_bins] + edges[1:n_bins + 1])
-    for label, r in results:
-        ax0.plot(centres, 100 * r["area_fraction"][:n_bins], "o-", ms=3, label=label)
+    for (label, r), color in zip(results, series_colors(len(results)), strict=True):
+        ax0.plot(centres, 100 * r["area_fraction"][:n_bins], "o-", ms=3, label=label,
+                 color=color)
         above = r["above_percent"][:n_bins]
         ax1.semilogy(edges[:n_bins], np.where(above > 1e-6, above, np.nan), "o-", ms=3,
-                     label=label)
+                     label=label, color=color)
     ax0.set_xlabel(xlabel)
     ax0.set_ylabel(ylabel)
     ax0.set_title(title)

@@ -10,8 +10,16 @@ from __future__ import annotations
 from pathlib import Path
 from types import SimpleNamespace
 
+from craters._shared import ParameterError
 from craters._shared.cli import CliError, check_report_outputs
-from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
+from craters._shared.report import (
+    plot_slopes,
+    save_figure,
+    series_colors,
+    slope_csv,
+    slope_table,
+    write_csv,
+)
 
 from ..fractal import dimension_warning
 from ..stack import read_stack
@@ -36,18 +44,26 @@ def _inputs(s: Settings) -> list[tuple[str, object]]:
     return out
 
 
+def _legend(label: str, pixel_m: float) -> str:
+    """A plot legend entry: the input's label and its pixel size ('layer 3, 0.25 m/px')."""
+    return f"{label}, {pixel_m:.3g} m/px"
+
+
 def _slopes(s: Settings) -> int:
     args = SimpleNamespace(**s)
     check_report_outputs(args, [("input", p) for p in (s["input"], *(s["compare"] or []),
                                                      s.config)])
+    inputs = _inputs(s)
     results = [(label, slope_distribution(d, args.bin_deg, args.method))
-               for label, d in _inputs(s)]
+               for label, d in inputs]
     if args.csv:
         slope_csv(args.csv, f"dem slopes: {args.method} slopes in degrees; pixels weighted by "
                   "ground area; area fractions sum to 1; percent of the area steeper than the "
                   "bin's lower edge", results)
     if args.plot:
-        plot_slopes(args.plot, results, xlabel=f"slope (deg), {args.bin_deg:g} deg bins",
+        legends = [(_legend(label, d.resolution_m), r)
+                   for (label, d), (_, r) in zip(inputs, results, strict=True)]
+        plot_slopes(args.plot, legends, xlabel=f"slope (deg), {args.bin_deg:g} deg bins",
                     ylabel="share of the area (%)",
                     title=f"slope-area distribution ({args.method})")
     if not args.quiet:
@@ -63,7 +79,12 @@ def _spectrum(s: Settings) -> int:
     for label, d in _inputs(s):
         if not d.known.all():
             raise CliError(f"{label}: the DEM has unknown pixels; fill them first (dem fill)")
-        wl, p = power_spectrum(d)
+        try:
+            wl, p = power_spectrum(d)
+        except ParameterError as exc:  # about this input, not an option
+            if exc.name != "dem":
+                raise
+            raise CliError(exc.shown_as(f"{label}:")) from None
         results.append((label, wl, p, spectral_exponent(wl, p), d.resolution_m))
     if args.csv:
         n = max(len(wl) for _, wl, *_ in results)
@@ -84,8 +105,10 @@ def _spectrum(s: Settings) -> int:
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(7, 5))
-        for label, wl, p, beta, _ in results:
-            ax.loglog(wl, p, ".-", ms=3, label=f"{label} (beta {beta:.2f})")
+        for (label, wl, p, beta, px), color in zip(results, series_colors(len(results)),
+                                                   strict=True):
+            ax.loglog(wl, p, ".-", ms=3, color=color,
+                      label=f"{_legend(label, px)} (beta {beta:.2f})")
         ax.invert_xaxis()
         ax.set_xlabel("wavelength (m)")
         ax.set_ylabel("power spectral density (m$^4$)")

@@ -77,8 +77,8 @@ def _region(text):
     """The text forms of :func:`dem.core.parse_region` (the one definition)."""
     try:
         return parse_region(str(text))
-    except ValueError as exc:
-        raise argparse.ArgumentTypeError(str(exc)) from None
+    except ParameterError as exc:  # the flag is argparse's, in front
+        raise argparse.ArgumentTypeError(exc.rule) from None
 
 
 # --------------------------------------------------------------------------- the table
@@ -265,12 +265,13 @@ class Settings(dict):
         try:
             yield
         except (TypeError, ValueError) as exc:
-            name = parameter_of(exc)
-            where = self.where(name)
+            named = isinstance(exc, ParameterError | ParameterTypeError)
+            if named and self.where(exc.name):  # its own name first, then the tag of a caller
+                raise CliError(exc.shown_as(self.where(exc.name),
+                                            lambda k: self.where(k) or f"`{k}`")) from None
+            where = self.where(parameter_of(exc))
             if where is None:
                 raise
-            if isinstance(exc, ParameterError | ParameterTypeError) and exc.name == name:
-                raise CliError(exc.shown_as(where, lambda k: self.where(k) or f"`{k}`")) from None
             raise CliError(f"{where}: {exc}") from None
 
 

@@ -13,7 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
-from craters._shared.report import plot_slopes, save_figure, slope_csv, slope_table, write_csv
+from craters._shared.report import (
+    plot_slopes,
+    save_figure,
+    series_colors,
+    slope_csv,
+    slope_table,
+    write_csv,
+)
 from latlong import (
     Body,
     ShapeModel,
@@ -176,8 +183,8 @@ def cmd_spectrum(args) -> int:
         import matplotlib.pyplot as plt
 
         fig, ax = plt.subplots(figsize=(7, 5))
-        for label, d, p, _ in results:
-            ax.loglog(d[1:], p[1:], label=label)
+        for (label, d, p, _), color in zip(results, series_colors(len(results)), strict=True):
+            ax.loglog(d[1:], p[1:], label=label, color=color)
         ax.set_xlabel("spherical-harmonic degree l")
         ax.set_ylabel("degree variance S_l (m$^2$)")
         ax.set_title("radius power spectrum")

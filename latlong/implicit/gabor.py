@@ -42,6 +42,7 @@ from craters._shared import (
     normalize_rng,
     parse_spec,
 )
+from craters._shared.files import check_regular_file
 
 from . import _kernels as _k
 from .grid import VoxelGrid
@@ -273,8 +274,7 @@ def read_example(path) -> tuple[np.ndarray, bool]:
     picture (``.png``, ``.jpg``, ``.tif``: grey levels 0-1). Returns (image, is_heights).
     """
     path = Path(path)
-    if not path.is_file():
-        raise ValueError(f"example {str(path)!r} does not exist")
+    check_regular_file(path, "example")
     suffix = path.suffix.lower()
     if suffix == ".npy":
         try:

@@ -16,7 +16,7 @@ import dataclasses
 
 import numpy as np
 
-from craters._shared import check_int, check_range, normalize_rng
+from craters._shared import ParameterError, check_int, check_range, normalize_rng
 
 from ..shapes import ShapeModel, sample_surface
 from . import _kernels as _k
@@ -141,7 +141,7 @@ def metaball_distance(meta: Metaballs, grid: VoxelGrid) -> np.ndarray:
         seed[tuple(a)] |= cross
         seed[tuple(b)] |= cross
     if not seed.any():
-        raise ValueError(f"`voxel_m` = {grid.h:.4g} m: no grid point falls inside the body "
+        raise ParameterError("voxel_m", f"= {grid.h:.4g} m: no grid point falls inside the body "
                          "(the voxel is coarser than the body); use a smaller voxel or more "
                          "polygons")
     idx = np.argwhere(seed)  # (k, j, i), C order

@@ -254,7 +254,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
         shape = tuple(int(v) for v in (np.ceil((ghi - glo) / h).astype(np.int64) + 1)[::-1])
         need = _estimate_bytes(shape)
         if need > 0.6 * physical_memory_bytes():
-            raise ValueError(f"`voxel_m` = {h:.4g} m needs a {shape[2]} x {shape[1]} x "
+            raise ParameterError("voxel_m", f"= {h:.4g} m needs a {shape[2]} x {shape[1]} x "
                              f"{shape[0]} grid, about {need / 2**30:.1f} GiB; this machine has "
                              f"{physical_memory_bytes() / 2**30:.1f} GiB: use fewer polygons "
                              "or a larger voxel")

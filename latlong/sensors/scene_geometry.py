@@ -18,6 +18,7 @@ import numpy as np
 
 import craters
 from craters._shared import ParameterError, check_choice
+from craters._shared.files import check_regular_file
 
 from ..body import Body, load
 from ..export import body_mesh_source
@@ -184,8 +185,7 @@ def scene_geometry(model, *, units: str = "m", craters=None, mesh=None) -> Scene
         geo = _from_source(model.mesh_source(), model.craters, model.boulders, "mesh surface")
     elif isinstance(model, str | Path):
         path = Path(model)
-        if not path.is_file():
-            raise ParameterError("model", f"file {str(path)!r} does not exist")
+        check_regular_file(path, "model file")
         suffix = path.suffix.lower()
         if suffix == ".npz":
             body = load(path)
@@ -235,5 +235,7 @@ def craters_catalog(path) -> np.ndarray:
     """A crater catalog CSV (as ``latlong build --catalog`` writes it)."""
     try:
         return craters.read_catalog(path)
+    except FileNotFoundError:
+        raise
     except (OSError, KeyError) as exc:
         raise ValueError(f"cannot read crater catalog {str(path)!r}: {exc}") from None

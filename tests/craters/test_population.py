@@ -119,7 +119,7 @@ def test_catalog_validation(tmp_path):
         craters.make_catalog(lat_deg=[95.0], lon_deg=[0.0], diameter_m=[1.0])
     with pytest.raises(ValueError, match="length"):
         craters.make_catalog(x_m=[0.0, 1.0], y_m=[0.0], diameter_m=[1.0, 2.0])
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist"):
         craters.read_catalog(tmp_path / "none.csv")
     bad = tmp_path / "bad.csv"
     bad.write_text("x_m,y_m,diameter_m\n1,2,abc\n")

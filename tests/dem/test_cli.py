@@ -55,6 +55,16 @@ def lola_tif(tmp_path, lola_crop):
 MOON = ["--body-radius-m", "1737400"]
 
 
+def write_ellipsoid(path):
+    """A geographic GeoTIFF on an ellipsoid (Mars's axes): no one radius, so the body
+    radius must be given (a sphere's CRS, as the Moon's, gives it itself)."""
+    with rasterio.open(path, "w", driver="GTiff", width=9, height=9, count=1,
+                       dtype="float32", crs="+proj=longlat +a=3396190 +b=3376200 +no_defs",
+                       transform=Affine(0.25, 0, 148.0, 0, -0.25, 32.0)) as ds:
+        ds.write(np.zeros((9, 9), np.float32), 1)
+    return path
+
+
 def test_expand_acceptance_257(run_cli, capsys, tmp_path, lola_tif):
     out = tmp_path / "out.tif"
     proc = run_cli("dem", "expand", str(lola_tif), "-o", str(out), "--levels", "1",
@@ -150,7 +160,8 @@ ENTRY_POINT = {"nocrs", "geographic", "allnan", "outside", "not-raster", "no-com
 @pytest.mark.parametrize("case,args,needles", [
     ("nocrs", ["expand", "{nocrs}", "-o", "{out}"], ["no CRS", "--pixel-size-m"]),
     ("nocrs-info", ["info", "{nocrs}"], ["no CRS", "--pixel-size-m"]),
-    ("geographic", ["expand", "{geo}", "-o", "{out}"], ["geographic CRS", "--body-radius-m"]),
+    ("geographic", ["expand", "{ellipsoid}", "-o", "{out}"],
+     ["geographic CRS", "--body-radius-m"]),
     ("allnan", ["fill", "{nan}", "-o", "{out}", "--pixel-size-m", "1"], ["NoData/NaN"]),
     ("outside", ["expand", "{geo}", "-o", "{out}", "--region", "200,200,129", *MOON],
      ["not inside the DEM"]),
@@ -184,7 +195,9 @@ def test_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_path, lo
     write_no_crs(tmp_path / "nocrs.tif")
     dem.write(dem.Dem(np.full((5, 5), np.nan), pixel_size_m=1.0), tmp_path / "nan.tif")
     (tmp_path / "notes.txt").write_text("not a raster\n")
+    write_ellipsoid(tmp_path / "ellipsoid.tif")
     names = {"nocrs": tmp_path / "nocrs.tif", "geo": lola_tif, "nan": tmp_path / "nan.tif",
+             "ellipsoid": tmp_path / "ellipsoid.tif",
              "text": tmp_path / "notes.txt", "missing": tmp_path / "none.tif",
              "out": tmp_path / "out.tif", "png": tmp_path / "out.png"}
     before = sorted(p.name for p in tmp_path.iterdir())
@@ -350,7 +363,8 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
      ["craters", "d_min_m"]),
     ("no-output", {"output": None}, [], ["-o/--output"]),
     ("no-input", {"input": None}, [], ["needs an input"]),
-    ("no-radius", {"body_radius_m": None}, [], ["geographic CRS", "--body-radius-m"]),
+    ("no-radius", {"body_radius_m": None, "input": "ellipsoid.tif"}, [],
+     ["geographic CRS", "--body-radius-m"]),
     ("bad-toml", None, [], ["TOML"]),
     ("missing-scene", "missing", [], ["does not exist"]),
 ])
@@ -362,6 +376,8 @@ def test_enhance_bad_input_one_line_exit_2_nothing_written(run_cli, capsys, tmp_
     elif extra != "missing":
         keys = {k: v for k, v in {**scene_keys(tmp_path, lola_tif), **extra}.items()
                 if v is not None}
+        if keys.get("input") == "ellipsoid.tif":
+            keys["input"] = str(write_ellipsoid(tmp_path / "ellipsoid.tif"))
         write_scene(scene, **keys)
     before = sorted(p.name for p in tmp_path.iterdir())
     runner = run_cli if case in ("unknown-key", "target-outside", "size-zero") else \

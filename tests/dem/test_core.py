@@ -20,7 +20,7 @@ MOON_WKT = ('GEOGCS["Moon",DATUM["D_Moon",SPHEROID["Moon",1737400,0]],'
 def test_pixel_size_without_crs():
     d = Dem(np.zeros((3, 4)), pixel_size_m=(2.0, 3.0))
     assert d.pixel_size_m == (2.0, 3.0) and d.resolution_m == pytest.approx(math.sqrt(6))
-    with pytest.raises(ValueError, match="no CRS.*pixel_size_m"):
+    with pytest.raises(ValueError, match="pixel_size_m.*no CRS"):
         Dem(np.zeros((3, 4)))
     with pytest.raises(ValueError, match="pixel_size_m"):
         Dem(np.zeros((3, 4)), pixel_size_m=-1.0)
@@ -45,8 +45,10 @@ def test_pixel_size_geographic(lat0):
     ground = 1737400.0 * math.radians(1)
     assert d.pixel_size_m == pytest.approx((0.25 * ground * math.cos(math.radians(lat0)),
                                             0.5 * ground))
-    with pytest.raises(ValueError, match=r"geographic CRS.*radius 1737400 m.*body_radius_m"):
-        Dem(np.zeros((11, 8)), t, MOON_WKT)
+    # a sphere's CRS gives the radius itself (issue 19 item 7); an ellipsoid's does not
+    assert Dem(np.zeros((11, 8)), t, MOON_WKT).pixel_size_m == d.pixel_size_m
+    with pytest.raises(ValueError, match=r"body_radius_m.*geographic CRS.*radius 3396190 m"):
+        Dem(np.zeros((11, 8)), t, "+proj=longlat +a=3396190 +b=3376200 +no_defs")
 
 
 def test_validation():

@@ -230,7 +230,7 @@ def test_write_read_roundtrip_and_files(tmp_path, stack):
                 [float(wx[0]), float(wy[0])])
             assert gj["crs"]["properties"]["name"] == "EPSG:32633"
     # an existing stack is replaced only with force; a foreign folder never
-    with pytest.raises(ValueError, match="exists; replace it with `force`"):
+    with pytest.raises(ValueError, match="`force` is needed: output .* exists"):
         stack.write(out)
     stack.write(out, force=True)
     other = tmp_path / "photos"

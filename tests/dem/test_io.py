@@ -83,10 +83,11 @@ def write_foreign_geographic(path, z):
     return path
 
 
-def test_geographic_needs_radius_unless_craterform_wrote_it(tmp_path, lola_crop):
+def test_geographic_radius_from_the_file_its_sphere_or_the_caller(tmp_path, lola_crop):
     foreign = write_foreign_geographic(tmp_path / "f.tif", lola_crop.heights)
-    with pytest.raises(ValueError, match="geographic CRS.*radius 1737400 m.*`body_radius_m`"):
-        dem.read(foreign)
+    # the CRS is a sphere (the Moon's): its radius, as `dem info` prints (issue 19 item 7)
+    assert dem.read(foreign).body_radius_m == 1737400.0
+    assert dem.read(foreign).pixel_size_m == pytest.approx(lola_crop.pixel_size_m)
     assert dem.read(foreign, body_radius_m=1737400.0).pixel_size_m == pytest.approx(
         lola_crop.pixel_size_m)
     p = dem.write(lola_crop, tmp_path / "g.tif")  # records the radius it knows
@@ -104,7 +105,7 @@ def test_geographic_needs_radius_unless_craterform_wrote_it(tmp_path, lola_crop)
 
 
 def test_read_errors(tmp_path, tiny_geotiff):
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist"):
         dem.read(tmp_path / "none.tif")
     text = tmp_path / "notes.tif"
     text.write_text("hello, not a raster\n")
@@ -118,7 +119,7 @@ def test_read_errors(tmp_path, tiny_geotiff):
     with rasterio.open(nocrs, "w", driver="GTiff", width=4, height=4, count=1,
                        dtype="float32", transform=Affine(2, 0, 0, 0, -2, 8)) as ds:
         ds.write(np.zeros((4, 4), np.float32), 1)
-    with pytest.raises(ValueError, match="no CRS.*`pixel_size_m`"):
+    with pytest.raises(ValueError, match="`pixel_size_m` is needed: the DEM has no CRS"):
         dem.read(nocrs)
     assert dem.read(nocrs, pixel_size_m=3.0).pixel_size_m == (3.0, 3.0)
     allnan = tmp_path / "nan.tif"
@@ -258,7 +259,8 @@ def test_pds_errors(tmp_path, image_extra, pointer, match):
     data = np.ones((3, 3), dtype="<i2")
     path = write_pds(tmp_path, data, sample_type="LSB_INTEGER", bits=16,
                      image_extra=image_extra, pointer=pointer)
-    with pytest.raises(ValueError, match=match):
+    missing = match == "is missing"  # the image file: FileNotFoundError, as any input
+    with pytest.raises(FileNotFoundError if missing else ValueError, match=match):
         dem.read(path, band=2 if "BANDS" in image_extra else 1)
 
 

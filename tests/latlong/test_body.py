@@ -49,16 +49,42 @@ def test_save_load_roundtrip_and_determinism(body, tmp_path):
 
 
 def test_load_errors(tmp_path):
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist"):
         load(tmp_path / "missing.npz")
     bad = tmp_path / "bad.npz"
     bad.write_bytes(b"not a zip")
-    with pytest.raises(ValueError, match="cannot read"):
+    with pytest.raises(ValueError, match="is not a body .npz.*not a .npz .zip. archive"):
         load(bad)
     other = tmp_path / "other.npz"
     np.savez(other, x=np.zeros(3))
     with pytest.raises(ValueError, match="not a craterform body"):
         load(other)
+
+
+def _mesh(tmp, name):
+    Body.sphere(LatLongGrid(4), 10.0).export(tmp / name)
+
+
+def _pickles(tmp, name):
+    np.savez(tmp / name, x=np.array([{"a": 1}], dtype=object))
+
+
+def _npy(tmp, name):
+    np.save(tmp / name, np.zeros(3))
+
+
+@pytest.mark.parametrize("name,make,why", [
+    ("b.ply", _mesh, "a .ply file is a mesh, which holds no lat/long body"),
+    ("b.obj", _mesh, "a .obj file is a mesh"),
+    ("b.npz", _pickles, "holds Python objects .pickles., which a body never does"),
+    ("b.npy", _npy, "it is not a .npz .zip. archive"),
+])
+def test_load_says_a_body_npz_is_needed(tmp_path, name, make, why):
+    """Not numpy's "pickled data ... allow_pickle" message (issue 19 item 7)."""
+    make(tmp_path, name)
+    with pytest.raises(ValueError, match=f"is not a body .npz .*{why}") as info:
+        load(tmp_path / name)
+    assert "allow_pickle" not in str(info.value)
 
 
 def read_binary_ply(path):

@@ -195,9 +195,10 @@ def test_read_example(tmp_path):
     Image.fromarray((np.clip(z + 3, 0, 6) * 40).astype(np.uint8)).save(tmp_path / "z.png")
     img, heights = read_example(tmp_path / "z.png")
     assert not heights and img.shape == (40, 50) and 0 <= img.min() <= img.max() <= 1
-    for name, match in (("missing.npy", "does not exist"), ("z.txt", "unknown format")):
+    for name, match, kind in (("missing.npy", "does not exist", FileNotFoundError),
+                              ("z.txt", "unknown format", ValueError)):
         (tmp_path / "z.txt").write_text("1 2")
-        with pytest.raises(ValueError, match=match):
+        with pytest.raises(kind, match=match):
             read_example(tmp_path / name)
     np.save(tmp_path / "v.npy", np.zeros(5))
     with pytest.raises(ValueError, match="2-D"):

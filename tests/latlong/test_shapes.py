@@ -82,7 +82,7 @@ def test_pyvista_formats(tmp_path, suffix):
 def test_reader_errors(tmp_path):
     with pytest.raises(ValueError, match="units"):
         read_shape_model(DATA / "itokawa_8.obj", units="au")
-    with pytest.raises(ValueError, match="does not exist"):
+    with pytest.raises(FileNotFoundError, match="does not exist"):
         read_shape_model(tmp_path / "none.obj", units="m")
     with pytest.raises(ValueError, match="empty"):
         read_shape_model(write_text(tmp_path / "e.obj", "# nothing\n"), units="m")
