@@ -58,12 +58,14 @@ from .terrain import (
     spectral_exponent,
     spectral_fit,
 )
+from .tiledfill import FilledFile, fill_to_file
 
 __all__ = [
     "CraterDensity",
     "Dem",
     "EnhanceConfig",
     "ExpandedFile",
+    "FilledFile",
     "SourceCraterLayer",
     "FractalFit",
     "LocalFrame",
@@ -84,6 +86,7 @@ __all__ = [
     "expansion_sizes",
     "fill_crater_gaps",
     "fill_gaps",
+    "fill_to_file",
     "fractal_dimension",
     "fractal_fit",
     "laplacian",
