@@ -312,6 +312,7 @@ def layers_of(run: Run, *, progress: bool = False):
         else:
             rr, cc, w = run.windows[k - 1]
             parent = prev[0].replace(heights=prev[1])
+            prev = meta = z = None  # the caller may drop them too: only the copy is held
             meta = expand(parent, 1, run.fd, cfg.roughness, Window(cc, rr, w, w), rng=run.seed)
             del parent
         z, cat = _stamp_layer(np.array(meta.heights), run.plans[k], run.geometry, k,
@@ -321,8 +322,7 @@ def layers_of(run: Run, *, progress: bool = False):
         if cfg.boulder_layers:
             z, rock = _stamp_boulders_layer(z, run.rock_plans[k], run.geometry, k, run.a0,
                                             rock_shape)
-        z = np.array(z, dtype=np.float64)
-        prev = None  # the previous layer's arrays go before the next is made
+        z = np.asarray(z, dtype=np.float64)  # a fresh array already (the stamped copy)
         yield k, meta, z, cat, rock
         prev = (meta, z)
 
