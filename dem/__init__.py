@@ -68,12 +68,14 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         spectral_exponent,
         spectral_fit,
     )
+    from .tiledfill import FilledFile, fill_to_file
 
 __all__ = [
     "CraterDensity",
     "Dem",
     "EnhanceConfig",
     "ExpandedFile",
+    "FilledFile",
     "SourceCraterLayer",
     "FractalFit",
     "LocalFrame",
@@ -94,6 +96,7 @@ __all__ = [
     "expansion_sizes",
     "fill_crater_gaps",
     "fill_gaps",
+    "fill_to_file",
     "fractal_dimension",
     "fractal_fit",
     "laplacian",

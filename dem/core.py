@@ -25,7 +25,8 @@ from craters._shared import (
     package_version,
 )
 
-__all__ = ["Dem", "HISTORY_TAG", "crs_label", "crs_sphere_radius_m", "parse_region"]
+__all__ = ["Dem", "HISTORY_TAG", "crs_label", "crs_sphere_radius_m", "parse_region",
+           "raster_pixel_size_m"]
 
 #: GeoTIFF tag holding the JSON list of craterform steps that made a layer.
 HISTORY_TAG = "CRATERFORM_HISTORY"
@@ -149,6 +150,42 @@ def _crs_radius_text(crs: CRS) -> str:
     return f", whose ellipsoid has radius {float(radius):.7g} m" if radius else ""
 
 
+
+def raster_pixel_size_m(transform: Affine, crs, shape, *, body_radius_m=None,
+                        pixel_size_m=None) -> tuple[float, float]:
+    """Pixel size (x, y) in metres of a raster of ``shape`` (what :attr:`Dem.pixel_size_m`
+    is, for a raster too big to hold as a Dem): the CRS's linear units, a geographic
+    CRS's degrees at the raster's centre latitude on a sphere of ``body_radius_m``, or
+    ``pixel_size_m`` (only without CRS)."""
+    t = transform
+    sx, sy = math.hypot(t.a, t.d), math.hypot(t.b, t.e)
+    if crs is None:
+        if pixel_size_m is None:
+            raise ParameterError("pixel_size_m", "is needed: the DEM has no CRS; give "
+                                 "its pixel size in metres")
+        return pixel_size_m
+    if pixel_size_m is not None:
+        raise ParameterError("pixel_size_m", f"is only for DEMs without a CRS; this DEM's "
+                             f"CRS ({crs_label(crs)}) gives the pixel size")
+    if crs.is_geographic:
+        if body_radius_m is None:
+            raise ParameterError(
+                "body_radius_m", f"is needed: the DEM has a geographic CRS "
+                f"({crs_label(crs)}){_crs_radius_text(crs)}; give the body radius in "
+                f"metres to convert degrees to metres")
+        rad = crs.units_factor[1]  # radians per angular unit
+        rows, cols = shape
+        lat_c = t.d * cols / 2.0 + t.e * rows / 2.0 + t.f
+        coslat = math.cos(lat_c * rad)
+        return (body_radius_m * rad * sx * abs(coslat), body_radius_m * rad * sy)
+    try:
+        factor = crs.linear_units_factor[1]
+    except CRSError as exc:
+        raise ValueError(f"cannot get a pixel size in metres from the CRS "
+                         f"{crs.to_string()!r}: {exc}") from None
+    return sx * factor, sy * factor
+
+
 class Dem:
     """A digital elevation model: a 2-D height array plus its georeferencing.
 
@@ -258,34 +295,8 @@ class Dem:
         self._cache: dict = {}
 
     def _derive_pixel_size(self) -> tuple[float, float]:
-        t = self._transform
-        sx, sy = math.hypot(t.a, t.d), math.hypot(t.b, t.e)
-        crs = self._crs
-        if crs is None:
-            if self._own_px is None:
-                raise ParameterError("pixel_size_m", "is needed: the DEM has no CRS; give "
-                                     "its pixel size in metres")
-            return self._own_px
-        if self._own_px is not None:
-            raise ParameterError("pixel_size_m", f"is only for DEMs without a CRS; this DEM's "
-                                 f"CRS ({crs_label(crs)}) gives the pixel size")
-        if crs.is_geographic:
-            if self._radius is None:
-                raise ParameterError(
-                    "body_radius_m", f"is needed: the DEM has a geographic CRS "
-                    f"({crs_label(crs)}){_crs_radius_text(crs)}; give the body radius in "
-                    f"metres to convert degrees to metres")
-            rad = crs.units_factor[1]  # radians per angular unit
-            rows, cols = self._h.shape
-            lat_c = t.d * cols / 2.0 + t.e * rows / 2.0 + t.f
-            coslat = math.cos(lat_c * rad)
-            return (self._radius * rad * sx * abs(coslat), self._radius * rad * sy)
-        try:
-            factor = crs.linear_units_factor[1]
-        except CRSError as exc:
-            raise ValueError(f"cannot get a pixel size in metres from the CRS "
-                             f"{crs.to_string()!r}: {exc}") from None
-        return sx * factor, sy * factor
+        return raster_pixel_size_m(self._transform, self._crs, self._h.shape,
+                                   body_radius_m=self._radius, pixel_size_m=self._own_px)
 
     # ------------------------------------------------------------------ data
     @property

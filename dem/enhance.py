@@ -44,6 +44,7 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
+from typing import NamedTuple
 
 import numpy as np
 from rasterio.windows import Window
@@ -70,7 +71,7 @@ from .planning import (
 )
 from .stack import Stack, propagate_up
 
-__all__ = ["enhance"]
+__all__ = ["Run", "enhance", "finish", "layer_step", "layers_of", "prepare", "stack_info"]
 
 logger = logging.getLogger(__name__)
 
@@ -201,13 +202,62 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     >>> c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
     True
     """
+    run = prepare(config, dem)
+    arrays: list[np.ndarray] = []
+    metas: list[Dem] = []
+    stamped: list[np.ndarray] = []
+    rocks: list = []
+    for k, meta, z, cat, rock in layers_of(run, progress=progress):
+        arrays.append(z)
+        metas.append(meta)
+        stamped.append(cat)
+        rocks.append(rock)
+        propagate_up(arrays, run.windows, k)
+    info = stack_info(run, stamped, rocks)
+    layers = [metas[k].with_step(arrays[k], "dem.enhance", run.seed, layer_step(run, k, stamped,
+                                                                              rocks))
+              for k in range(run.cfg.layers)]
+    return finish(run, layers, stamped, rocks, info)
+
+
+class Run(NamedTuple):
+    """A stack's settings and plan, made once before its layers (:func:`prepare`)."""
+
+    cfg: EnhanceConfig
+    seed: int
+    layer0: Dem
+    win0: Window
+    windows: list
+    t0: tuple
+    t_base: tuple
+    frame: object
+    a0: object
+    p0: float
+    geometry: StackGeometry
+    target: object
+    plans: list
+    accounting: dict
+    rock_plans: list
+    rock_accounting: dict | None
+    source_density: object
+    fd: float
+    fd_estimated: float | None
+
+
+def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -> Run:
+    """Check a stack's description, read the base, plan the layers, craters and boulders.
+
+    ``layers_held``: how many layer-sized arrays the run keeps at once (default: every
+    layer, as :func:`enhance`), for the up-front memory check.
+    """
     cfg = EnhanceConfig.from_mapping(config)
     if (dem is None) == (cfg.input is None):
         raise ValueError("give the base DEM either as the `input` key or as `dem`, not both"
                          if dem is not None else "no base DEM: give the `input` key")
     if dem is not None and not isinstance(dem, Dem):
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
-    need = cfg.layers * cfg.size**2 * 8 * 2.5 + (2 * cfg.size + 8) ** 2 * 8 * 2.3
+    held = cfg.layers * 2.5 if layers_held is None else layers_held
+    need = held * cfg.size**2 * 8 + (2 * cfg.size + 8) ** 2 * 8 * 2.3
     if need > 0.85 * physical_memory_bytes():
         raise ValueError(f"{cfg.layers} layers of {cfg.size}^2 pixels need about "
                          f"{human_bytes(need)} of memory; this machine has "
@@ -236,73 +286,97 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     crater_layers = below_source(crater_layers, cfg.source_crater_px, p0)
     plans, accounting = plan_craters(crater_layers, geometry, min_px=cfg.min_crater_px,
                                      reach_radii=reach_radii, seed=seed)
-    with_rocks = bool(cfg.boulder_layers)
     rock_plans, rock_accounting = (plan_boulders(cfg.boulder_layers, geometry,
                                                  min_px=cfg.min_boulder_px, seed=seed)
-                                   if with_rocks else ([None] * cfg.layers, None))
-    rock_shape = craters.BoulderShape()
+                                   if cfg.boulder_layers else ([None] * cfg.layers, None))
     fd = cfg.fractal_dimension
     fd_estimated = None
     if fd is None:
         fd_estimated = expansion_fit(layer0).fractal_dimension
         fd = min(3.0, max(2.0, fd_estimated))
-    arrays: list[np.ndarray] = []
-    metas: list[Dem] = []
-    stamped: list[np.ndarray] = []
-    rocks: list = []
+    return Run(cfg, seed, layer0, win0, windows, t0, t_base, frame, a0, p0, geometry, target,
+               plans, accounting, rock_plans, rock_accounting, source_density, fd,
+               fd_estimated)
+
+
+def layers_of(run: Run, *, progress: bool = False):
+    """The layers of a stack one after the other: ``(k, meta, heights, craters,
+    boulders)``, layer k with its own craters and boulders, not yet synchronised with the
+    finer layers (:func:`dem.stack.propagate_up`); only the previous layer is kept."""
+    cfg = run.cfg
+    rock_shape = craters.BoulderShape()
+    prev = None
     for k in progress_bar(range(cfg.layers), enabled=progress, desc="enhance"):
         if k == 0:
-            meta = layer0
+            meta = run.layer0
         else:
-            rr, cc, w = windows[k - 1]
-            parent = metas[k - 1].replace(heights=arrays[k - 1])
-            meta = expand(parent, 1, fd, cfg.roughness, Window(cc, rr, w, w), rng=seed)
-        z, cat = _stamp_layer(np.array(meta.heights), plans[k], geometry, k,
-                              roughness=not cfg.smooth_craters, seed=seed, progress=False,
-                              target=target)
+            rr, cc, w = run.windows[k - 1]
+            parent = prev[0].replace(heights=prev[1])
+            prev = meta = z = None  # the caller may drop them too: only the copy is held
+            meta = expand(parent, 1, run.fd, cfg.roughness, Window(cc, rr, w, w), rng=run.seed)
+            del parent
+        z, cat = _stamp_layer(np.array(meta.heights), run.plans[k], run.geometry, k,
+                              roughness=not cfg.smooth_craters, seed=run.seed, progress=False,
+                              target=run.target)
         rock = None
-        if with_rocks:
-            z, rock = _stamp_boulders_layer(z, rock_plans[k], geometry, k, a0, rock_shape)
-        arrays.append(np.array(z, dtype=np.float64))
-        metas.append(meta)
-        stamped.append(cat)
-        rocks.append(rock)
-        propagate_up(arrays, windows, k)
+        if cfg.boulder_layers:
+            z, rock = _stamp_boulders_layer(z, run.rock_plans[k], run.geometry, k, run.a0,
+                                            rock_shape)
+        z = np.asarray(z, dtype=np.float64)  # a fresh array already (the stamped copy)
+        yield k, meta, z, cat, rock
+        prev = (meta, z)
+
+
+def layer_step(run: Run, k: int, stamped, rocks) -> dict:
+    """The ``dem.enhance`` step recorded in layer k's history."""
+    step = {"layer": k, "craters_stamped": len(stamped[k]),
+            "synchronised_with_finer_layers": k < run.cfg.layers - 1}
+    if run.cfg.boulder_layers:
+        step["boulders_stamped"] = len(rocks[k])
+    return step
+
+
+def stack_info(run: Run, stamped, rocks) -> dict:
+    """The stack's ``info`` (seed, parameters, target, crater and boulder accounting)."""
+    cfg = run.cfg
+    accounting = run.accounting
     n_stamped = [len(c) for c in stamped]
     accounting["stamped"] = n_stamped
     accounting["erased_on_steep_ground"] = [a - s for a, s in
                                             zip(accounting["assigned"], n_stamped, strict=True)]
+    rock_accounting = run.rock_accounting
     if rock_accounting is not None:
         n_rocks = [0 if r is None else len(r) for r in rocks]
         rock_accounting["stamped"] = n_rocks
         rock_accounting["off_grid"] = [a - s for a, s in
                                        zip(rock_accounting["assigned"], n_rocks, strict=True)]
     params = cfg.to_dict()
-    params.update(seed=seed, fractal_dimension=fd, fractal_dimension_estimated=fd_estimated)
-    info = {
-        "seed": seed,
+    params.update(seed=run.seed, fractal_dimension=run.fd,
+                  fractal_dimension_estimated=run.fd_estimated)
+    density = run.source_density
+    win0 = run.win0
+    return {
+        "seed": run.seed,
         "parameters": params,
         "target": {"world": None if cfg.target is None else list(cfg.target),
-                   "pixel_in_base": list(t_base), "pixel_in_layer0": list(t0),
-                   "world_pixel_centre": [float(v) for v in layer0.xy(*t0)]},
+                   "pixel_in_base": list(run.t_base), "pixel_in_layer0": list(run.t0),
+                   "world_pixel_centre": [float(v) for v in run.layer0.xy(*run.t0)]},
         "layer0_window_in_base": [int(win0.row_off), int(win0.col_off), cfg.size],
         "craters": accounting,
-        "source_crater_density": None if source_density is None else {
-            "c": source_density.c, "k": source_density.k, "count": source_density.count,
-            "area_m2": source_density.area_m2, "d_lo_m": source_density.d_lo_m,
-            "d_hi_m": source_density.d_hi_m},
+        "source_crater_density": None if density is None else {
+            "c": density.c, "k": density.k, "count": density.count,
+            "area_m2": density.area_m2, "d_lo_m": density.d_lo_m,
+            "d_hi_m": density.d_hi_m},
         "boulders": rock_accounting,
         "randomness": "numpy SeedSequence(seed, spawn_key=(1, band)) for the population of "
                       "each diameter band, (2, band) and (3,) for the rejected counts, "
                       "(4, layer) for stamping; the RMD key is default_rng(seed)'s first "
                       "draw",
     }
-    layers = []
-    for k in range(cfg.layers):
-        step = {"layer": k, "craters_stamped": n_stamped[k],
-                "synchronised_with_finer_layers": k < cfg.layers - 1}
-        if with_rocks:
-            step["boulders_stamped"] = len(rocks[k])
-        layers.append(metas[k].with_step(arrays[k], "dem.enhance", seed, step))
-    catalogs = [_to_local(c, a0, p0) for c in stamped]
-    return Stack(layers, windows, frame, catalogs, info, rocks if with_rocks else None)
+
+
+def finish(run: Run, layers, stamped, rocks, info) -> Stack:
+    """The :class:`Stack` of the finished ``layers`` (catalogs to the local frame)."""
+    catalogs = [_to_local(c, run.a0, run.p0) for c in stamped]
+    return Stack(layers, run.windows, run.frame, catalogs, info,
+                 rocks if run.cfg.boulder_layers else None)

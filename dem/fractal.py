@@ -75,8 +75,8 @@ from .core import Dem
 MAX_ROUGHNESS = 1000.0
 
 __all__ = ["MAX_ROUGHNESS", "FractalFit", "SpectralFit", "dimension_warning", "expansion_fit",
-           "fractal_dimension", "fractal_fit", "local_msd", "local_roughness", "variogram",
-           "window_mean"]
+           "fractal_dimension", "fractal_fit", "fractal_fit_rows", "local_msd",
+           "local_roughness", "variogram", "window_mean"]
 
 #: Lags (pixels) of the fractal-dimension estimate: the finest scales above the pixel.
 DEFAULT_MIN_LAG_PX = 2
@@ -329,10 +329,84 @@ def fractal_fit(dem: Dem, max_lag_px: int = DEFAULT_MAX_LAG_PX, *,
     min_lag_px = check_int("min_lag_px", min_lag_px, 1, max_lag_px)
     fit = _normalised_fit(dem, _lag_range(dem.shape, min_lag_px, max_lag_px),
                           NORMALISER_WINDOW_PX)
+    return _band_limited(fit)
+
+
+def _band_limited(fit: FractalFit) -> FractalFit:
     if fit.lag_range_px != (2, 8) or fit.roughness == 0.0:
         return fit
     f = band_limited_dimension(fit.power_law_dimension)
     return dataclasses.replace(fit, fractal_dimension=f, hurst=3.0 - f)
+
+
+def fractal_fit_rows(read_rows, shape, pixel_size_m, resolution_m: float, *,
+                     strip_rows: int = 256) -> FractalFit:
+    """:func:`fractal_fit` (default lags) of a DEM read strip by strip: the same result,
+    bit for bit, for DEMs bigger than memory.
+
+    ``read_rows(a, b)`` returns rows ``a..b-1`` of the heights (all columns, float64,
+    NaN = unknown); ``shape``, ``pixel_size_m`` (x, y) and ``resolution_m`` are the
+    whole DEM's. Every local quantity (neighbour differences, the 9 x 9 normaliser) is
+    computed on strips of ``strip_rows`` rows with enough rows around them to be the
+    whole DEM's values, and every mean is a :class:`dem.streamsum.PairwiseSum` over the
+    same values in the same order as numpy's mean of the whole: so it reads the DEM
+    twice (the counts, then the sums). Raises ValueError as :func:`fractal_fit` does.
+    """
+    from .streamsum import PairwiseSum
+
+    rows, cols = (int(v) for v in shape)
+    strip_rows = check_int("strip_rows", strip_rows, 1)
+    lag_px = _lag_range((rows, cols), DEFAULT_MIN_LAG_PX, DEFAULT_MAX_LAG_PX)
+    keys = [("msd", 0)] + [(axis, k) for axis in (1, 0) for k in lag_px
+                           if k < (cols if axis == 1 else rows)]
+    halo = NORMALISER_WINDOW_PX // 2 + 1  # the normaliser: msd within 4 px, z within 1
+
+    def strips():
+        """Per strip, per key: the values the whole-DEM mean adds, in its order."""
+        for a in range(0, rows, strip_rows):
+            b = min(a + strip_rows, rows)
+            lo, hi = max(a - halo, 0), min(b + max(lag_px) + halo, rows)
+            z = np.asarray(read_rows(lo, hi), dtype=np.float64)
+            msd = local_msd(z)
+            norm_px = window_mean(msd, NORMALISER_WINDOW_PX)
+            part = msd[a - lo:b - lo]
+            out = {("msd", 0): part[np.isfinite(part)]}
+            for axis, k in keys[1:]:
+                if axis == 1:
+                    zz, nn = z[a - lo:b - lo], norm_px[a - lo:b - lo]
+                    d = zz[:, k:] - zz[:, :-k]
+                    norm = 0.5 * (nn[:, k:] + nn[:, :-k])
+                else:  # pairs (i, i + k) for i in a..b-1
+                    e = min(b, rows - k)
+                    if e <= a:
+                        out[(axis, k)] = np.zeros(0)
+                        continue
+                    d = z[a - lo + k:e - lo + k] - z[a - lo:e - lo]
+                    norm = 0.5 * (norm_px[a - lo + k:e - lo + k] + norm_px[a - lo:e - lo])
+                ok = np.isfinite(d) & (norm > 0)
+                out[(axis, k)] = d[ok] ** 2 / norm[ok]
+            yield out
+
+    counts = dict.fromkeys(keys, 0)
+    for part in strips():
+        for key in keys:
+            counts[key] += part[key].size
+    sums = {key: PairwiseSum(counts[key]) for key in keys}
+    for part in strips():
+        for key in keys:
+            sums[key].push(part[key])
+    n_msd = counts[("msd", 0)]
+    roughness = (math.sqrt(sums[("msd", 0)].total / n_msd) / resolution_m if n_msd
+                 else math.nan)
+    dx, dy = pixel_size_m
+    lags, gam, used = [], [], []
+    for axis, k in keys[1:]:
+        if counts[(axis, k)]:
+            lags.append(k * (dx if axis == 1 else dy))
+            used.append(k)
+            gam.append(sums[(axis, k)].total / counts[(axis, k)])
+    return _band_limited(_fit_result((rows, cols), resolution_m, lag_px, roughness, lags,
+                                     gam, used))
 
 
 def expansion_fit(dem: Dem) -> FractalFit:
@@ -377,18 +451,24 @@ def _normalised_fit(dem: Dem, lag_px: list[int], window_px: int) -> FractalFit:
                 lags.append(k * size)
                 used.append(k)
                 gam.append(float(np.mean(d[ok] ** 2 / norm[ok])))
+    return _fit_result(z.shape, dem.resolution_m, lag_px, roughness, lags, gam, used)
+
+
+def _fit_result(shape, resolution_m: float, lag_px, roughness: float, lags, gam,
+                used) -> FractalFit:
+    """The :class:`FractalFit` of the normalised variogram ``gam`` at ``lags`` (metres;
+    ``used``: in pixels) and the RMS ``roughness`` (m/m)."""
     span = (min(used), max(used)) if used else (min(lag_px, default=1), max(lag_px, default=1))
     if not math.isfinite(roughness) or len(set(lags)) < 2:
         if math.isfinite(roughness) and roughness == 0.0:
-            return FractalFit(2.0, 1.0, 0.0, dem.resolution_m, tuple(lags), tuple(gam), span,
-                              2.0)
+            return FractalFit(2.0, 1.0, 0.0, resolution_m, tuple(lags), tuple(gam), span, 2.0)
         raise ValueError(
-            f"cannot estimate the fractal statistics of a {z.shape[0]} x {z.shape[1]} DEM with "
+            f"cannot estimate the fractal statistics of a {shape[0]} x {shape[1]} DEM with "
             f"{len(set(lags))} usable lag(s): give `fractal_dimension` and `roughness` "
             f"explicitly")
     slope = float(np.polyfit(np.log(lags), np.log(gam), 1)[0])
     hurst = slope / 2.0
-    return FractalFit(3.0 - hurst, hurst, roughness, dem.resolution_m,
+    return FractalFit(3.0 - hurst, hurst, roughness, resolution_m,
                       tuple(float(v) for v in lags), tuple(gam), span, 3.0 - hurst)
 
 

@@ -52,9 +52,7 @@ import numpy as np
 import craters
 from craters._shared import about
 
-from .core import Dem
 from .craterdensity import RESOLVED_CRATER_PX, CraterDensity, crater_density
-from .frame import crater_target
 
 __all__ = ["gap_crater_layer", "stamp_gap_craters"]
 
@@ -84,20 +82,26 @@ def gap_crater_layer(spec):
                     f"got {type(spec).__name__}")
 
 
-def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key: int,
-                      target=None):
+def stamp_gap_craters(z: np.ndarray, sl, hole: np.ndarray, layer, key: int, target, *,
+                      pixel_size_m, level: int, origin, around, offset=(0, 0)):
     """Stamp craters into one filled gap of ``z`` in place; returns (catalog, note).
 
-    ``sl`` is the gap's bounding box in ``z``, ``hole`` its mask there, ``layer`` "auto"
-    or a :class:`craters.CraterLayer`; the catalog has ``x_m, y_m`` from the centre of
-    pixel (0, 0) of ``z`` (columns and rows times the pixel sizes) and the stamped
-    columns of ``craters.stamp_many``; the note records the density used (None when
-    the gap holds no crater).
+    ``z`` is the DEM or a window of it at pixel ``offset`` of the DEM, holding the gap
+    and, with ``layer`` "auto", one gap size around it (or the DEM's edge); ``sl`` is
+    the gap's bounding box in ``z``, ``hole`` its mask there, ``layer`` "auto" or a
+    :class:`craters.CraterLayer`, ``target`` the craters' body; ``pixel_size_m`` the
+    DEM's (x, y), ``level`` and ``origin`` its lattice place (:attr:`Dem.origin`),
+    ``around(w0, w1, v0, v1)`` the DEM (original known pixels) of rows ``w0:w1`` and
+    columns ``v0:v1`` of ``z`` (what the density is measured on). The catalog has
+    ``x_m, y_m`` from the centre of the DEM's pixel (0, 0) (columns and rows times the
+    pixel sizes) and the stamped columns of ``craters.stamp_many``; the note records
+    the density used (None when the gap holds no crater).
     """
     from scipy import ndimage
 
     r0, r1, c0, c1 = sl[0].start, sl[0].stop, sl[1].start, sl[1].stop
-    dx, dy = dem.pixel_size_m
+    g0, h0 = origin[0] + offset[0] + r0, origin[1] + offset[1] + c0  # lattice index
+    dx, dy = pixel_size_m
     pixel = math.sqrt(dx * dy)
     # distance (pixels) from each gap pixel to the nearest pixel outside the gap
     inside = ndimage.distance_transform_edt(np.pad(hole, 1))[1:-1, 1:-1]
@@ -108,10 +112,9 @@ def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key:
         d_fit = min(d_fit, layer.d_max_m)
     if d_fit <= d_lo:
         return None, None
-    note = {"gap": [int(dem.origin[0] + r0), int(dem.origin[1] + c0), int(r1 - r0),
-                    int(c1 - c0)]}
+    note = {"gap": [int(g0), int(h0), int(r1 - r0), int(c1 - c0)]}
     if layer == "auto":
-        density = _density_around(z, dem, sl, hole)
+        density = _density_around(z, sl, around)
         note.update(source="measured around the gap",
                     craters_found=0 if density is None else density.count)
         if density is None or density.count < _MIN_COUNT:
@@ -123,8 +126,7 @@ def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key:
         law = dataclasses.replace(layer, d_min_m=d_lo, d_max_m=d_fit)
         note.update(source="given", layer=repr(layer))
     note.update(d_min_m=d_lo, d_max_m=d_fit)
-    gen = np.random.default_rng([key, 21, dem.level, dem.origin[0] + r0 + 2**40,
-                                 dem.origin[1] + c0 + 2**40])
+    gen = np.random.default_rng([key, 21, level, g0 + 2**40, h0 + 2**40])
     cat = craters.population([law],
                              x_range_m=(-0.5 * dx, (c1 - c0 - 0.5) * dx),
                              y_range_m=(-0.5 * dy, (r1 - r0 - 0.5) * dy), rng=gen)
@@ -140,23 +142,23 @@ def stamp_gap_craters(z: np.ndarray, dem: Dem, sl, hole: np.ndarray, layer, key:
     local = {name: cat[name] for name in cat.dtype.names}
     local.update(x_m=cat["x_m"] / dx * pixel, y_m=cat["y_m"] / dy * pixel)
     block = z[r0:r1, c0:c1]
-    out, stamped = craters.stamp_many(block, pixel, craters.make_catalog(**local), rng=gen,
-                                      target=crater_target(dem) if target is None else target,
-                                      return_catalog=True)
+    # other gaps in the box that are not filled yet (a gap around an island holding one)
+    # are NaN; the craters lie inside this gap and never reach them, so any number does
+    ground = np.where(np.isnan(block), 0.0, block) if np.isnan(block).any() else block
+    out, stamped = craters.stamp_many(ground, pixel, craters.make_catalog(**local), rng=gen,
+                                      target=target, return_catalog=True)
     block[hole] = out[hole]
-    stamped["x_m"] = (stamped["x_m"] / pixel + c0) * dx
-    stamped["y_m"] = (stamped["y_m"] / pixel + r0) * dy
+    stamped["x_m"] = (stamped["x_m"] / pixel + (c0 + offset[1])) * dx
+    stamped["y_m"] = (stamped["y_m"] / pixel + (r0 + offset[0])) * dy
     note["stamped"] = len(stamped)
     return stamped, note
 
 
-def _density_around(z: np.ndarray, dem: Dem, sl, hole: np.ndarray) -> CraterDensity | None:
+def _density_around(z: np.ndarray, sl, around) -> CraterDensity | None:
     """:func:`dem.crater_density` of the known terrain within one gap size of the gap."""
-    from rasterio.windows import Window
-
     rows, cols = z.shape
     r0, r1, c0, c1 = sl[0].start, sl[0].stop, sl[1].start, sl[1].stop
     reach = max(r1 - r0, c1 - c0)
     w0, w1 = max(r0 - reach, 0), min(r1 + reach, rows)
     v0, v1 = max(c0 - reach, 0), min(c1 + reach, cols)
-    return crater_density(dem.crop(Window(v0, w0, v1 - v0, w1 - w0)))
+    return crater_density(around(w0, w1, v0, v1))

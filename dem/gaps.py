@@ -43,6 +43,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from rasterio.windows import Window
 
 from craters._shared import about, check_range
 
@@ -57,14 +58,18 @@ from ._fill_kernels import (
 from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import MAX_ROUGHNESS, NORMALISER_WINDOW_PX, fractal_fit, local_msd, window_mean
+from .frame import crater_target
 from .gapcraters import gap_crater_layer, stamp_gap_craters
 
 __all__ = ["fbm_noise", "fill_gaps", "harmonic_fill"]
 
+# fill_hole, known_dimension, record_craters and the constants are also what
+# dem.tiledfill fills a DEM bigger than memory with, hole by hole
+
 #: Noise box: the hole's bounding box plus this fraction of its longer side on each side.
 NOISE_MARGIN = 0.25
 #: Most craters listed one by one in the history tags (more: the count only).
-_MAX_RECORDED = 2000
+MAX_RECORDED = 2000
 #: F used when the known terrain is too small to estimate it (and no value is given).
 DEFAULT_FRACTAL_DIMENSION = 2.5
 # Laplace solve (multigrid-preconditioned conjugate gradients): stop when a step changes
@@ -135,6 +140,54 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
     if not dem.known.any():
         raise ValueError("`dem` has no known pixel (all NaN): there is nothing to fill from")
+    roughness, fractal_dimension, layer, key, seed = fill_arguments(
+        roughness, fractal_dimension, craters, rng)
+    unknown = ~dem.known
+    params: dict = {"roughness": "local" if roughness is None else roughness}
+    if fractal_dimension is None:
+        estimated = _known_dimension(dem) if unknown.any() else math.nan
+        params["fractal_dimension_estimated"] = estimated
+        fractal_dimension = known_dimension(estimated)
+    params.update(fractal_dimension=fractal_dimension, key=key,
+                  filled_pixels=int(unknown.sum()))
+    z = np.array(dem.heights, dtype=np.float64, copy=True)
+    holes = _holes(unknown)
+    params["holes"] = len(holes)
+    catalogs, notes = [], []
+    if layer is not None and target is None:
+        target = crater_target(dem)
+    if holes:
+        amp = (None if roughness is not None
+               else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
+
+        def around(w0, w1, v0, v1):
+            return dem.crop(Window(v0, w0, v1 - v0, w1 - w0))
+
+        for sl, hole in holes:
+            fill_hole(z, sl, hole, amp, roughness * dem.resolution_m if roughness is not None
+                      else None, fractal_dimension, key, level=dem.level, origin=dem.origin)
+            if layer is not None:
+                cat, note = stamp_gap_craters(z, sl, hole, layer, key, target,
+                                              pixel_size_m=dem.pixel_size_m, level=dem.level,
+                                              origin=dem.origin, around=around)
+                if note is not None:
+                    notes.append(note)
+                if cat is not None:
+                    catalogs.append(cat)
+    catalog = record_craters(params, catalogs, notes, layer, dem.pixel_size_m)
+    out = dem.with_step(z, "dem.fill_gaps", seed, params)
+    if not return_catalog:
+        return out
+    if catalog is None:
+        import craters as _craters_pkg
+
+        catalog = _craters_pkg.make_catalog(x_m=[], y_m=[], diameter_m=[])
+    return out, catalog
+
+
+def fill_arguments(roughness, fractal_dimension, craters, rng):
+    """The checked arguments of a fill: (roughness, fractal_dimension, crater layer, noise
+    key, seed recorded)."""
     if roughness is not None:
         with about("roughness"):
             roughness = check_range("roughness", roughness, 0.0, MAX_ROUGHNESS)
@@ -144,47 +197,30 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     layer = gap_crater_layer(craters)
     with about("rng"):
         key, seed = key_from_rng(rng)
-    unknown = ~dem.known
-    params: dict = {"roughness": "local" if roughness is None else roughness}
-    if fractal_dimension is None:
-        estimated = _known_dimension(dem) if unknown.any() else math.nan
-        params["fractal_dimension_estimated"] = estimated
-        fractal_dimension = (DEFAULT_FRACTAL_DIMENSION if not math.isfinite(estimated)
-                             else min(3.0, max(2.0, estimated)))
-    params.update(fractal_dimension=fractal_dimension, key=key,
-                  filled_pixels=int(unknown.sum()))
-    z = np.array(dem.heights, dtype=np.float64, copy=True)
-    holes = _holes(unknown)
-    params["holes"] = len(holes)
-    catalogs, notes = [], []
-    if holes:
-        amp = (None if roughness is not None
-               else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
-        for sl, hole in holes:
-            _fill_hole(z, dem, sl, hole, amp, roughness, fractal_dimension, key)
-            if layer is not None:
-                cat, note = stamp_gap_craters(z, dem, sl, hole, layer, key, target)
-                if note is not None:
-                    notes.append(note)
-                if cat is not None:
-                    catalogs.append(cat)
+    return roughness, fractal_dimension, layer, key, seed
+
+
+def known_dimension(estimated: float) -> float:
+    """The F a fill uses: the estimate clipped to [2, 3], or
+    :data:`DEFAULT_FRACTAL_DIMENSION` when there is none (NaN)."""
+    return (DEFAULT_FRACTAL_DIMENSION if not math.isfinite(estimated)
+            else min(3.0, max(2.0, estimated)))
+
+
+def record_craters(params: dict, catalogs: list, notes: list, layer, pixel_size_m):
+    """Record the gap craters in the step's ``params`` (count, densities, and up to
+    :data:`MAX_RECORDED` as [row, col, diameter_m, degradation]); their catalog (None:
+    none)."""
     catalog = (np.concatenate(catalogs) if catalogs else None)
     params["craters"] = 0 if catalog is None else len(catalog)
     params["crater_density"] = "none" if layer is None else notes
-    if catalog is not None and len(catalog) <= _MAX_RECORDED:
+    if catalog is not None and len(catalog) <= MAX_RECORDED:
         params["crater_catalog"] = [
-            [round(float(r["y_m"] / dem.pixel_size_m[1]), 3),
-             round(float(r["x_m"] / dem.pixel_size_m[0]), 3),
+            [round(float(r["y_m"] / pixel_size_m[1]), 3),
+             round(float(r["x_m"] / pixel_size_m[0]), 3),
              round(float(r["diameter_m"]), 3), round(float(r["degradation"]), 4)]
             for r in catalog]
-    out = dem.with_step(z, "dem.fill_gaps", seed, params)
-    if not return_catalog:
-        return out
-    if catalog is None:
-        import craters as _craters_pkg
-
-        catalog = _craters_pkg.make_catalog(x_m=[], y_m=[], diameter_m=[])
-    return out, catalog
+    return catalog
 
 
 def _known_dimension(dem: Dem) -> float:
@@ -205,8 +241,15 @@ def _holes(unknown: np.ndarray) -> list[tuple[tuple[slice, slice], np.ndarray]]:
     return [(sl, labels[sl] == k) for k, sl in enumerate(ndimage.find_objects(labels), 1)]
 
 
-def _fill_hole(z, dem: Dem, sl, hole, amp, roughness, fractal_dimension, key) -> None:
-    """Fill one hole of ``z`` in place (``sl`` its bounding box, ``hole`` its mask)."""
+def fill_hole(z, sl, hole, amp, uniform_m, fractal_dimension, key, *, level: int,
+              origin) -> None:
+    """Fill one hole of ``z`` in place (``sl`` its bounding box, ``hole`` its mask).
+
+    ``z`` is the DEM or a window of it holding the hole with 6 pixels around it (or the
+    DEM's edge): the result depends on nothing else. ``amp``: the local relief
+    (metres, aligned with ``z``) unless ``uniform_m`` (metres) is given; ``level`` and
+    ``origin`` place ``z[0, 0]`` on the global lattice of the noise.
+    """
     rows, cols = z.shape
     r0, r1, c0, c1 = sl[0].start, sl[0].stop, sl[1].start, sl[1].stop
     # the window: the hole and its 4-neighbours (the Dirichlet data)
@@ -214,19 +257,19 @@ def _fill_hole(z, dem: Dem, sl, hole, amp, roughness, fractal_dimension, key) ->
     v0, v1 = max(c0 - 1, 0), min(c1 + 1, cols)
     solve = np.zeros((w1 - w0, v1 - v0), dtype=bool)
     solve[r0 - w0:r1 - w0, c0 - v0:c1 - v0] = hole
-    if roughness is None:
+    if uniform_m is None:
         sigma = np.where(solve, np.nan, amp[w0:w1, v0:v1])
         sigma = harmonic_fill(np.where(np.isfinite(sigma), sigma, np.nan), solve)
     else:
-        sigma = np.full(solve.shape, roughness * dem.resolution_m)
+        sigma = np.full(solve.shape, uniform_m)
     if not np.any(sigma[solve] > 0):
         z[w0:w1, v0:v1] = np.where(solve, harmonic_fill(z[w0:w1, v0:v1], solve),
                                    z[w0:w1, v0:v1])
         return
     m = max(1, int(math.ceil(NOISE_MARGIN * max(r1 - r0, c1 - c0))))
     box = (r1 - r0 + 2 * m, c1 - c0 + 2 * m)
-    noise = fbm_noise(box, fractal_dimension, key=key, level=dem.level,
-                      origin=(dem.origin[0] + r0 - m, dem.origin[1] + c0 - m))
+    noise = fbm_noise(box, fractal_dimension, key=key, level=level,
+                      origin=(origin[0] + r0 - m, origin[1] + c0 - m))
     n_w = noise[w0 - r0 + m:w1 - r0 + m, v0 - c0 + m:v1 - c0 + m]
     texture = np.where(np.isfinite(sigma), sigma, 0.0) * n_w
     mismatch = harmonic_fill(z[w0:w1, v0:v1] - texture, solve)

@@ -55,7 +55,7 @@ _COG_OPTIONS = {"compress": "DEFLATE", "predictor": "FLOATING_POINT", "blocksize
 
 # --------------------------------------------------------------------------- read
 def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = None,
-         body: str | None = None, *, window=None) -> Dem:
+         body: str | None = None, *, window=None, allow_unknown: bool = False) -> Dem:
     """Read a DEM: a GeoTIFF (or any raster GDAL reads) or a PDS3 ``.IMG``/``.LBL`` pair.
 
     NoData pixels become NaN; the band's scale and offset are applied; the CRS (with
@@ -95,7 +95,8 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         ``read(path).crop(window)`` - its transform, lattice origin and pixel size are
         the window's - without reading the rest of the file (GeoTIFFs read their
         blocks, PDS3 images their lines), so a window of a DEM bigger than memory can
-        be worked on. A window whose every pixel is NoData is an error.
+        be worked on. A window whose every pixel is NoData is an error unless
+        ``allow_unknown`` (a tile in a gap of a DEM bigger than memory).
 
     Returns
     -------
@@ -130,7 +131,7 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
                            PIXEL_SIZE_TAG)
     if body_radius_m is None and body is not None and crs is not None and crs.is_geographic:
         body_radius_m = get_target(body).radius_m
-    if not np.isfinite(heights).any():
+    if not allow_unknown and not np.isfinite(heights).any():
         where = "" if win is None else f" of the window {_window_text(win)}"
         raise ValueError(f"{str(path)!r}: every pixel{where} is NoData/NaN; there is no "
                          f"terrain to work with")

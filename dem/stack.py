@@ -384,18 +384,22 @@ def check_stack_folder(folder, *, force: bool, inputs=()) -> Path:
     return folder
 
 
-def write_stack(stack: Stack, folder: Path, *, progress: bool = False) -> Path:
+def write_stack(stack: Stack, folder: Path, *, progress: bool = False,
+                layer_files=None) -> Path:
     """Write ``stack`` into ``folder``, already checked by :func:`check_stack_folder`
     (:meth:`Stack.write` does both; the command line checks before the work); return the
     manifest's path. The files go to a temporary folder next to ``folder`` that is renamed
-    into place at the end, so an error leaves nothing behind."""
+    into place at the end, so an error leaves nothing behind. ``layer_files``: the layers'
+    GeoTIFFs made already (on the same file system; moved in instead of written)."""
     n = len(stack)
     with _atomic_folder(Path(folder)) as tmp:
         steps = [("layer", k) for k in range(n)]
         steps += [("craters", k) for k in range(n) if stack.catalogs[k] is not None]
         steps += [("boulders", k) for k in range(n) if stack.boulders[k] is not None]
         for what, k in progress_bar(steps, enabled=progress, desc="write"):
-            if what == "layer":
+            if what == "layer" and layer_files is not None:
+                os.replace(layer_files[k], tmp / _layer_file(k))
+            elif what == "layer":
                 write(stack.layers[k], tmp / _layer_file(k))
             else:
                 _write_catalog(stack, k, tmp, boulders=what == "boulders")

@@ -184,6 +184,10 @@ OPTIONS: tuple[Opt, ...] = (
         "density the crater detector finds around each gap), none, or a crater layer "
         "c=..,k=..,d_min_m=..,d_max_m=.. (N_cum = c D^k per m^2, D in metres)", (_FILL,),
         metavar="SPEC"),
+    Opt(("--max-memory-gb",), "max_memory_gb", _number, None,
+        "memory the fill may use, GB: a DEM whose whole-raster fill would need more is "
+        "filled tile by tile from the file (the same bytes); a gap too large to fill "
+        "within it is refused", (_FILL,), "0.8 x this machine's memory", metavar="GB"),
     Opt(("--levels",), "levels", _integer, 1, "number of 2x expansions (1..16)", (_EXPAND,),
         metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
@@ -323,11 +327,12 @@ def check_output(s: Settings, suffixes) -> Path:
     return check_output_path(out, force=s["force"], suffixes=suffixes)
 
 
-def read_input(s: Settings, path=None):
-    """Read the input DEM (or ``path``) with the band, pixel size and body radius options."""
+def read_input(s: Settings, path=None, **kw):
+    """Read the input DEM (or ``path``) with the band, pixel size and body radius options
+    (``kw``: more of :func:`dem.read`'s, e.g. a window)."""
     return read(s["input"] if path is None else path, band=s.get("band", 1),
                 pixel_size_m=s["pixel_size_m"], body_radius_m=s["body_radius_m"],
-                body=s.get("body"))
+                body=s.get("body"), **kw)
 
 
 # --------------------------------------------------------------------------- parsers

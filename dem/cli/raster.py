@@ -15,6 +15,7 @@ from ..frame import crater_target
 from ..gaps import fill_gaps
 from ..io import GEOTIFF_SUFFIXES, write
 from ..terrain import MATCHED_BAND_PX, spectral_fit
+from ..tiledfill import fill_to_file, fits_whole, raster_shape
 from .options import Settings, add_command, check_output, read_input
 
 #: ``dem info`` counts craters of up to this many pixels on DEMs up to this many pixels
@@ -40,6 +41,21 @@ def _transform(s: Settings) -> int:
     show = not s["quiet"]
     bar = progress_bar(total=3, enabled=show, desc=command)
     bar.set_description(f"read {s['input']}")
+    head = read_input(s, window=(0, 0, 1, 1), allow_unknown=True) if command == "fill" \
+        else None
+    if head is not None and not fits_whole(raster_shape(s["input"]),
+                                           s["max_memory_gb"]):
+        # bigger than memory: tile by tile from the file (the same bytes)
+        bar.close()
+        made = fill_to_file(s["input"], s["output"], s["roughness"],
+                            fractal_dimension=s["fractal_dimension"], craters=s["craters"],
+                            rng=seed, target=crater_target(head, s.get("body"),
+                                                           s.get("gravity_m_s2")),
+                            band=s["band"], pixel_size_m=s["pixel_size_m"],
+                            body_radius_m=s["body_radius_m"], body=s.get("body"),
+                            max_memory_gb=s["max_memory_gb"], progress=show)
+        _summary(s, seed, raster_shape(s["input"]), made.shape, made.parameters)
+        return 0
     dem = read_input(s)
     bar.update()
     bar.set_description(command)
@@ -58,15 +74,21 @@ def _transform(s: Settings) -> int:
         shape, params = made.shape, made.parameters
     bar.update()
     bar.close()
-    if show:
-        detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
-                           else f"{k} {params[k]}" for k in params
-                           if k in ("levels", "fractal_dimension", "roughness",
-                                    "filled_pixels", "holes", "craters"))
-        print(f"dem {command}: {dem.shape[0]} x {dem.shape[1]} -> {shape[0]} x "
-              f"{shape[1]} pixels, seed {seed}, {detail}")
-        print(f"wrote {s['output']}")
+    _summary(s, seed, dem.shape, shape, params)
     return 0
+
+
+def _summary(s: Settings, seed: int, shape_in, shape, params: dict) -> None:
+    """The two lines ``dem fill`` / ``dem expand`` print unless ``--quiet``."""
+    if s["quiet"]:
+        return
+    detail = ", ".join(f"{k} {params[k]:.4g}" if isinstance(params[k], float)
+                       else f"{k} {params[k]}" for k in params
+                       if k in ("levels", "fractal_dimension", "roughness",
+                                "filled_pixels", "holes", "craters"))
+    print(f"dem {s.command}: {shape_in[0]} x {shape_in[1]} -> {shape[0]} x "
+          f"{shape[1]} pixels, seed {seed}, {detail}")
+    print(f"wrote {s['output']}")
 
 
 def _convert(s: Settings) -> int:

@@ -8,9 +8,9 @@ from craters._shared import about
 from craters._shared.cli import CliError
 
 from ..config import EnhanceConfig
-from ..enhance import enhance
+from ..enhancefile import enhance_to_folder
 from ..mesh import MESH_SUFFIXES, to_mesh
-from ..stack import check_stack_folder, read_stack, write_stack
+from ..stack import check_stack_folder, read_stack
 from .options import Settings, add_command, check_output, read_input
 
 
@@ -24,8 +24,9 @@ def _enhance(s: Settings) -> int:
         folder = check_stack_folder(s["output"], force=s["force"],
                                     inputs=(("DEM", s["input"]), ("config", s.config)))
     show = not s["quiet"]
-    stack = enhance(cfg, progress=show)
-    manifest = write_stack(stack, folder, progress=show)
+    # layer by layer into the folder (the bytes of enhance + write_stack; memory for
+    # about two layers, not all of them)
+    stack, manifest = enhance_to_folder(cfg, folder, progress=show)
     if show:
         info = stack.info
         c = info["craters"]
