@@ -33,6 +33,8 @@ from .shapes import from_shape_model
 __all__ = ["build", "mesh_spacing_m"]
 
 GENERATOR = "craterform latlong build"
+#: Vertices per block of the whole-body numpy steps (8 MB of radii).
+_BLOCK = 1 << 20
 logger = logging.getLogger(__name__)
 
 
@@ -45,7 +47,8 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool, out=None
     if isinstance(base, SphereBase):
         if out is None:
             return np.zeros(grid.n_vertices), body.radius_m, {}
-        out.fill(0.0)
+        for b0 in range(0, len(out), _BLOCK):
+            out[b0:b0 + _BLOCK] = 0.0
         return out, body.radius_m, {}
     if isinstance(base, FaultingParams):  # its stretch is the body's (the scene made it so)
         heights = two_phase_faulting(grid, body.radius_m, base, rng=rng, progress=progress)
@@ -136,7 +139,10 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
     grid = LatLongGrid(scene.body.magnitude)
     rng = np.random.default_rng(scene.seed)
     heights, radius_m, params = _base_heights(scene, grid, rng, progress, out)
-    heights += radius_m  # the radii, in place (`heights` is this function's own array)
+    # the radii, in place (`heights` is this function's own array), a block at a time so
+    # a disk-backed array's pages can be dropped between blocks (latlong.scratch)
+    for b0 in range(0, len(heights), _BLOCK):
+        heights[b0:b0 + _BLOCK] += radius_m
     craters, boulders = scene.craters, scene.boulders
     target = scene.target()
     metadata = _metadata(scene, params)

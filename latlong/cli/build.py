@@ -69,12 +69,12 @@ def _summary(made, scene: Scene) -> str:
 def _distance_range(body) -> tuple[float, float]:
     """Nearest and farthest surface points from the centre: the radii when unstretched,
     else |stretch * r * u| (a stretched body's radii are not its size), in 1 M-vertex
-    blocks."""
-    if tuple(body.stretch) == (1.0, 1.0, 1.0):
-        return float(body.radii_m.min()), float(body.radii_m.max())
+    blocks (a disk-backed body's pages are dropped between them)."""
     lo, hi = np.inf, 0.0
+    plain = tuple(body.stretch) == (1.0, 1.0, 1.0)
     for s in range(0, body.n_vertices, 1 << 20):
-        d = np.linalg.norm(body.vertices(s, min(s + (1 << 20), body.n_vertices)), axis=1)
+        e = min(s + (1 << 20), body.n_vertices)
+        d = body.radii_m[s:e] if plain else np.linalg.norm(body.vertices(s, e), axis=1)
         lo, hi = min(lo, float(d.min())), max(hi, float(d.max()))
     return lo, hi
 
