@@ -114,7 +114,8 @@ def build(scene: Scene, *, progress: bool = False, scratch_dir=None):
     if isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh":
         return _build_mesh(scene, progress)
     on_disk = scene.radii_on_disk()
-    radii = disk_radii(6 * scene.body.magnitude ** 2 + 2, scratch_dir) if on_disk else None
+    radii = disk_radii(LatLongGrid(scene.body.magnitude).n_vertices, scratch_dir) \
+        if on_disk else None
     try:
         return _build_latlong(scene, progress, overwrite=True, out=radii)
     except WaveScheduleOutgrown:

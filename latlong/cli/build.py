@@ -15,7 +15,7 @@ import numpy as np
 
 from craters._shared import human_bytes, progress_bar
 from craters._shared.cli import CliError
-from latlong import Scene, build
+from latlong import LatLongGrid, Scene, build
 from latlong.outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
 
 from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, shown
@@ -94,9 +94,9 @@ def cmd_build(args) -> int:
     if scene.radii_on_disk():
         scratch = Path(files[0]).parent
         if show:
-            print(f"keeping the {6 * scene.body.magnitude ** 2 + 2:.3g} radii "
-                  f"({(6 * scene.body.magnitude ** 2 + 2) * 8 / 1e9:.3g} GB) in a scratch file "
-                  f"in {str(scratch)!r} (--radii-on-disk)", file=sys.stderr)
+            n = LatLongGrid(scene.body.magnitude).n_vertices
+            print(f"keeping the {n:.3g} radii ({n * 8 / 1e9:.3g} GB) in a scratch file in "
+                  f"{str(scratch)!r} (--radii-on-disk)", file=sys.stderr)
     made = build(scene, progress=show, scratch_dir=scratch)
     bar.update()
     write_outputs(made, scene, outputs, progress=show, done=bar.update)
