@@ -12,21 +12,28 @@ import numpy as np
 
 from craters._shared import check_int, normalize_rng
 
+from ._surface_kernels import band_triangle_areas, band_triangle_areas_serial, sample_in_bands
 from .body import Body
 
 __all__ = ["band_areas", "sample_surface_points", "surface_positions"]
 
-#: Triangles per step of :func:`band_areas` (~250 B each while a step runs); each band's
+#: Triangles per step of :func:`band_areas` (8 B each while a step runs); each band's
 #: area is summed over the band alone, so the steps never change a value.
-_TRIANGLES_PER_STEP = 1 << 18
+_TRIANGLES_PER_STEP = 1 << 20
 
 
-def _triangle_areas(body: Body, band_lo: int, band_hi: int):
-    """Triangles of bands band_lo..band_hi-1 and their actual areas (m^2)."""
-    t = body.grid.band_triangles(band_lo, band_hi)
-    v0, v1 = int(t.min()), int(t.max()) + 1
-    p = body.vertices(v0, v1)[t - v0]
-    return t, 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1)
+def _triangle_areas(body: Body, band_lo: int, band_hi: int) -> np.ndarray:
+    """Actual areas (m^2) of the triangles of bands band_lo..band_hi-1, in
+    :meth:`LatLongGrid.band_triangles` order: the bits of
+    ``0.5 * norm(cross(p1 - p0, p2 - p0))`` over :meth:`Body.vertices` (a numba kernel,
+    bands in parallel when there are many; tests compare it with that expression)."""
+    g = body.grid
+    bo = g.band_offsets()
+    out = np.empty(int(bo[band_hi] - bo[band_lo]))
+    kernel = band_triangle_areas if band_hi - band_lo > 8 else band_triangle_areas_serial
+    kernel(g.magnitude, g.ring_offsets(), bo, body.radii_m,
+           np.ascontiguousarray(body.stretch, dtype=np.float64), band_lo, band_hi, out)
+    return out
 
 
 def band_areas(body: Body) -> np.ndarray:
@@ -47,7 +54,7 @@ def band_areas(body: Body) -> np.ndarray:
     while lo < n_bands:  # whole bands, about _TRIANGLES_PER_STEP triangles at a time
         hi = min(max(lo + 1, int(np.searchsorted(bo, bo[lo] + _TRIANGLES_PER_STEP,
                                                  side="right")) - 1), n_bands)
-        _, a = _triangle_areas(body, lo, hi)
+        a = _triangle_areas(body, lo, hi)
         totals[lo:hi] = np.add.reduceat(a, bo[lo:hi] - bo[lo])
         lo = hi
     return totals
@@ -62,6 +69,20 @@ def sample_surface_points(body: Body, areas: np.ndarray, n: int,
     For callers that already hold the band areas (one computation per body); the
     stream of ``rng`` draws is the same whatever the body.
     """
+    total, a, b, band, resid = _draws(areas, n, rng)
+    p = np.empty((n, 3))
+    order = np.argsort(band, kind="stable")
+    starts = np.searchsorted(band[order], np.arange(len(areas) + 1))
+    g = body.grid
+    sample_in_bands(g.magnitude, g.ring_offsets(), g.band_offsets(), body.radii_m,
+                    np.ascontiguousarray(body.stretch, dtype=np.float64),
+                    np.flatnonzero(np.diff(starts)), starts, order, resid, a, b, p)
+    return (*_grid_lat_lon(body, p), total)
+
+
+def _draws(areas: np.ndarray, n: int, rng: np.random.Generator):
+    """The random part of :func:`sample_surface_points`: (total area, barycentric a and b
+    folded into the triangle, each point's band, its area left within the band)."""
     cum = np.cumsum(areas)
     total = float(cum[-1])
     u = rng.random(n) * total
@@ -70,22 +91,16 @@ def sample_surface_points(body: Body, areas: np.ndarray, n: int,
     a[flip], b[flip] = 1 - a[flip], 1 - b[flip]
     band = np.minimum(np.searchsorted(cum, u, side="right"), len(cum) - 1)
     resid = u - np.concatenate([[0.0], cum[:-1]])[band]
-    p = np.empty((n, 3))
-    order = np.argsort(band, kind="stable")
-    starts = np.searchsorted(band[order], np.arange(len(areas) + 1))
-    for bnd in np.flatnonzero(np.diff(starts)):
-        sel = order[starts[bnd]:starts[bnd + 1]]
-        t, area = _triangle_areas(body, int(bnd), int(bnd) + 1)
-        k = np.minimum(np.searchsorted(np.cumsum(area), resid[sel], side="right"), len(t) - 1)
-        tri = t[k]
-        v = body.vertices(int(tri.min()), int(tri.max()) + 1)
-        v0, v1, v2 = (v[tri[:, c] - tri.min()] for c in range(3))
-        p[sel] = v0 + a[sel, None] * (v1 - v0) + b[sel, None] * (v2 - v0)
+    return total, a, b, band, resid
+
+
+def _grid_lat_lon(body: Body, p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Grid (lat_deg, lon_deg) of points ``p`` (m): their directions with the stretch undone."""
     q = p / np.asarray(body.stretch)
     q /= np.linalg.norm(q, axis=1, keepdims=True)
     lat = np.degrees(np.arcsin(np.clip(q[:, 2], -1, 1)))
     lon = np.mod(np.degrees(np.arctan2(q[:, 1], q[:, 0])), 360.0)
-    return lat, lon, total
+    return lat, lon
 
 
 def surface_positions(body: Body, n: int, *, rng=None) -> tuple[np.ndarray, np.ndarray, float]:
