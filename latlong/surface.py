@@ -17,9 +17,10 @@ from .body import Body
 
 __all__ = ["band_areas", "sample_surface_points", "surface_positions"]
 
-#: Triangles per step of :func:`band_areas` (8 B each while a step runs); each band's
-#: area is summed over the band alone, so the steps never change a value.
-_TRIANGLES_PER_STEP = 1 << 20
+#: Triangles per step of :func:`band_areas` (8 B each while a step runs: 32 MB, dozens of
+#: bands for the threads to share even at M = 13 000); each band's area is summed over
+#: the band alone, so the steps never change a value.
+_TRIANGLES_PER_STEP = 1 << 22
 
 
 def _triangle_areas(body: Body, band_lo: int, band_hi: int) -> np.ndarray:
@@ -30,7 +31,8 @@ def _triangle_areas(body: Body, band_lo: int, band_hi: int) -> np.ndarray:
     g = body.grid
     bo = g.band_offsets()
     out = np.empty(int(bo[band_hi] - bo[band_lo]))
-    kernel = band_triangle_areas if band_hi - band_lo > 8 else band_triangle_areas_serial
+    many = band_hi - band_lo > 1 and bo[band_hi] - bo[band_lo] > 100_000
+    kernel = band_triangle_areas if many else band_triangle_areas_serial
     kernel(g.magnitude, g.ring_offsets(), bo, body.radii_m,
            np.ascontiguousarray(body.stretch, dtype=np.float64), band_lo, band_hi, out)
     return out
