@@ -257,7 +257,8 @@ TILE_PX = 2049
 
 def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | None = None,
                    roughness: float | None = None, region=None, rng=None, *,
-                   tile_px: int | None = None, progress: bool = False) -> ExpandedFile:
+                   tile_px: int | None = None, scheduler: str | None = None,
+                   workers: int | None = None, progress: bool = False) -> ExpandedFile:
     """:func:`expand` written tile by tile into a GeoTIFF: results bigger than memory.
 
     The region is expanded as square tiles of ``2^k + 1`` input pixels sharing their
@@ -277,6 +278,11 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     tile_px : int, optional
         Largest output tile side in pixels (>= 3); default :data:`TILE_PX` (2049, about
         80 MB a tile).
+    scheduler, workers : optional
+        Expand the tiles as dask.distributed tasks: on the scheduler at an address such as
+        ``tcp://127.0.0.1:8786``, or on a local cluster of ``workers`` processes; each tile
+        is written as it arrives (the same bytes; the input DEM is sent to each worker
+        once). Neither: tile after tile in this process.
 
     Returns
     -------
@@ -294,10 +300,15 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     >>> info.shape, info.tiles, same
     ((65, 65), 16, True)
     """
+    from craters._shared.batch import check_dask_address
+    from craters._shared.tiletasks import map_tiles
+
     from .io import WindowWriter
 
     with about("tile_px"):
         tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
+    if scheduler is not None or workers is not None:
+        check_dask_address(scheduler, workers)
     plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
     step = 2**plan.levels
     # input tile: 2^k + 1 pixels, the largest whose expansion fits tile_px (at least 3)
@@ -318,9 +329,10 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
                       tags=tags, body_radius_m=dem.body_radius_m,
                       pixel_size_m=plan.pixel_size_m) as out:
         tiles = [(i, j) for i in range(n) for j in range(n)]
-        for i, j in progress_bar(tiles, enabled=progress, desc="expand tiles"):
-            z = _expand_tile(dem, plan, plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1),
-                             t_in)
+        corners = [(plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1), t_in) for i, j in tiles]
+        made = map_tiles(_tile_task, (dem, plan), corners, scheduler=scheduler, workers=workers)
+        for k, z in progress_bar(made, enabled=progress, total=len(tiles), desc="expand tiles"):
+            i, j = tiles[k]
             # tiles share their edge pixels: each writes all but its last row / column,
             # the last ones all (windows aligned to the output's blocks when large)
             rows = t_out if i == n - 1 else t_out - 1
@@ -396,6 +408,11 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
     origin = ((dem.origin[0] + r0) * 2**levels, (dem.origin[1] + c0) * 2**levels)
     return _Plan(r0, c0, width, levels, side, fractal_dimension, key, seed, params, uniform,
                  fallback, transform, px, origin)
+
+
+def _tile_task(shared: tuple[Dem, _Plan], corner: tuple[int, int, int]) -> np.ndarray:
+    """One tile of :func:`expand_to_file` (a task: ``shared`` is sent once a worker)."""
+    return _expand_tile(*shared, *corner)
 
 
 def _expand_tile(dem: Dem, plan: _Plan, r0: int, c0: int, width: int, *,

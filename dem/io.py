@@ -36,13 +36,24 @@ from craters._shared.files import check_regular_file
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
 from .crscode import CRS_TAG, crs_tags, restore_crs
 from .pdsimage import read_pds
+from .zarrio import (
+    ZARR_OPTIONS,
+    ZARR_SUFFIXES,
+    ChunkWriter,
+    ZarrStore,
+    check_zarr_output,
+    is_zarr,
+    is_zarr_store,
+)
 
-__all__ = ["GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "read", "write"]
+__all__ = ["DEM_SUFFIXES", "GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "read", "write"]
 
 logger = logging.getLogger(__name__)
 
-#: Suffixes :func:`write` accepts.
+#: GeoTIFF suffixes.
 GEOTIFF_SUFFIXES = (".tif", ".tiff")
+#: Suffixes :func:`write` accepts: GeoTIFF, or a Zarr store (:mod:`dem.zarrio`).
+DEM_SUFFIXES = GEOTIFF_SUFFIXES + ZARR_SUFFIXES
 #: Suffixes :func:`read` hands to the PDS3 reader (label checks, then GDAL's PDS driver).
 PDS_SUFFIXES = (".img", ".lbl")
 # tile size of the written cloud-optimised GeoTIFFs, pixels
@@ -110,7 +121,12 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         pixel; the message is one line naming the file.
     """
     path = Path(path)
-    check_regular_file(path, "DEM file")
+    if is_zarr(path) and path.is_dir():
+        if not is_zarr_store(path):
+            raise ValueError(f"{str(path)!r} is a folder but not a Zarr store (no .zgroup, "
+                             f".zarray or zarr.json)")
+    else:
+        check_regular_file(path, "DEM file")
     with about("band"):
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
@@ -237,7 +253,8 @@ def write(dem: Dem, path) -> Path:
     ``_HISTORY``, the body radius if known, ``CRATERFORM_BODY_RADIUS_M``, without a
     CRS the pixel size, ``CRATERFORM_PIXEL_SIZE_M``, and a CRS code the GeoTIFF keys
     cannot hold, e.g. ``IAU_2015:30135``, ``CRATERFORM_CRS``) are written. An existing file is
-    replaced.
+    replaced. A ``.zarr`` path writes a Zarr store instead (:mod:`dem.zarrio`: the same
+    heights and tags, no overviews), replacing only a Zarr DEM.
 
     Examples
     --------
@@ -250,13 +267,20 @@ def write(dem: Dem, path) -> Path:
     """
     if not isinstance(dem, Dem):
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
-    path = _check_geotiff_path(path)
+    path = _check_dem_path(path)
     rows, cols = dem.shape
     top = float(np.nanmax(np.abs(dem.heights))) if dem.known.any() else 0.0
     if top > np.finfo(np.float32).max:
         raise ValueError(f"output {str(path)!r}: heights up to {top:.6g} m do not fit the "
-                         f"GeoTIFF's float32 (at most {np.finfo(np.float32).max:.6g})")
+                         f"output's float32 (at most {np.finfo(np.float32).max:.6g})")
     data = dem.heights.astype(np.float32)
+    if is_zarr(path):
+        check_zarr_output(path, force=True)
+        with ZarrStore(path) as out:
+            with _open_zarr(out.store, rows, cols, dem.crs, dem.transform) as ds:
+                _write_metadata(ds, dem)
+            ChunkWriter(out.store).write(data, 0, 0)
+        return path
     with atomic_path(path) as tmp:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -269,12 +293,22 @@ def write(dem: Dem, path) -> Path:
     return path
 
 
-def _check_geotiff_path(path) -> Path:
+def _check_dem_path(path) -> Path:
     path = Path(path)
-    if path.suffix.lower() not in GEOTIFF_SUFFIXES:
-        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF; allowed: "
-                         f"{' '.join(GEOTIFF_SUFFIXES)}")
+    if path.suffix.lower() not in DEM_SUFFIXES:
+        raise ValueError(f"output {str(path)!r}: a DEM is written as GeoTIFF or Zarr; "
+                         f"allowed: {' '.join(DEM_SUFFIXES)}")
     return path
+
+
+def _open_zarr(store: Path, rows: int, cols: int, crs, transform):
+    """A new Zarr store (GDAL's driver, :data:`dem.zarrio.ZARR_OPTIONS`) to write into."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        return rasterio.open(store, "w", driver="Zarr", width=cols, height=rows, count=1,
+                             dtype="float32", nodata=np.nan, crs=crs,
+                             transform=Affine.identity() if transform is None else transform,
+                             **ZARR_OPTIONS)
 
 
 def _file_tags(tags, crs, body_radius_m, pixel_size_m) -> dict:
@@ -301,7 +335,9 @@ def _set_metadata(ds, tags: dict) -> None:
 
 class WindowWriter:
     """A DEM written window by window into the cloud-optimised GeoTIFF :func:`write`
-    makes of the whole (the same bytes), for DEMs bigger than memory.
+    makes of the whole (the same bytes), for DEMs bigger than memory; a ``.zarr`` path
+    writes the windows straight into the Zarr store's chunks (the same files as
+    :func:`write` makes).
 
     The windows go into a temporary tiled GeoTIFF next to ``path`` (256 x 256 blocks,
     uncompressed: 4 bytes a pixel on disk while it exists); :meth:`close` copies it into
@@ -335,7 +371,7 @@ class WindowWriter:
     def __init__(self, path, shape, *, transform: Affine | None = None, crs=None,
                  tags=None, body_radius_m: float | None = None, pixel_size_m=None,
                  cache_mb: int = 256):
-        self.path = _check_geotiff_path(path)
+        self.path = _check_dem_path(path)
         rows, cols = (check_int("shape", v, 1) for v in shape)
         self.shape = (rows, cols)
         transform = Affine.identity() if transform is None else transform
@@ -344,19 +380,31 @@ class WindowWriter:
                 raise ParameterError("pixel_size_m", "is needed for a DEM without CRS")
             pair = np.broadcast_to(np.asarray(pixel_size_m, dtype=np.float64), (2,))
             pixel_size_m = tuple(float(v) for v in pair)
-        self._tmp = temp_file(self.path, ".part.tif")
+        self._tmp = self._zarr = None
+        if is_zarr(self.path):  # straight into the store's chunks
+            check_zarr_output(self.path, force=True)
+            self._zarr = ZarrStore(self.path)
+        else:
+            self._tmp = temp_file(self.path, ".part.tif")
         self._env = rasterio.Env(GDAL_CACHEMAX=int(cache_mb))
         self._env.__enter__()
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", NotGeoreferencedWarning)
-                self._ds = rasterio.open(self._tmp, "w", driver="GTiff", width=cols,
-                                         height=rows, count=1, dtype="float32",
-                                         nodata=np.nan, crs=crs, transform=transform,
-                                         tiled=True, blockxsize=_BLOCK, blockysize=_BLOCK,
-                                         bigtiff="IF_SAFER", sparse_ok=True)
+                if self._zarr is not None:
+                    self._ds = _open_zarr(self._zarr.store, rows, cols, crs, transform)
+                else:
+                    self._ds = rasterio.open(self._tmp, "w", driver="GTiff", width=cols,
+                                             height=rows, count=1, dtype="float32",
+                                             nodata=np.nan, crs=crs, transform=transform,
+                                             tiled=True, blockxsize=_BLOCK,
+                                             blockysize=_BLOCK, bigtiff="IF_SAFER",
+                                             sparse_ok=True)
                 _set_metadata(self._ds, _file_tags(tags or {}, crs, body_radius_m,
                                                    pixel_size_m))
+            if self._zarr is not None:  # GDAL wrote the metadata; the heights go in chunks
+                self._ds.close()
+                self._chunks = ChunkWriter(self._zarr.store)
         except BaseException:
             self._discard()
             raise
@@ -368,7 +416,10 @@ class WindowWriter:
             raise ValueError(f"`heights` must be 2-D; got shape {z.shape}")
         win = (int(row_off), int(col_off), *z.shape)
         _check_inside(win, *self.shape, self.path)
-        self._ds.write(z, 1, window=Window(win[1], win[0], win[3], win[2]))
+        if self._zarr is not None:
+            self._chunks.write(z, win[0], win[1])
+        else:
+            self._ds.write(z, 1, window=Window(win[1], win[0], win[3], win[2]))
 
     def close(self) -> Path:
         """Turn the written windows into the COG at ``path`` (unwritten pixels: NoData)."""
@@ -376,6 +427,9 @@ class WindowWriter:
             return self.path
         try:
             self._ds.close()
+            if self._zarr is not None:
+                store, self._zarr = self._zarr, None
+                return store.commit()
             with atomic_path(self.path) as tmp:
                 with warnings.catch_warnings():
                     warnings.simplefilter("ignore", NotGeoreferencedWarning)
@@ -388,8 +442,12 @@ class WindowWriter:
         ds, self._ds = getattr(self, "_ds", None), None
         if ds is not None and not ds.closed:
             ds.close()
-        with contextlib.suppress(FileNotFoundError):
-            self._tmp.unlink()
+        if self._tmp is not None:
+            with contextlib.suppress(FileNotFoundError):
+                self._tmp.unlink()
+        store, self._zarr = getattr(self, "_zarr", None), None
+        if store is not None:
+            store.discard()
         env, self._env = self._env, None
         if env is not None:
             env.__exit__(None, None, None)

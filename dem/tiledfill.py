@@ -378,7 +378,7 @@ def fill_to_file(path, out, roughness: float | None = None, *,
                 top = float(np.nanmax(np.abs(z))) if not np.isnan(z).all() else 0.0
                 if top > np.finfo(np.float32).max:
                     raise ValueError(f"output {str(out)!r}: heights up to {top:.6g} m do not "
-                                     f"fit the GeoTIFF's float32 (at most "
+                                     f"fit the output's float32 (at most "
                                      f"{np.finfo(np.float32).max:.6g})")
                 writer.write(z, r, c)
     finally:

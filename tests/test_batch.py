@@ -333,7 +333,14 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
     config.write_text(STACK)
     monkeypatch.chdir(ROOT)  # the config's input is relative to the working folder
     dem.batch(config, "1", out=tmp_path / "dem_local", scheduler=scheduler)
+    expand = ("dem", "expand", str(LOLA), "--levels", "2", "--seed", "4", "-q")
+    proc = _cli(*expand, "-o", str(tmp_path / "here.tif"))
+    assert proc.returncode == 0, proc.stderr
     with _separate_cluster(tmp_path) as address:
+        # the tiles of one DEM as tasks on the separate workers: the same bytes
+        proc = _cli(*expand, "--scheduler", address, "-o", str(tmp_path / "there.tif"))
+        assert proc.returncode == 0, proc.stderr
+        assert sha256_file(tmp_path / "here.tif") == sha256_file(tmp_path / "there.tif")
         proc = _cli("latlong", "batch", str(scene), "--seeds", "1-2", "--vary",
                     "magnitude=16,18", "--scheduler", address, "-o", str(tmp_path / "remote"))
         assert proc.returncode == 0, proc.stderr
@@ -347,3 +354,48 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
         assert [(r["files"], r["sha256"]) for r in rows_a] == \
             [(r["files"], r["sha256"]) for r in rows_b]
     assert len(rows_a) == 1 and "manifest.json" in rows_a[0]["files"]
+
+
+# --------------------------------------------------------------------------- DEM tiles
+def test_expand_tiles_as_tasks_give_the_same_bytes(tmp_path, scheduler):
+    """``dem.expand_to_file`` with its tiles as dask tasks (this module's cluster, and a
+    local cluster of its own through ``dem expand --workers``) = tile after tile here."""
+    from dem.expansion import expand_to_file
+
+    base = dem.read(LOLA)
+    here = expand_to_file(base, tmp_path / "here.tif", 3, rng=9, tile_px=513)
+    assert here.tiles == 16
+    there = expand_to_file(base, tmp_path / "there.tif", 3, rng=9, tile_px=513,
+                           scheduler=scheduler)
+    assert there.tiles == 16
+    assert sha256_file(here.path) == sha256_file(there.path)
+    assert dem_main(["expand", str(LOLA), "--levels", "3", "--seed", "9", "--workers", "2",
+                     "--tile-px", "513",
+                     "-q", "-o", str(tmp_path / "cli.tif")]) == 0
+    assert dem.read(tmp_path / "cli.tif").heights.tobytes() == \
+        dem.read(here.path).heights.tobytes()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--workers", "0"], "--workers must be an integer >= 1; got 0"),
+    (["--scheduler", "nowhere"], "--scheduler must be a dask scheduler address"),
+    (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers applies to the local"),
+])
+def test_expand_task_options_are_one_line_errors(tmp_path, capsys, args, message):
+    out = tmp_path / "x.tif"
+    assert dem_main(["expand", str(LOLA), "-o", str(out), *args]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: ") and message in err, err
+    assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_map_tiles_on_dask_yields_every_result_and_raises_a_failure(scheduler):
+    import operator
+
+    from craters._shared.tiletasks import map_tiles
+
+    got = sorted(map_tiles(operator.mul, 3, list(range(10)), scheduler=scheduler, window=3))
+    assert got == [(i, 3 * i) for i in range(10)]
+    with pytest.raises(ZeroDivisionError):
+        list(map_tiles(operator.truediv, 1.0, [1.0, 2.0, 0.0, 4.0], scheduler=scheduler,
+                       retries=0))

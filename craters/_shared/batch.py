@@ -51,7 +51,8 @@ from .files import atomic_path, check_parent_folder
 from .progress import progress_bar
 from .validation import ParameterError, ParameterTypeError, parameter_of
 
-__all__ = ["INDEX", "BatchResult", "Job", "Variant", "combinations", "parse_seeds",
+__all__ = ["INDEX", "BatchResult", "Job", "Variant", "check_dask_address", "combinations",
+           "dask_client", "parse_seeds",
            "read_index", "run_batch", "sha256_file", "value_text", "variants", "vary_error"]
 
 #: The index file of a batch folder.
@@ -328,7 +329,7 @@ def _check_folder(out, jobs: Sequence[Job], *, resume: bool, force: bool) -> Pat
     return folder
 
 
-def _check_address(scheduler, workers) -> None:
+def check_dask_address(scheduler, workers) -> None:
     if scheduler is None:
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
                                     or workers < 1):
@@ -343,7 +344,7 @@ def _check_address(scheduler, workers) -> None:
 
 
 @contextlib.contextmanager
-def _client(scheduler: str | None, workers: int | None):
+def dask_client(scheduler: str | None, workers: int | None):
     """A dask client: of a new LocalCluster on 127.0.0.1, or of the scheduler at an
     address (which must have workers)."""
     import distributed  # noqa: F401 - its import sets the level of its loggers
@@ -415,7 +416,7 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
     names = [j.variant.name for j in jobs]
     if not jobs or len(set(names)) != len(names):
         raise ParameterError("jobs", "must be a non-empty list of uniquely named variants")
-    _check_address(scheduler, workers)
+    check_dask_address(scheduler, workers)
     folder = _check_folder(out, jobs, resume=resume, force=force)
     columns = _columns([k for k, _ in jobs[0].variant.values])
     index = folder / INDEX
@@ -433,7 +434,7 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
     others = [r for name, r in previous.items() if name not in ours]
     redo = {j.variant.name for j in todo}
     with contextlib.ExitStack() as stack:
-        client = stack.enter_context(_client(scheduler, workers)) if todo else None
+        client = stack.enter_context(dask_client(scheduler, workers)) if todo else None
         folder.mkdir(exist_ok=True)  # only once the cluster is there
         for stale in folder.glob(f".*{TMP_SUFFIX}"):
             shutil.rmtree(stale, ignore_errors=True)

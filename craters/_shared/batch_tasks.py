@@ -14,7 +14,7 @@ import time
 import uuid
 from pathlib import Path
 
-__all__ = ["TMP_SUFFIX", "one_line", "run_variant", "sha256_file"]
+__all__ = ["TMP_SUFFIX", "limit_numba_threads", "one_line", "run_variant", "sha256_file"]
 
 #: Suffix of a variant's temporary folder (stale ones are removed when a batch starts).
 TMP_SUFFIX = ".batch-tmp"
@@ -43,7 +43,7 @@ def run_variant(task, payload, folder: str, name: str, threads: int | None = Non
     threads of the task (None: the worker's own setting)."""
     start = time.perf_counter()
     if threads is not None:
-        _limit_numba_threads(threads)
+        limit_numba_threads(threads)
     _reset_peak()
     dest = Path(folder)
     tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=TMP_SUFFIX, dir=dest))
@@ -70,7 +70,7 @@ def _move(src: Path, dst: Path, tmp: Path) -> None:
     os.replace(src, dst)
 
 
-def _limit_numba_threads(threads: int) -> None:
+def limit_numba_threads(threads: int) -> None:
     """At most ``threads`` numba threads in this (the task's) thread. ``set_num_threads``
     and not ``NUMBA_NUM_THREADS``: a spawned worker whose parent's main module imports
     numba (``python -m latlong``) has numba's pool sized before dask sets the worker's

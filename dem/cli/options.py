@@ -37,6 +37,7 @@ from craters._shared.cli import CliError
 from ..config import EnhanceConfig
 from ..core import parse_region
 from ..io import read
+from ..zarrio import check_zarr_output, is_zarr
 
 __all__ = ["OPTIONS", "Opt", "Settings", "add_command", "check_output", "options_for",
            "read_input"]
@@ -137,7 +138,8 @@ OPTIONS: tuple[Opt, ...] = (
         _NO_INPUT, toml=str),
     Opt(("input",), "input", str, None, "a DEM (GeoTIFF, PDS .lbl/.img) or a stack manifest "
         "(.json: every layer is one input)", _REPORT, _NO_INPUT, toml=str),
-    Opt(("-o", "--output"), "output", str, None, "output GeoTIFF (.tif)",
+    Opt(("-o", "--output"), "output", str, None,
+        "output DEM: a cloud-optimised GeoTIFF (.tif) or a Zarr store (.zarr)",
         (_FILL, _EXPAND, _CONVERT), "none: required", toml=str, metavar="OUT"),
     Opt(("-o", "--output"), "output", str, None,
         "output folder of the stack (layer GeoTIFFs, crater catalogs, manifest.json)",
@@ -190,6 +192,16 @@ OPTIONS: tuple[Opt, ...] = (
         "within it is refused", (_FILL,), "0.8 x this machine's memory", metavar="GB"),
     Opt(("--levels",), "levels", _integer, 1, "number of 2x expansions (1..16)", (_EXPAND,),
         metavar="N"),
+    Opt(("--tile-px",), "tile_px", _integer, None,
+        "largest side of an output tile in pixels (>= 3): the unit of memory and of work "
+        "(one dask task a tile)", (_EXPAND,), "2049, about 80 MB a tile", metavar="PX"),
+    Opt(("--scheduler",), "scheduler", str, None,
+        "expand the tiles as tasks on the dask scheduler at ADDRESS, e.g. "
+        "tcp://127.0.0.1:8786 (its workers must see the input and output paths; the same "
+        "bytes)", (_EXPAND,), "tiles in this process", metavar="ADDRESS"),
+    Opt(("--workers",), "workers", _integer, None,
+        "expand the tiles as tasks on a local dask cluster of N worker processes on "
+        "127.0.0.1 (the same bytes)", (_EXPAND,), "tiles in this process", metavar="N"),
     Opt(("--fractal-dimension",), "fractal_dimension", _number, None,
         "fractal dimension F in [2, 3]", (_FILL, _EXPAND, _ENHANCE), "estimated from the input",
         metavar="F"),
@@ -324,6 +336,8 @@ def check_output(s: Settings, suffixes) -> Path:
         raise CliError("nothing to write: give -o/--output")
     out = Path(s["output"])
     check_not_input(out, (("DEM", s["input"]), ("config", s.config)))
+    if is_zarr(out) and out.suffix.lower() in suffixes:  # a folder
+        return check_zarr_output(out, force=s["force"])
     return check_output_path(out, force=s["force"], suffixes=suffixes)
 
 

@@ -13,7 +13,7 @@ from ..expansion import expand_to_file
 from ..fractal import fractal_fit
 from ..frame import crater_target
 from ..gaps import fill_gaps
-from ..io import GEOTIFF_SUFFIXES, write
+from ..io import DEM_SUFFIXES, write
 from ..terrain import MATCHED_BAND_PX, spectral_fit
 from ..tiledfill import fill_to_file, fits_whole, raster_shape
 from .options import Settings, add_command, check_output, read_input
@@ -36,7 +36,7 @@ def _seed(s: Settings) -> int:
 def _transform(s: Settings) -> int:
     """``dem fill`` and ``dem expand``."""
     command = s.command
-    check_output(s, GEOTIFF_SUFFIXES)
+    check_output(s, DEM_SUFFIXES)
     seed = _seed(s)
     show = not s["quiet"]
     bar = progress_bar(total=3, enabled=show, desc=command)
@@ -69,7 +69,8 @@ def _transform(s: Settings) -> int:
         shape, params = out.shape, out.history[-1]["parameters"]
     else:  # tile by tile into the file: outputs bigger than memory
         made = expand_to_file(dem, s["output"], s["levels"], s["fractal_dimension"],
-                              s["roughness"], s["region"], rng=seed, progress=show)
+                              s["roughness"], s["region"], rng=seed, tile_px=s["tile_px"],
+                              scheduler=s["scheduler"], workers=s["workers"], progress=show)
         bar.update()
         shape, params = made.shape, made.parameters
     bar.update()
@@ -92,8 +93,9 @@ def _summary(s: Settings, seed: int, shape_in, shape, params: dict) -> None:
 
 
 def _convert(s: Settings) -> int:
-    """``dem convert``: any DEM :func:`dem.read` reads (PDS3, GeoTIFF, ...) -> GeoTIFF."""
-    check_output(s, GEOTIFF_SUFFIXES)
+    """``dem convert``: any DEM :func:`dem.read` reads (PDS3, GeoTIFF, ...) -> GeoTIFF or
+    Zarr."""
+    check_output(s, DEM_SUFFIXES)
     dem = read_input(s)
     write(dem, s["output"])
     if not s["quiet"]:
@@ -187,8 +189,8 @@ def register(sub) -> None:
     add_command(sub, "info", _info,
                 "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)")
     add_command(sub, "convert", _convert,
-                "convert a DEM (PDS3 .lbl/.img, GeoTIFF, any raster GDAL reads) to a "
-                "cloud-optimised GeoTIFF")
+                "convert a DEM (PDS3 .lbl/.img, GeoTIFF, Zarr, any raster GDAL reads) to a "
+                "cloud-optimised GeoTIFF or a Zarr store")
     add_command(sub, "fill", _transform,
                 "fill the unknown pixels of a DEM with fractal terrain, outside in")
     add_command(sub, "expand", _transform,
