@@ -81,7 +81,7 @@ def enhance_to_folder(config, folder, *, dem=None, progress: bool = False
             shells.append(meta.with_step(np.zeros(meta.shape), "dem.enhance", run.seed, step))
             out = WindowWriter(work / f"layer_{k:02d}.tif", meta.shape,
                                transform=meta.transform, crs=meta.crs,
-                               tags=meta.step_tags("dem.enhance", run.seed, step),
+                               tags=shells[-1].tags,
                                body_radius_m=meta.body_radius_m,
                                pixel_size_m=meta.pixel_size_m)
             writers.append(out)

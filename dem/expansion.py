@@ -307,8 +307,7 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
 
     with about("tile_px"):
         tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
-    if scheduler is not None or workers is not None:
-        check_dask_address(scheduler, workers)
+    check_dask_address(scheduler, workers)  # before any work (map_tiles checks when it runs)
     plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
     step = 2**plan.levels
     # input tile: 2^k + 1 pixels, the largest whose expansion fits tile_px (at least 3)

@@ -374,7 +374,7 @@ def fractal_fit_rows(read_rows, shape, pixel_size_m, resolution_m: float, *,
             for axis, k in keys[1:]:
                 if axis == 1:
                     zz, nn = z[a - lo:b - lo], norm_px[a - lo:b - lo]
-                    d = zz[:, k:] - zz[:, :-k]
+                    d = _axis_diffs(zz, k, 1)
                     norm = 0.5 * (nn[:, k:] + nn[:, :-k])
                 else:  # pairs (i, i + k) for i in a..b-1
                     e = min(b, rows - k)

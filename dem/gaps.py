@@ -159,13 +159,14 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     if holes:
         amp = (None if roughness is not None
                else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
+        uniform = None if roughness is None else roughness * dem.resolution_m
 
         def around(w0, w1, v0, v1):
             return dem.crop(Window(v0, w0, v1 - v0, w1 - w0))
 
         for sl, hole in holes:
-            fill_hole(z, sl, hole, amp, roughness * dem.resolution_m if roughness is not None
-                      else None, fractal_dimension, key, level=dem.level, origin=dem.origin)
+            fill_hole(z, sl, hole, amp, uniform, fractal_dimension, key, level=dem.level,
+                      origin=dem.origin)
             if layer is not None:
                 cat, note = stamp_gap_craters(z, sl, hole, layer, key, target,
                                               pixel_size_m=dem.pixel_size_m, level=dem.level,

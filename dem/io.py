@@ -46,7 +46,8 @@ from .zarrio import (
     is_zarr_store,
 )
 
-__all__ = ["DEM_SUFFIXES", "GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "read", "write"]
+__all__ = ["DEM_SUFFIXES", "GEOTIFF_SUFFIXES", "PDS_SUFFIXES", "WindowWriter", "check_float32",
+           "read", "write"]
 
 logger = logging.getLogger(__name__)
 
@@ -269,17 +270,13 @@ def write(dem: Dem, path) -> Path:
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
     path = _check_dem_path(path)
     rows, cols = dem.shape
-    top = float(np.nanmax(np.abs(dem.heights))) if dem.known.any() else 0.0
-    if top > np.finfo(np.float32).max:
-        raise ValueError(f"output {str(path)!r}: heights up to {top:.6g} m do not fit the "
-                         f"output's float32 (at most {np.finfo(np.float32).max:.6g})")
+    check_float32(dem.heights, path)
     data = dem.heights.astype(np.float32)
-    if is_zarr(path):
-        check_zarr_output(path, force=True)
-        with ZarrStore(path) as out:
-            with _open_zarr(out.store, rows, cols, dem.crs, dem.transform) as ds:
-                _write_metadata(ds, dem)
-            ChunkWriter(out.store).write(data, 0, 0)
+    if is_zarr(path):  # the chunks of a Zarr store: one window
+        with WindowWriter(path, dem.shape, transform=dem.transform, crs=dem.crs,
+                          tags=dem.tags, body_radius_m=dem.body_radius_m,
+                          pixel_size_m=dem.pixel_size_m) as out:
+            out.write(data, 0, 0)
         return path
     with atomic_path(path) as tmp:
         with warnings.catch_warnings():
@@ -291,6 +288,15 @@ def write(dem: Dem, path) -> Path:
                 ds.write(data, 1)
                 _write_metadata(ds, dem)
     return path
+
+
+def check_float32(heights: np.ndarray, path) -> None:
+    """The known ``heights`` fit the output's float32 (one-line ValueError naming it)."""
+    known = ~np.isnan(heights)
+    top = float(np.abs(heights[known]).max()) if known.any() else 0.0
+    if top > np.finfo(np.float32).max:
+        raise ValueError(f"output {str(path)!r}: heights up to {top:.6g} m do not fit the "
+                         f"output's float32 (at most {np.finfo(np.float32).max:.6g})")
 
 
 def _check_dem_path(path) -> Path:

@@ -56,7 +56,7 @@ from .fractal import NORMALISER_WINDOW_PX, fractal_fit_rows, local_msd, window_m
 from .frame import crater_target
 from .gapcraters import stamp_gap_craters
 from .gaps import fill_arguments, fill_hole, known_dimension, record_craters
-from .io import PDS_SUFFIXES, WindowWriter, read
+from .io import PDS_SUFFIXES, WindowWriter, check_float32, read
 
 __all__ = ["DEFAULT_TILE_PX", "MEMORY_SHARE", "WHOLE_BYTES_PER_PX", "FilledFile", "fill_to_file",
            "fits_whole", "holes_of_file", "raster_shape"]
@@ -375,11 +375,7 @@ def fill_to_file(path, out, roughness: float | None = None, *,
                 gaps = np.isnan(z)
                 if gaps.any():
                     z[gaps] = _scratch_read(scratch, cols, (r, c, h, w))[gaps]
-                top = float(np.nanmax(np.abs(z))) if not np.isnan(z).all() else 0.0
-                if top > np.finfo(np.float32).max:
-                    raise ValueError(f"output {str(out)!r}: heights up to {top:.6g} m do not "
-                                     f"fit the output's float32 (at most "
-                                     f"{np.finfo(np.float32).max:.6g})")
+                check_float32(z, out)
                 writer.write(z, r, c)
     finally:
         with contextlib.suppress(FileNotFoundError):

@@ -95,11 +95,7 @@ class ZarrStore:
         self.store = self._holder / f"store{ZARR_SUFFIXES[0]}"
 
     def commit(self) -> Path:
-        try:
-            for root, _, files in os.walk(self.store):  # the modes atomic_path gives files
-                os.chmod(root, 0o755)
-                for name in files:
-                    os.chmod(os.path.join(root, name), 0o644)
+        try:  # GDAL made the store with the umask's modes (only the holder is private)
             replace_output(self.store, self.path)
         finally:
             self.discard()

@@ -57,7 +57,8 @@ def _area_of(tri, t, oa, na, pa, pb, ob):
 @njit(cache=True, inline="always")
 def _band_areas_one(m, band, ring_offsets, radii, stretch, tri, pa, pb, out, t0):
     """Areas of band ``band``'s triangles into out[t0:], with ``tri``, ``pa``, ``pb``
-    scratch of at least (na + nb, 3), (na, 3) and (nb, 3) rows."""
+    scratch of at least (na + nb, 3), (na, 3) and (nb, 3) rows. Returns (oa, na, ob,
+    triangles): the band's rings as the scratch holds them, for :func:`_corner`."""
     if band < m:
         ra, rb, south = band, band + 1, False
     else:
@@ -70,6 +71,7 @@ def _band_areas_one(m, band, ring_offsets, radii, stretch, tri, pa, pb, out, t0)
     n_tri = 6 if (na == 1 or nb == 1) else na + nb
     for t in range(n_tri):
         out[t0 + t] = _area_of(tri, t, oa, na, pa, pb, ob)
+    return oa, na, ob, n_tri
 
 
 @njit(cache=True, parallel=True, nogil=True)
@@ -117,8 +119,8 @@ def _search_right(cum, n, x):
 
 
 @njit(cache=True, parallel=True, nogil=True)
-def sample_in_bands(m, ring_offsets, band_offsets, radii, stretch, bands, starts, order,
-                    resid, a, b, out):
+def sample_in_bands(m, ring_offsets, radii, stretch, bands, starts, order, resid, a, b,
+                    out):
     """Uniform points in the bands ``bands`` (in parallel): sample ``order[starts[band]:
     starts[band + 1]]`` of band ``band`` takes the triangle where the band's running area
     first exceeds ``resid`` and the point ``v0 + a (v1 - v0) + b (v2 - v0)`` in it, into
@@ -130,15 +132,10 @@ def sample_in_bands(m, ring_offsets, band_offsets, radii, stretch, bands, starts
         pa = np.empty((n, 3))
         pb = np.empty((n, 3))
         cum = np.empty(2 * n)
-        _band_areas_one(m, band, ring_offsets, radii, stretch, tri, pa, pb, cum, 0)
-        n_tri = band_offsets[band + 1] - band_offsets[band]
+        oa, na, ob, n_tri = _band_areas_one(m, band, ring_offsets, radii, stretch, tri, pa,
+                                            pb, cum, 0)
         for t in range(1, n_tri):
             cum[t] = cum[t - 1] + cum[t]
-        if band < m:
-            ra, rb = band, band + 1
-        else:
-            ra, rb = band + 1, band
-        oa, na, ob = ring_offsets[ra], _ring_size(ra, m), ring_offsets[rb]
         for s in range(starts[band], starts[band + 1]):
             j = order[s]
             k = min(_search_right(cum, n_tri, resid[j]), n_tri - 1)

@@ -76,7 +76,7 @@ def sample_surface_points(body: Body, areas: np.ndarray, n: int,
     order = np.argsort(band, kind="stable")
     starts = np.searchsorted(band[order], np.arange(len(areas) + 1))
     g = body.grid
-    sample_in_bands(g.magnitude, g.ring_offsets(), g.band_offsets(), body.radii_m,
+    sample_in_bands(g.magnitude, g.ring_offsets(), body.radii_m,
                     np.ascontiguousarray(body.stretch, dtype=np.float64),
                     np.flatnonzero(np.diff(starts)), starts, order, resid, a, b, p)
     return (*_grid_lat_lon(body, p), total)

@@ -43,8 +43,8 @@ def _transform(s: Settings) -> int:
     bar.set_description(f"read {s['input']}")
     head = read_input(s, window=(0, 0, 1, 1), allow_unknown=True) if command == "fill" \
         else None
-    if head is not None and not fits_whole(raster_shape(s["input"]),
-                                           s["max_memory_gb"]):
+    shape_in = None if head is None else raster_shape(s["input"])
+    if head is not None and not fits_whole(shape_in, s["max_memory_gb"]):
         # bigger than memory: tile by tile from the file (the same bytes)
         bar.close()
         made = fill_to_file(s["input"], s["output"], s["roughness"],
@@ -54,7 +54,7 @@ def _transform(s: Settings) -> int:
                             band=s["band"], pixel_size_m=s["pixel_size_m"],
                             body_radius_m=s["body_radius_m"], body=s.get("body"),
                             max_memory_gb=s["max_memory_gb"], progress=show)
-        _summary(s, seed, raster_shape(s["input"]), made.shape, made.parameters)
+        _summary(s, seed, shape_in, made.shape, made.parameters)
         return 0
     dem = read_input(s)
     bar.update()
