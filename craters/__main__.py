@@ -1,10 +1,10 @@
 """The ``craters`` command, as its console script and as ``python -m craters``: started by
-:mod:`craters._shared.start` (a Ctrl-C or a bad ``NUMBA_NUM_THREADS`` while the libraries
+:mod:`craters.cli.start` (a Ctrl-C or a bad ``NUMBA_NUM_THREADS`` while the libraries
 load is one error line)."""
 
 import sys
 
-from craters._shared.start import start_command
+from craters.cli.start import start_command
 
 
 def main(argv: list[str] | None = None) -> int:

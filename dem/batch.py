@@ -3,7 +3,7 @@ built on dask.distributed.
 
 :func:`batch` builds every variant -- each seed of ``seeds`` with each combination of the
 values in ``vary`` (a cartesian product) -- as one task (the engine:
-``craters._shared.batch``) and writes each variant's stack into its own folder of the
+``latlong.parallel.batch``) and writes each variant's stack into its own folder of the
 batch folder, ``FOLDER/seed0001_layers=9/`` (``manifest.json``, layer GeoTIFFs, crater
 catalogs), with ``FOLDER/index.csv`` listing every file, its sha256, seconds, peak memory
 and status. Every variant's description is checked before anything runs. A variant's
@@ -25,7 +25,8 @@ from craters._shared import (
     load_toml,
     package_version,
 )
-from craters._shared.batch import (
+from craters._shared.files import check_regular_file
+from latlong.parallel.batch import (
     BatchResult,
     Job,
     combinations,
@@ -33,7 +34,6 @@ from craters._shared.batch import (
     variants,
     vary_error,
 )
-from craters._shared.files import check_regular_file
 
 from .config import EnhanceConfig
 from .enhance import enhance

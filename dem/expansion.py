@@ -300,8 +300,8 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     >>> info.shape, info.tiles, same
     ((65, 65), 16, True)
     """
-    from craters._shared.batch import check_dask_address
-    from craters._shared.tiletasks import map_tiles
+    from latlong.parallel.batch import check_dask_address
+    from latlong.parallel.tiles import map_tiles
 
     from .io import WindowWriter
 

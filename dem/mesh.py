@@ -18,7 +18,7 @@ outline. Needs footprints one pixel clear of their layer's border (what
 
 Formats
 -------
-The shared mesh writers (:mod:`craters._shared.meshio`: PLY, OBJ, STL, VTP, VTK, GLB)
+The shared mesh writers (:mod:`latlong.meshio.writers`: PLY, OBJ, STL, VTP, VTK, GLB)
 with a per-vertex ``layer`` (uchar); PLY and VTP are written layer by layer (memory ~ a
 few arrays of one layer), STL gathers the vertices first.
 
@@ -37,8 +37,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared.meshio import MESH_SUFFIXES, MeshSource, write_mesh
 from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes, mesh_chunk
+from latlong.meshio.writers import MESH_SUFFIXES, MeshSource, write_mesh
 
 from .core import Dem
 from .frame import local_frame, pixel_affine
@@ -237,7 +237,7 @@ def mesh_arrays(source) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def mesh_source(source, *, boulders: bool = True) -> MeshSource:
     """The multi-resolution mesh of a stack (or one DEM) as a streamed mesh for the shared
-    writers (:mod:`craters._shared.meshio`): layer by layer, then the boulders."""
+    writers (:mod:`latlong.meshio.writers`): layer by layer, then the boulders."""
     stack = _as_stack(source)
     lay = _Layout(stack)
     rocks = _Rocks(stack if boulders else stack.replace(boulders=[None] * len(stack)))
@@ -284,7 +284,7 @@ def mesh_source(source, *, boulders: bool = True) -> MeshSource:
 
 def to_mesh(source, path, *, progress: bool = False, boulders: bool = True) -> Path:
     """Write the multi-resolution mesh of a stack (or one DEM) to a mesh file chosen by
-    suffix (``.ply .obj .stl .vtp .vtk .glb``, :mod:`craters._shared.meshio`), atomically.
+    suffix (``.ply .obj .stl .vtp .vtk .glb``, :mod:`latlong.meshio.writers`), atomically.
 
     See the module notes for the geometry, the frame and the formats.
 

@@ -24,11 +24,11 @@ import numpy as np
 from craters._shared import (
     ParameterError,
     about,
-    area_slope_summary,
     check_choice,
     check_int,
     check_range,
 )
+from latlong.geometry.stats import area_slope_summary
 
 from .core import Dem
 from .fractal import FractalFit, SpectralFit, fractal_fit

@@ -4,7 +4,7 @@ Every value is computed as the numpy code it replaces computed it (same operatio
 the same order, float64 rounded once to float32), so the files keep their bytes; the
 kernels only skip the intermediate arrays and the per-patch Python work. The chunk
 kernels run on one thread without the GIL: the exports make several chunks at once on
-worker threads (``craters._shared.ordered_chunks``).
+worker threads (``latlong.meshio.chunks.ordered_chunks``).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 :func:`batch` builds every variant of a scene -- each seed of ``seeds`` with each
 combination of the values in ``vary`` (a cartesian product) -- as one task per variant
-(the engine: ``craters._shared.batch``), and writes per variant the outputs the scene
+(the engine: ``latlong.parallel.batch``), and writes per variant the outputs the scene
 names (or a ``.npz`` and, with crater layers, the crater catalog) into one folder, each
 file under the variant's name: ``seed0001_radius-m=1000.npz``, a named output
 ``body.ply`` as ``seed0001_radius-m=1000_body.ply``. ``index.csv`` lists every variant
@@ -21,7 +21,10 @@ from collections.abc import Callable, Mapping
 from pathlib import Path
 
 from craters._shared import ParameterError, ParameterTypeError, load_toml, package_version
-from craters._shared.batch import (
+
+from .build import build
+from .outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
+from .parallel.batch import (
     BatchResult,
     Job,
     combinations,
@@ -29,9 +32,6 @@ from craters._shared.batch import (
     variants,
     vary_error,
 )
-
-from .build import build
-from .outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
 from .scene import SETTINGS, Scene
 
 __all__ = ["batch"]

@@ -1,4 +1,4 @@
-"""Mesh export of a body: the body as a streamed :class:`~craters._shared.meshio.MeshSource`
+"""Mesh export of a body: the body as a streamed :class:`~latlong.meshio.writers.MeshSource`
 for the shared writers (PLY, OBJ, STL, VTP, VTK), and the patched-strip glTF for ``.glb``.
 
 Nothing holds the whole triangle array: triangles are generated a few latitude bands at a
@@ -22,19 +22,19 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import ordered_chunks
-from craters._shared.meshio import (
+from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
+
+from ._export_kernels import _ply_face_kernel, _ply_vertex_kernel
+from ._grid_kernels import lon_table
+from .gltf import export_glb
+from .meshio.chunks import ordered_chunks
+from .meshio.writers import (
     MESH_SUFFIXES,
     MeshSource,
     pack_faces,
     pack_vertices,
     write_mesh,
 )
-from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
-
-from ._export_kernels import _ply_face_kernel, _ply_vertex_kernel
-from ._grid_kernels import lon_table
-from .gltf import export_glb
 
 __all__ = ["EXPORT_SUFFIXES", "body_mesh_source", "export_body"]
 

@@ -16,10 +16,11 @@ import os
 
 import numpy as np
 
-from craters._shared import ordered_chunks, progress_bar
+from craters._shared import progress_bar
 
 from ._export_kernels import _patch_kernel
 from ._window_kernels import _window_normals_kernel, _window_positions_kernel
+from .meshio.chunks import ordered_chunks
 
 __all__ = ["WINDOW_VERTICES", "leaf_metadata", "write_leaf_data"]
 

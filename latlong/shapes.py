@@ -28,11 +28,11 @@ import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int
 from craters._shared.files import check_regular_file
-from craters._shared.meshfiles import check_mesh_file
 
 from ._shape_kernels import _brute_force_kernel, _raycast_kernel
 from .body import Body
 from .grid import LatLongGrid
+from .meshio.checks import check_mesh_file
 
 __all__ = ["ShapeModel", "cast_radii", "from_shape_model", "mean_surface_distance",
            "read_shape_model", "sample_surface"]

@@ -21,7 +21,7 @@ import math
 
 import numpy as np
 
-from craters._shared import area_slope_summary, check_int, check_range
+from craters._shared import check_int, check_range
 
 from ._slope_kernels import (
     _cap_average_kernel,
@@ -31,6 +31,7 @@ from ._slope_kernels import (
     _vertex_normals_kernel,
 )
 from .body import Body
+from .geometry.stats import area_slope_summary
 from .shapes import ShapeModel
 
 __all__ = ["SLOPE_BIN_DEG", "direction_cap_sums", "facet_slopes", "mesh_slopes", "radius_spectrum",

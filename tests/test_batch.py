@@ -18,10 +18,10 @@ import pytest
 
 import dem
 import latlong
-from craters._shared.batch import parse_seeds, read_index, sha256_file, variants
-from craters._shared.batch_tasks import run_variant
 from dem.cli import main as dem_main
 from latlong.cli import main as latlong_main
+from latlong.parallel.batch import parse_seeds, read_index, sha256_file, variants
+from latlong.parallel.batch_tasks import run_variant
 
 pytestmark = pytest.mark.xdist_group("batch")
 
@@ -238,7 +238,7 @@ def test_bad_options_are_one_line_errors(tmp_path, scene, capsys, args, message)
 
 
 def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys, monkeypatch):
-    import craters._shared.batch as engine
+    import latlong.parallel.batch as engine
 
     monkeypatch.setattr(engine, "_CONNECT_S", 2)
     out = tmp_path / "batch"
@@ -392,7 +392,7 @@ def test_expand_task_options_are_one_line_errors(tmp_path, capsys, args, message
 def test_map_tiles_on_dask_yields_every_result_and_raises_a_failure(scheduler):
     import operator
 
-    from craters._shared.tiletasks import map_tiles
+    from latlong.parallel.tiles import map_tiles
 
     got = sorted(map_tiles(operator.mul, 3, list(range(10)), scheduler=scheduler, window=3))
     assert got == [(i, 3 * i) for i in range(10)]

@@ -293,7 +293,7 @@ def test_no_python_warning_reaches_the_terminal(tmp_path, argv):
 
 # --------------------------------------------------------------------------- plots
 def test_many_series_get_distinct_colours():
-    from craters._shared.report import series_colors
+    from craters.cli.report import series_colors
 
     for n in (1, 10, 11, 24):
         colours = [tuple(c) for c in series_colors(n)]
@@ -305,7 +305,7 @@ def test_dem_stack_plots_distinct_colours_and_pixel_sizes(tmp_path, monkeypatch)
     says its layer's pixel size."""
     import matplotlib.pyplot as plt
 
-    import craters._shared.report as report
+    import craters.cli.report as report
     import dem.cli.analysis as analysis
     from dem.cli import main
 

@@ -4,7 +4,7 @@ TOML), progress bars, machine facts, ``key=value`` specs, slope statistics, repo
 mesh writers. ``craters`` is the ground floor of the import graph
 (``latlong -> craters <- dem``), so it lives here, privately.
 
-The command-line helpers are in :mod:`craters._shared.cli`; nothing here imports them, so
+The command-line helpers are in :mod:`craters.cli.kit`; nothing here imports them, so
 importing a library never loads argparse.
 """
 
@@ -14,13 +14,11 @@ from .lazy import lazy_package
 
 if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
     from .files import (
-        BackgroundWriter,
         atomic_path,
         check_output_path,
         check_parent_folder,
         check_suffix,
         load_toml,
-        ordered_chunks,
     )
     from .outputs import (
         check_not_input,
@@ -34,7 +32,6 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
     )
     from .progress import progress_bar
     from .spec import parse_spec
-    from .stats import area_slope_summary
     from .system import human_bytes, package_version, physical_memory_bytes
     from .validation import (
         ParameterError,
@@ -50,12 +47,11 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         parameter_of,
     )
 
-__all__ = ["BackgroundWriter", "ParameterError", "ParameterTypeError", "RngLike", "about",
-           "area_slope_summary",
+__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_not_input", "check_outside_folder",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
-           "load_toml", "normalize_rng", "ordered_chunks", "package_version", "parameter_of",
+           "load_toml", "normalize_rng", "package_version", "parameter_of",
            "parse_spec",
            "output_group", "physical_memory_bytes",
            "progress_bar", "replace_output", "same_file", "sweep_temporaries", "temp_file",

@@ -1,7 +1,7 @@
 """Packages whose public names load on first use (PEP 562), so that importing a package
 costs almost nothing: ``import latlong`` loads neither numpy nor numba until a name such
 as ``latlong.Body`` is used. The command lines rely on it to start without tracebacks
-(:mod:`craters._shared.start`).
+(:mod:`craters.cli.start`).
 
 A package lists its names once, as relative imports in an ``if TYPE_CHECKING:`` block,
 which type checkers and readers see as plain imports; at run time

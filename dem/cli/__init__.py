@@ -18,7 +18,7 @@ from __future__ import annotations
 import sys
 
 from craters._shared import package_version
-from craters._shared.cli import OneLineParser, run_cli
+from craters.cli.kit import OneLineParser, run_cli
 
 from . import analysis, batch, raster, stack
 

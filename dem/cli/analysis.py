@@ -11,8 +11,8 @@ from pathlib import Path
 from types import SimpleNamespace
 
 from craters._shared import ParameterError
-from craters._shared.cli import CliError, check_report_outputs
-from craters._shared.report import (
+from craters.cli.kit import CliError, check_report_outputs
+from craters.cli.report import (
     plot_slopes,
     save_figure,
     series_colors,

@@ -32,7 +32,7 @@ from craters._shared import (
     load_toml,
     parameter_of,
 )
-from craters._shared.cli import CliError
+from craters.cli.kit import CliError
 
 from ..config import EnhanceConfig
 from ..core import parse_region

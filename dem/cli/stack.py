@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from craters._shared import about
-from craters._shared.cli import CliError
+from craters.cli.kit import CliError
 
 from ..config import EnhanceConfig
 from ..enhancefile import enhance_to_folder

@@ -13,7 +13,7 @@ import argparse
 import sys
 
 from craters._shared import package_version
-from craters._shared.cli import OneLineParser, run_cli
+from craters.cli.kit import OneLineParser, run_cli
 
 from .analysis import add_parsers as add_analysis_parsers
 from .batch import add_batch_parser

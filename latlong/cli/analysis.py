@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared.cli import CliError, add_report_arguments, check_report_outputs
-from craters._shared.report import (
+from craters.cli.kit import CliError, add_report_arguments, check_report_outputs
+from craters.cli.report import (
     plot_slopes,
     save_figure,
     series_colors,
@@ -33,7 +33,8 @@ from latlong import (
     slope_summary,
     slopes_and_areas,
 )
-from latlong.slopes import SLOPE_BIN_DEG
+
+from ..slopes import SLOPE_BIN_DEG
 
 
 def _load_input(path: str, units: str | None):

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import argparse
 
-from craters._shared.cli import (
+from craters.cli.kit import (
     add_batch_arguments,
     batch_error,
     batch_reporter,

@@ -5,10 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from craters._shared import check_not_input, check_output_path, human_bytes
-from craters._shared.cli import CliError
+from craters.cli.kit import CliError
 from latlong import PreviewSettings, export_glb, export_vtp_strips, load, render_preview
-from latlong.presets import preset_table
 
+from ..presets import preset_table
 from .options import RENDER_OPTIONS, given_options
 
 __all__ = ["add_body_parsers"]

@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import human_bytes, progress_bar
-from craters._shared.cli import CliError
+from craters.cli.kit import CliError
 from latlong import LatLongGrid, Scene, build
-from latlong.outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
 
+from ..outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
 from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, shown
 
 __all__ = ["add_build_parser"]

@@ -22,7 +22,7 @@ from craters._shared import (
     replace_output,
     temp_folder,
 )
-from craters._shared.cli import CliError, parse_seed
+from craters.cli.kit import CliError, parse_seed
 
 from .sensor_options import (
     add_pose_options,

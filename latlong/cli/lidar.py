@@ -5,12 +5,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from craters._shared.cli import parse_seed
-from latlong.sensors.engine import RayMesh
-from latlong.sensors.lidar import LIDAR_PATTERNS, LidarSettings
-from latlong.sensors.lidar_files import lidar_run
-from latlong.sensors.scene_geometry import scene_geometry
+from craters.cli.kit import parse_seed
 
+from ..sensors.engine import RayMesh
+from ..sensors.lidar import LIDAR_PATTERNS, LidarSettings
+from ..sensors.lidar_files import lidar_run
+from ..sensors.scene_geometry import scene_geometry
 from .sensor_options import (
     add_pose_options,
     allow_negative_lists,

@@ -13,9 +13,10 @@ from dataclasses import dataclass
 from typing import Any
 
 from craters._shared import ParameterError, ParameterTypeError, load_toml, physical_memory_bytes
-from craters._shared.cli import CliError, parse_seed
+from craters.cli.kit import CliError, parse_seed
 from latlong import SETTING_DEFAULTS
-from latlong.settings import MEMORY_SHARE
+
+from ..settings import MEMORY_SHARE
 
 __all__ = ["BUILD_OPTIONS", "OUTPUT_KEYS", "RENDER_OPTIONS", "Opt", "add_options",
            "flag_of", "given_options", "read_config", "shown"]

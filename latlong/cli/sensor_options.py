@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError, check_outside_folder
-from craters._shared.cli import CliError
+from craters.cli.kit import CliError
 
 __all__ = ["POSE_FLAGS", "add_pose_options", "allow_negative_lists", "numbers",
            "output_folder", "poses_from_args", "refuse_inside", "wxh"]

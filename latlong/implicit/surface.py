@@ -34,8 +34,8 @@ from craters._shared import (
     physical_memory_bytes,
     progress_bar,
 )
-from craters._shared.meshio import MESH_SUFFIXES, MeshSource, array_source, write_mesh
 
+from ..meshio.writers import MESH_SUFFIXES, MeshSource, array_source, write_mesh
 from ..shapes import ShapeModel, read_shape_model
 from . import _kernels as _k
 from .distance import mesh_distance, smoothed_constraint
@@ -119,7 +119,7 @@ class ImplicitSurface:
 
     def save(self, path, *, progress: bool = False) -> Path:
         """Write the mesh to a file chosen by suffix (``.ply .obj .stl .vtp .vtk .glb``,
-        :mod:`craters._shared.meshio`), atomically."""
+        :mod:`latlong.meshio.writers`), atomically."""
         return write_mesh(self.mesh_source(), path, progress=progress)
 
     def to_body(self, magnitude: int, *, crossings: str = "error"):

@@ -24,8 +24,8 @@ from craters.kernels import (
     table,
     table_value,
 )
-from latlong._crater_kernels import PARALLEL_MIN, _fill_holes, _fit_quadric_points, _quadric
 
+from .._crater_kernels import PARALLEL_MIN, _fill_holes, _fit_quadric_points, _quadric
 from ._kernels import _geodesic_gather
 
 #: Graph distance over straight-line distance allowed when gathering a region: mesh

@@ -21,9 +21,9 @@ import numpy as np
 
 from craters import validate_catalog
 from craters._shared import ParameterError, check_finite, check_int, check_positive
-from craters._shared.meshio import MeshSource, write_mesh
 from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
 
+from ..meshio.writers import MeshSource, write_mesh
 from ..perlin import fbm3, random_rotation
 from ..shapes import ShapeModel, read_shape_model
 from .refine import refine_mesh

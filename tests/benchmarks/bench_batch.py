@@ -44,7 +44,7 @@ def _env(**extra) -> dict:
 
 
 def _rows(folder: Path) -> list[dict]:
-    from craters._shared.batch import read_index
+    from latlong.parallel.batch import read_index
 
     index = folder / "index.csv"
     return read_index(index) if index.exists() else []
@@ -204,7 +204,7 @@ def main() -> int:
         subprocess.run([sys.executable, "-m", "latlong", "build", "--config", str(scene),
                         "--seed", str(s), "-q", "--force", "-o", str(single / files[0]),
                         "--catalog", str(single / files[1])], env=_env(), check=True)
-        from craters._shared.batch import sha256_file
+        from latlong.parallel.batch import sha256_file
 
         agree_single += all(sha256_file(single / f) == found["A"].get((name, f)) for f in files)
         if not args.keep:

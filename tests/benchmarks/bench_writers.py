@@ -32,9 +32,9 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import atomic_path, package_version
-from craters._shared.meshio import write_mesh
 from latlong import Body, LatLongGrid
 from latlong.export import body_mesh_source
+from latlong.meshio.writers import write_mesh
 from latlong.strips import join_strips, patch_tree, strip_triangles
 
 

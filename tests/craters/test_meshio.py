@@ -1,11 +1,11 @@
-"""The shared mesh writers (craters._shared.meshio): every format reads back as written."""
+"""The shared mesh writers (latlong.meshio.writers): every format reads back as written."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from craters._shared.meshio import MESH_SUFFIXES, MeshSource, array_source, write_mesh
+from latlong.meshio.writers import MESH_SUFFIXES, MeshSource, array_source, write_mesh
 
 
 def _tetra(fields: bool):
@@ -76,7 +76,7 @@ def test_unknown_suffix_writes_nothing(tmp_path):
 
 
 def test_background_writer_keeps_order_and_raises_write_errors(tmp_path):
-    from craters._shared import BackgroundWriter
+    from latlong.meshio.chunks import BackgroundWriter
 
     with open(tmp_path / "x.bin", "wb") as fh, BackgroundWriter(fh) as out:
         for k in range(50):
@@ -99,7 +99,7 @@ def test_ordered_chunks_keeps_order_and_bounds_the_buffers(threads):
     import threading
     import time
 
-    from craters._shared import ordered_chunks
+    from latlong.meshio.chunks import ordered_chunks
 
     made = []
     lock = threading.Lock()

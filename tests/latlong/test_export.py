@@ -275,9 +275,9 @@ def test_glb_patches_match_the_numpy_reference(tmp_path, m, k, stretch):
 def test_ply_fast_path_gives_the_generic_bytes(tmp_path, with_boulders):
     import dataclasses
 
-    from craters._shared.meshio import write_mesh
     from latlong import BoulderLayer, boulder_population, place_boulders
     from latlong.export import body_mesh_source
+    from latlong.meshio.writers import write_mesh
 
     g = LatLongGrid(24)
     body = Body.from_heights(g, 400.0, perlin_fbm(g, 2.0, 4, 0.5, 2.0, 15.0, rng=1),

@@ -12,7 +12,6 @@ import pyvista as pv
 from scipy import stats
 
 import craters
-from craters._shared.meshio import array_source, write_mesh
 from latlong.implicit import (
     ImplicitSurface,
     LcsnLayer,
@@ -24,6 +23,7 @@ from latlong.implicit import (
 )
 from latlong.implicit import _kernels as K
 from latlong.implicit.metaballs import Metaballs, metaball_distance
+from latlong.meshio.writers import array_source, write_mesh
 from latlong.shapes import ShapeModel, mean_surface_distance, read_shape_model
 
 DATA = Path(__file__).parents[1] / "data"

@@ -11,7 +11,7 @@ import csv
 
 import numpy as np
 
-from .files import atomic_path
+from .._shared.files import atomic_path
 
 __all__ = ["plot_slopes", "save_figure", "series_colors", "slope_csv", "slope_table",
            "write_csv"]

@@ -8,17 +8,17 @@ import sys
 
 import numpy as np
 
-from ._shared import atomic_path, check_output_path, package_version
-from ._shared.cli import CliError, OneLineParser, parse_seed, run_cli
-from ._shared.report import save_figure
-from .catalog import CATALOG_COLUMNS, write_catalog
-from .chronology import CHRONOLOGY_SYSTEMS, equilibrium_density, get_chronology_system
-from .layers import ModelAgeLayer, parse_layer_spec
-from .morphology import morphology_class
-from .population import population
-from .profile import crater_morphometry, radial_profile
-from .scc import write_scc
-from .targets import TARGETS, get_target
+from .._shared import atomic_path, check_output_path, package_version
+from ..catalog import CATALOG_COLUMNS, write_catalog
+from ..chronology import CHRONOLOGY_SYSTEMS, equilibrium_density, get_chronology_system
+from ..layers import ModelAgeLayer, parse_layer_spec
+from ..morphology import morphology_class
+from ..population import population
+from ..profile import crater_morphometry, radial_profile
+from ..scc import write_scc
+from ..targets import TARGETS, get_target
+from .kit import CliError, OneLineParser, parse_seed, run_cli
+from .report import save_figure
 
 CHRONOLOGY_NAMES = tuple(CHRONOLOGY_SYSTEMS)
 

@@ -46,10 +46,11 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
+from craters._shared.files import atomic_path, check_parent_folder
+from craters._shared.progress import progress_bar
+from craters._shared.validation import ParameterError, ParameterTypeError, parameter_of
+
 from .batch_tasks import TMP_SUFFIX, one_line, run_variant, sha256_file
-from .files import atomic_path, check_parent_folder
-from .progress import progress_bar
-from .validation import ParameterError, ParameterTypeError, parameter_of
 
 __all__ = ["INDEX", "BatchResult", "Job", "Variant", "check_dask_address", "combinations",
            "dask_client", "parse_seeds",

@@ -5,7 +5,7 @@ Loading a command line loads numpy, numba, pyvista and rasterio (a second or mor
 problems of that start-up would show a traceback. This module and the packages' lazy
 ``__init__`` (:mod:`craters._shared.lazy`) import nothing heavy, so a command starts here
 before any of it loads: a Ctrl-C while the libraries load is ``error: interrupted`` and
-exit code 130 (as a Ctrl-C later in a run, :func:`craters._shared.cli.run_cli`), and a
+exit code 130 (as a Ctrl-C later in a run, :func:`craters.cli.kit.run_cli`), and a
 ``NUMBA_NUM_THREADS`` numba would refuse at import is one ``error:`` line and exit code 2.
 """
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .validation import check_range
+from craters._shared import check_range
 
 __all__ = ["area_slope_summary"]
 

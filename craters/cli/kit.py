@@ -15,9 +15,9 @@ import sys
 import threading
 from collections.abc import Callable, Collection, Iterator, Mapping
 
-from .files import check_output_path
-from .outputs import check_not_input, output_group
-from .validation import ParameterError, ParameterTypeError, parameter_of
+from .._shared.files import check_output_path
+from .._shared.outputs import check_not_input, output_group
+from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
 __all__ = ["BATCH_FLAGS", "CliError", "OneLineParser", "add_batch_arguments",
            "add_report_arguments", "batch_error", "batch_reporter", "batch_summary",

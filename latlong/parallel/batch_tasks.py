@@ -1,4 +1,4 @@
-"""The worker side of a batch (:mod:`craters._shared.batch`): one variant in a temporary
+"""The worker side of a batch (:mod:`latlong.parallel.batch`): one variant in a temporary
 folder inside the batch folder, hashed, renamed into place, timed, with the worker's peak
 resident memory during the task."""
 

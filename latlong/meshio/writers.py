@@ -32,8 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .files import BackgroundWriter, atomic_path
-from .progress import progress_bar
+from craters._shared import atomic_path, progress_bar
+
+from .chunks import BackgroundWriter
 
 __all__ = ["MESH_SUFFIXES", "MESH_WRITERS", "MeshSource", "array_source", "pack_faces",
            "pack_vertices", "ply_face_dtype", "ply_vertex_dtype", "write_mesh"]
