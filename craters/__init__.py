@@ -92,6 +92,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         radial_profile,
         slope_erosion,
     )
+    from .references import REFERENCES, Reference, reference
     from .stamp import (
         Crater,
         Roughness,
@@ -115,10 +116,12 @@ __all__ = [
     "EQUILIBRIUM_FUNCTIONS",
     "LAYER_TYPES",
     "LCSN_PRESETS",
+    "REFERENCES",
     "TARGETS",
     "Target",
     "Crater",
     "CraterLayer",
+    "Reference",
     "LcsnParams",
     "ModelAgeLayer",
     "Roughness",
@@ -153,6 +156,7 @@ __all__ = [
     "power_law_population",
     "profile_tables",
     "radial_profile",
+    "reference",
     "read_catalog",
     "read_scc",
     "rim_perturbations",

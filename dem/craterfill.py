@@ -1,4 +1,4 @@
-r"""Crater gap filling and crater replacement (Martin et al., lunar paper IV.C and IV.D).
+r"""Crater gap filling and crater replacement (Martin, Parkes & Dunstan 2014, IV.C and IV.D).
 
 Crater positions are metres in a local frame (:mod:`dem.frame`): by default the DEM's own
 (origin at its centre pixel), or the stack's (origin at the site). Convert world

@@ -1,4 +1,4 @@
-r"""Random midpoint displacement (RMD) expansion of DEMs (Martin et al., lunar paper IV.A).
+r"""Random midpoint displacement (RMD) expansion of DEMs (Martin, Parkes & Dunstan 2014, IV.A).
 
 One level doubles the resolution of a square region of ``W = 2**n + 1`` pixels: the new
 grid has ``2 W - 1`` pixels a side, its even pixels are the old pixels (bit for bit),
@@ -33,7 +33,7 @@ is ``gamma(rho sqrt 2) / 4 + gamma(2 rho) / 8 = gamma(rho) (2^(H-2) + 2^(2H-3))`
     s_square(L) = sigma sqrt(k(H)) 2^(-(L - 1/2) H),   s_diamond(L) = sigma sqrt(k(H)) 2^(-L H).
 
 Each half step (square -> diamond -> next square) shrinks the scale by
-``2^(-H/2) = 2^(-(3-F)/2)``, Peitgen & Saupe's factor (the paper's eq. 14). The paper's
+``2^(-H/2) = 2^(-(3-F)/2)``, Peitgen & Saupe's (1988) factor (the paper's eq. 14). The paper's
 starting scale (eq. 15, from a height-range factor and the resolution) and its scale
 after ``n`` RMD iterations (eq. 16) are replaced by ``sigma``, *measured* on the input at
 its own resolution, so the expansion continues the input's roughness across scales. The

@@ -21,7 +21,7 @@ averaged over 9 x 9 pixels) at the rim, interpolated harmonically across the hol
 is :func:`dem.fractal_fit`'s estimate of the known terrain (clipped to [2, 3]) unless
 given.
 
-Why not the paper's outside-in filling (Martin et al., lunar paper IV.B: pixels with
+Why not the paper's outside-in filling (Martin, Parkes & Dunstan 2014, IV.B: pixels with
 the most known 8-neighbours first, each the inverse-distance average of the nearest
 known pixel along the 8 grid directions plus a Gaussian; this module's first version).
 Measured on 160-px discs cut from the LOLA crop and from fBm (``bench_dem.py --only

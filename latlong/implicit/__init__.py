@@ -8,12 +8,12 @@ Pipeline (:func:`implicit_surface`):
    distance-transformed (``scipy.ndimage.distance_transform_edt``; the boundary lies half
    a voxel beyond the last inside voxel), and balls are placed greedily, the largest
    free ball first (inside the shape, not overlapping the balls already placed: a
-   non-uniform packing in the spirit of Weller & Zachmann's ProtoSphere), down to a
-   minimum radius. Coverage = packed volume / mesh volume.
-2. **Metaballs** (:func:`fit_metaballs`): Wyvill's soft-object kernel
-   ``(1 - d^2/R^2)^3`` (compact support R = blend x ball radius, so every ball's own
-   iso-surface sits at the same fraction of its radius) summed over the balls; the
-   blend factor and the iso-value T are *fitted to the constraint*: on 20 000 points
+   non-uniform packing in the spirit of Weller & Zachmann's (2010) ProtoSphere), down to
+   a minimum radius. Coverage = packed volume / mesh volume.
+2. **Metaballs** (:func:`fit_metaballs`): the soft-object kernel of Wyvill, McPheeters &
+   Wyvill 1986, ``(1 - d^2/R^2)^3`` (compact support R = blend x ball radius, so every
+   ball's own iso-surface sits at the same fraction of its radius) summed over the balls;
+   the blend factor and the iso-value T are *fitted to the constraint*: on 20 000 points
    uniform on the constraint surface, T is the median of f weighted by 1/|grad f|,
    which minimises the mean first-order distance |f - T| / |grad f| of those points to
    the iso-surface, and the blend factor with the smallest such mean is kept.
@@ -28,7 +28,7 @@ Pipeline (:func:`implicit_surface`):
    smoothed copy, KS distance 0.51-0.58 from the constraint's, median 13-14 degrees for
    3.5-4.7; with the constraint's field 0.02-0.04 and a mean distance of 0.02-0.08 % of
    the long axis, :func:`~latlong.implicit.fidelity.shape_fidelity`). Weight 0 gives
-   Li et al.'s bare metaball surface.
+   Li et al.'s (2020) bare metaball surface.
 4. **Craters** (:class:`LcsnLayer`): the multi-level grid has cells of ``cell_m / 2^l``
    at level l (each cell holds 2^3 cells of the next level); a layer uses the finest
    level whose cells hold its largest crater. Every cell of that level that the coarse
@@ -58,7 +58,8 @@ strips, boulders and exports of the lat/long toolkit apply.
 
 Modules (none imports the lat/long grid; ``surface`` meets it in ``to_body`` only)::
 
-    surface    implicit_surface, ImplicitSurface                   (the build: steps 1-6)
+    build      implicit_surface                                   (the build: steps 1-6)
+    surface    ImplicitSurface: the mesh and catalog it returns
     packing    sphere_packing, SpherePacking                      (step 1)
     metaballs  fit_metaballs, Metaballs, metaball_distance        (steps 2-3)
     distance   mesh_distance, smoothed_constraint                 (step 3)
@@ -69,6 +70,7 @@ Modules (none imports the lat/long grid; ``surface`` meets it in ``to_body`` onl
     _kernels   the numba kernels (craters.kernels.lcsn_height for the LCSN formulas)
 """
 
+from .build import implicit_surface
 from .distance import mesh_distance, smoothed_constraint
 from .fidelity import ShapeFidelity, shape_fidelity
 from .gabor import (
@@ -84,7 +86,7 @@ from .grid import VoxelGrid
 from .layers import LcsnLayer, parse_lcsn_spec
 from .metaballs import Metaballs, fit_metaballs
 from .packing import SpherePacking, sphere_packing
-from .surface import MESH_SUFFIXES, ImplicitSurface, implicit_surface
+from .surface import MESH_SUFFIXES, ImplicitSurface
 
 __all__ = ["MESH_SUFFIXES", "GaborNoise", "GaborPatch", "ImplicitSurface", "LcsnLayer",
            "Metaballs", "ShapeFidelity", "SpherePacking", "VoxelGrid", "fit_gabor", "fit_metaballs",
