@@ -8,11 +8,6 @@ independent tiles (``dem expand``; default serial, ``--workers`` / ``--scheduler
 :mod:`.batch_tasks` is what a variant's task runs. ``dem`` uses it too (``dem ->
 latlong``, never the reverse).
 
-:mod:`.batch` runs one task per variant (``latlong batch``, ``dem batch``) on a local
-cluster or an existing scheduler; :mod:`.tiles` maps a function over independent tiles
-(``dem expand --workers``); :mod:`.batch_tasks` is what runs on a worker. ``dem`` uses it
-too (``dem -> latlong``, never the reverse).
-
 Batches: ``latlong batch`` and ``dem batch``
 --------------------------------------------
 Many terrains from one scene file: every seed of ``--seeds``, times every combination of
