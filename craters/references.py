@@ -4,9 +4,11 @@ Every citation in the source of ``craters``, ``latlong`` and ``dem`` (``Pike 197
 ``Fassett & Thomson (2014)``, ``Martin, Parkes & Dunstan 2014``, ``Li et al. 2022`` ...)
 names an entry here by its first author's surname and year, and every entry is cited
 where it is used (``tests/test_references.py`` checks both ways). A ``doi`` is given only
-where it was confirmed by a look-up; books, proceedings, abstracts and works whose DOI
-was not confirmed have ``doi=None`` and an identifier (publisher, ISBN, ADS bibcode) in
-``venue``.
+where a record was found that shows it for the same title; books, proceedings, abstracts
+and works whose DOI was not confirmed have ``doi=None`` and an identifier (publisher, ISBN,
+ADS bibcode, PMID) in ``venue``. A title that no record confirmed is kept but marked
+``(title not confirmed)`` in ``venue``; where no title is known at all the title is
+``(title not confirmed; cited by venue)``.
 
 The entries, by topic (keys of :data:`REFERENCES`):
 
@@ -129,19 +131,21 @@ REFERENCES = _entries(
     # ---------------------------------------------------------------- crater shapes
     _R("pike1977", ("Pike, R. J.",), 1977,
        "Size-dependence in the shape of fresh impact craters on the Moon",
-       "Impact and Explosion Cratering (Roddy, Pepin & Merrill, eds.), Pergamon, 489-509"),
+       "Impact and Explosion Cratering: Planetary and Terrestrial Implications (Roddy, Pepin & "
+       "Merrill, eds.), Pergamon, 489-509"),
     _R("pike1980", ("Pike, R. J.",), 1980,
        "Control of crater morphology by gravity and target type: Mars, Earth, Moon",
        "Proceedings of the 11th Lunar and Planetary Science Conference, 2159-2189"),
     _R("pike1985", ("Pike, R. J.",), 1985,
-       "Some morphologic systematics of complex impact structures", "Meteoritics 20(1), 49-68"),
+       "Some morphologic systematics of complex impact structures",
+       "Meteoritics 20(1), 49-68 (title not confirmed)"),
     _R("pike1988", ("Pike, R. J.",), 1988, "Geomorphology of impact craters on Mercury",
        "Mercury (Vilas, Chapman & Matthews, eds.), University of Arizona Press, 165-273"),
     _R("hale1979", ("Hale, W.", "Head, J. W."), 1979,
        "Central peaks in lunar craters: Morphology and morphometry",
        "Proceedings of the 10th Lunar and Planetary Science Conference"),
     _R("melosh1989", ("Melosh, H. J.",), 1989, "Impact Cratering: A Geologic Process",
-       "Oxford University Press (Oxford Monographs on Geology and Geophysics 11)"),
+       "Oxford University Press, New York"),
     _R("baker2011", ("Baker, D. M. H.", "Head, J. W.", "Fassett, C. I.", "Kadish, S. J.",
                      "Smith, D. E.", "Zuber, M. T.", "Neumann, G. A."), 2011,
        "The transition from complex crater to peak-ring basin on the Moon: New observations "
@@ -152,7 +156,8 @@ REFERENCES = _entries(
        "Orbiter Laser Altimeter", "Geophysical Research Letters 25(24), 4405-4408",
        "10.1029/1998GL900177"),
     _R("grieve1987", ("Grieve, R. A. F.",), 1987, "Terrestrial impact structures",
-       "Annual Review of Earth and Planetary Sciences 15, 245-270 (DOI not confirmed)"),
+       "Annual Review of Earth and Planetary Sciences 15, 245-270 (title not confirmed; DOI not "
+       "confirmed)"),
     _R("sun2023", ("Sun, Q.", "Fa, W.", "Zhu, M.-H.", "Du, J."), 2023,
        "Morphological characteristics of impact craters with diameters of 5-20 km on the "
        "Moon", "Icarus 115688", "10.1016/j.icarus.2023.115688"),
@@ -161,7 +166,8 @@ REFERENCES = _entries(
        "Science 353(6303), aaf4759", "10.1126/science.aaf4759"),
     _R("marchi2015", ("Marchi, S.", "Chapman, C. R.", "Barnouin, O. S.", "Richardson, J. E.",
                       "Vincent, J.-B."), 2015, "Cratering on asteroids",
-       "Asteroids IV (Michel, DeMeo & Bottke, eds.), University of Arizona Press, 725"),
+       "Asteroids IV (Michel, DeMeo & Bottke, eds.), University of Arizona Press, Tucson, 725 "
+       "(title not confirmed)"),
     _R("daly2020", ("Daly, R. T.", "Bierhaus, E. B.", "Barnouin, O. S.", "et al."), 2020,
        "The morphometry of impact craters on Bennu",
        "Geophysical Research Letters 47(24), e2020GL089672", "10.1029/2020GL089672"),
@@ -242,15 +248,15 @@ REFERENCES = _entries(
        "A partially differentiated interior for (1) Ceres deduced from its gravity field and "
        "shape", "Nature 537, 515-517", "10.1038/nature18955"),
     _R("thomas1994", ("Thomas, P. C.", "et al."), 1994,
-       "The shape of Gaspra", "Icarus 107 (DOI not confirmed)"),
+       "The shape of Gaspra", "Icarus 107 (title not confirmed; DOI not confirmed)"),
     _R("thomas1996", ("Thomas, P. C.", "et al."), 1996,
-       "The shape of Ida", "Icarus 120 (DOI not confirmed)"),
+       "The shape of Ida", "Icarus 120 (title not confirmed; DOI not confirmed)"),
     _R("sierks2011", ("Sierks, H.", "Lamy, P.", "Barbieri, C.", "et al."), 2011,
        "Images of asteroid 21 Lutetia: A remnant planetesimal from the early solar system",
        "Science 334(6055), 487-490", "10.1126/science.1207325"),
-    _R("willner2014", ("Willner, K.", "et al."), 2014,
-       "Phobos' shape and topography models",
-       "Planetary and Space Science (DOI not confirmed)"),
+    _R("willner2014", ("Willner, K.", "Shi, X.", "Oberst, J."), 2014,
+       "Phobos' shape and topography models", "Planetary and Space Science",
+       "10.1016/j.pss.2013.12.006"),
     # ---------------------------------------------------------------- presets: Eros
     _R("veverka2000", ("Veverka, J.", "et al."), 2000,
        "NEAR at Eros: Imaging and spectral results", "Science 289(5487), 2088-2097",
@@ -260,16 +266,17 @@ REFERENCES = _entries(
        "Asteroids III (Bottke, Cellino, Paolicchi & Binzel, eds.), University of Arizona "
        "Press, 315-330"),
     _R("berthoud2001", ("Berthoud, M.", "Thomas, P. C.", "Veverka, J."), 2001,
-       _UNCONFIRMED, "Bulletin of the American Astronomical Society 33, 59.04 (DPS abstract)"),
+       "Eros: Crater densities in 3 major impact features",
+       "Bulletin of the American Astronomical Society 33(3), DPS 2001 abstract 59.04"),
     _R("thomas2001", ("Thomas, P. C.", "et al."), 2001,
        "Shoemaker crater as the source of most ejecta blocks on the asteroid 433 Eros",
-       "Nature 413, 394-396 (DOI not confirmed)"),
+       "Nature 413(6854), 394-396 (PMID 11574880; DOI not confirmed)"),
     _R("michikami2021", ("Michikami, T.", "Hagermann, A."), 2021,
        "Boulder sizes and shapes on asteroids: A comparative study of Eros, Itokawa and "
-       "Ryugu", "Icarus 357, 114282 (DOI not confirmed)"),
+       "Ryugu", "Icarus 357, 114282", "10.1016/j.icarus.2020.114282"),
     _R("yeomans2000", ("Yeomans, D. K.", "et al."),
        2000, "Radio science results during the NEAR-Shoemaker spacecraft rendezvous with "
-       "Eros", "Science 289(5487), 2085-2088 (DOI not confirmed)"),
+       "Eros", "Science 289(5487), 2085-2088", "10.1126/science.289.5487.2085"),
     _R("zuber2000", ("Zuber, M. T.", "et al."), 2000,
        "The shape of 433 Eros from the NEAR-Shoemaker Laser Rangefinder",
        "Science 289(5487), 2097-2101", "10.1126/science.289.5487.2097"),
@@ -282,7 +289,7 @@ REFERENCES = _entries(
        "10.1016/j.icarus.2008.10.027"),
     _R("michel2009", ("Michel, P.", "et al."), 2009,
        "Itokawa's cratering record as observed by Hayabusa: Implications for its age and "
-       "collisional history", "Icarus 200(2), 503-513 (DOI not confirmed)"),
+       "collisional history", "Icarus 200(2), 503-513", "10.1016/j.icarus.2008.04.002"),
     _R("michikami2008", ("Michikami, T.", "et al."), 2008,
        "Size-frequency statistics of boulders on global surface of asteroid 25143 Itokawa",
        "Earth, Planets and Space 60, 13-20", "10.1186/BF03352757"),
@@ -295,7 +302,7 @@ REFERENCES = _entries(
        "from radar and lightcurve observations", "Icarus 226(1), 629-640 (DOI not confirmed)"),
     _R("bierhaus2022", ("Bierhaus, E. B.", "et al."), 2022,
        "Crater population on asteroid (101955) Bennu indicates impact armouring and a young "
-       "surface", "Nature Geoscience 15 (DOI not confirmed)"),
+       "surface", "Nature Geoscience 15 (title not confirmed; DOI not confirmed)"),
     _R("walsh2019", ("Walsh, K. J.", "Jawin, E. R.", "Ballouz, R.-L.", "et al."), 2019,
        "Craters, boulders and regolith of (101955) Bennu indicative of an old and dynamic "
        "surface", "Nature Geoscience 12, 242-246", "10.1038/s41561-019-0326-6"),
@@ -304,7 +311,7 @@ REFERENCES = _entries(
        "analysis", "Nature Astronomy 3, 341-351", "10.1038/s41550-019-0731-1"),
     _R("scheeres2019", ("Scheeres, D. J.", "et al."), 2019,
        "The dynamic geophysical environment of (101955) Bennu based on OSIRIS-REx "
-       "measurements", "Nature Astronomy 3, 352-361 (DOI not confirmed)"),
+       "measurements", "Nature Astronomy 3(4), 352-361", "10.1038/s41550-019-0721-3"),
     # ---------------------------------------------------------------- gravity
     _R("werner1997", ("Werner, R. A.", "Scheeres, D. J."), 1997,
        "Exterior gravitation of a polyhedron derived and compared with harmonic and mascon "
@@ -344,7 +351,7 @@ REFERENCES = _entries(
        "10.1007/BF01900346"),
     _R("weller2010", ("Weller, R.", "Zachmann, G."), 2010,
        "ProtoSphere: A GPU-assisted prototype guided sphere packing algorithm for arbitrary "
-       "objects", "SIGGRAPH Asia 2010 Sketches (DOI not confirmed)"),
+       "objects", "SIGGRAPH Asia 2010 (DOI not confirmed)"),
     _R("zorin1996", ("Zorin, D.", "Schröder, P.", "Sweldens, W."), 1996,
        "Interpolating subdivision for meshes with arbitrary topology",
        "SIGGRAPH '96 Proceedings, 189-192", "10.1145/237170.237254"),
@@ -392,7 +399,7 @@ REFERENCES = _entries(
        "Photometric functions for photoclinometry and other applications",
        "Icarus 92(2), 298-311", "10.1016/0019-1035(91)90053-V"),
     _R("mcewen1996", ("McEwen, A. S.",), 1996, "A precise lunar photometric function",
-       "27th Lunar and Planetary Science Conference, 841"),
+       "27th Lunar and Planetary Science Conference, 841 (title not confirmed)"),
     _R("hapke1984", ("Hapke, B.",), 1984,
        "Bidirectional reflectance spectroscopy: 3. Correction for macroscopic roughness",
        "Icarus 59(1), 41-59", "10.1016/0019-1035(84)90054-X"),
@@ -415,14 +422,16 @@ REFERENCES = _entries(
        "Asteroids II (Binzel, Gehrels & Matthews, eds.), University of Arizona Press, 557"),
     _R("ishiguro2014", ("Ishiguro, M.", "et al."), 2014,
        "Optical properties of (162173) 1999 JU3: In preparation for the JAXA Hayabusa 2 "
-       "sample return mission", "The Astrophysical Journal 792, 74 (DOI not confirmed)"),
+       "sample return mission", "The Astrophysical Journal 792(1), 74 (ADS 2014ApJ...792...74I)",
+       "10.1088/0004-637X/792/1/74"),
     _R("li2004", ("Li, J.-Y.", "et al."), 2004,
-       "Photometric analysis of Eros from NEAR data", "Icarus 172(2), 415-431 (DOI not "
-       "confirmed)"),
+       "Photometric analysis of Eros from NEAR data", "Icarus 172(2), 415-431 (title not "
+       "confirmed; DOI not confirmed)"),
     _R("grier2001", ("Grier, J. A.", "McEwen, A. S.", "Lucey, P. G.", "Milazzo, M.",
                      "Strom, R. G."), 2001,
        "Optical maturity of ejecta from large rayed lunar craters",
-       "Journal of Geophysical Research 106(E12), 32847-32862 (DOI not confirmed)"),
+       "Journal of Geophysical Research 106(E12), 32847-32862 (title not confirmed; DOI not "
+       "confirmed)"),
 )
 del _R
 

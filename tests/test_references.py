@@ -167,6 +167,16 @@ def test_entries_are_well_formed():
         assert "et al." not in ref.authors[:-1], key
 
 
+def test_confirmation_marks_agree_with_the_fields():
+    """A DOI and "(DOI not confirmed)" exclude each other; an unconfirmed title is marked once."""
+    placeholder = "(title not confirmed; cited by venue)"
+    for key, ref in REFERENCES.items():
+        assert ref.doi is None or "DOI not confirmed" not in ref.venue, key
+        assert "not confirmed" not in ref.title or ref.title == placeholder, key
+        assert not (ref.title == placeholder and "title not confirmed" in ref.venue), key
+        assert ref.venue.count("title not confirmed") <= 1, key
+
+
 def test_reference_lookup():
     assert craters.reference("fassett2014") is REFERENCES["fassett2014"]
     assert craters.reference("fassett2014").cite() == "Fassett & Thomson 2014"
