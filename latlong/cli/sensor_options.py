@@ -61,7 +61,7 @@ def add_model_options(parser, what: str, model_help: str, *, units: bool = True)
         parser.add_argument("--units", choices=("m", "km"), default="m",
                             help="units of a mesh file's coordinates (default: m)")
     parser.add_argument("--catalog", help=f"crater catalog CSV that labels the {what} "
-                        "(default: the model's own; a mesh file has none)")
+                        "(default: the model's own, if it has one)")
 
 
 def add_sensor_command(sub, name: str, help: str, add_options: Callable, run: Callable,
