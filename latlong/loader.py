@@ -47,7 +47,8 @@ def load_surface(path, *, units: str = "m"):
     if suffix in MESH_SUFFIXES:
         return read_mesh_file(path, units=units)
     raise ParameterError("model", f"must be a body .npz or a mesh file "
-                         f"({' '.join(MESH_SUFFIXES)}); got {str(path)!r}")
+                         f"({' '.join(MESH_SUFFIXES)}; a DEM or a layer stack is a "
+                         f"dem.DemSurface: dem camera, dem lidar); got {str(path)!r}")
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
