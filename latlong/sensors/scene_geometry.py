@@ -56,11 +56,16 @@ class SceneGeometry:
     """Where it came from."""
 
 
+def _is_surface(model) -> bool:
+    """``model`` has the members of a surface the sensors use."""
+    return all(hasattr(model, k) for k in SURFACE_MEMBERS)
+
+
 def _of_surface(model: Surface | SceneGeometry) -> SceneGeometry:
     """The mesh and the surface's own catalogs (map catalogs not placed yet)."""
     if isinstance(model, SceneGeometry):
         return model
-    if not all(hasattr(model, k) for k in SURFACE_MEMBERS):
+    if not _is_surface(model):
         raise TypeError("`model` must be a surface (latlong.geometry.Surface: a Body, a "
                         "mesh surface, a mesh file from latlong.load_surface, a dem "
                         f"DemSurface) or a SceneGeometry; got {type(model).__name__}")
@@ -121,8 +126,7 @@ def scene_mesh(model, *, build_quality: str = "medium") -> RayMesh:
         return model
     if isinstance(model, tuple) and len(model) == 2:
         return RayMesh(*model, build_quality=build_quality)
-    if not isinstance(model, SceneGeometry) and not all(hasattr(model, k)
-                                                       for k in SURFACE_MEMBERS):
+    if not (isinstance(model, SceneGeometry) or _is_surface(model)):
         raise TypeError("`model` must be a RayMesh, a surface, a SceneGeometry or "
                         f"(vertices, faces); got {type(model).__name__}")
     geo = _of_surface(model)
