@@ -1,4 +1,4 @@
-"""craters: crater science shared by the body (latlong) and raster (dem) pipelines.
+r"""craters: crater science shared by the body (latlong) and raster (dem) pipelines.
 
 Science only, pure functions over numpy arrays: fresh crater shapes on any target body
 (simple bowls, flat floors, terraces, central peaks, peak rings; Pike 1977 and the
@@ -23,7 +23,88 @@ Imports neither ``latlong`` nor ``dem``.
 
 The plumbing every package needs (checks, RNG, atomic files, progress, ``key=value``
 specs, reports, the mesh-writer registry) is the private ``craters._shared``, and the
-command line ``craters.cli``; neither is crater science.
+command line ``craters.cli``; neither is crater science. More in the subpackages'
+docstrings: :mod:`craters.chronology` (populations by model age), :mod:`craters.lcsn`
+(Li et al.'s kernels), :mod:`craters.boulders`.
+
+The ``craters`` command
+-----------------------
+The commands of this docstring run as written, in order, from the repository's folder,
+into ``out/craters/``; ``tests/test_readme_commands.py`` runs them at small sizes.
+
+.. code-block:: bash
+
+    mkdir -p out/craters
+    craters profile --diameter-m 1000 --age-gyr 3 --csv out/craters/p.csv \
+        --plot out/craters/p.png
+    craters profile --diameter-m 100000 --body moon  # 4.2 km deep, 59 km flat floor, 2 km peak
+    craters profile --diameter-m 20000 --body mars --plot out/craters/mars.png
+    craters population --body mars \
+        --craters npf=mars,age_gyr=3.5,d_min_m=5000,d_max_m=100000 -o out/craters/mars_all.csv
+    craters population --craters c=0.5,k=-2,d_min_m=5,d_max_m=800 --radius-m 2000 --seed 1 \
+        -o out/craters/cat.csv --plot out/craters/sfd.png
+
+    # a 3.8 Gyr lunar surface on 10 000 km^2 (Neukum et al. 2001), capped at the Trask
+    # equilibrium below its saturation diameter (printed: 420 m); craterstats reads the .scc
+    craters population \
+        --craters npf=moon,age_gyr=3.8,d_min_m=100,d_max_m=40000,equilibrium=trask \
+        --area-m2 1e10 --seed 1 -o out/craters/moon.scc --plot out/craters/moon_sfd.png
+    # Mars at 3.5 Gyr (Ivanov 2001 production function, Hartmann & Neukum 2001 chronology),
+    # CSV with the Robbins database's columns (LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG, km)
+    craters population --craters npf=mars,age_gyr=3.5,d_min_m=1000,d_max_m=40000 \
+        --area-m2 1e11 --seed 1 -o out/craters/mars.csv --columns robbins
+
+Crater shapes by body, size and age
+-----------------------------------
+A fresh crater's shape follows its target body (:data:`TARGETS`: ``moon``, ``mars``,
+``mercury``, ``earth``, ``ceres``, ``vesta``, and :func:`small_body` (radius_m,
+density_kg_m3) for an asteroid, whose gravity follows from its size; ``--body``,
+``--gravity-m-s2`` on every command). Below the body's simple/complex transition (Moon
+~15 km; Mars 8 km, Garvin & Frawley 1998; Mercury 10.3 km, Pike 1988; measured where
+published, else scaled as 1/g from the Moon's) a crater is a bowl with Pike's (1977)
+simple depth 0.196 D^1.010 and rim 0.036 D^1.014 (D in km) and Fassett & Thomson's
+(2014) fresh interior; above it, continuously through a transitional range (0.8–1.6
+D_t), a flat floor that widens with D, terraced walls, a central peak (height
+0.032 D^0.9 km, base 0.22 D) and Pike's complex depth 1.044 D^0.301 and rim 0.236
+D^0.399; beyond the peak-ring onset (Moon ~200 km, Baker et al. 2011) a peak ring; the
+ejecta thins as r^-3 (McGetchin et al. 1973). Ageing is topographic diffusion
+(Fassett & Thomson 2014: κ = 5.5 m²/Myr at 1 km, ∝ D^0.9): a crater of age T is its
+fresh profile diffused for κT, solved exactly in Hankel space and cached per (D, κT) for
+stamping, so old craters are shallow and rimless (a 1 km lunar crater: d/D 0.196 fresh,
+0.161 at 1 Gyr, 0.103 at 3.5 Gyr) and ``degradation`` (the share of the fresh depth
+removed, an explicit override) = 1 leaves no relief. Catalogs list each crater's
+``morphology`` (simple, transitional, complex, peak-ring), its depth, rim height, floor
+diameter, peak height and κt as stamped. ``python examples/plot_crater_morphology.py``
+draws them; ``craters.stamp_many(heights, pixel_size_m, catalog, target=...)`` stamps a
+catalog into any 2-D height grid, with Martin et al.'s irregular rims and fractal
+roughness, on all cores: craters whose boxes cannot overlap are stamped together, in
+waves that keep the age order wherever it matters (the same bytes for any thread count).
+
+Catalogs crater-counting tools read
+-----------------------------------
+``-o cat.scc`` writes a craterstats spatial crater count (:func:`write_scc`: ellipsoid
+axes, ``Total_area`` in km², one row per crater with diameter in km, fraction,
+longitude and latitude; :func:`read_scc` reads it and CraterTools' files). craterstats
+fits a synthetic surface's age back: with ``pip install craterstats 'numpy<2'
+'scipy<1.14'`` in a virtual environment of its own, ``craterstats -cs "Moon, Neukum et
+al. (2001)" -p source=out/craters/moon.scc,type=c-fit,range=[1,20] -f csv`` gives
+3.8 Gyr. ``python tests/benchmarks/bench_age_roundtrip.py`` runs the whole round trip
+(it makes that environment; the opt-in test ``CRATERFORM_CRATERSTATS=1 python -m pytest
+tests/craters/test_craterstats_roundtrip.py`` does the same): Moon 1.0 Gyr → 0.96–1.02,
+Moon 3.8 → 3.79–3.81, Mars 3.5 → 3.49–3.53 Gyr over five seeds, 400–2100 craters in
+1–20 km each.
+
+.. code-block:: python
+
+    import craters
+
+    layer = craters.ModelAgeLayer("moon", 3.8, d_min_m=100.0, d_max_m=40000.0,
+                                  equilibrium="trask")
+    cat = craters.population([layer], area_m2=1e10, rng=1)  # sizes, ages, positions ...
+    craters.write_scc(cat, "out/craters/moon_lib.scc", area_m2=1e10,
+                      body_radius_m=1737400.0)
+    print(layer.saturation_diameter_m, layer.expected_count(1e10),
+          layer.cumulative_m2(1000.0))
 """
 
 import logging
@@ -92,6 +173,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         radial_profile,
         slope_erosion,
     )
+    from .references import REFERENCES, Reference, reference
     from .stamp import (
         Crater,
         Roughness,
@@ -115,10 +197,12 @@ __all__ = [
     "EQUILIBRIUM_FUNCTIONS",
     "LAYER_TYPES",
     "LCSN_PRESETS",
+    "REFERENCES",
     "TARGETS",
     "Target",
     "Crater",
     "CraterLayer",
+    "Reference",
     "LcsnParams",
     "ModelAgeLayer",
     "Roughness",
@@ -153,6 +237,7 @@ __all__ = [
     "power_law_population",
     "profile_tables",
     "radial_profile",
+    "reference",
     "read_catalog",
     "read_scc",
     "rim_perturbations",

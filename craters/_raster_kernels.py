@@ -5,7 +5,7 @@
   h = p0 + gx x + gy y from its nine running sums (3 x 3 normal equations by cofactors);
 * :func:`_idw8`: the inverse-distance average of the nearest known cell along each of
   the 8 directions (:data:`DR8`, :data:`DC8`), the hole filler of local DEM mapping
-  (Martin 2014, V.A) and of outside-in gap filling (Martin et al., lunar paper IV.B).
+  (Martin 2014, V.A) and of outside-in gap filling (Martin, Parkes & Dunstan 2014, IV.B).
 
 No validation: callers validate first.
 """

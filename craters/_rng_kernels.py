@@ -2,7 +2,7 @@
 
 A deviate is a pure function of the integers that key it (a seed, a stream, a level,
 an index ...), never of the order in which a kernel visits them, of the thread count or
-of the tiling (DESIGN §3). The mix is Steele, Lea & Flood's splitmix64 (the
+of the tiling (DESIGN §3). The mix is Steele, Lea & Flood's (2014) splitmix64 (the
 ``java.util.SplittableRandom`` finaliser, variant 13); a 64-bit hash gives two 53-bit
 uniforms and one standard normal by Box–Muller (cosine branch).
 """

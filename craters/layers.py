@@ -27,6 +27,7 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from . import chronology
 from ._shared import (
     ParameterError,
     check_finite,
@@ -35,20 +36,6 @@ from ._shared import (
     check_range,
     normalize_rng,
     parse_spec,
-)
-from .chronology import (
-    check_age,
-    check_diameter_range,
-    cumulative_density,
-    equilibrium_bin_edges,
-    equilibrium_caps,
-    equilibrium_density,
-    expected_survivors,
-    formation_ages,
-    get_chronology_system,
-    get_equilibrium,
-    sample_pf_diameters,
-    saturation_diameter_m,
 )
 
 __all__ = ["LAYER_TYPES", "CraterLayer", "ModelAgeLayer", "as_crater_layer", "expected_count",
@@ -202,11 +189,11 @@ class ModelAgeLayer:
     catalog's ``kind``; the shape class is the catalog's ``morphology``."""
 
     def __post_init__(self):
-        system = get_chronology_system(self.npf)
-        check_age(system, self.age_gyr)
-        check_diameter_range(system, self.d_min_m, self.d_max_m)
+        system = chronology.get_chronology_system(self.npf)
+        chronology.check_age(system, self.age_gyr)
+        chronology.check_diameter_range(system, self.d_min_m, self.d_max_m)
         if self.equilibrium is not None:
-            get_equilibrium(self.equilibrium)
+            chronology.get_equilibrium(self.equilibrium)
         if self.degradation is not None:
             check_range("degradation", self.degradation, 0.0, 1.0)
         _check_kind(self.kind)
@@ -218,12 +205,12 @@ class ModelAgeLayer:
         it never saturates."""
         if self.equilibrium is None:
             return None
-        return saturation_diameter_m(self.npf, self.age_gyr, self.equilibrium)
+        return chronology.saturation_diameter_m(self.npf, self.age_gyr, self.equilibrium)
 
     def cumulative_m2(self, diameter_m) -> np.ndarray:
         """N(>D) per m^2 of the production function at ``age_gyr`` (D in metres; before
         any equilibrium cap)."""
-        return cumulative_density(self.npf, self.age_gyr, diameter_m)
+        return chronology.cumulative_density(self.npf, self.age_gyr, diameter_m)
 
     def expected_count(self, area_m2: float, d_min_m: float | None = None,
                        d_max_m: float | None = None) -> float:
@@ -232,28 +219,28 @@ class ModelAgeLayer:
         after the cap (in saturated bins ``E[min(n, cap)]`` of the Poisson count n,
         :func:`craters.chronology.expected_survivors`)."""
         lo, hi = _range(self, d_min_m, d_max_m)
-        system = get_chronology_system(self.npf)
-        lo, hi = check_diameter_range(system, lo, hi)
+        system = chronology.get_chronology_system(self.npf)
+        lo, hi = chronology.check_diameter_range(system, lo, hi)
         if self.equilibrium is None:
             n = self.cumulative_m2([lo, hi])
             return float(area_m2 * (n[0] - n[1]))
-        edges = equilibrium_bin_edges(lo, hi)
+        edges = chronology.equilibrium_bin_edges(lo, hi)
         pf = self.cumulative_m2(edges)
-        eq = equilibrium_density(self.equilibrium, edges)
+        eq = chronology.equilibrium_density(self.equilibrium, edges)
         lam = area_m2 * (pf[:-1] - pf[1:])
         want = area_m2 * (eq[:-1] - eq[1:])
         saturated = lam > want
         return float(lam[~saturated].sum()
-                     + expected_survivors(lam[saturated], want[saturated]).sum())
+                     + chronology.expected_survivors(lam[saturated], want[saturated]).sum())
 
     def sample_diameters(self, n: int, *, rng=None) -> np.ndarray:
         """``n`` diameters (m) of the production function in [d_min_m, d_max_m]
         (without the equilibrium cap)."""
-        return sample_pf_diameters(n, self.npf, self.d_min_m, self.d_max_m, rng=rng)
+        return chronology.sample_pf_diameters(n, self.npf, self.d_min_m, self.d_max_m, rng=rng)
 
     def sample_ages(self, n: int, *, rng=None) -> np.ndarray:
         """``n`` formation ages (Gyr), ``P(age <= t) = N1(t) / N1(age_gyr)``."""
-        return formation_ages(n, self.npf, self.age_gyr, rng=rng)
+        return chronology.formation_ages(n, self.npf, self.age_gyr, rng=rng)
 
     def draw(self, area_m2: float, *, rng=None) -> tuple[np.ndarray, np.ndarray]:
         """Diameters (m) and formation ages (Gyr) of the layer's craters on ``area_m2``.
@@ -274,9 +261,9 @@ class ModelAgeLayer:
             n = int(rng.poisson(self.expected_count(area_m2)))
             d = self.sample_diameters(n, rng=rng)
             return d, self.sample_ages(n, rng=rng)
-        system = get_chronology_system(self.npf)
-        edges, caps = equilibrium_caps(system, self.age_gyr, self.equilibrium, area_m2,
-                                       self.d_min_m, self.d_max_m, rng=rng)
+        system = chronology.get_chronology_system(self.npf)
+        edges, caps = chronology.equilibrium_caps(system, self.age_gyr, self.equilibrium,
+                                                  area_m2, self.d_min_m, self.d_max_m, rng=rng)
         pf = self.cumulative_m2(edges)
         produced = rng.poisson(area_m2 * (pf[:-1] - pf[1:]))
         kept = np.where(caps >= 0, np.minimum(produced, caps), produced)
@@ -285,9 +272,9 @@ class ModelAgeLayer:
         ds, ages = [], []
         for b in np.flatnonzero(kept):
             k, n = int(kept[b]), int(produced[b])
-            ds.append(sample_pf_diameters(k, system, edges[b], edges[b + 1], rng=rng))
+            ds.append(chronology.sample_pf_diameters(k, system, edges[b], edges[b + 1], rng=rng))
             if k == n:
-                ages.append(formation_ages(k, system, self.age_gyr, rng=rng))
+                ages.append(chronology.formation_ages(k, system, self.age_gyr, rng=rng))
                 continue
             s = np.cumsum(rng.standard_exponential(k))
             u = s / (s[-1] + rng.standard_gamma(n - k + 1))

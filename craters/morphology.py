@@ -20,9 +20,9 @@ rim crest at x = 1), for a fresh crater of rim-crest diameter D on a
   diameter above the peak-ring onset (Baker et al. 2011: ring / rim ~ 0.5).
 * the complex form replaces the simple one over the transitional range 0.8-1.6 D_t
   (smoothstep in log D): floors widen, peaks and terraces grow in, nothing jumps.
-* exterior: the rim falls to McGetchin et al.'s ejecta thickness 0.14 R^0.74 (r/R)^-3
+* exterior: the rim falls to McGetchin et al.'s (1973) ejecta thickness 0.14 R^0.74 (r/R)^-3
   (metres, capped at the rim height) with the corrective quadratic that ends it on the
-  terrain at the ejecta edge (lunar paper III, :mod:`craters.profile`).
+  terrain at the ejecta edge (Martin, Parkes & Dunstan 2014, III; :mod:`craters.profile`).
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ _FT_CREST = 0.98
 # complex craters (lunar values, self-similar in D / D_t elsewhere)
 _FLOOR_LAW = (0.187, 1.249)         # floor diameter, km (Pike 1977)
 _PEAK_LAW = (0.032, 0.9)            # central peak height, km (Hale & Head 1979)
-_PEAK_BASE = 0.22                   # central peak base diameter / D
+_PEAK_BASE = 0.22                   # central peak base diameter / D (Hale & Head 1979)
 _RING_X = 0.5                       # peak ring diameter / rim diameter (Baker et al. 2011)
 _RING_WIDTH = 0.08                  # peak ring half-width, crater radii
 _TRANSITION = (0.8, 1.6)            # transitional range, in D_t
@@ -212,6 +212,6 @@ def _fresh_rows(x: np.ndarray, d: np.ndarray, t: Target, ejecta_edge: float) -> 
     inner = inner + col["peak_height_m"] * ((1.0 - q) * bump + q * ring)
     # exterior: ejecta from the rim to the edge
     radius = 0.5 * d[:, None]
-    e0 = np.minimum(0.14 * radius**0.74, rim)
+    e0 = np.minimum(0.14 * radius**0.74, rim)  # McGetchin et al. 1973, metres
     outer = _exterior(np.maximum(xx, 1.0), rim, e0, ejecta_edge)
     return np.where(xx <= 1.0, inner, np.where(xx < ejecta_edge, outer, 0.0))

@@ -7,7 +7,7 @@ is dimensionless): the expected number of craters with diameter in [d_min, d_max
 area A is ``A c (d_min^k - d_max^k)`` (Martin eq. 12), the count is drawn from a
 Poisson distribution with that mean, diameters follow the truncated power law by
 inversion sampling (Li et al. 2022 eq. 17-21 with B = -k) and ages are uniform in
-[age_min, age_max] (the "linear" age distribution of the lunar paper). A model-age
+[age_min, age_max] (the "linear" age distribution of Martin, Parkes & Dunstan 2014). A model-age
 layer takes sizes from a body's production function and ages from its chronology
 (:mod:`craters.chronology`). Positions are uniform on the sphere (normalised Gaussian
 vectors, Martin 2014 eq. 1-4) or in a rectangle; catalogs come sorted oldest first, the

@@ -268,23 +268,9 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     erased = np.zeros(n, dtype=np.bool_)
     rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
     gain = 2.0 ** (rough.fractal_dimension - 3.0)
-    args = (h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds, ejecta_edge,
-            bool(slope_erosion), onset, full, rough_arr, gain, scale, slope, erased)
-    waves = numba.get_num_threads() > 1 and n >= WAVE_MIN
-    if waves:
-        reach = _crater_reach_px(pixel, diam, rim_tabs, ejecta_edge)
-        cost = _box_pixels(h.shape[0], cy, reach) * _box_pixels(h.shape[1], cx, reach)
-        waves = cost.sum() >= WAVE_MIN_PIXELS
-    if waves:
-        _stamp_in_waves(args, reach, cost, progress)
-    else:
-        step = _BATCH if progress else max(n, 1)
-        for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
-            e = min(s + step, n)
-            _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], prof.tables[s:e],
-                               prof.depth_m[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge,
-                               bool(slope_erosion), onset, full, rough_arr, gain, scale[s:e],
-                               slope[s:e], erased[s:e])
+    _stamp_all((h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds,
+                ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain, scale, slope,
+                erased), progress)
     if erased.any():
         logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
                     int(erased.sum()), n, full)
@@ -293,6 +279,27 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     cols = {k: cat[k] for k in names}
     cols.update(as_stamped(prof, scale, diam), slope_deg=slope, seed=seeds)
     return h, make_catalog(**cols)[~erased]
+
+
+def _stamp_all(args: tuple, progress: bool) -> None:
+    """Run the stamping kernel on ``args`` (its arguments, full arrays): in parallel waves
+    when there are threads and enough craters and pixels to pay for them, else the
+    serial kernel (in batches of :data:`_BATCH` craters behind a progress bar)."""
+    (h, pixel, cx, cy, diam, tables, depth, rim_tabs, seeds, ejecta_edge, erosion, onset, full,
+     rough, gain, scale, slope, erased) = args
+    n = len(cx)
+    if numba.get_num_threads() > 1 and n >= WAVE_MIN:
+        reach = _crater_reach_px(pixel, diam, rim_tabs, ejecta_edge)
+        cost = _box_pixels(h.shape[0], cy, reach) * _box_pixels(h.shape[1], cx, reach)
+        if cost.sum() >= WAVE_MIN_PIXELS:
+            _stamp_in_waves(args, reach, cost, progress)
+            return
+    step = _BATCH if progress else max(n, 1)
+    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+        e = min(s + step, n)
+        _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], tables[s:e], depth[s:e],
+                           rim_tabs[s:e], seeds[s:e], ejecta_edge, erosion, onset, full, rough,
+                           gain, scale[s:e], slope[s:e], erased[s:e])
 
 
 def _crater_reach_px(pixel_size_m: float, diameter_m, rim_tabs, ejecta_edge: float) -> np.ndarray:

@@ -109,6 +109,7 @@ def _scaled_law(law: tuple[float, float], factor: float) -> tuple[float, float]:
     return (a * factor ** (1.0 - b), b)
 
 
+# fresh lunar craters (Pike 1977): depth and rim height a D^b, D and result in km
 _PIKE_SIMPLE_DEPTH = (0.196, 1.010)
 _PIKE_SIMPLE_RIM = (0.036, 1.014)
 _PIKE_COMPLEX_DEPTH = (1.044, 0.301)
@@ -163,7 +164,7 @@ def small_body(radius_m: float, density_kg_m3: float = 2000.0,
                depth_ratio: float = 0.2) -> Target:
     """A generic small body: surface gravity ``4/3 pi G rho R`` of a sphere of that size
     and bulk density, asteroid fresh craters (d/D = ``depth_ratio``, default 0.2 (Marchi et
-    al. 2015); rim/depth as Pike's lunar simple craters), transition and peak-ring
+    al. 2015); rim/depth as Pike's (1977) lunar simple craters), transition and peak-ring
     diameters by 1/g from the Moon's. A measured body's own d/D goes in ``depth_ratio``,
     e.g. Bennu 0.10 +- 0.03 for craters >= 10 m (Daly et al. 2020, GRL 47, e2020GL089672).
 

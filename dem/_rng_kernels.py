@@ -6,7 +6,7 @@ gap filling), ``level`` is the expansion level and ``row, col`` the *global* pix
 index at that level. Nothing depends on the order in which pixels are visited, on the
 thread count or on how a raster is cut into tiles (DESIGN §3).
 
-Hash: Steele, Lea & Flood's splitmix64 (``craters.kernels.splitmix64``) chained over
+Hash: Steele, Lea & Flood's (2014) splitmix64 (``craters.kernels.splitmix64``) chained over
 the five integers; the deviate is ``craters.kernels.hash_normal`` of the hash (two 53-bit
 uniforms, Box–Muller, cosine branch).
 """

@@ -1,5 +1,5 @@
 """Batches of layer stacks: one ``dem enhance`` description, many seeds and varied keys,
-built on dask.distributed.
+built on dask.distributed (or serially).
 
 :func:`batch` builds every variant -- each seed of ``seeds`` with each combination of the
 values in ``vary`` (a cartesian product) -- as one task (the engine:
@@ -45,11 +45,11 @@ __all__ = ["batch"]
 _RUN_KEYS = ("output", "force", "quiet")
 
 
-def batch(config, seeds, *, out, vary: Mapping | None = None, scheduler: str | None = None,
-          workers: int | None = None, resume: bool = False, force: bool = False,
-          progress: bool = False, retries: int = 2,
+def batch(config, seeds, *, out, vary: Mapping | None = None, backend: str | None = None,
+          scheduler: str | None = None, workers: int | None = None, resume: bool = False,
+          force: bool = False, progress: bool = False, retries: int = 2,
           on_done: Callable[[dict], None] | None = None) -> BatchResult:
-    """Build every variant of a stack description on dask.distributed into ``out``.
+    """Build every variant of a stack description (on dask.distributed) into ``out``.
 
     Parameters
     ----------
@@ -64,11 +64,12 @@ def batch(config, seeds, *, out, vary: Mapping | None = None, scheduler: str | N
     vary : Mapping, optional
         Key -> list of values (:meth:`EnhanceConfig.keys` but ``seed``; values as in the
         file); every combination is built.
-    scheduler, workers, resume, force, progress, retries, on_done
-        As :func:`latlong.batch`: a running scheduler's address or a local cluster of
-        ``workers`` processes, keep finished variants, redo all, a progress bar, retries
-        of tasks that raised something other than a bad-input error, a callback per
-        finished variant's index row.
+    backend, scheduler, workers, resume, force, progress, retries, on_done
+        As :func:`latlong.batch`: dask (default) or ``"serial"`` in this process, a
+        running scheduler's address or a local cluster of ``workers`` processes, keep
+        finished variants, redo all, a progress bar, retries of tasks that raised
+        something other than a bad-input error, a callback per finished variant's index
+        row.
 
     Returns
     -------
@@ -87,9 +88,9 @@ def batch(config, seeds, *, out, vary: Mapping | None = None, scheduler: str | N
         describe = json.dumps({"config": cfg.to_dict(), "version": package_version()},
                               sort_keys=True, default=str)
         jobs.append(Job(v, (cfg, where), describe, (v.name,)))
-    return run_batch(jobs, _enhance_variant, out, scheduler=scheduler, workers=workers,
-                     resume=resume, force=force, progress=progress, retries=retries,
-                     on_done=on_done)
+    return run_batch(jobs, _enhance_variant, out, backend=backend, scheduler=scheduler,
+                     workers=workers, resume=resume, force=force, progress=progress,
+                     retries=retries, on_done=on_done)
 
 
 def _config_keys(config) -> dict:

@@ -1,4 +1,4 @@
-r"""Crater gap filling and crater replacement (Martin et al., lunar paper IV.C and IV.D).
+r"""Crater gap filling and crater replacement (Martin, Parkes & Dunstan 2014, IV.C and IV.D).
 
 Crater positions are metres in a local frame (:mod:`dem.frame`): by default the DEM's own
 (origin at its centre pixel), or the stack's (origin at the site). Convert world
@@ -225,41 +225,68 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
     cat = craters.sort_oldest_first(_as_catalog(craters_))
     extent = check_range("extent", extent, 0.1, 1.5)
     gen = normalize_rng(rng)
-    seed = int(rng) if rng is not None and not isinstance(rng, np.random.Generator) else None
+    seed = _seed_of(rng)
     p, gx, gy = _grid_positions(dem, frame, cat["x_m"], cat["y_m"])
-    cx, cy = gx / p, gy / p  # pixel (col, row) of the centres
-    r_fill = extent * cat["diameter_m"] / 2.0 / p
-    irr = 0.0 if smooth_craters else _IRREGULARITY
-    reach = craters.DEFAULT_EJECTA_EDGE * (1.0 + irr) * cat["diameter_m"] / 2.0 / p
-    fill = _discs(dem.shape, (0, 0), cx, cy, r_fill) & ~dem.known
+    fill = _discs(dem.shape, (0, 0), gx / p, gy / p, extent * cat["diameter_m"] / 2.0 / p)
+    fill &= ~dem.known
     params = {"craters": len(cat), "extent": extent, "smooth_craters": smooth_craters,
               "filled_pixels": int(fill.sum())}
     if not fill.any():
         out = dem.with_step(np.array(dem.heights), "dem.fill_crater_gaps", seed, params)
         return (out, cat[:0]) if return_catalog else out
-    r0, r1, c0, c1 = _bbox(cx, cy, reach, dem.shape, 2)
-    fr, fc = np.nonzero(fill)
-    r0, r1 = min(r0, fr.min()), max(r1, fr.max() + 1)
-    c0, c1 = min(c0, fc.min()), max(c1, fc.max() + 1)
+    r0, r1, c0, c1 = _work_window(fill, gx / p, gy / p, cat["diameter_m"], p, smooth_craters)
     crop = dem.crop(Window(c0, r0, c1 - c0, r1 - r0))
-    base = fill_gaps(crop, roughness, craters=None, rng=gen)
     local = {name: cat[name] for name in cat.dtype.names}
     local.update(x_m=gx - c0 * p, y_m=gy - r0 * p)
-    synth, stamped = craters.stamp_many(base.heights, p, craters.make_catalog(**local),
-                                        roughness=not smooth_craters, slope_erosion=False,
-                                        rng=gen, return_catalog=True)
-    region = fill[r0:r1, c0:c1]
-    warp = harmonic_warp(crop.heights, synth, region)
-    z = np.array(dem.heights)
-    block = z[r0:r1, c0:c1]
-    block[region] = synth[region] + warp[region]
-    params["warp_max_abs_m"] = float(np.abs(warp[region]).max())
+    synth, stamped = _synthetic_copy(crop, p, craters.make_catalog(**local), roughness,
+                                     smooth_craters, _IRREGULARITY, gen)
+    z, params["warp_max_abs_m"] = _blend(dem, synth, fill, (r0, r1, c0, c1))
     out = dem.with_step(z, "dem.fill_crater_gaps", seed, params)
     if not return_catalog:
         return out
     stamped["x_m"] = cat["x_m"]  # every crater is stamped, in this order (no erosion)
     stamped["y_m"] = cat["y_m"]
     return out, stamped
+
+
+def _blend(dem: Dem, synth: np.ndarray, fill: np.ndarray, window) -> tuple[np.ndarray, float]:
+    """Step 2 of the module notes: the heights of ``dem`` with its pixels ``fill`` taken
+    from ``synth`` (the synthetic copy of the ``window`` (r0, r1, c0, c1)) plus the
+    harmonic warp; and the warp's largest magnitude (m)."""
+    r0, r1, c0, c1 = window
+    region = fill[r0:r1, c0:c1]
+    warp = harmonic_warp(dem.heights[r0:r1, c0:c1], synth, region)
+    z = np.array(dem.heights)
+    block = z[r0:r1, c0:c1]
+    block[region] = synth[region] + warp[region]
+    return z, float(np.abs(warp[region]).max())
+
+
+def _seed_of(rng) -> int | None:
+    """The seed a step records: ``rng`` when it is an int, else None."""
+    return int(rng) if rng is not None and not isinstance(rng, np.random.Generator) else None
+
+
+def _work_window(fill: np.ndarray, cx_px, cy_px, diameter_m, pixel_size_m: float,
+                 smooth: bool):
+    """(r0, r1, c0, c1) of the pixels ``fill`` and the reach of the craters (centres in
+    pixels; the ejecta edge times 1 + rim irregularity), plus 2 pixels."""
+    irr = 0.0 if smooth else _IRREGULARITY
+    reach = craters.DEFAULT_EJECTA_EDGE * (1.0 + irr) * diameter_m / 2.0 / pixel_size_m
+    r0, r1, c0, c1 = _bbox(cx_px, cy_px, reach, fill.shape, 2)
+    fr, fc = np.nonzero(fill)
+    return (min(r0, fr.min()), max(r1, fr.max() + 1), min(c0, fc.min()),
+            max(c1, fc.max() + 1))
+
+
+def _synthetic_copy(crop: Dem, pixel_size_m: float, cat, roughness, smooth: bool,
+                    irregularity: float, gen):
+    """``crop`` with its gaps filled by fractal terrain and the craters of ``cat`` (grid
+    frame) stamped on it, whatever the slope; the heights and the stamped catalog."""
+    base = fill_gaps(crop, roughness, craters=None, rng=gen)
+    return craters.stamp_many(base.heights, pixel_size_m, cat, roughness=not smooth,
+                              irregularity=irregularity, slope_erosion=False, rng=gen,
+                              return_catalog=True)
 
 
 def _replace_in_layer(d: Dem, frame: LocalFrame, crater, *, roughness, smooth, gen):
@@ -273,14 +300,11 @@ def _replace_in_layer(d: Dem, frame: LocalFrame, crater, *, roughness, smooth, g
     crop = d.crop(Window(c0, r0, c1 - c0, r1 - r0))
     disc = _discs(crop.shape, (r0, c0), [cx], [cy], [reach])
     erased = crop.replace(heights=np.where(disc, np.nan, crop.heights))
-    base = fill_gaps(erased, roughness, craters=None, rng=gen)
     cat = craters.make_catalog(x_m=[gx[0] - c0 * p], y_m=[gy[0] - r0 * p],
                                diameter_m=[crater.diameter_m],
                                degradation=[crater.degradation], kind=["replacement"],
                                layer=[-1], index=[0])
-    synth, stamped = craters.stamp_many(base.heights, p, cat, roughness=not smooth,
-                                        irregularity=irr, slope_erosion=False, rng=gen,
-                                        return_catalog=True)
+    synth, stamped = _synthetic_copy(erased, p, cat, roughness, smooth, irr, gen)
     z = np.array(d.heights)
     block = z[r0:r1, c0:c1]
     block[disc] = synth[disc]
@@ -357,7 +381,7 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
     if not isinstance(crater, craters.Crater):
         raise TypeError(f"`crater` must be a craters.Crater; got {type(crater).__name__}")
     gen = normalize_rng(rng)
-    seed = int(rng) if rng is not None and not isinstance(rng, np.random.Generator) else None
+    seed = _seed_of(rng)
     params = {"x_m": crater.x_m, "y_m": crater.y_m, "diameter_m": crater.diameter_m,
               "degradation": crater.degradation, "smooth_craters": smooth_craters}
     if isinstance(target, Dem):
@@ -373,20 +397,47 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
         raise TypeError(f"`target` must be a Dem or a Stack; got {type(target).__name__}")
     if frame is not None:
         raise ValueError("`frame` is only for a Dem; a stack's craters are in stack.frame")
-    frame = target.frame
-    layers = target.layers
+    return _replace_in_stack(target, crater, roughness=roughness, smooth=smooth_craters,
+                             gen=gen, seed=seed, params=params)
+
+
+def _replace_in_stack(stack: Stack, crater, *, roughness, smooth: bool, gen, seed,
+                      params: dict) -> Stack:
+    """The stack with ``crater`` replaced in the finest layer that holds its reach, the
+    change carried up and down so the layers still match, the crater in its catalog."""
+    frame = stack.frame
+    layers = stack.layers
     home = next((k for k in range(len(layers) - 1, -1, -1)
-                 if _contains(layers[k], frame, crater, smooth_craters)), None)
+                 if _contains(layers[k], frame, crater, smooth)), None)
     if home is None:
         raise ValueError(f"the crater (diameter {crater.diameter_m:g} m at x_m {crater.x_m:g}, "
                          f"y_m {crater.y_m:g}) with its ejecta does not fit inside any layer")
     z, row = _replace_in_layer(layers[home], frame, crater, roughness=roughness,
-                               smooth=smooth_craters, gen=gen)
+                               smooth=smooth, gen=gen)
     arrays = [np.array(d.heights) for d in layers]
     arrays[home] = z
-    propagate_up(arrays, target.windows, home)
+    propagate_up(arrays, stack.windows, home)
+    _propagate_down(arrays, stack, home)
+    params["layer"] = home
+    new_layers = [d if np.array_equal(arrays[k], d.heights) else
+                  d.with_step(arrays[k], "dem.replace_crater", seed, params)
+                  for k, d in enumerate(layers)]
+    catalogs = list(stack.catalogs)
+    cat = catalogs[home]
+    row["index"] = max((int(c["index"].max()) for c in catalogs
+                        if c is not None and len(c) and "index" in c.dtype.names),
+                       default=-1) + 1
+    catalogs[home] = _append(cat, row)
+    return stack.replace(layers=new_layers, catalogs=catalogs)
+
+
+def _propagate_down(arrays: list, stack: Stack, home: int) -> None:
+    """Give each layer finer than ``home`` its parent's change, interpolated bilinearly
+    (its even pixels set to the parent's exactly), in place; stop at the first layer the
+    change does not reach."""
+    layers = stack.layers
     for j in range(home + 1, len(layers)):
-        r0, c0, w = target.windows[j - 1]
+        r0, c0, w = stack.windows[j - 1]
         parent_new = arrays[j - 1][r0:r0 + w, c0:c0 + w]
         delta = parent_new - layers[j - 1].heights[r0:r0 + w, c0:c0 + w]
         if not delta.any():
@@ -394,14 +445,3 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
         fine = layers[j].heights + _upsample(delta)
         fine[::2, ::2] = parent_new
         arrays[j] = fine
-    params["layer"] = home
-    new_layers = [d if np.array_equal(arrays[k], d.heights) else
-                  d.with_step(arrays[k], "dem.replace_crater", seed, params)
-                  for k, d in enumerate(layers)]
-    catalogs = list(target.catalogs)
-    cat = catalogs[home]
-    row["index"] = max((int(c["index"].max()) for c in catalogs
-                        if c is not None and len(c) and "index" in c.dtype.names),
-                       default=-1) + 1
-    catalogs[home] = _append(cat, row)
-    return target.replace(layers=new_layers, catalogs=catalogs)

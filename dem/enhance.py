@@ -1,4 +1,4 @@
-r"""Multi-resolution enhancement of a DEM around a site (Martin et al., lunar paper IV.A).
+r"""Multi-resolution enhancement of a DEM around a site (Martin, Parkes & Dunstan 2014, IV.A).
 
 :func:`enhance` builds a :class:`dem.Stack` of ``layers`` square layers of ``size`` =
 2^n + 1 pixels, described by a :class:`dem.EnhanceConfig`: layer 0 is the

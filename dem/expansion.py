@@ -1,4 +1,4 @@
-r"""Random midpoint displacement (RMD) expansion of DEMs (Martin et al., lunar paper IV.A).
+r"""Random midpoint displacement (RMD) expansion of DEMs (Martin, Parkes & Dunstan 2014, IV.A).
 
 One level doubles the resolution of a square region of ``W = 2**n + 1`` pixels: the new
 grid has ``2 W - 1`` pixels a side, its even pixels are the old pixels (bit for bit),
@@ -33,7 +33,7 @@ is ``gamma(rho sqrt 2) / 4 + gamma(2 rho) / 8 = gamma(rho) (2^(H-2) + 2^(2H-3))`
     s_square(L) = sigma sqrt(k(H)) 2^(-(L - 1/2) H),   s_diamond(L) = sigma sqrt(k(H)) 2^(-L H).
 
 Each half step (square -> diamond -> next square) shrinks the scale by
-``2^(-H/2) = 2^(-(3-F)/2)``, Peitgen & Saupe's factor (the paper's eq. 14). The paper's
+``2^(-H/2) = 2^(-(3-F)/2)``, Peitgen & Saupe's (1988) factor (the paper's eq. 14). The paper's
 starting scale (eq. 15, from a height-range factor and the resolution) and its scale
 after ``n`` RMD iterations (eq. 16) are replaced by ``sigma``, *measured* on the input at
 its own resolution, so the expansion continues the input's roughness across scales. The
@@ -257,8 +257,9 @@ TILE_PX = 2049
 
 def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | None = None,
                    roughness: float | None = None, region=None, rng=None, *,
-                   tile_px: int | None = None, scheduler: str | None = None,
-                   workers: int | None = None, progress: bool = False) -> ExpandedFile:
+                   tile_px: int | None = None, backend: str | None = None,
+                   scheduler: str | None = None, workers: int | None = None,
+                   progress: bool = False) -> ExpandedFile:
     """:func:`expand` written tile by tile into a GeoTIFF: results bigger than memory.
 
     The region is expanded as square tiles of ``2^k + 1`` input pixels sharing their
@@ -278,11 +279,13 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     tile_px : int, optional
         Largest output tile side in pixels (>= 3); default :data:`TILE_PX` (2049, about
         80 MB a tile).
-    scheduler, workers : optional
-        Expand the tiles as dask.distributed tasks: on the scheduler at an address such as
-        ``tcp://127.0.0.1:8786``, or on a local cluster of ``workers`` processes; each tile
-        is written as it arrives (the same bytes; the input DEM is sent to each worker
-        once). Neither: tile after tile in this process.
+    backend, scheduler, workers : optional
+        Expand the tiles as dask.distributed tasks (:mod:`latlong.parallel.backends`): on
+        the scheduler at an address such as ``tcp://127.0.0.1:8786``, or on a local
+        cluster of ``workers`` processes (``backend="dask"`` alone: one per core); each
+        tile is written as it arrives (the same bytes; the input DEM is sent to each
+        worker once). None of them (or ``backend="serial"``): tile after tile in this
+        process.
 
     Returns
     -------
@@ -300,27 +303,16 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     >>> info.shape, info.tiles, same
     ((65, 65), 16, True)
     """
-    from latlong.parallel.batch import check_dask_address
+    from latlong.parallel.backends import choose_backend
     from latlong.parallel.tiles import map_tiles
 
     from .io import WindowWriter
 
     with about("tile_px"):
         tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
-    check_dask_address(scheduler, workers)  # before any work (map_tiles checks when it runs)
+    choose_backend(backend, scheduler, workers)  # before any work (map_tiles checks later)
     plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
-    step = 2**plan.levels
-    # input tile: 2^k + 1 pixels, the largest whose expansion fits tile_px (at least 3)
-    k = max(1, min((plan.width - 1).bit_length() - 1,
-                   ((tile_px - 1) // step).bit_length() - 1))
-    t_in = 2**k + 1
-    t_out = (t_in - 1) * step + 1
-    need = (t_out + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
-        raise ValueError(f"one tile of {t_in} x {t_in} pixels expanded {levels} levels is "
-                         f"{t_out} x {t_out} pixels and needs about {human_bytes(need)} of "
-                         f"memory; this machine has {human_bytes(have)}")
+    t_in, t_out = _tile_sides(plan, tile_px)
     n = (plan.width - 1) // (t_in - 1)
     tags = dem.step_tags("dem.expand", plan.seed, plan.params, level=dem.level + plan.levels,
                          origin=plan.origin)
@@ -329,7 +321,8 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
                       pixel_size_m=plan.pixel_size_m) as out:
         tiles = [(i, j) for i in range(n) for j in range(n)]
         corners = [(plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1), t_in) for i, j in tiles]
-        made = map_tiles(_tile_task, (dem, plan), corners, scheduler=scheduler, workers=workers)
+        made = map_tiles(_tile_task, (dem, plan), corners, backend=backend, scheduler=scheduler,
+                         workers=workers)
         for k, z in progress_bar(made, enabled=progress, total=len(tiles), desc="expand tiles"):
             i, j = tiles[k]
             # tiles share their edge pixels: each writes all but its last row / column,
@@ -338,6 +331,24 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
             cols = t_out if j == n - 1 else t_out - 1
             out.write(z[:rows, :cols], i * (t_out - 1), j * (t_out - 1))
     return ExpandedFile(out.path, (plan.side, plan.side), plan.seed, plan.params, len(tiles))
+
+
+def _tile_sides(plan: _Plan, tile_px: int) -> tuple[int, int]:
+    """Input and output side of :func:`expand_to_file`'s tiles: ``2^k + 1`` input pixels,
+    the largest whose expansion fits ``tile_px`` (at least 3); a tile too large for this
+    machine's memory is refused."""
+    step = 2**plan.levels
+    k = max(1, min((plan.width - 1).bit_length() - 1,
+                   ((tile_px - 1) // step).bit_length() - 1))
+    t_in = 2**k + 1
+    t_out = (t_in - 1) * step + 1
+    need = (t_out + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
+    have = physical_memory_bytes()
+    if need > 0.85 * have:
+        raise ValueError(f"one tile of {t_in} x {t_in} pixels expanded {plan.levels} levels "
+                         f"is {t_out} x {t_out} pixels and needs about {human_bytes(need)} of "
+                         f"memory; this machine has {human_bytes(have)}")
+    return t_in, t_out
 
 
 class _Plan(NamedTuple):

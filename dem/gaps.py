@@ -21,7 +21,7 @@ averaged over 9 x 9 pixels) at the rim, interpolated harmonically across the hol
 is :func:`dem.fractal_fit`'s estimate of the known terrain (clipped to [2, 3]) unless
 given.
 
-Why not the paper's outside-in filling (Martin et al., lunar paper IV.B: pixels with
+Why not the paper's outside-in filling (Martin, Parkes & Dunstan 2014, IV.B: pixels with
 the most known 8-neighbours first, each the inverse-distance average of the nearest
 known pixel along the 8 grid directions plus a Gaussian; this module's first version).
 Measured on 160-px discs cut from the LOLA crop and from fBm (``bench_dem.py --only
@@ -63,8 +63,8 @@ from .gapcraters import gap_crater_layer, stamp_gap_craters
 
 __all__ = ["fbm_noise", "fill_gaps", "harmonic_fill"]
 
-# fill_hole, known_dimension, record_craters and the constants are also what
-# dem.tiledfill fills a DEM bigger than memory with, hole by hole
+# fill_arguments, fill_parameters, fill_hole, record_craters and the constants are also
+# what dem.tiledfill fills a DEM bigger than memory with, hole by hole
 
 #: Noise box: the hole's bounding box plus this fraction of its longer side on each side.
 NOISE_MARGIN = 0.25
@@ -143,38 +143,15 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
     roughness, fractal_dimension, layer, key, seed = fill_arguments(
         roughness, fractal_dimension, craters, rng)
     unknown = ~dem.known
-    params: dict = {"roughness": "local" if roughness is None else roughness}
-    if fractal_dimension is None:
-        estimated = _known_dimension(dem) if unknown.any() else math.nan
-        params["fractal_dimension_estimated"] = estimated
-        fractal_dimension = known_dimension(estimated)
-    params.update(fractal_dimension=fractal_dimension, key=key,
-                  filled_pixels=int(unknown.sum()))
-    z = np.array(dem.heights, dtype=np.float64, copy=True)
     holes = _holes(unknown)
-    params["holes"] = len(holes)
-    catalogs, notes = [], []
+    params, fractal_dimension = fill_parameters(
+        roughness, fractal_dimension, key, lambda: _known_dimension(dem) if holes else math.nan,
+        filled_pixels=int(unknown.sum()), holes=len(holes))
     if layer is not None and target is None:
         target = crater_target(dem)
-    if holes:
-        amp = (None if roughness is not None
-               else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
-        uniform = None if roughness is None else roughness * dem.resolution_m
-
-        def around(w0, w1, v0, v1):
-            return dem.crop(Window(v0, w0, v1 - v0, w1 - w0))
-
-        for sl, hole in holes:
-            fill_hole(z, sl, hole, amp, uniform, fractal_dimension, key, level=dem.level,
-                      origin=dem.origin)
-            if layer is not None:
-                cat, note = stamp_gap_craters(z, sl, hole, layer, key, target,
-                                              pixel_size_m=dem.pixel_size_m, level=dem.level,
-                                              origin=dem.origin, around=around)
-                if note is not None:
-                    notes.append(note)
-                if cat is not None:
-                    catalogs.append(cat)
+    z = np.array(dem.heights, dtype=np.float64, copy=True)
+    catalogs, notes = _fill_holes(z, dem, holes, roughness, fractal_dimension, layer, key,
+                                  target)
     catalog = record_craters(params, catalogs, notes, layer, dem.pixel_size_m)
     out = dem.with_step(z, "dem.fill_gaps", seed, params)
     if not return_catalog:
@@ -184,6 +161,34 @@ def fill_gaps(dem: Dem, roughness: float | None = None, *,
 
         catalog = _craters_pkg.make_catalog(x_m=[], y_m=[], diameter_m=[])
     return out, catalog
+
+
+def _fill_holes(z: np.ndarray, dem: Dem, holes: list, roughness, fractal_dimension: float,
+                layer, key: int, target) -> tuple[list, list]:
+    """Fill ``holes`` (:func:`_holes`) of ``z`` (the heights of ``dem``) in place, with
+    their gap craters; the craters' catalogs and density notes."""
+    catalogs, notes = [], []
+    if not holes:
+        return catalogs, notes
+    amp = (None if roughness is not None
+           else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
+    uniform = None if roughness is None else roughness * dem.resolution_m
+
+    def around(w0, w1, v0, v1):
+        return dem.crop(Window(v0, w0, v1 - v0, w1 - w0))
+
+    for sl, hole in holes:
+        fill_hole(z, sl, hole, amp, uniform, fractal_dimension, key, level=dem.level,
+                  origin=dem.origin)
+        if layer is not None:
+            cat, note = stamp_gap_craters(z, sl, hole, layer, key, target,
+                                          pixel_size_m=dem.pixel_size_m, level=dem.level,
+                                          origin=dem.origin, around=around)
+            if note is not None:
+                notes.append(note)
+            if cat is not None:
+                catalogs.append(cat)
+    return catalogs, notes
 
 
 def fill_arguments(roughness, fractal_dimension, craters, rng):
@@ -199,6 +204,21 @@ def fill_arguments(roughness, fractal_dimension, craters, rng):
     with about("rng"):
         key, seed = key_from_rng(rng)
     return roughness, fractal_dimension, layer, key, seed
+
+
+def fill_parameters(roughness, fractal_dimension, key: int, estimate, *, filled_pixels: int,
+                    holes: int) -> tuple[dict, float]:
+    """The step's parameters of a fill (its ``CRATERFORM_PARAMETERS``) and the F it uses:
+    ``fractal_dimension``, or else ``estimate()`` (NaN when there is none) through
+    :func:`known_dimension`."""
+    params: dict = {"roughness": "local" if roughness is None else roughness}
+    if fractal_dimension is None:
+        estimated = estimate()
+        params["fractal_dimension_estimated"] = estimated
+        fractal_dimension = known_dimension(estimated)
+    params.update(fractal_dimension=fractal_dimension, key=key, filled_pixels=filled_pixels,
+                  holes=holes)
+    return params, fractal_dimension
 
 
 def known_dimension(estimated: float) -> float:

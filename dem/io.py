@@ -121,13 +121,7 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
         ``pixel_size_m``, a geographic CRS without body radius, or a DEM with no known
         pixel; the message is one line naming the file.
     """
-    path = Path(path)
-    if is_zarr(path) and path.is_dir():
-        if not is_zarr_store(path):
-            raise ValueError(f"{str(path)!r} is a folder but not a Zarr store (no .zgroup, "
-                             f".zarray or zarr.json)")
-    else:
-        check_regular_file(path, "DEM file")
+    path = _check_source(path)
     with about("band"):
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
@@ -137,43 +131,78 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
             body_radius_m = label_radius
     else:
         heights, transform, crs, tags = _read_gdal(path, band, win)
-        # written by craterform: the body radius / the pixel size of a DEM without CRS
-        try:
-            if body_radius_m is None and RADIUS_TAG in tags:
-                body_radius_m = float(tags[RADIUS_TAG])
-            if pixel_size_m is None and crs is None and PIXEL_SIZE_TAG in tags:
-                pixel_size_m = tuple(float(v) for v in tags[PIXEL_SIZE_TAG].split(","))
-        except ValueError:
-            logger.warning("%s: ignoring malformed %s/%s tags", path, RADIUS_TAG,
-                           PIXEL_SIZE_TAG)
+        body_radius_m, pixel_size_m = _written_sizes(tags, path, crs, body_radius_m,
+                                                     pixel_size_m)
     if body_radius_m is None and body is not None and crs is not None and crs.is_geographic:
         body_radius_m = get_target(body).radius_m
-    if not allow_unknown and not np.isfinite(heights).any():
-        where = "" if win is None else f" of the window {_window_text(win)}"
-        raise ValueError(f"{str(path)!r}: every pixel{where} is NoData/NaN; there is no "
-                         f"terrain to work with")
-    level, origin = 0, (0, 0)
-    try:
-        if LEVEL_TAG in tags:
-            level = int(tags[LEVEL_TAG])
-            origin = tuple(int(v) for v in tags.get(ORIGIN_TAG, "0,0").split(","))
-    except ValueError:
-        logger.warning("%s: ignoring malformed %s/%s tags", path, LEVEL_TAG, ORIGIN_TAG)
-        level, origin = 0, (0, 0)
+    if not allow_unknown:
+        _check_known(heights, path, win)
+    level, origin = _lattice(tags, path)
     if win is not None:  # as Dem.crop: the window's transform and lattice origin
-        r0, c0 = win[0], win[1]
-        transform = transform @ Affine.translation(c0, r0)
-        origin = (origin[0] + r0, origin[1] + c0)
+        transform = transform @ Affine.translation(win[1], win[0])
+        origin = (origin[0] + win[0], origin[1] + win[1])
     try:
         return Dem._own(heights, transform, crs, pixel_size_m=pixel_size_m,
                         body_radius_m=body_radius_m, tags=tags, level=level, origin=origin)
     except (ValueError, TypeError) as exc:
-        if isinstance(exc, ParameterError | ParameterTypeError):  # the file named, the rule
-            shown = str(path).replace("{", "{{").replace("}", "}}") if exc.see else str(path)
-            raise type(exc)(exc.name, f"{exc.rule} (reading {shown!r})", see=exc.see) from None
-        with about(parameter_of(exc)):  # the file named, the parameter kept
-            kind = ValueError if isinstance(exc, ValueError) else TypeError  # plain kinds:
-            raise kind(f"{str(path)!r}: {exc}") from None  # a ParameterError needs a rule
+        raise _naming_file(exc, path) from None
+
+
+def _check_source(path) -> Path:
+    """``path`` as a Path: a Zarr store's folder or a regular file."""
+    path = Path(path)
+    if is_zarr(path) and path.is_dir():
+        if not is_zarr_store(path):
+            raise ValueError(f"{str(path)!r} is a folder but not a Zarr store (no .zgroup, "
+                             f".zarray or zarr.json)")
+    else:
+        check_regular_file(path, "DEM file")
+    return path
+
+
+def _check_known(heights: np.ndarray, path: Path, win) -> None:
+    """At least one known pixel (of the window ``win``, if any)."""
+    if not np.isfinite(heights).any():
+        where = "" if win is None else f" of the window {_window_text(win)}"
+        raise ValueError(f"{str(path)!r}: every pixel{where} is NoData/NaN; there is no "
+                         f"terrain to work with")
+
+
+def _written_sizes(tags: dict, path: Path, crs, body_radius_m, pixel_size_m):
+    """(body radius, pixel size) with what craterform wrote in the tags where not given:
+    the body radius, and the pixel size of a DEM without CRS."""
+    try:
+        if body_radius_m is None and RADIUS_TAG in tags:
+            body_radius_m = float(tags[RADIUS_TAG])
+        if pixel_size_m is None and crs is None and PIXEL_SIZE_TAG in tags:
+            pixel_size_m = tuple(float(v) for v in tags[PIXEL_SIZE_TAG].split(","))
+    except ValueError:
+        logger.warning("%s: ignoring malformed %s/%s tags", path, RADIUS_TAG, PIXEL_SIZE_TAG)
+    return body_radius_m, pixel_size_m
+
+
+def _lattice(tags: dict, path: Path) -> tuple[int, tuple[int, int]]:
+    """The expansion level and lattice origin the tags record ((0, (0, 0)) if none)."""
+    try:
+        if LEVEL_TAG in tags:
+            return (int(tags[LEVEL_TAG]),
+                    tuple(int(v) for v in tags.get(ORIGIN_TAG, "0,0").split(",")))
+    except ValueError:
+        logger.warning("%s: ignoring malformed %s/%s tags", path, LEVEL_TAG, ORIGIN_TAG)
+    return 0, (0, 0)
+
+
+def _naming_file(exc: ValueError | TypeError, path: Path) -> ValueError | TypeError:
+    """A bad DEM's error with the file named, its parameter kept."""
+    if isinstance(exc, ParameterError | ParameterTypeError):  # the file named, the rule
+        shown = str(path).replace("{", "{{").replace("}", "}}") if exc.see else str(path)
+        return type(exc)(exc.name, f"{exc.rule} (reading {shown!r})", see=exc.see)
+    kind = ValueError if isinstance(exc, ValueError) else TypeError  # plain kinds: a
+    out = kind(f"{str(path)!r}: {exc}")  # ParameterError needs a rule
+    tag = parameter_of(exc)
+    if tag is not None:
+        out.parameter = tag
+    return out
 
 
 def _check_window(window) -> tuple[int, int, int, int]:

@@ -25,6 +25,7 @@ import re
 import tempfile
 import warnings
 from pathlib import Path
+from typing import NamedTuple
 
 import numpy as np
 import rasterio
@@ -62,6 +63,28 @@ _KM = ("KM", "KILOMETER", "KILOMETERS", "KILOMETRE", "KILOMETRES")
 _LABEL, _DATA = "LABEL.LBL", "DATA.IMG"
 
 
+class _Image(NamedTuple):
+    """The checked layout of a PDS3 ``IMAGE`` object."""
+
+    lines: int
+    samples: int
+    bands: int
+    kind: str
+    """numpy kind of the samples: ``i``, ``u`` or ``f``."""
+    order: str
+    """Byte order: ``<`` or ``>``."""
+    bits: int
+    prefix: int
+    """Bytes before each line's samples."""
+    suffix: int
+    """Bytes after each line's samples."""
+
+    @property
+    def stride(self) -> int:
+        """Bytes per line."""
+        return self.prefix + self.samples * self.bits // 8 + self.suffix
+
+
 def read_pds(path: Path, band: int, win=None):
     """Heights, transform, CRS, tags and body radius (m, or None) of a PDS3 image.
 
@@ -77,61 +100,28 @@ def read_pds(path: Path, band: int, win=None):
     image, parent = find_object(label, "IMAGE")
     if image is None:
         raise ValueError(f"{where!r}: the PDS label has no IMAGE object")
-    lines = int(label_number(image, "LINES", where))
-    samples = int(label_number(image, "LINE_SAMPLES", where))
-    bands = int(label_number(image, "BANDS", where, 1))
-    bits = int(label_number(image, "SAMPLE_BITS", where))
-    if min(lines, samples, bands) < 1:
-        raise ValueError(f"{where!r}: LINES, LINE_SAMPLES and BANDS must be >= 1; got "
-                         f"{lines}, {samples}, {bands}")
-    stype = str(image.get("SAMPLE_TYPE", "")).upper().replace(" ", "_")
-    if stype not in SAMPLE_TYPES:
-        raise ValueError(f"{where!r}: unsupported SAMPLE_TYPE {stype or '(none)'!r}")
-    kind, order = SAMPLE_TYPES[stype]
-    if bits not in (8, 16, 32, 64) or (kind == "f" and bits < 32):
-        raise ValueError(f"{where!r}: unsupported SAMPLE_BITS {bits} for {stype}")
-    nbytes = bits // 8
-    if band > bands:
-        with about("band"):
-            raise ParameterError("band", f"must be in [1, {bands}] for {where!r}; got {band}")
-    if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
-            "BAND_SEQUENTIAL":
-        raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
-    prefix = int(label_number(image, "LINE_PREFIX_BYTES", where, 0))
-    suffix = int(label_number(image, "LINE_SUFFIX_BYTES", where, 0))
-    if prefix < 0 or suffix < 0:
-        raise ValueError(f"{where!r}: LINE_PREFIX_BYTES and LINE_SUFFIX_BYTES must be >= 0")
-    stride = prefix + samples * nbytes + suffix
+    layout = _image_layout(image, band, where)
     data_path, offset = _image_start(label, parent, label_path, where)
-    band_offset = offset + (band - 1) * lines * stride
-    size = data_path.stat().st_size
-    if size < band_offset + lines * stride:
-        raise ValueError(f"{str(data_path)!r} is truncated: {lines} x {samples} samples of "
-                         f"{nbytes} bytes need {lines * stride} bytes from offset "
-                         f"{band_offset}")
-    r0, c0, n_lines, n_samples = (0, 0, lines, samples) if win is None else win
-    if r0 + n_lines > lines or c0 + n_samples > samples:
+    _check_extent(layout, data_path, offset + (band - 1) * layout.lines * layout.stride)
+    r0, c0, n_lines, n_samples = (0, 0, layout.lines, layout.samples) if win is None else win
+    if r0 + n_lines > layout.lines or c0 + n_samples > layout.samples:
         with about("window"):
             raise ValueError(f"`window` (row_off, col_off, rows, cols) = {tuple(win)} is not "
-                             f"inside {str(path)!r} ({lines} x {samples} pixels)")
-
+                             f"inside {str(path)!r} ({layout.lines} x {layout.samples} "
+                             f"pixels)")
     proj, _ = find_object(label, "IMAGE_MAP_PROJECTION")
-    gdal_label = _gdal_label(label, proj, lines=lines, samples=samples, bands=bands,
-                             stype=_GDAL_TYPES[kind, order], bits=bits, prefix=prefix,
-                             suffix=suffix, offset=offset)
-    dtype = np.dtype(f"{kind}{nbytes}")
+    dtype = np.dtype(f"{layout.kind}{layout.bits // 8}")
     raw, gdal_transform, gdal_crs = _read_with_gdal(
-        gdal_label, data_path, band, Window(c0, r0, n_samples, n_lines), dtype, where)
-
+        _gdal_label(label, proj, layout, offset), data_path, band,
+        Window(c0, r0, n_samples, n_lines), dtype, where)
     heights = raw.astype(np.float64)
-    missing = sample_constant(image.get("MISSING_CONSTANT"), kind, nbytes)
+    missing = sample_constant(image.get("MISSING_CONSTANT"), layout.kind, dtype.itemsize)
     if missing is not None:
         heights[raw == missing] = np.nan
     # heights in kilometres (UNIT = KILOMETER, as LOLA's floating-point polar products
     # give them, with OFFSET = 1737.4): metres, the OFFSET too
     unit_m = 1000.0 if str(image.get("UNIT", "")).upper() in _KM else 1.0
     heights *= label_number(image, "SCALING_FACTOR", where, 1.0) * unit_m
-
     tags = {"PDS_LABEL": label_path.name}
     for key in ("PRODUCT_ID", "TARGET_NAME", "DATA_SET_ID"):
         if isinstance(label.get(key), str):
@@ -150,6 +140,43 @@ def read_pds(path: Path, band: int, win=None):
         else:
             heights += pds_offset
     return heights, transform, crs, tags, radius_m
+
+
+def _image_layout(image: dict, band: int, where: str) -> _Image:
+    """The IMAGE object's sizes, sample type and line padding, checked (and ``band``
+    against its bands)."""
+    lines = int(label_number(image, "LINES", where))
+    samples = int(label_number(image, "LINE_SAMPLES", where))
+    bands = int(label_number(image, "BANDS", where, 1))
+    bits = int(label_number(image, "SAMPLE_BITS", where))
+    if min(lines, samples, bands) < 1:
+        raise ValueError(f"{where!r}: LINES, LINE_SAMPLES and BANDS must be >= 1; got "
+                         f"{lines}, {samples}, {bands}")
+    stype = str(image.get("SAMPLE_TYPE", "")).upper().replace(" ", "_")
+    if stype not in SAMPLE_TYPES:
+        raise ValueError(f"{where!r}: unsupported SAMPLE_TYPE {stype or '(none)'!r}")
+    kind, order = SAMPLE_TYPES[stype]
+    if bits not in (8, 16, 32, 64) or (kind == "f" and bits < 32):
+        raise ValueError(f"{where!r}: unsupported SAMPLE_BITS {bits} for {stype}")
+    if band > bands:
+        with about("band"):
+            raise ParameterError("band", f"must be in [1, {bands}] for {where!r}; got {band}")
+    if bands > 1 and str(image.get("BAND_STORAGE_TYPE", "BAND_SEQUENTIAL")).upper() != \
+            "BAND_SEQUENTIAL":
+        raise ValueError(f"{where!r}: only BAND_SEQUENTIAL multi-band images are supported")
+    prefix = int(label_number(image, "LINE_PREFIX_BYTES", where, 0))
+    suffix = int(label_number(image, "LINE_SUFFIX_BYTES", where, 0))
+    if prefix < 0 or suffix < 0:
+        raise ValueError(f"{where!r}: LINE_PREFIX_BYTES and LINE_SUFFIX_BYTES must be >= 0")
+    return _Image(lines, samples, bands, kind, order, bits, prefix, suffix)
+
+
+def _check_extent(layout: _Image, data_path: Path, band_offset: int) -> None:
+    """The data file holds the band's lines from ``band_offset`` on."""
+    if data_path.stat().st_size < band_offset + layout.lines * layout.stride:
+        raise ValueError(f"{str(data_path)!r} is truncated: {layout.lines} x "
+                         f"{layout.samples} samples of {layout.bits // 8} bytes need "
+                         f"{layout.lines * layout.stride} bytes from offset {band_offset}")
 
 
 def _image_start(label: dict, parent: dict, label_path: Path, where: str):
@@ -240,19 +267,19 @@ def _plain(text: str) -> str:
     return " ".join(text.replace("/*", "/ *").replace("*/", "* /").split())
 
 
-def _gdal_label(label: dict, proj: dict | None, *, lines, samples, bands, stype, bits,
-                prefix, suffix, offset) -> str:
+def _gdal_label(label: dict, proj: dict | None, layout: _Image, offset: int) -> str:
     """The label GDAL reads: the checked image facts and the map projection's values."""
     out = ["PDS_VERSION_ID = PDS3", "RECORD_TYPE = FIXED_LENGTH",
-           f"RECORD_BYTES = {prefix + samples * bits // 8 + suffix}",
+           f"RECORD_BYTES = {layout.stride}",
            f'^IMAGE = ("{_DATA}", {offset + 1} <BYTES>)']
     if isinstance(label.get("TARGET_NAME"), str):
         out.append(f"TARGET_NAME = {_odl(label['TARGET_NAME'])}")
-    out += ["OBJECT = IMAGE", f"  LINES = {lines}", f"  LINE_SAMPLES = {samples}",
-            f"  BANDS = {bands}", "  BAND_STORAGE_TYPE = BAND_SEQUENTIAL",
-            f"  SAMPLE_TYPE = {stype}", f"  SAMPLE_BITS = {bits}",
-            f"  LINE_PREFIX_BYTES = {prefix}", f"  LINE_SUFFIX_BYTES = {suffix}",
-            "END_OBJECT = IMAGE"]
+    out += ["OBJECT = IMAGE", f"  LINES = {layout.lines}",
+            f"  LINE_SAMPLES = {layout.samples}", f"  BANDS = {layout.bands}",
+            "  BAND_STORAGE_TYPE = BAND_SEQUENTIAL",
+            f"  SAMPLE_TYPE = {_GDAL_TYPES[layout.kind, layout.order]}",
+            f"  SAMPLE_BITS = {layout.bits}", f"  LINE_PREFIX_BYTES = {layout.prefix}",
+            f"  LINE_SUFFIX_BYTES = {layout.suffix}", "END_OBJECT = IMAGE"]
     if proj is not None:
         out.append("OBJECT = IMAGE_MAP_PROJECTION")
         out += [f"  {key} = {_odl(value)}" for key, value in proj.items()

@@ -1,5 +1,5 @@
 r"""The plan of a layer stack: where its layers lie and which craters and boulders each
-takes (Martin et al., lunar paper IV.A; the run is :func:`dem.enhance`).
+takes (Martin, Parkes & Dunstan 2014, IV.A; the run is :func:`dem.enhance`).
 
 Geometry
 --------

@@ -1,4 +1,4 @@
-"""Slope distributions and power spectra of DEMs (lunar paper V.E).
+"""Slope distributions and power spectra of DEMs (Martin, Parkes & Dunstan 2014, V.E).
 
 * :func:`slope` - Horn's (1981) 3 x 3 slope (or 2-point central differences) in degrees,
   with the true ground size of every row on a geographic CRS (the pixel width shrinks
@@ -72,7 +72,7 @@ def slope(dem: Dem, method: str = "horn") -> np.ndarray:
 
     ``method="horn"``: ``dz/dx = ((c + 2f + i) - (a + 2d + g)) / (8 dx)`` on the 3 x 3
     window ``a b c / d e f / g h i`` (Horn 1981; ArcGIS/GDAL's default);
-    ``"central"``: ``(f - d) / (2 dx)`` (Zevenbergen & Thorne). NaN on the border and
+    ``"central"``: ``(f - d) / (2 dx)`` (Zevenbergen & Thorne 1987). NaN on the border and
     wherever the window holds an unknown pixel.
 
     Examples

@@ -8,10 +8,10 @@ and, for its craters, the known terrain within one hole size of it. So
 :func:`fill_to_file` gives the same file, byte for byte, reading the input window by
 window:
 
-1. *Holes*: the unknown pixels are labelled tile by tile (8-connected, scipy) and the
-   labels joined across tile edges (a graph of the labels that touch, its connected
-   components); each hole gets its bounding box, pixel count and first pixel in raster
-   order, the order in which ``fill_gaps`` fills them.
+1. *Holes* (:mod:`dem.holes`): the unknown pixels are labelled tile by tile
+   (8-connected, scipy) and the labels joined across tile edges (a graph of the labels
+   that touch, its connected components); each hole gets its bounding box, pixel count
+   and first pixel in raster order, the order in which ``fill_gaps`` fills them.
 2. *F*, unless given: :func:`dem.fractal_fit_rows`, the whole DEM's estimate computed
    strip by strip with numpy's own summation order (:mod:`dem.streamsum`): the same
    number, not an approximation.
@@ -33,6 +33,7 @@ exceeds ``max_memory_gb`` is refused up front, naming it.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import math
 import os
 from pathlib import Path
@@ -51,15 +52,16 @@ from craters._shared import (
 )
 
 from ._pds import find_object, label_number, label_text, parse_label
-from .core import raster_pixel_size_m
+from .core import Dem, raster_pixel_size_m
 from .fractal import NORMALISER_WINDOW_PX, fractal_fit_rows, local_msd, window_mean
 from .frame import crater_target
 from .gapcraters import stamp_gap_craters
-from .gaps import fill_arguments, fill_hole, known_dimension, record_craters
+from .gaps import fill_arguments, fill_hole, fill_parameters, record_craters
+from .holes import Holes, holes_of_file, tile_windows
 from .io import PDS_SUFFIXES, WindowWriter, check_float32, read
 
 __all__ = ["DEFAULT_TILE_PX", "MEMORY_SHARE", "WHOLE_BYTES_PER_PX", "FilledFile", "fill_to_file",
-           "fits_whole", "holes_of_file", "raster_shape"]
+           "fits_whole", "raster_shape"]
 
 #: Default tile side (pixels) of :func:`fill_to_file`: a multiple of the COG's 256-pixel
 #: blocks (about 0.5 GB of working memory while labelling).
@@ -98,19 +100,6 @@ class FilledFile(NamedTuple):
     """How many tiles were labelled and written."""
 
 
-class Holes(NamedTuple):
-    """The holes of a raster, in ``fill_gaps``'s order (first pixel in raster order)."""
-
-    box: np.ndarray
-    """(n, 4) int64: row0, row1, col0, col1 (exclusive ends)."""
-    first: np.ndarray
-    """(n,) int64: raster index (row * cols + col) of each hole's first pixel."""
-    pixels: np.ndarray
-    """(n,) int64: pixel count."""
-    known: int
-    """Known pixels of the raster."""
-
-
 def raster_shape(path) -> tuple[int, int]:
     """(rows, cols) of the raster :func:`dem.read` reads from ``path`` (call that first:
     it checks the file), without its pixels: the PDS3 label's LINES and LINE_SAMPLES, or
@@ -130,97 +119,6 @@ def raster_shape(path) -> tuple[int, int]:
         warnings.simplefilter("ignore", NotGeoreferencedWarning)
         with rasterio.open(path) as ds:
             return int(ds.height), int(ds.width)
-
-
-def _tiles(rows: int, cols: int, tile: int):
-    return [(r, c, min(tile, rows - r), min(tile, cols - c))
-            for r in range(0, rows, tile) for c in range(0, cols, tile)]
-
-
-def holes_of_file(read_window, shape, tile_px: int, *, progress: bool = False) -> Holes:
-    """The 8-connected components of the unknown pixels of a raster read tile by tile.
-
-    ``read_window(r, c, h, w)`` returns that window's heights (NaN = unknown). The same
-    components, boxes and order as ``scipy.ndimage.label`` of the whole unknown mask.
-    """
-    from scipy import ndimage, sparse
-    from scipy.sparse.csgraph import connected_components
-
-    rows, cols = shape
-    eight = np.ones((3, 3), dtype=bool)
-    boxes, firsts, counts = [np.zeros((0, 4), np.int64)], [np.zeros(0, np.int64)], \
-        [np.zeros(0, np.int64)]
-    edges_a, edges_b = [], []
-    bottom: dict = {}  # (tile row, tile col) -> labels of its last row (global ids)
-    right: dict = {}
-    next_id, known = 1, 0
-    tiles = _tiles(rows, cols, tile_px)
-    for r, c, h, w in progress_bar(tiles, enabled=progress, desc="fill: find holes"):
-        unknown = np.isnan(read_window(r, c, h, w))
-        known += int(unknown.size - unknown.sum())
-        lab, n = ndimage.label(unknown, structure=eight)
-        lab = lab.astype(np.int64)
-        if n:
-            objs = ndimage.find_objects(lab)
-            box = np.array([[s[0].start + r, s[0].stop + r, s[1].start + c, s[1].stop + c]
-                            for s in objs], dtype=np.int64)
-            first = np.array([(s[0].start + r) * cols + c + s[1].start
-                              + int(np.argmax(lab[s[0].start, s[1]] == k))
-                              for k, s in enumerate(objs, 1)], dtype=np.int64)
-            boxes.append(box)
-            firsts.append(first)
-            counts.append(np.bincount(lab.ravel(), minlength=n + 1)[1:].astype(np.int64))
-            lab[lab > 0] += next_id - 1
-        ti, tj = r // tile_px, c // tile_px
-        # join with the tiles above (three of them, diagonals included) and to the left
-        links = []
-        up = bottom.get((ti - 1, tj))
-        if up is not None:
-            for shift in (-1, 0, 1):
-                a = up[max(shift, 0):w + min(shift, 0)]
-                b = lab[0, max(-shift, 0):w - max(shift, 0)]
-                links.append((a, b))
-        left = right.get((ti, tj - 1))
-        if left is not None:
-            for shift in (-1, 0, 1):
-                a = left[max(shift, 0):h + min(shift, 0)]
-                b = lab[max(-shift, 0):h - max(shift, 0), 0]
-                links.append((a, b))
-        ul = bottom.get((ti - 1, tj - 1))
-        if ul is not None:
-            links.append((ul[-1:], lab[0, :1]))
-        ur = bottom.get((ti - 1, tj + 1))
-        if ur is not None:
-            links.append((ur[:1], lab[0, -1:]))
-        for a, b in links:
-            both = (a > 0) & (b > 0)
-            edges_a.append(a[both])
-            edges_b.append(b[both])
-        bottom[(ti, tj)] = lab[-1].copy()
-        right[(ti, tj)] = lab[:, -1].copy()
-        bottom.pop((ti - 2, tj + 1), None)
-        right.pop((ti, tj - 1), None)
-        next_id += n
-    box = np.concatenate(boxes)
-    first = np.concatenate(firsts)
-    count = np.concatenate(counts)
-    n = len(box)
-    if n == 0:
-        return Holes(box, first, count, known)
-    a = np.concatenate(edges_a) - 1 if edges_a else np.zeros(0, np.int64)
-    b = np.concatenate(edges_b) - 1 if edges_b else np.zeros(0, np.int64)
-    graph = sparse.coo_matrix((np.ones(len(a), np.int8), (a, b)), shape=(n, n))
-    m, comp = connected_components(graph, directed=False)
-    out_box = np.empty((m, 4), np.int64)
-    out_box[:, 0] = out_box[:, 2] = np.iinfo(np.int64).max
-    out_box[:, 1] = out_box[:, 3] = np.iinfo(np.int64).min
-    for j, fn in ((0, np.minimum), (1, np.maximum), (2, np.minimum), (3, np.maximum)):
-        fn.at(out_box[:, j], comp, box[:, j])
-    out_first = np.full(m, np.iinfo(np.int64).max, np.int64)
-    np.minimum.at(out_first, comp, first)
-    out_count = np.bincount(comp, weights=count, minlength=m).astype(np.int64)
-    order = np.argsort(out_first, kind="stable")
-    return Holes(out_box[order], out_first[order], out_count[order], known)
 
 
 def _budget(max_memory_gb) -> tuple[float, str]:
@@ -303,28 +201,94 @@ def fill_to_file(path, out, roughness: float | None = None, *,
     roughness, fractal_dimension, layer, key, seed = fill_arguments(
         roughness, fractal_dimension, craters, rng)
     limit, whose = _budget(max_memory_gb)
+    tile_px = _tile_side(tile_px, limit)
+    src = _open_source(path, {"band": band, "pixel_size_m": pixel_size_m,
+                              "body_radius_m": body_radius_m, "body": body,
+                              "allow_unknown": True})
+    rows, cols = src.shape
+    holes = holes_of_file(src.heights, src.shape, tile_px, progress=progress)
+    if holes.known == 0:
+        raise ValueError("`dem` has no known pixel (all NaN): there is nothing to fill from")
+    _check_hole_memory(holes, src.shape, layer == "auto", limit, whose)
+    params, fractal_dimension = fill_parameters(
+        roughness, fractal_dimension, key, lambda: _file_dimension(src, holes, tile_px),
+        filled_pixels=int(holes.pixels.sum()), holes=len(holes.box))
+    if layer is not None and target is None:
+        target = crater_target(src.head)
+    uniform = None if roughness is None else roughness * src.resolution_m
+    scratch = temp_file(out, ".fill")
+    try:
+        with open(scratch, "r+b") as fh:
+            fh.truncate(rows * cols * 8)  # sparse: disk only where holes are written
+        catalogs, notes = [], []
+        for i in progress_bar(range(len(holes.box)), enabled=progress, desc="fill: holes"):
+            cat, note = _fill_one(src, scratch, holes.box[i], int(holes.first[i]), layer,
+                                  key, target, uniform, fractal_dimension)
+            if note is not None:
+                notes.append(note)
+            if cat is not None:
+                catalogs.append(cat)
+        record_craters(params, catalogs, notes, layer, src.pixel_size_m)
+        tags = src.head.step_tags("dem.fill_gaps", seed, params)
+        written, tiles = _write_filled(src, scratch, out, tags, tile_px, progress=progress)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(scratch)
+    return FilledFile(written, (rows, cols), seed, params, tiles)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Source:
+    """The input DEM file of :func:`fill_to_file`, read window by window."""
+
+    path: Path
+    options: dict
+    """:func:`dem.read`'s options."""
+    head: Dem
+    """Its first pixel (CRS, transform, tags, lattice)."""
+    shape: tuple[int, int]
+    pixel_size_m: tuple[float, float]
+    """The whole DEM's pixel size (metres)."""
+
+    @property
+    def resolution_m(self) -> float:
+        return math.sqrt(self.pixel_size_m[0] * self.pixel_size_m[1])
+
+    def read(self, win) -> Dem:
+        """The window ``(row_off, col_off, rows, cols)`` as a :class:`Dem`."""
+        return read(self.path, window=win, **self.options)
+
+    def heights(self, r: int, c: int, h: int, w: int) -> np.ndarray:
+        """The heights of a window (a writable copy)."""
+        return np.array(self.read((r, c, h, w)).heights)
+
+
+def _open_source(path, options: dict) -> _Source:
+    """The input's first pixel, shape and pixel size (that of the whole DEM: a geographic
+    CRS's depends on the centre latitude)."""
+    head = read(path, window=(0, 0, 1, 1), **options)
+    rows, cols = raster_shape(path)
+    px = (head.pixel_size_m if head.crs is None  # given, or the file's tag
+          else raster_pixel_size_m(head.transform, head.crs, (rows, cols),
+                                   body_radius_m=head.body_radius_m))
+    return _Source(Path(path), options, head, (rows, cols), px)
+
+
+def _tile_side(tile_px, limit: float) -> int:
+    """``tile_px`` checked; by default :data:`DEFAULT_TILE_PX`, halved (down to 256)
+    while labelling a tile would take more than a quarter of ``limit`` bytes."""
     if tile_px is None:
         tile_px = DEFAULT_TILE_PX
         while tile_px > 256 and _TILE_BYTES_PER_PX * tile_px**2 > 0.25 * limit:
             tile_px //= 2
     with about("tile_px"):
-        tile_px = check_int("tile_px", tile_px, 16)
-    opts = {"band": band, "pixel_size_m": pixel_size_m, "body_radius_m": body_radius_m,
-            "body": body, "allow_unknown": True}
-    head = read(path, window=(0, 0, 1, 1), **opts)
-    rows, cols = raster_shape(path)
-    px = (head.pixel_size_m if head.crs is None  # given, or the file's tag
-          else raster_pixel_size_m(head.transform, head.crs, (rows, cols),
-                                   body_radius_m=head.body_radius_m))
-    resolution = math.sqrt(px[0] * px[1])
+        return check_int("tile_px", tile_px, 16)
 
-    def heights(r, c, h, w):
-        return np.array(read(path, window=(r, c, h, w), **opts).heights)
 
-    holes = holes_of_file(heights, (rows, cols), tile_px, progress=progress)
-    if holes.known == 0:
-        raise ValueError("`dem` has no known pixel (all NaN): there is nothing to fill from")
-    auto = layer == "auto"
+def _check_hole_memory(holes: Holes, shape, auto: bool, limit: float, whose: str) -> None:
+    """Every hole can be filled within ``limit`` bytes (else an error naming the first
+    that cannot)."""
+    rows, cols = shape
     for box, first in zip(holes.box, holes.first, strict=True):
         need = hole_bytes(box, rows, cols, auto)
         if need > limit:
@@ -333,54 +297,40 @@ def fill_to_file(path, out, roughness: float | None = None, *,
                 f"cols {box[2]}..{box[3] - 1} ({box[1] - box[0]} x {box[3] - box[2]} pixels,"
                 f" first pixel ({first // cols}, {first % cols})): filling it needs about "
                 f"{need / 1e9:.3g} GB, more than {limit / 1e9:.3g} GB{whose}")
-    params: dict = {"roughness": "local" if roughness is None else roughness}
-    if fractal_dimension is None:
-        estimated = math.nan
-        if len(holes.box):
-            strip = max(1, tile_px * tile_px // cols)
-            try:
-                estimated = float(fractal_fit_rows(lambda a, b: heights(a, 0, b - a, cols),
-                                                   (rows, cols), px, resolution,
-                                                   strip_rows=strip).fractal_dimension)
-            except ValueError:
-                estimated = math.nan
-        params["fractal_dimension_estimated"] = estimated
-        fractal_dimension = known_dimension(estimated)
-    params.update(fractal_dimension=fractal_dimension, key=key,
-                  filled_pixels=int(holes.pixels.sum()), holes=len(holes.box))
-    if layer is not None and target is None:
-        target = crater_target(head)
-    uniform = None if roughness is None else roughness * resolution
-    scratch = temp_file(out, ".fill")
+
+
+def _file_dimension(src: _Source, holes: Holes, tile_px: int) -> float:
+    """F of the whole DEM file (:func:`dem.fractal_fit_rows`, strips of about a tile's
+    pixels), NaN without holes or when it cannot be estimated."""
+    if not len(holes.box):
+        return math.nan
+    rows, cols = src.shape
+    strip = max(1, tile_px * tile_px // cols)
     try:
-        with open(scratch, "r+b") as fh:
-            fh.truncate(rows * cols * 8)  # sparse: disk only where holes are written
-        catalogs, notes = [], []
-        for i in progress_bar(range(len(holes.box)), enabled=progress, desc="fill: holes"):
-            cat, note = _fill_one(path, opts, scratch, (rows, cols), holes.box[i],
-                                  int(holes.first[i]), head, layer, key, target, uniform,
-                                  fractal_dimension, px)
-            if note is not None:
-                notes.append(note)
-            if cat is not None:
-                catalogs.append(cat)
-        record_craters(params, catalogs, notes, layer, px)
-        tags = head.step_tags("dem.fill_gaps", seed, params)
-        tiles = _tiles(rows, cols, tile_px)
-        with WindowWriter(out, (rows, cols), transform=head.transform, crs=head.crs,
-                          tags=tags, body_radius_m=head.body_radius_m,
-                          pixel_size_m=px) as writer:
-            for r, c, h, w in progress_bar(tiles, enabled=progress, desc="fill: write"):
-                z = heights(r, c, h, w)
-                gaps = np.isnan(z)
-                if gaps.any():
-                    z[gaps] = _scratch_read(scratch, cols, (r, c, h, w))[gaps]
-                check_float32(z, out)
-                writer.write(z, r, c)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(scratch)
-    return FilledFile(writer.path, (rows, cols), seed, params, len(tiles))
+        return float(fractal_fit_rows(lambda a, b: src.heights(a, 0, b - a, cols), src.shape,
+                                      src.pixel_size_m, src.resolution_m,
+                                      strip_rows=strip).fractal_dimension)
+    except ValueError:
+        return math.nan
+
+
+def _write_filled(src: _Source, scratch, out, tags: dict, tile_px: int, *,
+                  progress: bool) -> tuple[Path, int]:
+    """The input with the fills of the scratch file, written tile by tile into ``out``;
+    its path and the number of tiles."""
+    rows, cols = src.shape
+    tiles = tile_windows(rows, cols, tile_px)
+    with WindowWriter(out, src.shape, transform=src.head.transform, crs=src.head.crs,
+                      tags=tags, body_radius_m=src.head.body_radius_m,
+                      pixel_size_m=src.pixel_size_m) as writer:
+        for r, c, h, w in progress_bar(tiles, enabled=progress, desc="fill: write"):
+            z = src.heights(r, c, h, w)
+            gaps = np.isnan(z)
+            if gaps.any():
+                z[gaps] = _scratch_read(scratch, cols, (r, c, h, w))[gaps]
+            check_float32(z, out)
+            writer.write(z, r, c)
+    return writer.path, len(tiles)
 
 
 def _scratch_read(scratch, cols: int, win) -> np.ndarray:
@@ -404,15 +354,14 @@ def _scratch_write(scratch, cols: int, win, mask, values) -> None:
         del mm
 
 
-def _fill_one(path, opts, scratch, shape, box, first, head, layer, key, target, uniform, fd,
-              px):
+def _fill_one(src: _Source, scratch, box, first, layer, key, target, uniform, fd):
     """Fill the hole of ``box`` (global rows/cols) and keep its values in the scratch."""
     from scipy import ndimage
 
-    rows, cols = shape
+    rows, cols = src.shape
     win = _window(box, _margin(box, layer == "auto"), rows, cols)
     wr, wc, wh, ww = win
-    dem = read(path, window=win, **opts)
+    dem = src.read(win)
     z = np.array(dem.heights)
     sl = (slice(int(box[0]) - wr, int(box[1]) - wr), slice(int(box[2]) - wc, int(box[3]) - wc))
     # the hole: the component of the unknown pixels of its box that holds its first pixel
@@ -427,6 +376,7 @@ def _fill_one(path, opts, scratch, shape, box, first, head, layer, key, target, 
         part[gaps] = _scratch_read(scratch, cols, (wr + a0, wc + b0, a1 - a0, b1 - b0))[gaps]
     amp = (None if uniform is not None
            else np.sqrt(window_mean(local_msd(dem.heights), NORMALISER_WINDOW_PX)))
+    head = src.head
     origin = (head.origin[0] + wr, head.origin[1] + wc)
     fill_hole(z, sl, hole, amp, uniform, fd, key, level=head.level, origin=origin)
     cat = note = None
@@ -434,11 +384,11 @@ def _fill_one(path, opts, scratch, shape, box, first, head, layer, key, target, 
         def around(w0, w1, v0, v1):
             if (w0, w1, v0, v1) == (0, wh, 0, ww):
                 return dem
-            return read(path, window=(wr + w0, wc + v0, w1 - w0, v1 - v0), **opts)
+            return src.read((wr + w0, wc + v0, w1 - w0, v1 - v0))
 
-        cat, note = stamp_gap_craters(z, sl, hole, layer, key, target, pixel_size_m=px,
-                                      level=head.level, origin=head.origin, around=around,
-                                      offset=(wr, wc))
+        cat, note = stamp_gap_craters(z, sl, hole, layer, key, target,
+                                      pixel_size_m=src.pixel_size_m, level=head.level,
+                                      origin=head.origin, around=around, offset=(wr, wc))
     _scratch_write(scratch, cols, (int(box[0]), int(box[2]), int(box[1] - box[0]),
                                    int(box[3] - box[2])), hole, z[sl][hole])
     return cat, note

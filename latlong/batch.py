@@ -1,13 +1,15 @@
-"""Batches of bodies: one scene, many seeds and varied settings, built on dask.distributed.
+"""Batches of bodies: one scene, many seeds and varied settings, built on dask.distributed
+(or serially).
 
 :func:`batch` builds every variant of a scene -- each seed of ``seeds`` with each
 combination of the values in ``vary`` (a cartesian product) -- as one task per variant
-(the engine: ``latlong.parallel.batch``), and writes per variant the outputs the scene
-names (or a ``.npz`` and, with crater layers, the crater catalog) into one folder, each
-file under the variant's name: ``seed0001_radius-m=1000.npz``, a named output
-``body.ply`` as ``seed0001_radius-m=1000_body.ply``. ``index.csv`` lists every variant
-with its files, their sha256, seconds, peak memory and status. Every variant's scene and
-outputs are checked before anything runs. A variant's files are the bytes ``latlong
+(the engine: ``latlong.parallel.batch``, on the backend ``backend`` chooses), and writes
+per variant the outputs the scene names (or a ``.npz`` and, with crater layers, the
+crater catalog) into one folder, each file under the variant's name:
+``seed0001_radius-m=1000.npz``, a named output ``body.ply`` as
+``seed0001_radius-m=1000_body.ply``. ``index.csv`` lists every variant with its files,
+their sha256, seconds, peak memory and status. Every variant's scene and outputs are
+checked before anything runs. A variant's files are the bytes ``latlong
 build --config SCENE --seed S`` writes to the same file names (the same writer:
 :func:`latlong.outputs.write_outputs`; the same seed gives the same bytes whatever the
 thread count).
@@ -40,11 +42,11 @@ __all__ = ["batch"]
 _RUN_ONLY = ("quiet", "force")
 
 
-def batch(scene, seeds, *, out, vary: Mapping | None = None, scheduler: str | None = None,
-          workers: int | None = None, resume: bool = False, force: bool = False,
-          progress: bool = False, retries: int = 2,
+def batch(scene, seeds, *, out, vary: Mapping | None = None, backend: str | None = None,
+          scheduler: str | None = None, workers: int | None = None, resume: bool = False,
+          force: bool = False, progress: bool = False, retries: int = 2,
           on_done: Callable[[dict], None] | None = None) -> BatchResult:
-    """Build every variant of a scene on dask.distributed and write it into ``out``.
+    """Build every variant of a scene (on dask.distributed) and write it into ``out``.
 
     Parameters
     ----------
@@ -59,6 +61,9 @@ def batch(scene, seeds, *, out, vary: Mapping | None = None, scheduler: str | No
     vary : Mapping, optional
         Setting -> list of values (:data:`latlong.SETTINGS` but ``seed``; values as in a
         scene file, a crater layer list as a list of specs); every combination is built.
+    backend : {"dask", "serial"}, optional
+        Where the variants are built (:mod:`latlong.parallel.backends`): dask (the
+        default), or ``"serial"``, one after the other in this process (the same bytes).
     scheduler : str, optional
         Address of a running dask scheduler (``tcp://host:8786``); default: a local
         cluster on 127.0.0.1 with ``workers`` single-threaded worker processes (default:
@@ -98,9 +103,9 @@ def batch(scene, seeds, *, out, vary: Mapping | None = None, scheduler: str | No
                                "catalog_columns": named.catalog_columns,
                                "version": package_version()}, sort_keys=True, default=str)
         jobs.append(Job(v, (s, named), describe, tuple(named.files())))
-    return run_batch(jobs, _build_variant, out, scheduler=scheduler, workers=workers,
-                     resume=resume, force=force, progress=progress, retries=retries,
-                     on_done=on_done)
+    return run_batch(jobs, _build_variant, out, backend=backend, scheduler=scheduler,
+                     workers=workers, resume=resume, force=force, progress=progress,
+                     retries=retries, on_done=on_done)
 
 
 def _scene_parts(scene, vary) -> tuple[dict | None, Outputs]:

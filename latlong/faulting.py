@@ -1,4 +1,4 @@
-"""Poisson faulting base shapes (Martin et al. 2014, IV.A)."""
+"""Poisson faulting base shapes (Martin, Parkes, Dunstan & Rowell 2014, IV.A)."""
 
 from __future__ import annotations
 

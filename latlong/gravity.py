@@ -37,7 +37,7 @@ from .shapes import ShapeModel
 
 __all__ = ["GRAVITATIONAL_CONSTANT", "GravityField", "gravity", "polyhedron_gravity"]
 
-#: CODATA 2018 (m^3 kg^-1 s^-2), the value the polyhedral-gravity package uses.
+#: CODATA 2018 (Tiesinga et al. 2021), m^3 kg^-1 s^-2: the polyhedral-gravity package's value.
 GRAVITATIONAL_CONSTANT = 6.67430e-11
 _OFFSET = 1e-7  # evaluation points this fraction of the body's size outside the surface
 _NEIGHBOURS = 10  # evaluated vertices in a mesh vertex's local linear fit

@@ -9,6 +9,7 @@ import contextlib
 import json
 import logging
 import os
+import re
 import subprocess
 import sys
 import time
@@ -20,6 +21,7 @@ import dem
 import latlong
 from dem.cli import main as dem_main
 from latlong.cli import main as latlong_main
+from latlong.parallel.backends import choose_backend, open_backend, run_task
 from latlong.parallel.batch import parse_seeds, read_index, sha256_file, variants
 from latlong.parallel.batch_tasks import run_variant
 
@@ -139,11 +141,13 @@ def _probe_task(payload, folder, name):
 
 def test_a_variant_in_the_worker(tmp_path):
     """The task writes under a temporary folder, its files are hashed and renamed into
-    place; ``threads`` limits numba in the task; a bad variant leaves nothing behind."""
+    place; ``threads`` limits numba in a dask task (:func:`run_task`); a bad variant
+    leaves nothing behind."""
     import numba
 
     try:
-        rec = run_variant(_probe_task, "fine", str(tmp_path), "v1", threads=1)
+        rec = run_task(lambda _, payload: run_variant(_probe_task, payload, str(tmp_path), "v1"),
+                       None, "fine", 1)
         assert rec["status"] == "ok" and rec["files"] == ["v1.txt"]
         assert (tmp_path / "v1.txt").read_text() == "fine 1"
         assert rec["sha256"] == [sha256_file(tmp_path / "v1.txt")] and rec["peak_mb"] > 1
@@ -170,6 +174,60 @@ def test_named_outputs_keep_their_bytes(tmp_path, scheduler):
                              "-o", str(single / files[0]), "-o", str(single / files[2]),
                              "--catalog", str(single / files[3])]) == 0
     assert _shas(single, files) == _shas(out, files)
+
+
+def test_serial_backend_gives_the_dask_bytes(tmp_path, scene, scheduler, monkeypatch):
+    """The serial backend builds the variants in this process (no cluster): the same
+    files and index as dask's workers; a variant that fails is recorded, the others
+    built."""
+    vary = {"radius_m": [100.0, 150.0]}
+    there = latlong.batch(scene, "1-2", vary=vary, out=tmp_path / "dask", scheduler=scheduler)
+    here = latlong.batch(scene, "1-2", vary=vary, out=tmp_path / "serial", backend="serial")
+    assert (here.done, here.failed) == (4, 0)
+    assert [(r["files"], r["sha256"]) for r in here.rows] == \
+        [(r["files"], r["sha256"]) for r in there.rows]
+    monkeypatch.chdir(ROOT)  # the config's input is relative to the working folder
+    config = tmp_path / "stack.toml"
+    config.write_text(STACK)
+    rows = [dem.batch(config, "5", out=tmp_path / name, **how).rows[0]
+            for name, how in (("dem_dask", {"scheduler": scheduler}),
+                              ("dem_serial", {"backend": "serial"}))]
+    assert rows[0]["sha256"] == rows[1]["sha256"] and "manifest.json" in rows[0]["files"]
+    scene.write_text(SCENE + "max_memory_gb = 1e12\n")
+    mixed = latlong.batch(scene, "1", out=tmp_path / "mixed", backend="serial",
+                          vary={"craters": [["c=0.5,k=-2,d_min_m=8,d_max_m=15"], [TOO_MANY]]})
+    assert [r["status"] for r in mixed.rows] == ["ok", "failed"]
+    assert "asks for about" in mixed.rows[1]["error"]
+
+
+@pytest.mark.parametrize(("how", "message"), [
+    ({"backend": "threads"}, "`backend` must be one of serial, dask; got 'threads'"),
+    ({"backend": "serial", "workers": 2}, "`workers` applies to the dask backend"),
+    ({"backend": "serial", "scheduler": "tcp://127.0.0.1:9"},
+     "`scheduler` applies to the dask backend"),
+    ({"workers": 0}, "`workers` must be an integer >= 1; got 0"),
+])
+def test_backend_choice_errors_before_any_work(tmp_path, scene, how, message):
+    with pytest.raises(ValueError, match=re.escape(message)):
+        latlong.batch(scene, "1", out=tmp_path / "batch", **how)
+    assert not (tmp_path / "batch").exists()
+
+
+def test_the_backends_map_alike(scheduler):
+    """Both backends yield every result once; ``errors="return"`` hands a failure back
+    in place of its result, ``"raise"`` raises it."""
+    import operator
+
+    assert (choose_backend(), choose_backend(scheduler=scheduler),
+            choose_backend(default="dask")) == ("serial", "dask", "dask")
+    for how in ({"backend": "serial"}, {"scheduler": scheduler}):
+        with open_backend(**how) as backend:
+            got = dict(backend.map(operator.truediv, [1.0, 2.0, 0.0, 4.0], shared=8.0,
+                                   retries=0, errors="return"))
+            assert [got[i] for i in (0, 1, 3)] == [8.0, 4.0, 2.0]
+            assert isinstance(got[2], ZeroDivisionError)
+            with pytest.raises(ZeroDivisionError):
+                list(backend.map(operator.truediv, [0.0], shared=1.0, retries=0))
 
 
 def test_resume_redoes_only_missing_and_corrupt(tmp_path, scene, scheduler):
@@ -238,7 +296,7 @@ def test_bad_options_are_one_line_errors(tmp_path, scene, capsys, args, message)
 
 
 def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys, monkeypatch):
-    import latlong.parallel.batch as engine
+    import latlong.parallel.backends as engine
 
     monkeypatch.setattr(engine, "_CONNECT_S", 2)
     out = tmp_path / "batch"
@@ -387,6 +445,16 @@ def test_expand_task_options_are_one_line_errors(tmp_path, capsys, args, message
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and err.startswith("error: ") and message in err, err
     assert not out.exists() and list(tmp_path.iterdir()) == []
+
+
+def test_expand_checks_its_backend_before_any_work(tmp_path):
+    from dem.expansion import expand_to_file
+
+    for how, message in (({"backend": "serial", "workers": 2}, "`workers` applies to the dask"),
+                         ({"backend": "spark"}, "`backend` must be one of serial, dask")):
+        with pytest.raises(ValueError, match=message):
+            expand_to_file(dem.read(LOLA), tmp_path / "x.tif", 1, rng=1, **how)
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_map_tiles_on_dask_yields_every_result_and_raises_a_failure(scheduler):

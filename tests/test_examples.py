@@ -22,3 +22,10 @@ def test_example_runs(script, tmp_path, monkeypatch, capsys):
     assert all(p.stat().st_size > 10_000 for p in pngs)
     assert "wrote" in capsys.readouterr().out
     assert os.environ["CRATERFORM_EXAMPLE_OUT"] == str(tmp_path)
+
+
+def test_the_readme_names_every_example():
+    readme = (Path(__file__).parents[1] / "README.md").read_text(encoding="utf-8")
+    assert len(EXAMPLES) >= 10
+    missing = [p.name for p in EXAMPLES if f"`{p.stem.removeprefix('plot_')}`" not in readme]
+    assert not missing, missing

@@ -3,6 +3,7 @@ imports in the source tree and fails once installed)."""
 
 from __future__ import annotations
 
+import re
 import tomllib
 from pathlib import Path
 
@@ -19,3 +20,16 @@ def test_every_package_with_an_init_is_in_the_distribution():
                for top in ("latlong", "craters", "dem") for p in (ROOT / top).rglob("__init__.py")}
     assert on_disk <= shipped and {"craters._shared", "latlong.cli", "latlong.implicit",
                                    "dem.cli", "craters.lcsn", "craters.boulders"} <= shipped
+
+
+def test_the_readme_architecture_names_every_subpackage():
+    """The README's architecture section stays a map of the packages: each subpackage
+    (``latlong/sensors/`` ...) is named there, as ``sensors/`` or ``latlong/sensors/``."""
+    readme = (ROOT / "README.md").read_text(encoding="utf-8")
+    section = readme.split("\n## Architecture\n", 1)[1].split("\n## ", 1)[0]
+    subpackages = {p.parent.relative_to(ROOT).as_posix() for top in ("latlong", "craters", "dem")
+                   for p in (ROOT / top).glob("*/__init__.py")}
+    assert len(subpackages) >= 10
+    missing = sorted(s for s in subpackages
+                     if not re.search(rf"[`/]{re.escape(s.split('/', 1)[1])}/`", section))
+    assert not missing, missing

@@ -1,23 +1,36 @@
-"""Every ``bash`` block of the README runs, in order, at small sizes.
+"""Every ``bash`` and ``python`` block of the README and of the package docstrings runs.
 
-The blocks are read from ``README.md`` and run command by command with ``bash``, in one
-scratch folder that holds a copy of the repository's tracked files (``git ls-files``, as
-in a fresh clone; without git: README.md, examples/ and tests/data/), so later commands
-read what earlier ones wrote, as a user following the README does. A command that names a
-file the project does not ship, or that fails, fails the test with its stderr.
+Sources: ``README.md`` (its fenced ```bash and ```python blocks) and every package
+``__init__.py`` of ``latlong``, ``dem`` and ``craters`` whose docstring holds a
+``.. code-block:: bash`` or ``.. code-block:: python`` (read with ``ast``: nothing is
+imported). Each source runs on its own, its blocks in order, in a scratch folder holding a
+copy of the repository's tracked files (``git ls-files``, as in a fresh clone; without git:
+README.md, examples/, tests/data/ and the packages' ``__init__.py``), so later commands read
+what earlier ones wrote, as a user following the README or a docstring does. A command that
+names a file the project does not ship, that fails, or that prints a Python warning fails
+the test with its stderr.
+
+Outputs: the README writes only into ``out/``, which git ignores, so a user who follows
+the README and then runs the tests stays green; a package docstring writes only into
+``out/<its last name>/`` (``out/sensors/`` for ``latlong.sensors``), so the README and the
+docstrings can be followed in any order without one refusing to replace another's files.
 
 Sizes are made small by the substitutions of :data:`SMALLER` (each with its reason), and
 commands that need the network, services or the whole test suite are skipped by
-:data:`SKIPPED` (each with its reason); every other command runs exactly as written.
+:data:`SKIPPED` (each with its reason); every entry of both must apply to some command.
+Every other command runs exactly as written; Python blocks run exactly as written (with
+``python -P``, so the packages under test are imported, not the copy's sources).
 """
 
 from __future__ import annotations
 
+import ast
 import os
 import re
 import shutil
 import subprocess
 import sys
+import textwrap
 import time
 from pathlib import Path
 
@@ -25,6 +38,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
+PACKAGES = ("latlong", "dem", "craters")
 
 #: (pattern, replacement, why): applied in order to every command line before it runs.
 SMALLER: list[tuple[str, str, str]] = [
@@ -76,9 +90,54 @@ SKIPPED: list[tuple[str, str]] = [
 ]
 
 
-def bash_blocks(text: str) -> list[str]:
-    """The bodies of the ```bash blocks of ``text``, in order."""
-    return re.findall(r"^```bash\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)
+def readme_blocks(text: str) -> list[tuple[str, str]]:
+    """The ``(language, body)`` of the ```bash and ```python blocks of ``text``, in order."""
+    return re.findall(r"^```(bash|python)\n(.*?)^```", text, flags=re.MULTILINE | re.DOTALL)
+
+
+def docstring_blocks(doc: str) -> list[tuple[str, str]]:
+    """The ``(language, body)`` of the ``.. code-block:: bash|python`` blocks of ``doc``."""
+    lines, blocks, i = doc.splitlines(), [], 0
+    while i < len(lines):
+        match = re.match(r"^( *)\.\. code-block:: (bash|python)\s*$", lines[i])
+        i += 1
+        if not match:
+            continue
+        indent, body = len(match.group(1)), []
+        while i < len(lines) and (not lines[i].strip()
+                                  or len(lines[i]) - len(lines[i].lstrip()) > indent):
+            body.append(lines[i])
+            i += 1
+        blocks.append((match.group(2), textwrap.dedent("\n".join(body)).strip("\n") + "\n"))
+    return blocks
+
+
+def _init_docstring(package: str) -> str:
+    path = ROOT.joinpath(*package.split("."), "__init__.py")
+    return ast.get_docstring(ast.parse(path.read_text(encoding="utf-8"))) or ""
+
+
+def _documented_packages() -> list[str]:
+    """The packages whose ``__init__`` docstring holds runnable blocks, sorted."""
+    names = [".".join(p.parent.relative_to(ROOT).parts) for top in PACKAGES
+             for p in (ROOT / top).rglob("__init__.py")]
+    return sorted(n for n in names if docstring_blocks(_init_docstring(n)))
+
+
+#: README.md first, then the packages whose docstrings hold examples.
+SOURCES: list[str] = ["README.md", *_documented_packages()]
+
+
+def blocks_of(source: str) -> list[tuple[str, str]]:
+    """The runnable blocks of a source (``README.md`` or a dotted package name)."""
+    if source == "README.md":
+        return readme_blocks(README.read_text(encoding="utf-8"))
+    return docstring_blocks(_init_docstring(source))
+
+
+def output_folder(source: str) -> str:
+    """Where a source may write, relative to the repository's folder."""
+    return "out/" if source == "README.md" else f"out/{source.rsplit('.', 1)[-1]}/"
 
 
 def commands(block: str) -> list[str]:
@@ -99,10 +158,12 @@ def without_comment(line: str) -> str:
     return line
 
 
-def smaller(line: str) -> str:
-    """``line`` with :data:`SMALLER` applied."""
-    for pattern, replacement, _ in SMALLER:
-        line = re.sub(pattern, replacement, line)
+def smaller(line: str, used: set[int] | None = None) -> str:
+    """``line`` with :data:`SMALLER` applied (the indices that changed it added to ``used``)."""
+    for index, (pattern, replacement, _) in enumerate(SMALLER):
+        line, count = re.subn(pattern, replacement, line)
+        if count and used is not None:
+            used.add(index)
     return line
 
 
@@ -114,6 +175,11 @@ def skipped(line: str) -> str | None:
     return None
 
 
+def _bash_lines() -> list[str]:
+    return [line for source in SOURCES for language, body in blocks_of(source)
+            if language == "bash" for line in commands(body)]
+
+
 def _copy_repository(dest: Path) -> None:
     """The tracked files of the repository (working-tree contents), as a clone has them."""
     try:
@@ -123,54 +189,114 @@ def _copy_repository(dest: Path) -> None:
     except (OSError, subprocess.CalledProcessError):
         files = ["README.md"] + [str(p.relative_to(ROOT)) for top in ("examples", "tests/data")
                                  for p in (ROOT / top).rglob("*") if p.is_file()]
+        files += [str(p.relative_to(ROOT)) for top in PACKAGES
+                  for p in (ROOT / top).rglob("__init__.py")]
     for f in files:
         (dest / f).parent.mkdir(parents=True, exist_ok=True)
         shutil.copy2(ROOT / f, dest / f)
 
 
-def test_readme_parsing():
-    """The parser sees every block and the helpers do what the run relies on."""
+def _files(folder: Path) -> set[str]:
+    return {p.relative_to(folder).as_posix() for p in folder.rglob("*") if p.is_file()}
+
+
+def test_parsing():
+    """The parsers see every block and the helpers do what the runs rely on."""
     text = README.read_text(encoding="utf-8")
-    assert len(bash_blocks(text)) == text.count("```bash") >= 10
+    assert len(readme_blocks(text)) == text.count("```bash") + text.count("```python") >= 8
+    doc = "Text.\n\n.. code-block:: bash\n\n    a \\\n        b\n\n    c\n\nAfter.\n"
+    assert docstring_blocks(doc) == [("bash", "a \\\n    b\n\nc\n")]
     assert commands("a \\\n    b  # x\n# only a comment\nc\n") == ["a b  # x", "c"]
     assert without_comment('dem info x.tif   # a note') == "dem info x.tif"
     assert without_comment('--vary "craters=c=1;#x"') == '--vary "craters=c=1;#x"'
     assert smaller("latlong build --magnitude 400 -o a.npz") == \
         "latlong build --magnitude 24 -o a.npz"
-    assert skipped("pip install \".[test]\" && python -m pytest")
+    assert skipped("pip install \".[test]\" && python -m pytest -q")
+    # the three packages document their commands; none of the 43 commands of the
+    # reference README was dropped on the way into the docstrings
+    assert {"latlong", "dem", "craters"} <= set(SOURCES)
+    run = [line for line in _bash_lines()
+           if re.search(r"(^|&& )(latlong|dem|craters) ", line) and not skipped(line)]
+    assert len(run) >= 43
 
 
-@pytest.mark.xdist_group("readme")
-def test_readme_bash_blocks_run_in_order(tmp_path):
-    _copy_repository(tmp_path)
+def test_quick_start_comes_first_and_ci_runs_its_test_command():
+    """Install + demo, then install + tests, as the first two blocks; CI runs the latter."""
+    first, second = (commands(body) for _, body in readme_blocks(
+        README.read_text(encoding="utf-8"))[:2])
+    assert len(first) == 1 and first[0].startswith("pip install . && ")
+    assert "latlong build" in first[0]
+    assert second == ['pip install ".[test]" && python -m pytest -q']
+    ci = ROOT / ".ci" / "run"
+    if not ci.exists():
+        pytest.skip("no .ci/run in this copy (not a checkout)")
+    assert second[0] in ci.read_text(encoding="utf-8").splitlines()
+
+
+def test_the_readme_points_at_every_documented_package():
+    readme = README.read_text(encoding="utf-8")
+    missing = [name for name in SOURCES[1:] if f"`{name}`" not in readme]
+    assert not missing, f"the README does not name these packages' docstrings: {missing}"
+
+
+def test_every_substitution_and_skip_applies():
+    used: set[int] = set()
+    lines = [without_comment(line) for line in _bash_lines()]
+    for line in lines:
+        if not skipped(line):
+            smaller(line, used)
+    unused = [SMALLER[i][0] for i in range(len(SMALLER)) if i not in used]
+    unused += [p for p, _ in SKIPPED if not any(re.search(p, line) for line in lines)]
+    assert not unused, f"entries that apply to no command: {unused}"
+
+
+def _run(command: list[str], cwd: Path, env: dict, what: str, **kw) -> None:
+    start = time.perf_counter()
+    done = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True,
+                          timeout=300, **kw)
+    assert done.returncode == 0, (
+        f"{what}\nafter {time.perf_counter() - start:.1f} s, "
+        f"exit {done.returncode}\n{done.stderr[-3000:]}")
+    # no Python warning line (RuntimeWarning, ComplexWarning ...) reaches the user
+    assert not re.search(r"\b\w*Warning\b", done.stderr), (
+        f"{what}\nprinted a warning:\n{done.stderr[-3000:]}")
+
+
+@pytest.mark.parametrize("source", SOURCES)
+def test_blocks_run_in_order(source, tmp_path):
+    repo = tmp_path / "repo"
+    repo.mkdir()
+    _copy_repository(repo)
+    before = _files(repo)
     env = dict(os.environ, MPLBACKEND="Agg")
     env["PATH"] = os.pathsep.join([str(Path(sys.executable).parent), env.get("PATH", "")])
-    ran, times = 0, []
-    for number, block in enumerate(bash_blocks(README.read_text(encoding="utf-8")), 1):
-        for line in commands(block):
+    ran = 0
+    for number, (language, body) in enumerate(blocks_of(source), 1):
+        if language == "python":
+            _run([sys.executable, "-P", "-"], repo, env,
+                 f"{source} block {number} (python):\n{body}", input=body)
+            ran += 1
+            continue
+        for line in commands(body):
             if skipped(line):
                 continue
             command = smaller(without_comment(line))
-            start = time.perf_counter()
-            done = subprocess.run(["bash", "-e", "-o", "pipefail", "-c", command],
-                                  cwd=tmp_path, env=env, capture_output=True, text=True,
-                                  timeout=300)
-            times.append((time.perf_counter() - start, command))
-            assert done.returncode == 0, (
-                f"README bash block {number}: {line!r}\nran as: {command!r}\n"
-                f"after {times[-1][0]:.1f} s, "
-                f"exit {done.returncode}\n{done.stderr[-3000:]}")
-            # no Python warning line (RuntimeWarning, ComplexWarning ...) reaches the user
-            assert not re.search(r"\b\w*Warning\b", done.stderr), (
-                f"README bash block {number}: {command!r} printed a warning:\n"
-                f"{done.stderr[-3000:]}")
+            _run(["bash", "-e", "-o", "pipefail", "-c", command], repo, env,
+                 f"{source} block {number}: {line!r}\nran as: {command!r}")
             ran += 1
-    assert ran >= 40
+    assert ran
+    stray = sorted(f for f in _files(repo) - before if not f.startswith(output_folder(source)))
+    assert not stray, f"{source} wrote outside {output_folder(source)}: {stray[:20]}"
 
 
 if __name__ == "__main__":
-    for block in bash_blocks(README.read_text(encoding="utf-8")):
-        for line in commands(block):
-            why = skipped(line)
-            sys.stdout.write(f"SKIP ({why}): {line}\n" if why else
-                             f"RUN  {smaller(without_comment(line))}\n")
+    for name in SOURCES:
+        sys.stdout.write(f"== {name}\n")
+        for language, body in blocks_of(name):
+            if language == "python":
+                sys.stdout.write(f"PY   {len(body.splitlines())} lines\n")
+                continue
+            for line in commands(body):
+                why = skipped(line)
+                sys.stdout.write(f"SKIP ({why}): {line}\n" if why else
+                                 f"RUN  {smaller(without_comment(line))}\n")

@@ -199,9 +199,9 @@ _PHOBOS_A = "Phobos, Case A - SOM, Schmedemann et al (2014)"
 _PHOBOS_B = "Phobos, Case B - MBA, Schmedemann et al (2014)"
 
 #: Chronology systems by short name (radii: Moon 1737.4 km, Mars 3389.5 km, Mercury
-#: 2439.4 km (IAU 2015), Vesta 262.7 km (Russell et al. 2012), Ceres 469.7 km (Park et
-#: al. 2016), Ida 15.7 km, Gaspra 6.1 km (Thomas et al. 1994, 1996), Lutetia 49 km
-#: (Sierks et al. 2011), Phobos 11.08 km (Willner et al. 2014)).
+#: 2439.4 km (IAU 2015, Archinal et al. 2018), Vesta 262.7 km (Russell et al. 2012),
+#: Ceres 469.7 km (Park et al. 2016), Ida 15.7 km, Gaspra 6.1 km (Thomas et al. 1994, 1996),
+#: Lutetia 49 km (Sierks et al. 2011), Phobos 11.08 km (Willner et al. 2014)).
 CHRONOLOGY_SYSTEMS = types.MappingProxyType({s.key: s for s in (
     _system("moon", _MOON_2001, "Moon", 1737.4, _MOON_2001, _MOON_2001),
     _system("moon-neukum-1983", "Moon, Neukum (1983)", "Moon", 1737.4, "Moon, Neukum (1983)",

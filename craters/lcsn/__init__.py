@@ -11,6 +11,26 @@ and the named kernels of Table A.1 / Fig. 6.
   ``"closed"``, ``"numeric"``)
 * :mod:`~craters.lcsn.inverse`: :func:`lcsn_raw`
 * :mod:`~craters.lcsn.presets`: :class:`LcsnParams`, :data:`LCSN_PRESETS`
+
+Bodies cratered with these kernels: ``latlong build --backend implicit --lcsn ...``
+(:mod:`latlong.implicit`).
+
+.. code-block:: python
+
+    import craters
+
+    print(craters.lcsn_morphometry(3, "numeric",
+                                   **craters.LCSN_PRESETS["table-a1-1km-0gyr"].raw))
+    # {'H_t': 180.1, 'D_a': 766.75, 'D_rim': 962.38, 'H_rim': 35.53, 'L_d': nan}
+
+:func:`lcsn_morphometry` has three methods: ``"numeric"`` measures the sampled profile;
+``"paper"`` evaluates Li et al.'s eq. 4-16 as printed, whose eq. 9-11 put the crest at
+1/sqrt(gamma) and assume kappa = a (on Table A.1's fresh craters, kappa = 0.22-0.34 a:
+D_a 8-11 % short, L_d 50-60 % long); ``"closed"`` (default) refines those Lambert-W roots
+with three explicit Newton steps on the exact equations and keeps each only if a sign
+change proves a true root within 0.5 % (else NaN): on the 0 Gyr rows it equals
+``"numeric"`` to 1e-5 at 1/30 of its cost (``python tests/benchmarks/bench_implicit.py``
+prints every row). :func:`lcsn_raw` inverts each.
 """
 
 from .inverse import lcsn_raw

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .._shared import check_choice, check_positive
-from .kernel import BORDER_THRESHOLD, MORPH_KEYS, RAW_KEYS, check_kind, check_raw
+from .kernel import BORDER_THRESHOLD, MORPH_KEYS, RAW_KEYS, check_kind, check_names, check_raw
 from .morphometry import METHODS, morphometry_closed, morphometry_numeric, morphometry_paper
 
 __all__ = ["lcsn_raw"]
@@ -19,15 +19,10 @@ _LN2 = math.log(2.0)
 # --------------------------------------------------------------------------- inverse
 def _morph(kind: int, morph: dict) -> dict:
     keys = MORPH_KEYS[kind]
-    for name in morph:
-        if name not in keys:
-            raise ValueError(f"`{name}` does not apply to kind {kind}; its morphometric "
-                             f"parameters are {', '.join(keys)}")
     need = [k for k in keys if k != "L_d"]
+    check_names(kind, morph, keys, "morphometric parameters", need)
     out = {}
     for name in need:
-        if name not in morph:
-            raise ValueError(f"`{name}` is required for kind {kind}")
         out[name] = check_positive(name, morph[name])
     if "L_d" in morph:
         out["L_d"] = check_positive("L_d", morph["L_d"])

@@ -29,8 +29,8 @@ import numpy as np
 from .._lcsn_kernels import _lcsn_heights_kernel
 from .._shared import check_finite, check_positive
 
-__all__ = ["BORDER_THRESHOLD", "MORPH_KEYS", "RAW_KEYS", "check_kind", "check_raw",
-           "kernel_heights", "lcsn_degrade", "lcsn_kernel", "lcsn_scaled"]
+__all__ = ["BORDER_THRESHOLD", "MORPH_KEYS", "RAW_KEYS", "check_kind", "check_names",
+           "check_raw", "kernel_heights", "lcsn_degrade", "lcsn_kernel", "lcsn_scaled"]
 
 #: Raw parameters of each kind, in the order the numba kernels take them.
 RAW_KEYS = {1: ("a", "b"), 2: ("a", "b"), 3: ("kappa", "beta", "gamma", "a", "b"),
@@ -50,17 +50,24 @@ def check_kind(kind) -> int:
     return int(kind)
 
 
+def check_names(kind: int, given, keys, what: str, required) -> None:
+    """Every name of ``given`` is one of ``keys`` (the ``what`` of ``kind``) and every
+    name of ``required`` is given."""
+    for name in given:
+        if name not in keys:
+            raise ValueError(f"`{name}` does not apply to kind {kind}; its {what} are "
+                             f"{', '.join(keys)}")
+    for name in required:
+        if name not in given:
+            raise ValueError(f"`{name}` is required for kind {kind} ({', '.join(keys)})")
+
+
 def check_raw(kind: int, raw: dict) -> dict:
     """Check the raw parameters of ``kind``: the right names, finite, in range."""
     keys = RAW_KEYS[kind]
-    for name in raw:
-        if name not in keys:
-            raise ValueError(f"`{name}` does not apply to kind {kind}; its parameters are "
-                             f"{', '.join(keys)}")
+    check_names(kind, raw, keys, "parameters", keys)
     out = {}
     for name in keys:
-        if name not in raw:
-            raise ValueError(f"`{name}` is required for kind {kind} ({', '.join(keys)})")
         value = check_finite(name, raw[name])
         if name in ("b", "beta", "gamma") and value <= 0:
             raise ValueError(f"`{name}` must be > 0; got {value!r}")

@@ -1,5 +1,6 @@
 """Make ``ldem4_gappy.tif``: the LOLA LDEM_4 crop of ``tests/data`` with NoData holes
-where the truth is known, the input of the README's ``dem fill`` and gap-filling Python.
+where the truth is known, the input of the README's ``dem fill`` and of the gap-filling
+Python in ``dem``'s docstring.
 
 Three holes, like those of real DEMs: the floor of the crater Daedalus (93 km, 5.9 S
 179.4 E; a disc of 0.35 of its diameter, as a shadowed floor would be), a missing

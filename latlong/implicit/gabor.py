@@ -350,7 +350,7 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
     max_patches : int
         Keep at most this many patches (largest variance shares).
     weighting : {"relative", "linear"}
-        Least squares on the power itself (``"linear"``, Galerne et al.'s choice: the
+        Least squares on the power itself (``"linear"``, Galerne et al.'s (2012) choice: the
         strongest part of the spectrum dominates) or relative to a smoothed periodogram
         (``"relative"``: every frequency counts, so the weak high frequencies of a
         power-law terrain are kept).
@@ -379,11 +379,26 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
                                                                  allow_zero=True)
     p_small, by, bx = _block_mean(power, 96)
     # the dictionary is averaged over the same blocks of frequencies (a patch narrower
-    # than a block is otherwise misread); Gaussians are separable: mean = outer product
+    # than a block is otherwise misread)
     fxb = fx[:p_small.shape[1] * bx].reshape(-1, bx)
     fyb = fy[:p_small.shape[0] * by].reshape(-1, by)
-    nyq = 0.5 / pixel_m
-    step = nyq / n_frequencies
+    A, meta = _patch_dictionary(fxb, fyb, 0.5 / pixel_m, n_frequencies, n_orientations,
+                                n_bandwidths)
+    target = p_small.ravel()
+    if weighting == "relative":  # each frequency cell counts by its relative error
+        from scipy.ndimage import gaussian_filter
+
+        scale = np.maximum(gaussian_filter(p_small, 1.5).ravel(), 1e-12 * target.max())
+        A, target = A / scale[:, None], target / scale
+    w, _ = nnls(A, target, maxiter=50 * A.shape[1])
+    return GaborNoise(_largest_patches(w, meta, max_patches), amplitude_m, density)
+
+
+def _patch_dictionary(fxb, fyb, nyquist, n_frequencies, n_orientations, n_bandwidths):
+    """The least-squares dictionary of :func:`fit_gabor`: one column per Gaussian power
+    patch (both lobes at +-mu), block-averaged like the periodogram (``fxb``, ``fyb``:
+    the frequencies of each block, cycles/m), and the ``(mu_x, mu_y, a)`` of each."""
+    step = nyquist / n_frequencies
     centres = [(0.0, 0.0)]
     for fk in range(1, n_frequencies + 1):
         for m in range(n_orientations):
@@ -394,20 +409,19 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
     for a in bands:
         c = 2 * math.pi / a**2
         for mx, my in centres:
+            # Gaussians are separable: the block mean is the outer product of 1-D means
             g = np.outer(np.exp(-c * (fyb - my) ** 2).mean(1), np.exp(-c * (fxb - mx) ** 2).mean(1))
             if mx or my:
                 g += np.outer(np.exp(-c * (fyb + my) ** 2).mean(1),
                               np.exp(-c * (fxb + mx) ** 2).mean(1))
             cols.append(g.ravel())
             meta.append((mx, my, a))
-    A = np.stack(cols, axis=1)
-    target = p_small.ravel()
-    if weighting == "relative":  # each frequency cell counts by its relative error
-        from scipy.ndimage import gaussian_filter
+    return np.stack(cols, axis=1), meta
 
-        scale = np.maximum(gaussian_filter(p_small, 1.5).ravel(), 1e-12 * target.max())
-        A, target = A / scale[:, None], target / scale
-    w, _ = nnls(A, target, maxiter=50 * A.shape[1])
+
+def _largest_patches(w, meta, max_patches) -> tuple[GaborPatch, ...]:
+    """The patches of the non-negative weights ``w`` of the dictionary ``meta``, largest
+    variance share first, at most ``max_patches``, none below 1e-6 of the largest."""
     # variance of each patch: integral of its power over the plane (two lobes)
     share = np.array([wt * a * a / 2 * (2 if (mx or my) else 1)
                       for wt, (mx, my, a) in zip(w, meta, strict=True)])
@@ -421,4 +435,4 @@ def fit_gabor(image, pixel_m: float, *, amplitude_m: float | None = None,
         f = math.hypot(mx, my)
         patches.append(GaborPatch(f, a, math.degrees(math.atan2(my, mx)) if f else None,
                                   float(share[idx])))
-    return GaborNoise(tuple(patches), amplitude_m, density)
+    return tuple(patches)

@@ -194,22 +194,8 @@ def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, surfac
     for idx, (la, shape, level) in enumerate(zip(layers, shapes, levels, strict=True)):
         cell = cell_m / 2**level
         key3 = np.floor((centroid - lo) / cell).astype(np.int64)
-        dims = key3.max(axis=0) + 1
-        key = (key3[:, 2] * dims[1] + key3[:, 1]) * dims[0] + key3[:, 0]
-        order = np.argsort(key, kind="stable")
-        cells, start = np.unique(key[order], return_index=True)
-        end = np.append(start[1:], len(order))
-        chosen = np.flatnonzero(rng.random(len(cells)) < la.probability)
-        n = len(chosen)
-        # a uniform point of the surface inside each chosen cell
-        cum = np.cumsum(area[order])
-        before = np.where(start[chosen] > 0, cum[start[chosen] - 1], 0.0)
-        target = before + rng.random(n) * (cum[end[chosen] - 1] - before)
-        tri = order[np.minimum(np.searchsorted(cum, target, side="right"), end[chosen] - 1)]
-        u, v = rng.random(n), rng.random(n)
-        flip = u + v > 1
-        u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-        pos = a[tri] + u[:, None] * (b[tri] - a[tri]) + v[:, None] * (c[tri] - a[tri])
+        pos = _points_in_cells(key3, (a, b, c), area, la.probability, rng)
+        n = len(pos)
         diam = (_craters.sample_power_law_diameters(n, la.d_min_m, la.d_max_m, la.exponent,
                                                     rng=rng) if n else np.zeros(0))
         if la.depth_ratio is not None:
@@ -219,6 +205,37 @@ def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, surfac
             hscale = np.ones(n)
         hscale = hscale * la.weight
         parts.append((idx, level, shape, pos, diam, hscale))
+    out, cat_cols = _kernel_rows(parts)
+    normals = surface.normals(out["centers"]) if len(out["centers"]) else np.zeros((0, 3))
+    out["normals"] = np.ascontiguousarray(normals)
+    return out, cat_cols
+
+
+def _points_in_cells(key3, triangles, area, probability, rng):
+    """Each cell of the level (``key3``: the (i, j, k) cell of each triangle's centroid)
+    is chosen with ``probability`` and gets a uniform random point of the surface inside
+    it (a triangle by area, then a point of the triangle): (n, 3) metres."""
+    a, b, c = triangles
+    dims = key3.max(axis=0) + 1
+    key = (key3[:, 2] * dims[1] + key3[:, 1]) * dims[0] + key3[:, 0]
+    order = np.argsort(key, kind="stable")
+    cells, start = np.unique(key[order], return_index=True)
+    end = np.append(start[1:], len(order))
+    chosen = np.flatnonzero(rng.random(len(cells)) < probability)
+    n = len(chosen)
+    cum = np.cumsum(area[order])
+    before = np.where(start[chosen] > 0, cum[start[chosen] - 1], 0.0)
+    target = before + rng.random(n) * (cum[end[chosen] - 1] - before)
+    tri = order[np.minimum(np.searchsorted(cum, target, side="right"), end[chosen] - 1)]
+    u, v = rng.random(n), rng.random(n)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    return a[tri] + u[:, None] * (b[tri] - a[tri]) + v[:, None] * (c[tri] - a[tri])
+
+
+def _kernel_rows(parts):
+    """The drawn craters as kernel rows (each layer's reference kernel scaled to the
+    diameter, heights times ``hscale``) and catalog columns, in layer order."""
     total = sum(len(p[3]) for p in parts)
     out = {"centers": np.zeros((total, 3)), "kinds": np.zeros(total, np.int64),
            "params": np.zeros((total, 5)), "support": np.zeros(total),
@@ -258,7 +275,5 @@ def draw_impulses(layers, shapes, levels, cell_m, base_verts, base_faces, surfac
         cols["apparent_diameter_m"].append(m.get("D_a", math.nan) * scale)
         cols["weight"].append(hscale)
         s = e
-    normals = surface.normals(out["centers"]) if total else np.zeros((0, 3))
-    out["normals"] = np.ascontiguousarray(normals)
     cat_cols = {k: np.concatenate(v) if v else np.zeros(0) for k, v in cols.items()}
     return out, cat_cols

@@ -1,12 +1,13 @@
 """Metaballs fitted to a sphere packing (steps 2-3 of
 :func:`latlong.implicit.implicit_surface`).
 
-Wyvill's soft-object kernel ``(1 - d^2/R^2)^3`` (compact support R = blend x ball radius,
-so every ball's own iso-surface sits at the same fraction of its radius) summed over the
-balls; the blend factor and the iso-value T are *fitted to the constraint*: on 20 000
-points uniform on the constraint surface, T is the median of f weighted by 1/|grad f|,
-which minimises the mean first-order distance |f - T| / |grad f| of those points to the
-iso-surface, and the blend factor with the smallest such mean is kept. On a voxel grid,
+The soft-object kernel of Wyvill, McPheeters & Wyvill 1986, ``(1 - d^2/R^2)^3`` (compact
+support R = blend x ball radius, so every ball's own iso-surface sits at the same fraction
+of its radius) summed over the balls; the blend factor and the iso-value T are *fitted to
+the constraint*: on 20 000 points uniform on the constraint surface, T is the median of f
+weighted by 1/|grad f|, which minimises the mean first-order distance |f - T| / |grad f|
+of those points to the iso-surface, and the blend factor with the smallest such mean is
+kept. On a voxel grid,
 :func:`metaball_distance` turns the field into a signed distance to that surface.
 """
 

@@ -4,8 +4,8 @@ The mesh is voxelised by ray parity along x (a numba scan of every grid column),
 inside is distance-transformed (``scipy.ndimage.distance_transform_edt``; the boundary
 lies half a voxel beyond the last inside voxel), and balls are placed greedily, the
 largest free ball first (inside the shape, not overlapping the balls already placed: a
-non-uniform packing in the spirit of Weller & Zachmann's ProtoSphere), down to a
-minimum radius. Coverage = packed volume / mesh volume.
+non-uniform packing in the spirit of Weller & Zachmann's (2010) ProtoSphere), down to
+a minimum radius. Coverage = packed volume / mesh volume.
 """
 
 from __future__ import annotations

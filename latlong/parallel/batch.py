@@ -1,6 +1,7 @@
-"""Batches: one build per variant (a seed and one value of each varied setting), run on
-dask.distributed; the engine under ``latlong.batch`` and ``dem.batch``, which give the task
-that builds and writes one variant.
+"""Batches: one build per variant (a seed and one value of each varied setting), run on a
+backend (:mod:`.backends`: dask.distributed by default, or serial in this process); the
+engine under ``latlong.batch`` and ``dem.batch``, which give the task that builds and
+writes one variant.
 
 Each variant is one task. A task is pure: it writes all its files into a temporary
 folder inside the batch folder (under their final names, so files that name themselves
@@ -21,12 +22,13 @@ loses nothing finished, and the file is rewritten in variant order at the end.
 ``resume`` keeps a variant whose row says ``ok`` with the same settings hash and whose
 files are all there with the recorded sha256, and redoes the others.
 
-Without a scheduler address the batch runs on a :class:`distributed.LocalCluster` on
-127.0.0.1: one single-threaded worker process per core, each task limited to one numba
-thread (``numba.set_num_threads``), so variants do not oversubscribe the cores; no
-dashboard. Workers of an existing cluster keep their own numba setting (start them
-with ``NUMBA_NUM_THREADS=1`` and ``--nthreads 1``). The workers must see the batch
-folder and the scene's input files at the same paths as the caller.
+Without a scheduler address (and unless the serial backend is asked for) the batch runs
+on a :class:`distributed.LocalCluster` on 127.0.0.1: one single-threaded worker process
+per core, each task limited to one numba thread, so variants do not oversubscribe the
+cores; no dashboard. Workers of an existing cluster keep their own numba setting (start
+them with ``NUMBA_NUM_THREADS=1`` and ``--nthreads 1``). The workers must see the batch
+folder and the scene's input files at the same paths as the caller. The serial backend
+builds the variants one after the other in this process (no retries), the same bytes.
 """
 
 from __future__ import annotations
@@ -36,12 +38,9 @@ import csv
 import dataclasses
 import hashlib
 import itertools
-import logging
-import os
 import re
 import shutil
 import time
-import uuid
 from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
@@ -50,10 +49,10 @@ from craters._shared.files import atomic_path, check_parent_folder
 from craters._shared.progress import progress_bar
 from craters._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
+from .backends import Backend, choose_backend, open_backend
 from .batch_tasks import TMP_SUFFIX, one_line, run_variant, sha256_file
 
-__all__ = ["INDEX", "BatchResult", "Job", "Variant", "check_dask_address", "combinations",
-           "dask_client", "parse_seeds",
+__all__ = ["INDEX", "BatchResult", "Job", "Variant", "combinations", "parse_seeds",
            "read_index", "run_batch", "sha256_file", "value_text", "variants", "vary_error"]
 
 #: The index file of a batch folder.
@@ -61,9 +60,6 @@ INDEX = "index.csv"
 #: Most variants one batch takes.
 MAX_VARIANTS = 1_000_000
 _SAFE = re.compile(r"[A-Za-z0-9.+-]{1,40}")
-_ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
-_CONNECT_S = 10
-_WORKERS_S = 60
 
 
 def parse_seeds(seeds) -> tuple[int, ...]:
@@ -330,65 +326,6 @@ def _check_folder(out, jobs: Sequence[Job], *, resume: bool, force: bool) -> Pat
     return folder
 
 
-def check_dask_address(scheduler, workers) -> None:
-    if scheduler is None:
-        if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                    or workers < 1):
-            raise ParameterError("workers", f"must be an integer >= 1; got {workers!r}")
-        return
-    if not isinstance(scheduler, str) or not _ADDRESS.fullmatch(scheduler):
-        raise ParameterError("scheduler", f"must be a dask scheduler address like "
-                             f"tcp://127.0.0.1:8786; got {scheduler!r}")
-    if workers is not None:
-        raise ParameterError("workers", "applies to the local cluster (no {})",
-                             see=("scheduler",))
-
-
-@contextlib.contextmanager
-def dask_client(scheduler: str | None, workers: int | None):
-    """A dask client: of a new LocalCluster on 127.0.0.1, or of the scheduler at an
-    address (which must have workers)."""
-    import distributed  # noqa: F401 - its import sets the level of its loggers
-
-    quiet = logging.getLogger("distributed")
-    level = quiet.level
-    # the index says what happened to each variant; dask's own messages (a heartbeat
-    # cut short when the local cluster closes, a lost worker) would only be noise
-    quiet.setLevel(logging.CRITICAL)
-    try:
-        with _connected(scheduler, workers) as client:
-            yield client
-    finally:
-        quiet.setLevel(level)
-
-
-@contextlib.contextmanager
-def _connected(scheduler: str | None, workers: int | None):
-    from distributed import Client, LocalCluster
-
-    if scheduler is None:
-        n = workers or os.cpu_count() or 1
-        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
-                          dashboard_address=None, silence_logs=logging.CRITICAL,
-                          # no dashboard; the scheduler's HTTP endpoints on a free port
-                          scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
-                Client(cluster) as client:
-            yield client
-        return
-    try:
-        client = Client(scheduler, timeout=_CONNECT_S)
-    except (OSError, TimeoutError) as exc:
-        raise ParameterError("scheduler", f"{scheduler}: cannot connect within {_CONNECT_S} s "
-                             f"({type(exc).__name__})") from None
-    with client:
-        try:
-            client.wait_for_workers(1, timeout=_WORKERS_S)
-        except (OSError, TimeoutError):
-            raise ParameterError("scheduler", f"{scheduler} has no workers (waited "
-                                 f"{_WORKERS_S} s)") from None
-        yield client
-
-
 def _row(job: Job, rec: dict) -> dict:
     row = {"variant": job.variant.name, "seed": job.variant.seed,
            **{k: value_text(v) for k, v in job.variant.values},
@@ -408,43 +345,38 @@ def _write_index(path: Path, columns: list[str], rows: Iterable[dict]) -> None:
 
 
 def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, *,
-              scheduler: str | None = None, workers: int | None = None, resume: bool = False,
-              force: bool = False, progress: bool = False, retries: int = 2,
+              backend: str | None = None, scheduler: str | None = None,
+              workers: int | None = None, resume: bool = False, force: bool = False,
+              progress: bool = False, retries: int = 2,
               on_done: Callable[[dict], None] | None = None) -> BatchResult:
-    """Run ``task(payload, folder, name)`` of every job on dask (module notes) into the
-    folder ``out``; ``on_done(row)`` after each finished variant (in the caller)."""
+    """Run ``task(payload, folder, name)`` of every job into the folder ``out`` (module
+    notes) on ``backend`` (:func:`.backends.choose_backend`; default: dask, a local
+    cluster unless a ``scheduler`` is given); ``on_done(row)`` after each finished
+    variant (in the caller)."""
     started = time.perf_counter()
     names = [j.variant.name for j in jobs]
     if not jobs or len(set(names)) != len(names):
         raise ParameterError("jobs", "must be a non-empty list of uniquely named variants")
-    check_dask_address(scheduler, workers)
+    choose_backend(backend, scheduler, workers)
     folder = _check_folder(out, jobs, resume=resume, force=force)
     columns = _columns([k for k, _ in jobs[0].variant.values])
     index = folder / INDEX
-    previous: dict[str, dict] = {}
-    if resume and index.is_file():
-        with open(index, newline="", encoding="utf-8") as fh:
-            header = next(csv.reader(fh), [])
-        if header != columns:
-            raise ParameterError("resume", f"{str(index)!r} has the columns {header}; this "
-                                 f"batch's are {columns}")
-        previous = {r["variant"]: r for r in read_index(index)}
+    previous = _previous_rows(index, columns) if resume and index.is_file() else {}
     todo = [j for j in jobs if not _intact(previous.get(j.variant.name), j, folder)]
     rows = {name: previous[name] for name in names if name in previous}
     ours = set(names)
     others = [r for name, r in previous.items() if name not in ours]
     redo = {j.variant.name for j in todo}
-    with contextlib.ExitStack() as stack:
-        client = stack.enter_context(dask_client(scheduler, workers)) if todo else None
+    with (open_backend(backend, scheduler=scheduler, workers=workers, default="dask")
+          if todo else contextlib.nullcontext()) as runner:
         folder.mkdir(exist_ok=True)  # only once the cluster is there
         for stale in folder.glob(f".*{TMP_SUFFIX}"):
             shutil.rmtree(stale, ignore_errors=True)
         _write_index(index, columns, [*others, *(rows[n] for n in names
                                                  if n in rows and n not in redo)])
         if todo:
-            _collect(client, todo, task, folder, columns, rows, retries=retries,
-                     progress=progress, on_done=on_done,
-                     threads=1 if scheduler is None else None)
+            _collect(runner, todo, task, folder, columns, rows, retries=retries,
+                     progress=progress, on_done=on_done)
     _write_index(index, columns, [*others, *(rows[n] for n in names)])
     mine = [rows[n] for n in names]
     failed = sum(r["status"] != "ok" for r in mine)
@@ -454,34 +386,44 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
                        seconds=time.perf_counter() - started)
 
 
-def _collect(client, todo: Sequence[Job], task, folder: Path, columns: list[str], rows: dict,
-             *, retries: int, progress: bool, on_done, threads: int | None) -> None:
-    """Submit one task per job (``threads`` numba threads each; None: the workers' own
-    setting) and append each finished variant's row to the index."""
-    from distributed import as_completed
+def _previous_rows(index: Path, columns: list[str]) -> dict[str, dict]:
+    """The rows of an earlier run's index by variant (``resume``); its columns must be
+    this batch's."""
+    with open(index, newline="", encoding="utf-8") as fh:
+        header = next(csv.reader(fh), [])
+    if header != columns:
+        raise ParameterError("resume", f"{str(index)!r} has the columns {header}; this "
+                             f"batch's are {columns}")
+    return {r["variant"]: r for r in read_index(index)}
 
-    token = uuid.uuid4().hex[:8]
-    futures = {client.submit(run_variant, task, j.payload, str(folder), j.variant.name, threads,
-                             key=f"craterform-batch-{token}-{j.variant.name}", retries=retries,
-                             pure=False): j for j in todo}
+
+def _variant_task(shared, item) -> dict:
+    """A batch's task on the backend: one variant (:func:`.batch_tasks.run_variant`)."""
+    task, folder = shared
+    payload, name = item
+    return run_variant(task, payload, folder, name)
+
+
+def _collect(runner: Backend, todo: Sequence[Job], task, folder: Path, columns: list[str],
+             rows: dict, *, retries: int, progress: bool, on_done) -> None:
+    """Run one task per job, all submitted at once, and append each finished variant's
+    row to the index."""
+    items = [(j.payload, j.variant.name) for j in todo]
     bar = progress_bar(total=len(todo), enabled=progress, desc="batch")
     try:
         with open(folder / INDEX, "a", newline="", encoding="utf-8") as fh:
             writer = csv.DictWriter(fh, columns)
-            for fut in as_completed(futures):
-                job = futures[fut]
-                try:
-                    rec = fut.result()
-                except Exception as exc:  # retries spent, worker lost too often, ...
-                    rec = {"status": "failed", "error": one_line(exc)}
+            for i, rec in runner.map(_variant_task, items, shared=(task, str(folder)),
+                                     window=len(items), retries=retries, errors="return",
+                                     label="batch"):
+                if isinstance(rec, Exception):  # retries spent, worker lost too often, ...
+                    rec = {"status": "failed", "error": one_line(rec)}
+                job = todo[i]
                 row = rows[job.variant.name] = _row(job, rec)
                 writer.writerow(row)
                 fh.flush()
                 bar.update()
                 if on_done is not None:
                     on_done(row)
-    except BaseException:
-        client.cancel(list(futures))
-        raise
     finally:
         bar.close()

@@ -1,6 +1,6 @@
 """The worker side of a batch (:mod:`latlong.parallel.batch`): one variant in a temporary
 folder inside the batch folder, hashed, renamed into place, timed, with the worker's peak
-resident memory during the task."""
+resident memory during the task (the backend's worker, or this process when serial)."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ import time
 import uuid
 from pathlib import Path
 
-__all__ = ["TMP_SUFFIX", "limit_numba_threads", "one_line", "run_variant", "sha256_file"]
+__all__ = ["TMP_SUFFIX", "one_line", "run_variant", "sha256_file"]
 
 #: Suffix of a variant's temporary folder (stale ones are removed when a batch starts).
 TMP_SUFFIX = ".batch-tmp"
@@ -37,13 +37,10 @@ def one_line(exc: BaseException) -> str:
     return " ".join(text.split())
 
 
-def run_variant(task, payload, folder: str, name: str, threads: int | None = None) -> dict:
+def run_variant(task, payload, folder: str, name: str) -> dict:
     """Run one variant in a worker: the task writes into a temporary folder inside the
-    batch folder, then each entry is hashed and moved into place. ``threads``: numba
-    threads of the task (None: the worker's own setting)."""
+    batch folder, then each entry is hashed and moved into place."""
     start = time.perf_counter()
-    if threads is not None:
-        limit_numba_threads(threads)
     _reset_peak()
     dest = Path(folder)
     tmp = Path(tempfile.mkdtemp(prefix=f".{name}.", suffix=TMP_SUFFIX, dir=dest))
@@ -68,17 +65,6 @@ def _move(src: Path, dst: Path, tmp: Path) -> None:
     if src.is_dir() and dst.is_dir() and not dst.is_symlink():
         os.replace(dst, tmp / f".old-{uuid.uuid4().hex}")
     os.replace(src, dst)
-
-
-def limit_numba_threads(threads: int) -> None:
-    """At most ``threads`` numba threads in this (the task's) thread. ``set_num_threads``
-    and not ``NUMBA_NUM_THREADS``: a spawned worker whose parent's main module imports
-    numba (``python -m latlong``) has numba's pool sized before dask sets the worker's
-    environment, and a later compilation would then fail on the mismatch."""
-    with contextlib.suppress(ImportError):
-        import numba
-
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
 
 
 def _reset_peak() -> None:

@@ -12,8 +12,9 @@ import pytest
 
 from dem import Dem, fill_gaps, read, write
 from dem.fractal import fractal_fit, fractal_fit_rows
+from dem.holes import holes_of_file
 from dem.streamsum import PairwiseSum
-from dem.tiledfill import fill_to_file, holes_of_file
+from dem.tiledfill import fill_to_file
 
 
 def _sha(path) -> str:

@@ -1,0 +1,235 @@
+"""Where independent tasks run: the one seam between craterform and dask.
+
+A backend has one method, :meth:`Backend.map`: run ``fn(shared, item)`` for every item
+and yield ``(index, result)`` as results arrive. Two implement it:
+
+- :class:`Serial`: in this process, one item after the other, in order (numba keeps
+  all its threads; no retries).
+- :class:`Dask`: one dask.distributed task per item, on a local cluster on 127.0.0.1
+  (one single-threaded worker process per core, or ``workers``; each task limited to
+  one numba thread, so the processes do not oversubscribe the cores; no dashboard) or
+  on the scheduler at an address (its workers keep their own numba setting: start them
+  with ``NUMBA_NUM_THREADS=1`` and ``--nthreads 1``). ``shared`` is sent to every
+  worker once; at most ``window`` tasks are in flight; a task that raises something
+  other than a bad input is tried again (``retries``) and a worker that dies has its
+  tasks rescheduled.
+
+:func:`choose_backend` is the one place the choice is made: the backend named, else dask
+when a scheduler address or a worker count is given, else the caller's default (tiles:
+serial; batches: a local cluster). :func:`open_backend` opens the chosen one for a
+``with`` block. Callers write the same bytes on either: a task's result may depend only
+on its item and ``shared`` (counter-based randomness keyed by global index, never by
+process or order).
+
+Examples
+--------
+>>> with open_backend("serial") as backend:
+...     sorted(backend.map(lambda s, x: s * x, [1, 2, 3], shared=10))
+[(0, 10), (1, 20), (2, 30)]
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import itertools
+import logging
+import os
+import re
+import uuid
+from collections.abc import Callable, Iterator, Sequence
+from typing import Any, Protocol
+
+from craters._shared.validation import ParameterError
+
+__all__ = ["BACKENDS", "Backend", "Dask", "Serial", "choose_backend", "limit_numba_threads",
+           "open_backend", "run_task"]
+
+#: The backends :func:`choose_backend` knows.
+BACKENDS = ("serial", "dask")
+_ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
+_CONNECT_S = 10
+_WORKERS_S = 60
+
+
+class Backend(Protocol):
+    """What runs a batch's variants or a raster's tiles (module notes)."""
+
+    def map(self, fn: Callable[[Any, Any], Any], items: Sequence, *, shared: Any = None,
+            window: int | None = None, retries: int = 2, errors: str = "raise",
+            label: str = "task") -> Iterator[tuple[int, Any]]:
+        """Yield ``(i, fn(shared, items[i]))`` for every item, as results arrive.
+
+        ``window``: most tasks in flight (default two per worker); ``retries``: how often
+        a failed task is tried again (dask); ``errors``: ``"raise"`` the first failure,
+        or ``"return"`` it (the exception in place of the result) and go on; ``label``
+        names the tasks (``craterform-LABEL-...``).
+        """
+        ...  # pragma: no cover
+
+
+@dataclasses.dataclass(frozen=True)
+class Serial:
+    """Every item in this process, in order."""
+
+    def map(self, fn, items, *, shared=None, window=None, retries=2, errors="raise",
+            label="task"):
+        for i, item in enumerate(items):
+            try:
+                result = fn(shared, item)
+            except Exception as exc:
+                if errors == "raise":
+                    raise
+                result = exc
+            yield i, result
+
+
+@dataclasses.dataclass(frozen=True)
+class Dask:
+    """Every item as a task of a dask.distributed ``client``; ``threads``: numba threads
+    of each task (None: the workers' own setting)."""
+
+    client: Any
+    threads: int | None = None
+
+    def map(self, fn, items, *, shared=None, window=None, retries=2, errors="raise",
+            label="task"):
+        from distributed import as_completed
+
+        client = self.client
+        n_workers = max(1, len(client.scheduler_info().get("workers", {})))
+        window = max(1, window or 2 * n_workers)
+        token = uuid.uuid4().hex[:8]
+        [big] = client.scatter([shared], broadcast=True, hash=False)
+        todo = iter(enumerate(items))
+        running: dict = {}
+        done = as_completed()
+
+        def submit(batch):
+            for i, item in batch:
+                fut = client.submit(run_task, fn, big, item, self.threads, retries=retries,
+                                    key=f"craterform-{label}-{token}-{i}", pure=False)
+                running[fut] = i
+                done.add(fut)
+
+        try:
+            submit(itertools.islice(todo, window))
+            for fut in done:
+                i = running.pop(fut)
+                try:
+                    result = fut.result()
+                except Exception as exc:  # retries spent, worker lost too often, ...
+                    if errors == "raise":
+                        raise
+                    result = exc
+                fut.release()
+                submit(itertools.islice(todo, 1))
+                yield i, result
+        except BaseException:
+            client.cancel(list(running))
+            raise
+
+
+def run_task(fn, shared, item, threads: int | None):
+    """A task of :class:`Dask`: ``fn(shared, item)`` with at most ``threads`` numba
+    threads (None: as the worker is set)."""
+    if threads is not None:
+        limit_numba_threads(threads)
+    return fn(shared, item)
+
+
+def limit_numba_threads(threads: int) -> None:
+    """At most ``threads`` numba threads in this (the task's) thread. ``set_num_threads``
+    and not ``NUMBA_NUM_THREADS``: a spawned worker whose parent's main module imports
+    numba (``python -m latlong``) has numba's pool sized before dask sets the worker's
+    environment, and a later compilation would then fail on the mismatch."""
+    with contextlib.suppress(ImportError):
+        import numba
+
+        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+
+
+def choose_backend(backend: str | None = None, scheduler: str | None = None,
+                   workers: int | None = None, *, default: str = "serial") -> str:
+    """The backend that runs: ``backend`` if given, else ``"dask"`` when ``scheduler``
+    (a dask scheduler address) or ``workers`` (a local cluster's processes) is given,
+    else ``default``. Checks the three (one-line errors naming the parameter).
+
+    Examples
+    --------
+    >>> choose_backend(), choose_backend(workers=2), choose_backend(default="dask")
+    ('serial', 'dask', 'dask')
+    >>> choose_backend("serial", workers=2)
+    Traceback (most recent call last):
+    ...
+    craters._shared.validation.ParameterError: `workers` applies to the dask backend
+    """
+    if backend is not None and backend not in BACKENDS:
+        raise ParameterError("backend", f"must be one of {', '.join(BACKENDS)}; got "
+                             f"{backend!r}")
+    if scheduler is None:
+        if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
+                                    or workers < 1):
+            raise ParameterError("workers", f"must be an integer >= 1; got {workers!r}")
+    else:
+        if not isinstance(scheduler, str) or not _ADDRESS.fullmatch(scheduler):
+            raise ParameterError("scheduler", f"must be a dask scheduler address like "
+                                 f"tcp://127.0.0.1:8786; got {scheduler!r}")
+        if workers is not None:
+            raise ParameterError("workers", "applies to the local cluster (no {})",
+                                 see=("scheduler",))
+    dask = scheduler is not None or workers is not None
+    if backend == "serial" and dask:
+        raise ParameterError("scheduler" if scheduler is not None else "workers",
+                             "applies to the dask backend")
+    return backend or ("dask" if dask else default)
+
+
+@contextlib.contextmanager
+def open_backend(backend: str | None = None, *, scheduler: str | None = None,
+                 workers: int | None = None, default: str = "serial") -> Iterator[Backend]:
+    """The backend :func:`choose_backend` picks, open for a ``with`` block: dask connects
+    to the scheduler (which must have workers) or starts a local cluster, and closes the
+    client and the local cluster at the end."""
+    if choose_backend(backend, scheduler, workers, default=default) == "serial":
+        yield Serial()
+        return
+    import distributed  # noqa: F401 - its import sets the level of its loggers
+
+    quiet = logging.getLogger("distributed")
+    level = quiet.level
+    # the callers report what happened to each task; dask's own messages (a heartbeat
+    # cut short when the local cluster closes, a lost worker) would only be noise
+    quiet.setLevel(logging.CRITICAL)
+    try:
+        with _connected(scheduler, workers) as client:
+            yield Dask(client, threads=1 if scheduler is None else None)
+    finally:
+        quiet.setLevel(level)
+
+
+@contextlib.contextmanager
+def _connected(scheduler: str | None, workers: int | None):
+    from distributed import Client, LocalCluster
+
+    if scheduler is None:
+        n = workers or os.cpu_count() or 1
+        with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, host="127.0.0.1",
+                          dashboard_address=None, silence_logs=logging.CRITICAL,
+                          # no dashboard; the scheduler's HTTP endpoints on a free port
+                          scheduler_kwargs={"dashboard_address": "127.0.0.1:0"}) as cluster, \
+                Client(cluster) as client:
+            yield client
+        return
+    try:
+        client = Client(scheduler, timeout=_CONNECT_S)
+    except (OSError, TimeoutError) as exc:
+        raise ParameterError("scheduler", f"{scheduler}: cannot connect within {_CONNECT_S} s "
+                             f"({type(exc).__name__})") from None
+    with client:
+        try:
+            client.wait_for_workers(1, timeout=_WORKERS_S)
+        except (OSError, TimeoutError):
+            raise ParameterError("scheduler", f"{scheduler} has no workers (waited "
+                                 f"{_WORKERS_S} s)") from None
+        yield client
