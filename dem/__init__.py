@@ -10,6 +10,8 @@ r"""dem: digital elevation models: I/O, RMD expansion, gap filling, layer stacks
          batch (seeds x varied keys on dask.distributed)          -> stack folders
     Stack (stack: consistent layers + catalogs; write, read_stack)
       -> to_mesh (mesh: PLY/VTP) | slope, power_spectrum (terrain), fractal_fit (fractal)
+      -> DemSurface (surface: a DEM or a stack as a latlong surface, what the camera and
+         the LIDAR of latlong.sensors see)
 
 Beside them: ``frame`` (local metric frames), ``boulders`` (boulders on rasters),
 ``_*kernels`` (numba) and ``cli/`` (the
@@ -223,6 +225,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
     from .io import WindowWriter, read, write
     from .mesh import to_mesh
     from .stack import Stack, read_stack
+    from .surface import DemSurface
     from .terrain import (
         pixel_sizes_by_row,
         power_spectrum,
@@ -237,6 +240,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
 __all__ = [
     "CraterDensity",
     "Dem",
+    "DemSurface",
     "EnhanceConfig",
     "ExpandedFile",
     "FilledFile",

@@ -44,7 +44,7 @@ from .core import Dem
 from .frame import local_frame, pixel_affine
 from .stack import Stack
 
-__all__ = ["MESH_SUFFIXES", "mesh_arrays", "mesh_source", "to_mesh"]
+__all__ = ["MESH_SUFFIXES", "as_stack", "mesh_arrays", "mesh_source", "to_mesh"]
 
 
 class _Layout:
@@ -215,7 +215,9 @@ class _Rocks:
             yield (faces[None] + offsets).reshape(-1, 3)
 
 
-def _as_stack(source) -> Stack:
+def as_stack(source) -> Stack:
+    """A stack as it is; one DEM as a one-layer stack in its own local frame (origin at
+    its centre pixel)."""
     if isinstance(source, Stack):
         return source
     if isinstance(source, Dem):
@@ -228,7 +230,7 @@ def mesh_arrays(source) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
     For tests and small stacks; :func:`to_mesh` streams instead.
     """
-    lay = _Layout(_as_stack(source))
+    lay = _Layout(as_stack(source))
     verts = np.concatenate([np.stack(lay.vertices(k), 1) for k in range(len(lay.counts))])
     faces = np.concatenate([lay.faces(k) for k in range(len(lay.counts))])
     layer = np.repeat(np.arange(len(lay.counts)), lay.counts)
@@ -238,7 +240,7 @@ def mesh_arrays(source) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 def mesh_source(source, *, boulders: bool = True) -> MeshSource:
     """The multi-resolution mesh of a stack (or one DEM) as a streamed mesh for the shared
     writers (:mod:`latlong.meshio.writers`): layer by layer, then the boulders."""
-    stack = _as_stack(source)
+    stack = as_stack(source)
     lay = _Layout(stack)
     rocks = _Rocks(stack if boulders else stack.replace(boulders=[None] * len(stack)))
     if lay.n_vertices + rocks.n_vertices >= 2**31 - 1:

@@ -16,7 +16,9 @@ packing, LCSN craters, Gabor noise, marching cubes).
     scene (Scene: settings, presets) -> build(scene) -> Body   (writes nothing)
                                      -> outputs (write_outputs) | batch (seeds x settings, dask)
     implicit/ (packing, metaballs, LCSN layers, Gabor, marching cubes) -> to_body
-    sensors/ (ray engine over Embree, cameras, photometry, render: frames + ground truth)
+    loader (load_surface: a body .npz or a mesh file -> a surface, what sensors/ see)
+    sensors/ (ray engine over Embree, cameras, LIDAR, photometry: frames + ground truth of
+              any surface; they use only latlong.geometry and latlong.meshio)
     cli/ (the `latlong` command; the library never imports it)
 
 Imports point down that picture and into ``craters`` (never ``dem``). ``latlong build
@@ -259,6 +261,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         implicit_surface,
         sphere_packing,
     )
+    from .loader import MeshFile, load_surface
     from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
     from .presets import PRESETS
     from .preview import PreviewSettings, render_preview
@@ -312,6 +315,7 @@ __all__ = [
     "ImplicitSurface",
     "LatLongGrid",
     "LcsnLayer",
+    "MeshFile",
     "ShapeModel",
     "apply_faults",
     "area_mean",
@@ -336,6 +340,7 @@ __all__ = [
     "heat_smooth",
     "implicit_surface",
     "load",
+    "load_surface",
     "mesh_slopes",
     "perlin_fbm",
     "place_boulders",

@@ -18,7 +18,7 @@ from craters._shared import (
 )
 from craters._shared.files import check_regular_file
 
-from .export import EXPORT_SUFFIXES, export_body
+from .export import EXPORT_SUFFIXES, body_mesh_source, export_body
 from .grid import LatLongGrid
 
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
@@ -284,6 +284,11 @@ class Body:
         :mod:`latlong.export`.
         """
         return export_body(self, path, progress=progress)
+
+    def mesh_source(self):
+        """The body with its placed boulders as a streamed mesh for the mesh writers
+        (:func:`latlong.export.body_mesh_source`)."""
+        return body_mesh_source(self)
 
     def to_pyvista(self):
         """A ``pyvista.PolyData`` with point array ``height_m`` (radius minus reference)."""

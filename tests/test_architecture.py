@@ -7,6 +7,8 @@
   functions;
 * the libraries never import a command line (``*/cli/``, ``*/cli.py``,
   ``craters.cli.kit``, argparse), and importing them does not load argparse;
+* the sensors see any surface through the ``Surface`` protocol: ``latlong.sensors``
+  imports nothing of latlong but ``latlong.geometry``, ``latlong.meshio`` and itself;
 * no module reads another module's private (``_``-prefixed) name, except the numba
   kernels of its own package (``_*kernels`` modules);
 * no module over 500 lines;
@@ -106,6 +108,22 @@ def test_package_direction():
         for target, _, line in edges:
             other = target.split(".")[0]
             if other in PACKAGES and other != pkg and (pkg, other) not in ARROWS:
+                bad.append(f"{module}:{line} imports {target}")
+    assert not bad, "\n".join(bad)
+
+
+#: What ``latlong.sensors`` may import of latlong: the protocol, the mesh files, itself.
+SENSORS_SEE = ("latlong.geometry", "latlong.meshio", "latlong.sensors")
+
+
+def test_sensors_import_only_the_geometry_and_mesh_files():
+    bad = []
+    for module, edges in GRAPH.items():
+        if not (module == "latlong.sensors" or module.startswith("latlong.sensors.")):
+            continue
+        for target, _, line in edges:
+            if target.split(".")[0] == "latlong" and not any(
+                    target == ok or target.startswith(ok + ".") for ok in SENSORS_SEE):
                 bad.append(f"{module}:{line} imports {target}")
     assert not bad, "\n".join(bad)
 

@@ -1,6 +1,7 @@
 """The ``dem`` command line: ``dem info``, ``convert``, ``fill``, ``expand`` (:mod:`.raster`),
 ``enhance``, ``mesh`` (:mod:`.stack`), ``batch`` (:mod:`.batch`), ``slopes`` and ``spectrum``
-(:mod:`.analysis`).
+(:mod:`.analysis`), ``camera`` and ``lidar`` (:mod:`.sensors`: latlong's sensor commands
+over a site).
 
 Every command takes its input (a DEM, or for ``mesh``, ``slopes`` and ``spectrum`` also
 a stack manifest) as its positional argument, or as the key ``input`` of a TOML file
@@ -20,7 +21,7 @@ import sys
 from craters._shared import package_version
 from craters.cli.kit import OneLineParser, run_cli
 
-from . import analysis, batch, raster, stack
+from . import analysis, batch, raster, sensors, stack
 
 __all__ = ["build_parser", "main"]
 
@@ -31,7 +32,7 @@ def build_parser() -> OneLineParser:
                                                    "layer stacks with craters, meshes, info.")
     parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
-    for group in (raster, stack, batch, analysis):
+    for group in (raster, stack, batch, analysis, sensors):
         group.register(sub)
     return parser
 

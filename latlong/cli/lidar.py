@@ -1,5 +1,7 @@
 """``latlong lidar``: a LIDAR run over a body or any mesh (LAS 1.4 + range images +
-``lidar.json``; :mod:`latlong.sensors.lidar_files`)."""
+``lidar.json``; :func:`latlong.sensors.lidar_run`). The options and the steps are shared
+with ``dem lidar`` (:func:`add_lidar_options`, :func:`run_lidar`), which sees a DEM or a
+layer stack."""
 
 from __future__ import annotations
 
@@ -7,62 +9,63 @@ import numpy as np
 
 from craters.cli.kit import parse_seed
 
-from ..sensors.engine import RayMesh
-from ..sensors.lidar import LIDAR_PATTERNS, LidarSettings
-from ..sensors.lidar_files import lidar_run
-from ..sensors.scene_geometry import scene_geometry
 from .sensor_options import (
+    MODEL_FLAGS,
+    add_model_options,
     add_pose_options,
-    allow_negative_lists,
+    add_run_options,
+    add_sensor_command,
+    flagged,
+    load_model,
+    model_scene,
     output_folder,
     poses_from_args,
     refuse_inside,
     wxh,
 )
 
-__all__ = ["FLAGS", "add_lidar_parser"]
+__all__ = ["FLAGS", "add_lidar_options", "add_lidar_parser", "run_lidar"]
 
 #: Library parameter -> flag, for messages about a setting.
 FLAGS = {"pattern": "--pattern", "beams": "--beams", "fov_deg": "--fov-deg",
          "divergence_mrad": "--divergence-mrad", "rays_per_beam": "--rays-per-beam",
          "range_noise_m": "--range-noise-m", "max_range_m": "--max-range-m",
          "return_separation_m": "--return-separation-m", "pulse_rate_hz": "--pulse-rate-hz",
-         "quaternion_wxyz": "--quaternion", "position_m": "--position-m", "model": "MODEL",
-         "units": "--units"}
+         "quaternion_wxyz": "--quaternion", "position_m": "--position-m", **MODEL_FLAGS}
 
 
-def cmd_lidar(args) -> int:
-    settings = LidarSettings(
-        pattern=args.pattern, beams=args.beams, fov_deg=args.fov_deg,
-        divergence_mrad=args.divergence_mrad, rays_per_beam=args.rays_per_beam,
-        range_noise_m=args.range_noise_m, max_range_m=args.max_range_m,
-        multiple_returns=args.multiple_returns, return_separation_m=args.return_separation_m,
-        pulse_rate_hz=args.pulse_rate_hz)
-    output_folder(args)
-    poses = poses_from_args(args)
-    geo = scene_geometry(args.model, units=args.units)
-    mesh = RayMesh(geo.vertices, geo.faces)
-    geo = scene_geometry(geo, craters=args.catalog, mesh=mesh)  # a map catalog: one BVH
-    poses = poses if poses is not None else poses_from_args(args, mesh)
-    refuse_inside(mesh, poses, args, "sensor")
-    seed = args.seed if args.seed is not None else int(np.random.default_rng().integers(2**63))
-    man = lidar_run(geo, settings, poses, args.output, rng=seed, force=args.force,
-                    progress=not args.quiet, mesh=mesh, model_name=str(args.model))
+def run_lidar(args, load) -> int:
+    """The LIDAR command over the surface ``load(args)`` reads from MODEL."""
+    from latlong.sensors import LidarSettings, lidar_run
+
+    with flagged(FLAGS):
+        settings = LidarSettings(
+            pattern=args.pattern, beams=args.beams, fov_deg=args.fov_deg,
+            divergence_mrad=args.divergence_mrad, rays_per_beam=args.rays_per_beam,
+            range_noise_m=args.range_noise_m, max_range_m=args.max_range_m,
+            multiple_returns=args.multiple_returns,
+            return_separation_m=args.return_separation_m, pulse_rate_hz=args.pulse_rate_hz)
+        output_folder(args)
+        poses = poses_from_args(args)
+        geometry, mesh = model_scene(args, load)
+        poses = poses if poses is not None else poses_from_args(args, mesh)
+        refuse_inside(mesh, poses, args, "sensor")
+        seed = args.seed if args.seed is not None \
+            else int(np.random.default_rng().integers(2**63))
+        man = lidar_run(geometry, settings, poses, args.output, rng=seed, force=args.force,
+                        progress=not args.quiet, mesh=mesh, model_name=str(args.model))
     if not args.quiet:
         n = sum(f["n_returns"] for f in man["frames"])
         print(f"wrote {args.output}: {len(man['frames'])} frames, {n} returns (seed {seed})")
     return 0
 
 
-def add_lidar_parser(sub) -> None:
-    """Register ``latlong lidar``."""
-    p = sub.add_parser("lidar", help="simulate a LIDAR (flash or scanning) over a body or "
-                       "mesh: LAS 1.4 point clouds, range images and lidar.json")
-    p.add_argument("model", help="a body .npz or a mesh file (PLY, OBJ, STL, VTP, VTK, GLB)")
-    p.add_argument("-o", "--output", required=True,
-                   help="output folder (created; required)")
-    allow_negative_lists(p)
-    add_pose_options(p, "sensor")
+def add_lidar_options(p, *, model_help: str, units: bool = True, vertical=None) -> None:
+    """The options of a LIDAR command (``latlong lidar``, ``dem lidar``)."""
+    from latlong.sensors import LIDAR_PATTERNS
+
+    add_model_options(p, "returns", model_help, units=units)
+    add_pose_options(p, "sensor", vertical=vertical)
     p.add_argument("--pattern", choices=LIDAR_PATTERNS, default="flash",
                    help="flash (a grid of beams at once), scan (the grid as a raster, one "
                    "beam after the other) or rosette (default: flash)")
@@ -88,12 +91,12 @@ def add_lidar_parser(sub) -> None:
                    help="beams per second of scan and rosette (default: 100000)")
     p.add_argument("--seed", type=parse_seed,
                    help="range-noise seed (default: a fresh one, recorded in lidar.json)")
-    p.add_argument("--units", choices=("m", "km"), default="m",
-                   help="units of a mesh file (default: m)")
-    p.add_argument("--catalog", help="crater catalog CSV that labels the returns (default: "
-                   "the body's own)")
-    p.add_argument("--force", action="store_true",
-                   help="write into an existing, non-empty folder (default: off)")
-    p.add_argument("-q", "--quiet", action="store_true",
-                   help="no progress bars or messages (default: off)")
-    p.set_defaults(func=cmd_lidar)
+    add_run_options(p)
+
+
+def add_lidar_parser(sub) -> None:
+    """Register ``latlong lidar``."""
+    add_sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a body or "
+                       "mesh: LAS 1.4 point clouds, range images and lidar.json",
+                       add_lidar_options, run_lidar, load_model,
+                       model_help="a body .npz or a mesh file (PLY, OBJ, STL, VTP, VTK, GLB)")

@@ -1,10 +1,16 @@
-"""Options shared by the sensor commands (``latlong camera``, ``latlong lidar``): number
-lists, sizes, the pose / trajectory options and the output folder."""
+"""Options shared by the sensor commands (``latlong camera``, ``latlong lidar`` and their
+``dem`` twins ``dem camera``, ``dem lidar``): number lists, sizes, the model and output
+options, the pose / trajectory options, and the steps every sensor command takes (the
+output folder checked, the model read and its BVH built, poses inside the model refused,
+library errors shown under the flags)."""
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import re
+import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +18,10 @@ import numpy as np
 from craters._shared import ParameterError, ParameterTypeError, check_outside_folder
 from craters.cli.kit import CliError
 
-__all__ = ["POSE_FLAGS", "add_pose_options", "allow_negative_lists", "numbers",
-           "output_folder", "poses_from_args", "refuse_inside", "wxh"]
+__all__ = ["MODEL_FLAGS", "POSE_FLAGS", "add_model_options", "add_pose_options",
+           "add_run_options", "add_sensor_command", "allow_negative_lists", "flagged",
+           "load_model", "model_scene", "numbers", "output_folder", "poses_from_args",
+           "refuse_inside", "wxh"]
 
 _NUM = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
 #: "--position-m -3000,0,0": a comma list of numbers that starts with "-" is a value.
@@ -25,6 +33,52 @@ POSE_FLAGS = {"quaternion_wxyz": "--quaternion", "position_m": "--position-m",
               "path_azimuth_deg": "--path-azimuth-deg", "duration_s": "--duration-s",
               "vertical": "--vertical", "lat_deg": "--target-lat-lon",
               "lon_deg": "--target-lat-lon", "target_m": "--target-m", "time_s": "--time-s"}
+#: Library parameter -> flag of the model and output options.
+MODEL_FLAGS = {"model": "MODEL", "units": "--units", "craters": "--catalog"}
+
+
+@contextlib.contextmanager
+def flagged(flags: dict):
+    """Library parameter errors shown under the command's ``flags`` (one line)."""
+    try:
+        yield
+    except (ParameterError, ParameterTypeError) as exc:
+        if exc.name not in flags:
+            raise
+        raise CliError(exc.shown_as(flags[exc.name], lambda k: flags.get(k, f"`{k}`"))) \
+            from None
+
+
+def add_model_options(parser, what: str, model_help: str, *, units: bool = True) -> None:
+    """MODEL, ``-o/--output``, ``--catalog`` (and ``--units`` for mesh files); ``what``
+    the sensor's outputs (e.g. "frames")."""
+    # "--position-m -3000,0,0": a comma list of numbers starting with "-" is a value
+    allow_negative_lists(parser)
+    parser.add_argument("model", help=model_help)
+    parser.add_argument("-o", "--output", required=True,
+                        help="output folder (created; required)")
+    if units:
+        parser.add_argument("--units", choices=("m", "km"), default="m",
+                            help="units of a mesh file's coordinates (default: m)")
+    parser.add_argument("--catalog", help=f"crater catalog CSV that labels the {what} "
+                        "(default: the model's own, if it has one)")
+
+
+def add_sensor_command(sub, name: str, help: str, add_options: Callable, run: Callable,
+                       load: Callable, **options) -> None:
+    """Register the sensor command ``name``: its options (``add_options(parser,
+    **options)``) and ``run(args, load)``, ``load(args)`` the surface of MODEL."""
+    parser = sub.add_parser(name, help=help)
+    add_options(parser, **options)
+    parser.set_defaults(func=lambda args: run(args, load))
+
+
+def add_run_options(group) -> None:
+    """``--force`` and ``-q/--quiet``."""
+    group.add_argument("--force", action="store_true",
+                       help="write into an existing, non-empty folder (default: off)")
+    group.add_argument("-q", "--quiet", action="store_true",
+                       help="no progress bars or messages (default: off)")
 
 
 def allow_negative_lists(parser: argparse.ArgumentParser) -> None:
@@ -62,8 +116,9 @@ def wxh(what: str, example: str, hi: int = 16384):
     return parse
 
 
-def add_pose_options(group, sensor: str) -> None:
-    """The pose options: one pose, a trajectory file, or a generated approach."""
+def add_pose_options(group, sensor: str, *, vertical=None) -> None:
+    """The pose options: one pose, a trajectory file, or a generated approach;
+    ``vertical`` the default local vertical of an approach (None: radial)."""
     group.add_argument("--position-m", type=numbers(3, "X,Y,Z"),
                        help=f"{sensor} position X,Y,Z in metres (default: none; or --poses "
                        "or --target-*)")
@@ -91,18 +146,14 @@ def add_pose_options(group, sensor: str) -> None:
     group.add_argument("--path-azimuth-deg", type=float, default=0.0,
                        help="direction of that tilt from local north towards east, degrees "
                        "(default: 0)")
-    group.add_argument("--vertical", type=numbers(3, "X,Y,Z"),
+    group.add_argument("--vertical", type=numbers(3, "X,Y,Z"), default=vertical,
                        help="local vertical at the target of a generated approach, body "
-                       "frame; 0,0,1 for a dem mesh (default: the target's radial direction)")
+                       "frame; 0,0,1 for a dem mesh (default: " + (
+                           "the target's radial direction" if vertical is None else
+                           ",".join(f"{v:g}" for v in vertical) + ", the site's up") + ")")
     group.add_argument("--duration-s", type=float,
                        help="time from the first to the last generated frame, seconds "
                        "(default: one second per frame)")
-
-
-def _shown(exc, flags: dict) -> CliError:
-    if isinstance(exc, ParameterError | ParameterTypeError) and exc.name in flags:
-        return CliError(exc.shown_as(flags[exc.name]))
-    return CliError(str(exc))
 
 
 def poses_from_args(args, mesh=None):
@@ -118,7 +169,7 @@ def poses_from_args(args, mesh=None):
             args.target_lat_lon is not None and args.target_m is not None):
         raise CliError("give one of: --position-m with --quaternion, --poses FILE, or "
                        "--target-lat-lon / --target-m (with --range-m)")
-    try:
+    with flagged(POSE_FLAGS):
         if args.poses is not None:
             try:
                 return read_poses(args.poses)
@@ -139,8 +190,6 @@ def poses_from_args(args, mesh=None):
                         end_range_m=args.range_m[1], path_angle_deg=args.path_angle_deg,
                         path_azimuth_deg=args.path_azimuth_deg, duration_s=args.duration_s,
                         vertical=args.vertical)
-    except (ParameterError, ParameterTypeError) as exc:
-        raise _shown(exc, POSE_FLAGS) from None
 
 
 def refuse_inside(mesh, poses, args, sensor: str) -> None:
@@ -156,10 +205,33 @@ def refuse_inside(mesh, poses, args, sensor: str) -> None:
                            f"{str(args.model)!r}")
 
 
+def load_model(args):
+    """The surface of MODEL for ``latlong camera`` and ``latlong lidar``: a body ``.npz``
+    or a mesh file in ``--units`` (:func:`latlong.load_surface`)."""
+    from latlong import load_surface
+
+    return load_surface(args.model, units=args.units)
+
+
+def model_scene(args, load: Callable) -> tuple:
+    """``(geometry, mesh)`` of MODEL: the surface ``load(args)`` reads, labelled by
+    ``--catalog`` or its own catalog, and its BVH (built once, for every frame); unless
+    ``--quiet``, a line with its size and the time taken."""
+    from latlong.sensors import ray_scene
+
+    t0 = time.perf_counter()
+    with flagged(MODEL_FLAGS):
+        geometry, mesh = ray_scene(load(args), craters=args.catalog)
+    if not args.quiet:
+        print(f"model {args.model}: {len(mesh.faces)} triangles, read and BVH built in "
+              f"{time.perf_counter() - t0:.1f} s")
+    return geometry, mesh
+
+
 def output_folder(args) -> Path:
     """``-o/--output`` checked: a real folder, its parent writable, empty unless
     ``--force``, holding no input (MODEL, --poses, --catalog)."""
-    from latlong.sensors.lidar_files import check_output_folder
+    from latlong.sensors.runs import check_output_folder
 
     try:
         check_outside_folder(args.output, [

@@ -1,17 +1,30 @@
-r"""Sensors: a camera and a LIDAR that see a body or any mesh through one ray engine.
+r"""Sensors: a camera and a LIDAR that see any surface through one ray engine.
 
 ::
 
-    scene_geometry (SceneGeometry: mesh, boulder ids, catalogs)
+    any surface (latlong.geometry.Surface: a Body, a mesh surface, a mesh file from
+        latlong.load_surface, a dem.DemSurface of a DEM or a layer stack)
+      -> scene_geometry (SceneGeometry: mesh, boulder ids, catalogs; map catalogs draped)
       -> engine (RayMesh: Embree BVH built once, float64 refinement; shared by every sensor)
       -> camera (intrinsics, Brown-Conrady distortion, Pose, primary rays)
       -> photometry (Lambert, Lommel-Seeliger, lunar-Lambert, Hapke)
-      -> render (shading, cast shadows, ground truth) -> sensor (exposure, noise, PSF)
-      -> lidar (LidarSettings, lidar_frame) -> lidar_files (LAS 1.4, range images, lidar.json)
+      -> render (one frame: shading, cast shadows, ground truth) -> sensor (exposure,
+         noise, PSF) -> camera_files (CameraSettings, camera_run: frames + frames.json)
+      -> lidar (LidarSettings, lidar_frame: one frame)
+         -> lidar_files (lidar_run: LAS 1.4, range images, lidar.json)
       -> labels (crater_labels, boulder_labels, rim_curves, rim_ellipses)
-    poses (Poses, read_poses): trajectories; OpenCV sensor frame, sensor-to-body unit
-        quaternions w, x, y, z, positions in the body frame (metres)
+    poses (Poses, read_poses, approach): trajectories; OpenCV sensor frame,
+        sensor-to-body unit quaternions w, x, y, z, positions in the body frame (metres)
+    runs: output folders written whole (a temporary folder moved into place)
 
+One call per frame, one per run, the same for both sensors and for every surface::
+
+    render(surface, camera, pose, sun)        lidar_frame(surface, settings, position, q)
+    camera_run(surface, settings, poses, sun, folder)
+                                              lidar_run(surface, settings, poses, folder)
+
+The sensors use only the members of a surface that :mod:`.scene_geometry` names, and
+import nothing of ``latlong`` but :mod:`latlong.geometry` and :mod:`latlong.meshio`.
 ``latlong.render`` is :func:`latlong.sensors.render.render`.
 
 From the command line: ``latlong camera`` and ``latlong lidar``
@@ -42,7 +55,10 @@ The commands run as written from the repository's folder, in order, into
         --divergence-mrad 1 --rays-per-beam 4 --range-noise-m 0.02 --seed 1
 
 Both sensors look at a body ``.npz`` or any mesh file (PLY/OBJ/STL/VTP/GLB: shape models,
-``--surface mesh`` bodies, ``dem mesh`` outputs with ``--units``) through one ray engine:
+``--surface mesh`` bodies, ``dem mesh`` outputs with ``--units``) -- and, as ``dem camera``
+and ``dem lidar`` with the same options, at a layer stack or a DEM file (a
+``dem.DemSurface``: no mesh file needed, the stack's catalogs label the frames) -- through
+one ray engine:
 Embree (the ``embreex`` wheel) builds the BVH once per model, every hit is refined in
 float64 (ranges exact to ~1e-12 relative), shading and sampling run in numba, and the
 same seed gives the same bytes for any thread count. Conventions: OpenCV's camera frame
@@ -57,16 +73,19 @@ spaced geometrically, ``--frames``, ``--path-angle-deg``, ``--path-azimuth-deg``
 lambert|lommel-seeliger|lunar-lambert|hapke`` (``--hapke-preset moon|s-type|c-type``),
 cast shadows always (soft with ``--sun-angular-radius-deg`` and
 ``--soft-shadow-samples``), and a sensor model (exposure, gain, 8/16-bit PNG or float
-TIFF, photon and read noise, PSF). In Python: ``latlong.render(mesh, camera, pose, sun,
-ground_truth=geometry)`` with :func:`scene_geometry`, :func:`scene_mesh`,
-:class:`Camera`, :class:`Pose`, :class:`Sun`, and :func:`lidar_frame` /
-:func:`lidar_run` for the LIDAR. Previews (``latlong render``, ``--preview``) go through
+TIFF, photon and read noise, PSF). In Python, the same for any surface (a
+:class:`latlong.Body`, a mesh surface, ``latlong.load_surface(path)``, a
+``dem.DemSurface``): :func:`camera_run` (a :class:`CameraSettings`) and :func:`lidar_run`
+write a run, :func:`render` and :func:`lidar_frame` make one frame; for many frames of
+one model build its ray mesh once with :func:`ray_scene` and pass it with
+``ground_truth=geometry``. Previews (``latlong render``, ``--preview``) go through
 the same engine and cast shadows. ``python examples/plot_descent_strip.py`` and
 ``plot_lidar_sweep.py`` draw frames and scans.
 """
 
 from .albedo import ejecta_albedo
 from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
+from .camera_files import CameraSettings, camera_run
 from .engine import BUILD_QUALITIES, Hits, RayMesh
 from .labels import ELLIPSE_DTYPE, boulder_labels, crater_labels, rim_curves, rim_ellipses
 from .lidar import LIDAR_PATTERNS, LidarFrame, LidarSettings, beam_pattern, lidar_frame
@@ -82,16 +101,22 @@ from .photometry import (
     reflectance_model,
 )
 from .poses import Poses, read_poses
-from .render import SUN_RADIUS_1AU_DEG, Frame, Sun, camera_inside, render, scene_mesh
-from .scene_geometry import SceneGeometry, scene_geometry
+from .render import SUN_RADIUS_1AU_DEG, Frame, Sun, camera_inside, render
+from .scene_geometry import (
+    SceneGeometry,
+    drape_catalog,
+    ray_scene,
+    scene_geometry,
+    scene_mesh,
+)
 from .sensor import Sensor, expose
 
 __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
-           "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "Frame", "Hapke",
-           "Hits", "Lambert", "LidarFrame", "LidarSettings", "LommelSeeliger", "LunarLambert",
-           "Pose", "Poses", "RayMesh", "SceneGeometry", "Sensor", "Sun", "beam_pattern",
-           "boulder_labels", "camera_inside", "crater_labels", "ejecta_albedo", "expose",
-           "lidar_frame",
+           "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "CameraSettings",
+           "Frame", "Hapke", "Hits", "Lambert", "LidarFrame", "LidarSettings",
+           "LommelSeeliger", "LunarLambert", "Pose", "Poses", "RayMesh", "SceneGeometry",
+           "Sensor", "Sun", "beam_pattern", "boulder_labels", "camera_inside", "camera_run",
+           "crater_labels", "drape_catalog", "ejecta_albedo", "expose", "lidar_frame",
            "lidar_run", "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
-           "read_poses", "reflectance_model", "render", "rim_curves", "rim_ellipses",
-           "scene_geometry", "scene_mesh", "write_las"]
+           "ray_scene", "read_poses", "reflectance_model", "render", "rim_curves",
+           "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]

@@ -93,6 +93,14 @@ def _aligned(raw):
 
 
 @njit(cache=True, inline="always")
+def _ray_buffer():
+    """A fresh ``RTCRayHit`` buffer: its float32 and uint32 views and its address (the
+    views keep the memory alive)."""
+    buf, ptr = _aligned(np.empty(40, np.float32))
+    return buf, buf.view(np.uint32), ptr
+
+
+@njit(cache=True, inline="always")
 def _load_ray(buf, ibuf, origins, directions, i, centre, t0, tnear, tfar):
     r = _row(origins, i)
     for k in range(3):
@@ -115,9 +123,7 @@ def _intersect_kernel(intersect1, scene, origins, directions, t_max, centre, rad
     """Closest hit of every ray (Embree, float32), refined in float64 on its face."""
     n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
-        raw = np.empty(40, np.float32)
-        buf, ptr = _aligned(raw)
-        ibuf = buf.view(np.uint32)
+        buf, ibuf, ptr = _ray_buffer()
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
             t0 = _start(origins, directions, i, centre, radius)
             face_out[i] = -1
@@ -149,9 +155,7 @@ def _occluded_kernel(occluded1, scene, origins, directions, t_min, t_max, centre
     """True where something lies on the ray between ``t_min`` and ``t_max``."""
     n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
-        raw = np.empty(40, np.float32)
-        buf, ptr = _aligned(raw)
-        ibuf = buf.view(np.uint32)
+        buf, ibuf, ptr = _ray_buffer()
         for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
             t0 = min(_start(origins, directions, i, centre, radius), t_min[i])
             span = t_max[i] - t0

@@ -52,6 +52,7 @@ from ._lidar_kernels import _returns_kernel
 from .camera import quaternion_to_matrix
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
+from .scene_geometry import SceneGeometry, traced_model
 
 __all__ = ["LIDAR_PATTERNS", "MAX_RETURNS", "LidarFrame", "LidarSettings", "beam_pattern",
            "footprint_rays", "lidar_frame"]
@@ -224,14 +225,17 @@ def _perpendiculars(a):
     return p1, np.cross(a, p1)
 
 
-def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_wxyz, *,
-                time_s: float = 0.0, rng=None, geometry=None) -> LidarFrame:
+def lidar_frame(model, settings: LidarSettings, position_m, quaternion_wxyz, *,
+                time_s: float = 0.0, rng=None,
+                ground_truth: SceneGeometry | None = None) -> LidarFrame:
     """Simulate one LIDAR frame from a pose (module notes).
 
     Parameters
     ----------
-    mesh : RayMesh
-        The model (built once, shared by the frames).
+    model : surface, SceneGeometry or RayMesh
+        What the LIDAR sees, as for :func:`~latlong.sensors.render.render`: any surface
+        or its :class:`SceneGeometry` (whose catalogs label the returns), or its
+        :class:`RayMesh` built once and shared by the frames.
     settings : LidarSettings
     position_m, quaternion_wxyz
         Sensor position in the body frame (metres) and sensor-to-body rotation.
@@ -239,11 +243,10 @@ def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_w
         Frame time, seconds.
     rng : int, Generator or None
         Range noise key (only drawn from when ``range_noise_m`` > 0).
-    geometry : SceneGeometry, optional
-        Its crater catalog and per-triangle boulder ids label the returns.
+    ground_truth : SceneGeometry, optional
+        With a RayMesh: the geometry it was built from, whose crater catalog and
+        per-triangle boulder ids label the returns.
     """
-    if not isinstance(mesh, RayMesh):
-        raise TypeError(f"`mesh` must be a RayMesh; got {type(mesh).__name__}")
     if not isinstance(settings, LidarSettings):
         raise TypeError(f"`settings` must be LidarSettings; got {type(settings).__name__}")
     rot = quaternion_to_matrix(quaternion_wxyz)
@@ -251,64 +254,24 @@ def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_w
     if origin.shape != (3,) or not np.isfinite(origin).all():
         raise ParameterError("position_m", f"must be three finite numbers; got "
                              f"{np.asarray(position_m).tolist()}")
-    time_s = float(time_s)
+    mesh, ground_truth = traced_model(model, ground_truth)
     key = np.uint64(normalize_rng(rng).integers(0, 2**63)) if settings.range_noise_m > 0 \
         else np.uint64(0)
     axes_s, offsets_s = beam_pattern(settings)
     axes = axes_s @ rot.T
-    sub, weight = footprint_rays(settings.rays_per_beam, settings.divergence_mrad)
-    nr = len(weight)
-    spacing = 1e-3 * settings.divergence_mrad / np.sqrt(nr)
-    nmax = MAX_RETURNS if settings.multiple_returns else 1
-    nb = len(axes)
-    counts = np.zeros(nb, dtype=np.int64)
-    rng_out = np.zeros((nb, nmax))
-    lam_out = np.zeros((nb, nmax))
-    best_out = np.zeros((nb, nmax), dtype=np.int64)
-    labelled = geometry is not None
-    best_t = np.zeros((nb, nmax)) if labelled else None
-    best_face = np.full((nb, nmax), -1, dtype=np.int64) if labelled else None
-    best_dir = np.zeros((nb, nmax, 3)) if labelled else None
-    step = max(1, _SUBRAYS_PER_CHUNK // nr)
-    for s in range(0, nb, step):
-        e = min(s + step, nb)
-        if nr == 1:
-            d = axes[s:e]
-        else:
-            ax = axes_s[s:e]
-            p1, p2 = _perpendiculars(ax)
-            d = ax[:, None] + np.tan(sub[None, :, :1]) * p1[:, None] \
-                + np.tan(sub[None, :, 1:]) * p2[:, None]
-            d = (d / np.linalg.norm(d, axis=2, keepdims=True)).reshape(-1, 3) @ rot.T
-        hits = mesh.intersect(np.broadcast_to(origin, d.shape), d, settings.max_range_m)
-        _returns_kernel(hits.t_m.reshape(e - s, nr), hits.face.reshape(e - s, nr), d,
-                        mesh.face_normals, weight, spacing, _COS_85, settings.multiple_returns,
-                        float(settings.return_separation_m), nmax,
-                        float(settings.range_noise_m), key, s, counts[s:e], rng_out[s:e],
-                        lam_out[s:e], best_out[s:e])
-        if labelled:
-            rows, ks = np.nonzero(np.arange(nmax)[None] < counts[s:e, None])
-            flat = rows * nr + best_out[s:e][rows, ks]
-            best_t[s + rows, ks] = hits.t_m[flat]
-            best_face[s + rows, ks] = hits.face[flat]
-            best_dir[s + rows, ks] = d[flat]
-    beam, ks = np.nonzero(np.arange(nmax)[None] < counts[:, None])
+    traced = _trace_beams(mesh, settings, origin, rot, axes_s, axes, key,
+                          labelled=ground_truth is not None)
+    counts, rng_out = traced.counts, traced.range_m
+    beam, ks = np.nonzero(np.arange(rng_out.shape[1])[None] < counts[:, None])
     rng_m = rng_out[beam, ks]
-    n = len(beam)
-    labels_c = np.full(n, -1)
-    labels_b = np.full(n, -1)
-    if labelled:
-        if geometry.craters is not None:
-            pts = origin + best_t[beam, ks, None] * best_dir[beam, ks]
-            labels_c = crater_labels(pts, geometry.craters)
-        labels_b = boulder_labels(best_face[beam, ks], geometry.face_boulder_id)
-    image = np.full(nb, np.nan, dtype=np.float32)
+    labels_c, labels_b = _return_labels(traced, origin, beam, ks, ground_truth)
+    image = np.full(len(axes), np.nan, dtype=np.float32)
     image[counts > 0] = rng_out[counts > 0, 0]
-    total = weight.sum()
+    time_s = float(time_s)
     return LidarFrame(
         position_m=origin + rng_m[:, None] * axes[beam],
         range_m=rng_m,
-        intensity=np.round(np.clip(lam_out[beam, ks] / total, 0.0, 1.0)
+        intensity=np.round(np.clip(traced.energy[beam, ks] / traced.total_weight, 0.0, 1.0)
                            * 65535).astype(np.uint16),
         return_number=(ks + 1).astype(np.uint8),
         number_of_returns=np.repeat(counts, counts).astype(np.uint8),
@@ -321,3 +284,76 @@ def lidar_frame(mesh: RayMesh, settings: LidarSettings, position_m, quaternion_w
         pose={"position_m": origin.tolist(),
               "quaternion_wxyz": np.asarray(quaternion_wxyz, dtype=np.float64).tolist()},
     )
+
+
+@dataclass(frozen=True, slots=True)
+class _Traced:
+    """The returns of every beam of a frame, before they become points."""
+
+    counts: np.ndarray
+    """(nb,) returns per beam."""
+    range_m: np.ndarray
+    """(nb, nmax) range of each return, metres."""
+    energy: np.ndarray
+    """(nb, nmax) return energy, sum of w cos i over its sub-rays."""
+    total_weight: float
+    """Sum of the sub-ray weights of a beam."""
+    best_t: np.ndarray | None = None
+    """(nb, nmax) range of the strongest sub-ray hit of each return (with labels)."""
+    best_face: np.ndarray | None = None
+    """(nb, nmax) face of that hit."""
+    best_dir: np.ndarray | None = None
+    """(nb, nmax, 3) direction of that sub-ray."""
+
+
+def _sub_ray_directions(axes_s, rot, sub) -> np.ndarray:
+    """(k * N, 3) body-frame directions of the sub-rays of the sensor-frame beam axes."""
+    p1, p2 = _perpendiculars(axes_s)
+    d = axes_s[:, None] + np.tan(sub[None, :, :1]) * p1[:, None] \
+        + np.tan(sub[None, :, 1:]) * p2[:, None]
+    return (d / np.linalg.norm(d, axis=2, keepdims=True)).reshape(-1, 3) @ rot.T
+
+
+def _trace_beams(mesh: RayMesh, settings: LidarSettings, origin, rot, axes_s, axes, key,
+                 *, labelled: bool) -> _Traced:
+    """Cast every sub-ray of every beam (in chunks of about ``_SUBRAYS_PER_CHUNK``) and
+    group the hits into returns (:func:`_returns_kernel`)."""
+    sub, weight = footprint_rays(settings.rays_per_beam, settings.divergence_mrad)
+    nr = len(weight)
+    spacing = 1e-3 * settings.divergence_mrad / np.sqrt(nr)
+    nmax = MAX_RETURNS if settings.multiple_returns else 1
+    nb = len(axes)
+    counts = np.zeros(nb, dtype=np.int64)
+    rng_out, lam_out = np.zeros((nb, nmax)), np.zeros((nb, nmax))
+    best_out = np.zeros((nb, nmax), dtype=np.int64)
+    best = (np.zeros((nb, nmax)), np.full((nb, nmax), -1, dtype=np.int64),
+            np.zeros((nb, nmax, 3))) if labelled else (None, None, None)
+    step = max(1, _SUBRAYS_PER_CHUNK // nr)
+    for s in range(0, nb, step):
+        e = min(s + step, nb)
+        d = axes[s:e] if nr == 1 else _sub_ray_directions(axes_s[s:e], rot, sub)
+        hits = mesh.intersect(np.broadcast_to(origin, d.shape), d, settings.max_range_m)
+        _returns_kernel(hits.t_m.reshape(e - s, nr), hits.face.reshape(e - s, nr), d,
+                        mesh.face_normals, weight, spacing, _COS_85, settings.multiple_returns,
+                        float(settings.return_separation_m), nmax,
+                        float(settings.range_noise_m), key, s, counts[s:e], rng_out[s:e],
+                        lam_out[s:e], best_out[s:e])
+        if labelled:
+            rows, ks = np.nonzero(np.arange(nmax)[None] < counts[s:e, None])
+            flat = rows * nr + best_out[s:e][rows, ks]
+            best[0][s + rows, ks] = hits.t_m[flat]
+            best[1][s + rows, ks] = hits.face[flat]
+            best[2][s + rows, ks] = d[flat]
+    return _Traced(counts, rng_out, lam_out, weight.sum(), *best)
+
+
+def _return_labels(traced: _Traced, origin, beam, ks, ground_truth):
+    """Crater and boulder ids of the returns (at each return's strongest sub-ray hit)."""
+    labels_c = np.full(len(beam), -1)
+    labels_b = np.full(len(beam), -1)
+    if ground_truth is not None:
+        if ground_truth.craters is not None:
+            pts = origin + traced.best_t[beam, ks, None] * traced.best_dir[beam, ks]
+            labels_c = crater_labels(pts, ground_truth.craters)
+        labels_b = boulder_labels(traced.best_face[beam, ks], ground_truth.face_boulder_id)
+    return labels_c, labels_b

@@ -19,32 +19,22 @@ bytes depend only on the inputs (fixed LAS creation date, no clock in the manife
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
 import datetime
 import json
-import os
-import shutil
 from pathlib import Path
 
 import numpy as np
 
-from craters._shared import (
-    atomic_path,
-    normalize_rng,
-    package_version,
-    progress_bar,
-    replace_output,
-    sweep_temporaries,
-    temp_folder,
-)
+from craters._shared import atomic_path, normalize_rng, package_version, progress_bar
 
 from .engine import RayMesh
 from .lidar import LidarFrame, LidarSettings, lidar_frame
 from .poses import Poses
-from .scene_geometry import SceneGeometry
+from .runs import check_output_folder, run_folder
+from .scene_geometry import ray_scene
 
-__all__ = ["LIDAR_FORMAT", "check_output_folder", "lidar_run", "write_las"]
+__all__ = ["LIDAR_FORMAT", "lidar_run", "write_las"]
 
 LIDAR_FORMAT = "craterform.lidar/1"
 _LAS_DATE = datetime.date(2000, 1, 1)  # fixed: the same run gives the same bytes
@@ -90,27 +80,6 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0) -> Path:
     return path
 
 
-def check_output_folder(folder, *, force: bool) -> Path:
-    """An output folder: not a symlink, not a file, its parent exists; an existing folder
-    only with ``force`` (ValueError otherwise)."""
-    folder = Path(folder)
-    if folder.is_symlink():
-        raise ValueError(f"output folder {str(folder)!r} is a symbolic link; give a real "
-                         "folder")
-    if folder.exists() and not folder.is_dir():
-        raise ValueError(f"output {str(folder)!r} exists and is not a folder")
-    parent = folder.parent if str(folder.parent) else Path(".")
-    if not parent.is_dir():
-        raise ValueError(f"output folder {str(folder)!r}: {str(parent)!r} does not exist")
-    if not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"output folder {str(folder)!r}: {str(parent)!r} is not writable")
-    if folder.exists() and any(folder.iterdir()) and not force:
-        raise ValueError(f"output folder {str(folder)!r} exists and is not empty; use "
-                         "--force to write into it")
-    sweep_temporaries(parent)
-    return folder
-
-
 def _settings_json(settings: LidarSettings) -> dict:
     out = {}
     for f in dataclasses.fields(settings):
@@ -126,28 +95,34 @@ def _seed_of(rng) -> int:
     return int(normalize_rng(rng).integers(0, 2**63))
 
 
-def lidar_run(geometry: SceneGeometry, settings: LidarSettings, poses: Poses, folder, *,
+def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=None,
               rng=None, force: bool = False, progress: bool = False,
               mesh: RayMesh | None = None, model_name: str = "") -> dict:
-    """Simulate every frame of ``poses`` and write the run folder (module notes).
+    """Simulate every frame of ``poses`` and write the run folder (module notes); the
+    manifest.
 
-    The range noise of frame ``k`` is keyed by ``(seed, k)``: ``rng`` as an int is the
-    seed (recorded in the manifest); a Generator or None draws one. Returns the manifest.
+    ``model`` is any surface (a body, a mesh surface or file, a DEM site) or its
+    :class:`~latlong.sensors.scene_geometry.SceneGeometry`; ``craters`` a catalog (or
+    CSV) to label the returns instead of the surface's own
+    (:func:`~latlong.sensors.scene_geometry.scene_geometry`); ``mesh`` its
+    :class:`RayMesh` if built already. The range noise of frame ``k`` is keyed by
+    ``(seed, k)``: ``rng`` as an int is the seed (recorded in the manifest); a Generator
+    or None draws one. ``model_name`` names the model in the manifest (default: the
+    surface's source).
     """
-    if not isinstance(geometry, SceneGeometry):
-        raise TypeError(f"`geometry` must be a SceneGeometry; got {type(geometry).__name__}")
+    if not isinstance(settings, LidarSettings):
+        raise TypeError(f"`settings` must be LidarSettings; got {type(settings).__name__}")
     if not isinstance(poses, Poses):
         raise TypeError(f"`poses` must be Poses; got {type(poses).__name__}")
     folder = check_output_folder(folder, force=force)
     seed = _seed_of(rng)
-    mesh = mesh if mesh is not None else RayMesh(geometry.vertices, geometry.faces)
-    tmp = temp_folder(folder)
-    try:
+    geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
+    with run_folder(folder, "lidar.json") as tmp:
         frames = []
         for k in progress_bar(range(len(poses)), enabled=progress, desc="lidar frames"):
             fr = lidar_frame(mesh, settings, poses.position_m[k], poses.quaternion_wxyz[k],
                              time_s=float(poses.time_s[k]), rng=np.random.default_rng([seed, k]),
-                             geometry=geometry)
+                             ground_truth=geometry)
             names = {"points": f"lidar_{k:04d}.las", "range": f"range_{k:04d}.npy"}
             write_las(fr, tmp / names["points"], point_source_id=k)
             np.save(tmp / names["range"], fr.range_image, allow_pickle=False)
@@ -161,23 +136,4 @@ def lidar_run(geometry: SceneGeometry, settings: LidarSettings, poses: Poses, fo
         with open(tmp / "lidar.json", "w") as fh:
             json.dump(manifest, fh, indent=1)
             fh.write("\n")
-        _move_into(tmp, folder)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            shutil.rmtree(tmp)
     return manifest
-
-
-def _move_into(tmp: Path, folder: Path) -> None:
-    """Move the finished run into ``folder``: a rename when it does not exist yet, else
-    file by file with the manifest last."""
-    for p in tmp.iterdir():
-        os.chmod(p, 0o644)
-    if not folder.exists():
-        os.chmod(tmp, 0o755)
-        replace_output(tmp, folder)
-        return
-    names = sorted(p.name for p in tmp.iterdir())
-    names.remove("lidar.json")
-    for name in [*names, "lidar.json"]:
-        replace_output(tmp / name, folder / name)

@@ -63,55 +63,45 @@ __all__ = ["HAPKE_PRESETS", "REFLECTANCES", "Hapke", "Lambert", "LommelSeeliger"
            "LunarLambert", "Photometry", "radiance_factor", "reflectance_model"]
 
 
-def _albedo(value) -> float:
-    return check_range("albedo", value, 0.0, 10.0)
-
-
 @dataclass(frozen=True, slots=True)
-class Lambert:
-    """Lambert's law (module notes)."""
-
-    albedo: float = 0.12
-    """Normal albedo A: I/F at normal incidence, [0, 10]."""
-
-    code = LAMBERT
-
-    def __post_init__(self):
-        object.__setattr__(self, "albedo", _albedo(self.albedo))
-
-    def vector(self) -> np.ndarray:
-        return np.array([self.albedo], dtype=np.float64)
-
-
-@dataclass(frozen=True, slots=True)
-class LommelSeeliger:
-    """The Lommel–Seeliger law (module notes)."""
-
-    albedo: float = 0.12
-    """Normal albedo A: I/F at i = e = 0, [0, 10]."""
-
-    code = LOMMEL_SEELIGER
-
-    def __post_init__(self):
-        object.__setattr__(self, "albedo", _albedo(self.albedo))
-
-    def vector(self) -> np.ndarray:
-        return np.array([self.albedo], dtype=np.float64)
-
-
-@dataclass(frozen=True, slots=True)
-class LunarLambert:
-    """McEwen's lunar-Lambert function with a phase-dependent L(g) (module notes)."""
+class _AlbedoLaw:
+    """A law scaled by a normal albedo (the three simple models)."""
 
     albedo: float = 0.12
     """Normal albedo A: I/F at i = e = g = 0, [0, 10]."""
+
+    def __post_init__(self):
+        object.__setattr__(self, "albedo", check_range("albedo", self.albedo, 0.0, 10.0))
+
+    def vector(self) -> np.ndarray:
+        return np.array([self.albedo], dtype=np.float64)
+
+
+@dataclass(frozen=True, slots=True)
+class Lambert(_AlbedoLaw):
+    """Lambert's law (module notes)."""
+
+    code = LAMBERT
+
+
+@dataclass(frozen=True, slots=True)
+class LommelSeeliger(_AlbedoLaw):
+    """The Lommel–Seeliger law (module notes)."""
+
+    code = LOMMEL_SEELIGER
+
+
+@dataclass(frozen=True, slots=True)
+class LunarLambert(_AlbedoLaw):
+    """McEwen's lunar-Lambert function with a phase-dependent L(g) (module notes)."""
+
     l_coefficients: tuple[float, float, float] = (-0.019, 2.42e-4, -1.46e-6)
     """(a, b, c) of L(g) = 1 + a g + b g^2 + c g^3, g in degrees (McEwen's lunar fit)."""
 
     code = LUNAR_LAMBERT
 
     def __post_init__(self):
-        object.__setattr__(self, "albedo", _albedo(self.albedo))
+        _AlbedoLaw.__post_init__(self)
         coeffs = tuple(check_finite("l_coefficients", c) for c in self.l_coefficients)
         if len(coeffs) != 3:
             raise ParameterError("l_coefficients", f"must be three numbers; got {coeffs}")

@@ -40,10 +40,10 @@ from .camera import Camera, Pose
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
 from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
-from .scene_geometry import SceneGeometry
+from .scene_geometry import SceneGeometry, traced_model
 from .sensor import Sensor, expose
 
-__all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render", "scene_mesh"]
+__all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render"]
 
 #: Angular radius of the sun seen from 1 au, degrees (696 000 km / 1 au).
 SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
@@ -129,34 +129,6 @@ class Frame:
     ``ground_truth``."""
 
 
-def scene_mesh(geometry, *, build_quality: str = "medium") -> RayMesh:
-    """A :class:`RayMesh` for a RayMesh (returned as is), a :class:`SceneGeometry`, a
-    ``latlong.Body`` (its mesh and its boulders), a ``latlong.ShapeModel`` or a
-    ``(vertices, faces)`` pair."""
-    if isinstance(geometry, RayMesh):
-        return geometry
-    if isinstance(geometry, SceneGeometry):
-        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
-    from ..body import Body
-    from ..shapes import ShapeModel
-
-    if isinstance(geometry, Body):
-        verts, faces = geometry.vertices(), geometry.grid.triangles()
-        if geometry.boulders is not None and len(geometry.boulders):
-            from craters.boulders import boulder_world_meshes
-
-            bv, bf = boulder_world_meshes(geometry.boulders)
-            faces = np.concatenate([faces, bf + len(verts)])
-            verts = np.concatenate([verts, bv])
-        return RayMesh(verts, faces, build_quality=build_quality)
-    if isinstance(geometry, ShapeModel):
-        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
-    if isinstance(geometry, tuple) and len(geometry) == 2:
-        return RayMesh(*geometry, build_quality=build_quality)
-    raise TypeError("`geometry` must be a RayMesh, a Body, a ShapeModel or (vertices, faces);"
-                    f" got {type(geometry).__name__}")
-
-
 def camera_inside(mesh: RayMesh, position_m) -> bool:
     """True when a point is inside a closed model (or under an open surface): the first
     hits of rays along the six axes and eight diagonals all see the back of a facet."""
@@ -170,7 +142,7 @@ def camera_inside(mesh: RayMesh, position_m) -> bool:
     return bool((np.einsum("ij,ij->i", n, dirs[hits.hit]) > 0).all())
 
 
-def _model(reflectance):
+def _photometry(reflectance):
     if reflectance is None:
         return LommelSeeliger()
     if not isinstance(reflectance, Lambert | LommelSeeliger | LunarLambert | Hapke):
@@ -230,27 +202,30 @@ def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndar
     return lit
 
 
-def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
+def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
            soft_shadow_samples: int = 0, seed: int = 0,
            ground_truth: SceneGeometry | None = None) -> Frame:
-    """Render one frame of ``geometry`` (a :class:`RayMesh`: build it once with
-    :func:`scene_mesh` and share it between frames) seen by ``camera`` at ``pose``, lit
-    by ``sun`` (a :class:`Sun` or a direction towards it). See the module notes.
+    """Render one frame of ``model`` seen by ``camera`` at ``pose``, lit by ``sun`` (a
+    :class:`Sun` or a direction towards it). See the module notes.
 
-    ``reflectance`` defaults to Lommel–Seeliger with normal albedo 0.12; ``sensor``
-    to :class:`Sensor` (); ``normals`` is ``"smooth"``, ``"face"`` or an (n, 3) array of
-    vertex normals to blend (e.g. a sphere's exact radial directions); ``vertex_albedo``
-    an optional (n,) factor per vertex; ``seed`` keys the sun-disk samples and the
-    sensor noise; ``ground_truth`` (the :class:`SceneGeometry` the mesh was built from:
-    same triangles, with its catalogs) adds the crater-id and boulder-id label images.
+    ``model`` is any surface (a body, a mesh surface or file, a DEM site) or its
+    :class:`SceneGeometry`, whose catalogs then label the frame; or, for many frames, its
+    :class:`RayMesh` built once (:func:`~latlong.sensors.scene_geometry.ray_scene`) and
+    shared, with ``ground_truth`` (the :class:`SceneGeometry` the mesh was built from:
+    same triangles, with its catalogs) for the labels. ``reflectance`` defaults to
+    Lommel–Seeliger with normal albedo 0.12; ``sensor`` to :class:`Sensor` ();
+    ``normals`` is ``"smooth"``, ``"face"`` or an (n, 3) array of vertex normals to blend
+    (e.g. a sphere's exact radial directions); ``vertex_albedo`` an optional (n,) factor
+    per vertex; ``seed`` keys the sun-disk samples and the sensor noise. With ground
+    truth the frame has the crater-id and boulder-id label images.
     """
     if not isinstance(camera, Camera):
         raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
     if not isinstance(pose, Pose):
         raise TypeError(f"`pose` must be a Pose; got {type(pose).__name__}")
     sun = sun if isinstance(sun, Sun) else Sun(sun)
-    model = _model(reflectance)
+    photometry = _photometry(reflectance)
     sensor = Sensor() if sensor is None else sensor
     if not isinstance(sensor, Sensor):
         raise TypeError(f"`sensor` must be a Sensor; got {type(sensor).__name__}")
@@ -258,13 +233,7 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     seed = check_int("seed", seed, 0, 2**63 - 1)
     if sun.angular_radius_deg == 0.0:
         samples = 0
-    if ground_truth is not None and not isinstance(ground_truth, SceneGeometry):
-        raise TypeError("`ground_truth` must be a SceneGeometry; got "
-                        f"{type(ground_truth).__name__}")
-    mesh = scene_mesh(geometry)
-    if ground_truth is not None and len(ground_truth.faces) != len(mesh.faces):
-        raise ParameterError("ground_truth", f"must describe the rendered mesh: "
-                             f"{len(ground_truth.faces)} triangles, not {len(mesh.faces)}")
+    mesh, ground_truth = traced_model(model, ground_truth)
     h, w = camera.height, camera.width
     origin, dirs = camera.rays(pose)
     dirs = dirs.reshape(-1, 3)
@@ -287,7 +256,7 @@ def render(geometry, camera: Camera, pose: Pose, sun, *, reflectance=None,
     lit = _sunlit(mesh, pos, ng, facing, sun, samples, seed)
     albedo = _vertex_albedo(mesh, vertex_albedo, hits)
     refl = np.empty(n)
-    _shade_kernel(model.code, model.vector(), cosines, lit, albedo, refl)
+    _shade_kernel(photometry.code, photometry.vector(), cosines, lit, albedo, refl)
     refl = refl.reshape(h, w)
     depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))
     angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))

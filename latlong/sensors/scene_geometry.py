@@ -1,41 +1,49 @@
-"""What the sensors see: one triangle mesh in the body frame (metres) with its boulder ids
-and the catalogs that label it.
+"""What the sensors see: one triangle mesh in the surface's frame (metres) with its boulder
+ids and the catalogs that label it, made from any surface.
 
-A model is a :class:`latlong.Body` or its ``.npz``, a ``latlong.mesh.MeshSurface``
-(``--surface mesh``), or any mesh file pyvista reads (PLY, OBJ, STL, VTP, VTK, GLB:
-``dem mesh`` outputs, shape models). The body's placed boulders are part of the mesh
-(as the exports write them: boulders after the surface, ``boulder_id`` = catalog row);
-a mesh file's ``boulder_id`` point array is kept when it has one.
+A surface is anything with the members of :class:`latlong.geometry.surface.Surface` the
+sensors use: ``mesh_source()``, ``craters``, ``boulders`` and ``metadata`` -- a lat/long
+:class:`latlong.Body`, a ``latlong.mesh.MeshSurface``, a mesh file read by
+:func:`latlong.load_surface`, a DEM site of ``dem`` (``dem.DemSurface``). Its mesh is
+taken as the mesh writers take it (:meth:`Surface.mesh_source`): the surface, then its
+placed boulders as their own closed meshes with a per-vertex ``boulder_id`` (boulder
+catalog row, -1 on the surface). Its crater catalog labels the frames: a catalog as
+stamped (``centre_x_m, centre_y_m, centre_z_m``, ...) as it is; a map catalog (``x_m,
+y_m`` in a local frame with z up: a DEM site's, or ``dem enhance``'s for a ``dem mesh``
+file) placed on the surface straight below each centre (:func:`drape_catalog`). The
+sensors read nothing else of a surface: they never ask which kind they hold.
 """
 
 from __future__ import annotations
 
-import warnings
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 import craters
-from craters._shared import ParameterError, check_choice
-from craters._shared.files import check_regular_file
+from craters._shared import ParameterError
 
-from ..body import Body, load
-from ..export import body_mesh_source
+from .engine import RayMesh
 
-__all__ = ["MESH_SUFFIXES", "SceneGeometry", "scene_geometry"]
+if TYPE_CHECKING:
+    from ..geometry.surface import Surface
 
-#: Mesh files read through pyvista.
-MESH_SUFFIXES = (".ply", ".obj", ".stl", ".vtp", ".vtk", ".glb", ".gltf")
-_UNITS = {"m": 1.0, "km": 1000.0}
+__all__ = ["SceneGeometry", "craters_catalog", "drape_catalog", "ray_scene",
+           "scene_geometry", "scene_mesh", "traced_model"]
+
+#: The members of a surface the sensors use.
+SURFACE_MEMBERS = ("mesh_source", "craters", "boulders", "metadata")
 
 
 @dataclass(frozen=True, slots=True)
 class SceneGeometry:
-    """A triangle mesh in the body frame and the ground truth that labels it."""
+    """A triangle mesh in the surface's frame and the ground truth that labels it."""
 
     vertices: np.ndarray
-    """(n, 3) float64 positions, metres, body frame."""
+    """(n, 3) float64 positions, metres, the surface's frame."""
     faces: np.ndarray
     """(m, 3) int64 vertex indices."""
     face_boulder_id: np.ndarray
@@ -48,180 +56,128 @@ class SceneGeometry:
     """Where it came from."""
 
 
-def _from_source(src, craters_, boulders, source) -> SceneGeometry:
+def _is_surface(model) -> bool:
+    """``model`` has the members of a surface the sensors use."""
+    return all(hasattr(model, k) for k in SURFACE_MEMBERS)
+
+
+def _of_surface(model: Surface | SceneGeometry) -> SceneGeometry:
+    """The mesh and the surface's own catalogs (map catalogs not placed yet)."""
+    if isinstance(model, SceneGeometry):
+        return model
+    if not _is_surface(model):
+        raise TypeError("`model` must be a surface (latlong.geometry.Surface: a Body, a "
+                        "mesh surface, a mesh file from latlong.load_surface, a dem "
+                        f"DemSurface) or a SceneGeometry; got {type(model).__name__}")
     verts, ids = [], []
+    src = model.mesh_source()
     for xyz, values in src.vertex_chunks():
         verts.append(np.asarray(xyz, dtype=np.float64))
         ids.append(np.asarray(values.get("boulder_id", np.full(len(xyz), -1)), np.int32))
     faces = np.concatenate([np.asarray(f, dtype=np.int64) for f in src.faces()])
     vid = np.concatenate(ids)
-    return SceneGeometry(np.concatenate(verts), faces, vid[faces[:, 0]], craters_, boulders,
-                         source)
+    source = str(model.metadata.get("source") or "") or repr(model)
+    return SceneGeometry(np.concatenate(verts), faces, vid[faces[:, 0]], model.craters,
+                         model.boulders, source)
 
 
-_PLY_TYPES = {"float": "<f4", "float32": "<f4", "double": "<f8", "float64": "<f8",
-              "int": "<i4", "int32": "<i4", "uint": "<u4", "uint32": "<u4", "short": "<i2",
-              "int16": "<i2", "ushort": "<u2", "uint16": "<u2", "char": "i1", "int8": "i1",
-              "uchar": "u1", "uint8": "u1"}
-
-
-def _read_triangle_ply(path: Path):
-    """A binary little-endian PLY of triangles with scalar vertex properties (as the
-    craterform writers make them): ``(xyz, faces, {property: values})``, or None for any
-    other PLY (then pyvista reads it; VTK's reader drops the extra properties such as
-    ``boulder_id``)."""
-    with open(path, "rb") as fh:
-        if fh.readline().strip() != b"ply":
-            return None
-        elements, fmt = [], None
-        while True:
-            line = fh.readline()
-            if not line:
-                return None
-            words = line.decode("ascii", "replace").split()
-            if not words or words[0] in ("comment", "obj_info"):
-                continue
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                elements.append((words[1], int(words[2]), []))
-            elif words[0] == "property" and elements:
-                elements[-1][2].append(words[1:])
-            elif words[0] == "end_header":
-                break
-        names = [e[0] for e in elements]
-        if fmt != "binary_little_endian" or names != ["vertex", "face"]:
-            return None
-        (_, nv, vprops), (_, nf, fprops) = elements
-        if any(len(p) != 2 or p[0] not in _PLY_TYPES for p in vprops) or len(fprops) != 1 \
-                or fprops[0][0] != "list" or fprops[0][1] not in _PLY_TYPES \
-                or fprops[0][2] not in _PLY_TYPES:
-            return None
-        vdt = np.dtype([(p[1], _PLY_TYPES[p[0]]) for p in vprops])
-        fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]]), ("i", _PLY_TYPES[fprops[0][2]], 3)])
-        verts = np.fromfile(fh, dtype=vdt, count=nv)
-        faces = np.fromfile(fh, dtype=fdt, count=nf)
-    if len(verts) != nv or len(faces) != nf or not {"x", "y", "z"} <= set(vdt.names) \
-            or (faces["n"] != 3).any():
-        return None
-    xyz = np.stack([verts["x"], verts["y"], verts["z"]], 1).astype(np.float64)
-    return xyz, faces["i"].astype(np.int64), {k: verts[k] for k in vdt.names}
-
-
-def _read_mesh(path: Path, units: str) -> SceneGeometry:
-    if path.suffix.lower() == ".ply":
-        try:
-            ply = _read_triangle_ply(path)
-        except (OSError, ValueError):
-            ply = None
-        if ply is not None:
-            verts, faces, fields = ply
-            if len(faces) and (faces.min() < 0 or faces.max() >= len(verts)):
-                raise ValueError(f"cannot read mesh {str(path)!r}: face indices out of range")
-            return _mesh_geometry(verts * _UNITS[units], faces, fields, path)
-    import pyvista as pv
-    from vtkmodules.vtkCommonCore import vtkObject
-
-    shown = vtkObject.GetGlobalWarningDisplay()
-    vtkObject.GlobalWarningDisplayOff()  # a bad file: one line from us, not VTK's report
-    try:
-        with pv.vtk_verbosity("off"), warnings.catch_warnings():
-            warnings.simplefilter("error")
-            mesh = pv.read(path)
-    except Exception as exc:  # noqa: BLE001 - any reader failure is an unreadable mesh
-        raise ValueError(f"cannot read mesh {str(path)!r}: {exc}".splitlines()[0]) from None
-    finally:
-        vtkObject.SetGlobalWarningDisplay(shown)
-    if isinstance(mesh, pv.MultiBlock):
-        mesh = mesh.combine(merge_points=False)
-    if not isinstance(mesh, pv.PolyData):
-        mesh = mesh.extract_surface()
-    mesh = mesh.triangulate()
-    faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
-        else np.zeros((0, 3), np.int64)
-    return _mesh_geometry(np.asarray(mesh.points, dtype=np.float64) * _UNITS[units], faces,
-                          {k: np.asarray(mesh.point_data[k]) for k in mesh.point_data.keys()},
-                          path)
-
-
-def _mesh_geometry(verts, faces, fields, path) -> SceneGeometry:
-    if not len(faces):
-        raise ValueError(f"cannot read mesh {str(path)!r}: no triangles in it")
-    if not np.isfinite(verts).all():
-        raise ValueError(f"mesh {str(path)!r} has non-finite vertices")
-    if "boulder_id" in fields:
-        fid = np.asarray(fields["boulder_id"]).astype(np.int32)[faces[:, 0]]
-    else:
-        fid = np.full(len(faces), -1, dtype=np.int32)
-    return SceneGeometry(verts, faces, fid, None, None, str(path))
-
-
-def scene_geometry(model, *, units: str = "m", craters=None, mesh=None) -> SceneGeometry:
+def scene_geometry(model, *, craters=None, mesh: RayMesh | None = None) -> SceneGeometry:
     """The mesh and catalogs of ``model`` (module notes).
 
     Parameters
     ----------
-    model : Body, MeshSurface, SceneGeometry, or path
-        A body, a ``--surface mesh`` surface, or a file: ``.npz`` (a body) or a mesh
-        (``MESH_SUFFIXES``).
-    units : {"m", "km"}
-        Units of a mesh file's coordinates (bodies are in metres).
+    model : Surface or SceneGeometry
+        A surface (module notes; :func:`latlong.load_surface` reads one from a file), or
+        a geometry made already (returned with ``craters`` applied).
     craters : structured array or path, optional
         A crater catalog (CSV or array with ``centre_x_m, centre_y_m, centre_z_m`` and
-        ``rim_radius_m`` or ``diameter_m``) to use instead of the model's own; a map
-        catalog (``x_m, y_m``, as ``dem enhance`` writes it for a ``dem mesh`` in the same
-        local frame, z up) is placed on the surface straight below each centre (off the
-        mesh: no label).
+        ``rim_radius_m`` or ``diameter_m``) to use instead of the surface's own; a map
+        catalog (``x_m, y_m``, z up) is placed on the surface (:func:`drape_catalog`).
     mesh : RayMesh, optional
-        The model's ray mesh if already built (places a map catalog; else one is built).
+        The model's ray mesh if built already (places a map catalog; else one is built).
     """
-    check_choice("units", units, tuple(_UNITS))
-    if isinstance(model, SceneGeometry):
-        geo = model
-    elif isinstance(model, Body):
-        geo = _from_source(body_mesh_source(model), model.craters, model.boulders,
-                           repr(model))
-    elif hasattr(model, "mesh_source") and hasattr(model, "faces"):
-        geo = _from_source(model.mesh_source(), model.craters, model.boulders, "mesh surface")
-    elif isinstance(model, str | Path):
-        path = Path(model)
-        check_regular_file(path, "model file")
-        suffix = path.suffix.lower()
-        if suffix == ".npz":
-            body = load(path)
-            geo = _from_source(body_mesh_source(body), body.craters, body.boulders, str(path))
-        elif suffix in MESH_SUFFIXES:
-            geo = _read_mesh(path, units)
-        else:
-            raise ParameterError("model", f"must be a body .npz or a mesh file "
-                                 f"({' '.join(MESH_SUFFIXES)}); got {str(path)!r}")
-    else:
-        raise TypeError(f"`model` must be a Body, a mesh surface or a path; got "
-                        f"{type(model).__name__}")
+    geo = _of_surface(model)
+    catalog = geo.craters
     if craters is not None:
-        if isinstance(craters, str | Path):
-            craters = craters_catalog(craters)
-        craters = np.asarray(craters)
-        names = craters.dtype.names or ()
-        if "centre_x_m" not in names and {"x_m", "y_m"} <= set(names):
-            craters = _placed_on_surface(craters, geo, mesh)
-        geo = SceneGeometry(geo.vertices, geo.faces, geo.face_boulder_id, craters,
-                            geo.boulders, geo.source)
-    return geo
+        catalog = np.asarray(craters_catalog(craters) if isinstance(craters, str | Path)
+                             else craters)
+    if catalog is not None and _is_map_catalog(catalog):
+        catalog = drape_catalog(catalog, RayMesh(geo.vertices, geo.faces) if mesh is None
+                                else mesh)
+    return geo if catalog is geo.craters else dataclasses.replace(geo, craters=catalog)
 
 
-def _placed_on_surface(catalog, geo: SceneGeometry, mesh=None) -> np.ndarray:
+def ray_scene(model, *, craters=None, mesh: RayMesh | None = None,
+              build_quality: str = "medium") -> tuple[SceneGeometry, RayMesh]:
+    """:func:`scene_geometry` and the :class:`RayMesh` of ``model``, its BVH built once
+    (unless ``mesh`` is given) and used to place a map catalog: what every frame of a run
+    shares."""
+    geo = _of_surface(model)
+    if mesh is None:
+        mesh = RayMesh(geo.vertices, geo.faces, build_quality=build_quality)
+    return scene_geometry(geo, craters=craters, mesh=mesh), mesh
+
+
+def scene_mesh(model, *, build_quality: str = "medium") -> RayMesh:
+    """A :class:`RayMesh` of a RayMesh (returned as is), a surface or a
+    :class:`SceneGeometry` (its mesh with the boulders), or a ``(vertices, faces)``
+    pair."""
+    if isinstance(model, RayMesh):
+        return model
+    if isinstance(model, tuple) and len(model) == 2:
+        return RayMesh(*model, build_quality=build_quality)
+    if not (isinstance(model, SceneGeometry) or _is_surface(model)):
+        raise TypeError("`model` must be a RayMesh, a surface, a SceneGeometry or "
+                        f"(vertices, faces); got {type(model).__name__}")
+    geo = _of_surface(model)
+    return RayMesh(geo.vertices, geo.faces, build_quality=build_quality)
+
+
+def traced_model(model, ground_truth: SceneGeometry | None = None
+                 ) -> tuple[RayMesh, SceneGeometry | None]:
+    """The ray mesh a frame is traced in and the geometry that labels it (the first
+    argument of :func:`~latlong.sensors.render.render` and
+    :func:`~latlong.sensors.lidar.lidar_frame`): ``model`` a RayMesh or ``(vertices,
+    faces)``, labelled by ``ground_truth`` if given; or a surface or SceneGeometry, its
+    BVH built for the frame and labelled by its own catalogs unless ``ground_truth`` is
+    given (its mesh must be the same triangles)."""
+    if ground_truth is not None and not isinstance(ground_truth, SceneGeometry):
+        raise TypeError("`ground_truth` must be a SceneGeometry; got "
+                        f"{type(ground_truth).__name__}")
+    if isinstance(model, RayMesh) or isinstance(model, tuple):
+        mesh = scene_mesh(model)
+    else:
+        geo, mesh = ray_scene(model)
+        ground_truth = geo if ground_truth is None else ground_truth
+    if ground_truth is not None and len(ground_truth.faces) != len(mesh.faces):
+        raise ParameterError("ground_truth", f"must describe the traced mesh: "
+                             f"{len(ground_truth.faces)} triangles, not {len(mesh.faces)}")
+    return mesh, ground_truth
+
+
+def _is_map_catalog(catalog) -> bool:
+    names = catalog.dtype.names or ()
+    return "centre_x_m" not in names and {"x_m", "y_m"} <= set(names)
+
+
+def drape_catalog(catalog, mesh: RayMesh) -> np.ndarray:
     """A map catalog (``x_m, y_m``: a ``dem`` catalog in the mesh's local frame, z up) with
     ``centre_*`` on the surface straight below the highest point and ``normal_*`` = +z;
-    every row kept (ids are rows), ``centre_z_m`` NaN where the vertical misses the mesh."""
-    import numpy.lib.recfunctions as rfn
+    every row kept (ids are rows), ``centre_z_m`` NaN where the vertical misses the mesh.
 
-    from .engine import RayMesh
+    Examples
+    --------
+    >>> import craters
+    >>> plane = RayMesh([[-9, -9, 2], [9, -9, 2], [0, 9, 2]], [[0, 1, 2]])
+    >>> cat = craters.make_catalog(x_m=[0.0, 50.0], y_m=[0.0, 0.0], diameter_m=[2.0, 2.0])
+    >>> drape_catalog(cat, plane)["centre_z_m"].tolist()
+    [2.0, nan]
+    """
+    import numpy.lib.recfunctions as rfn
 
     x = np.asarray(catalog["x_m"], dtype=np.float64)
     y = np.asarray(catalog["y_m"], dtype=np.float64)
-    top = float(geo.vertices[:, 2].max()) + 1.0
-    mesh = RayMesh(geo.vertices, geo.faces) if mesh is None else mesh
+    top = float(mesh.vertices[:, 2].max()) + 1.0
     hits = mesh.intersect(np.stack([x, y, np.full(len(x), top)], 1),
                           np.tile([0.0, 0.0, -1.0], (len(x), 1)))
     z = np.where(hits.hit, top - hits.t_m, np.nan)

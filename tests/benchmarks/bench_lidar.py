@@ -69,7 +69,7 @@ def main():
     rate = n / t_thin
     print(f"flash {n_side}x{n_side}, thin beams: {n} returns in {t_thin:.3f} s = "
           f"{rate / 1e6:.2f} M returns/s")
-    t_lab, fr_lab = best_of(lambda: lidar_frame(mesh, thin, pos, q, geometry=geo))
+    t_lab, fr_lab = best_of(lambda: lidar_frame(mesh, thin, pos, q, ground_truth=geo))
     print(f"  with crater/boulder labels: {len(fr_lab) / t_lab / 1e6:.2f} M returns/s "
           f"({int((fr_lab.crater_id >= 0).sum())} returns in craters)")
     wide = LidarSettings(beams=(n_side // 2, n_side // 2), fov_deg=40.0, divergence_mrad=2.0,

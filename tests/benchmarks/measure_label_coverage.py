@@ -52,7 +52,7 @@ def measure(body, geo, mesh, pos, target, rims=None, size=512, sensor="lidar"):
         fr = render(mesh, cam, Pose(pos, q), Sun(pos / np.linalg.norm(pos)), ground_truth=geo)
         lab = fr.crater_id.astype(np.int64)
     else:
-        fr = lidar_frame(mesh, s, pos, q, geometry=geo)
+        fr = lidar_frame(mesh, s, pos, q, ground_truth=geo)
         lab = np.full(size * size, -1)
         lab[fr.beam] = fr.crater_id
         lab = lab.reshape(size, size)

@@ -66,7 +66,7 @@ def test_ranges_match_brute_force_ray_cast(small_body):
     pos = np.array([700.0, -250.0, 120.0])
     q = _look_at(pos, [380.0, 20.0, 15.0])
     s = LidarSettings(beams=(48, 40), fov_deg=45.0)
-    fr = lidar_frame(RayMesh(geo.vertices, geo.faces), s, pos, q, geometry=geo)
+    fr = lidar_frame(RayMesh(geo.vertices, geo.faces), s, pos, q, ground_truth=geo)
     axes = beam_pattern(s)[0] @ quaternion_to_matrix(q).T
     o = np.broadcast_to(pos, axes.shape)
     ref = np.concatenate([moller_trumbore(geo.vertices, geo.faces, o[i:i + 64], axes[i:i + 64])[0]

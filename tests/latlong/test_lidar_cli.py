@@ -117,7 +117,7 @@ def test_unreadable_model_and_bad_poses(run_cli, tmp_path):
 
 
 def test_existing_folder_needs_force_and_symlinks_are_refused(body_file, tmp_path):
-    geo = scene_geometry(body_file)
+    geo = scene_geometry(latlong.load_surface(body_file))
     s = LidarSettings(beams=(8, 8))
     poses = Poses.one([700.0, 0, 0], _look_at([700.0, 0, 0], [0.0, 0, 0]))
     out = tmp_path / "run"
@@ -139,10 +139,10 @@ def test_las_round_trip_keeps_a_tenth_of_a_millimetre(body_file, tmp_path):
     from latlong.sensors.engine import RayMesh
     from latlong.sensors.lidar import lidar_frame
 
-    geo = scene_geometry(body_file)
+    geo = scene_geometry(latlong.load_surface(body_file))
     q = _look_at([700.0, 0, 0], [0.0, 0, 0])
     fr = lidar_frame(RayMesh(geo.vertices, geo.faces), LidarSettings(beams=(16, 16),
-                     fov_deg=50.0), [700.0, 0, 0], q, time_s=3.25, geometry=geo)
+                     fov_deg=50.0), [700.0, 0, 0], q, time_s=3.25, ground_truth=geo)
     las = laspy.read(write_las(fr, tmp_path / "f.las", point_source_id=7))
     xyz = np.stack([las.x, las.y, las.z], 1)
     assert np.abs(xyz - fr.position_m).max() <= 0.5e-4 + 1e-9

@@ -195,7 +195,7 @@ def test_boulder_ids_of_a_body_with_boulders(tmp_path):
     # boulder_id property VTK drops; VTP through pyvista); OBJ has none
     for suffix in (".ply", ".vtp", ".obj"):
         path = body.export(tmp_path / f"b{suffix}")
-        got = scene_geometry(path)
+        got = scene_geometry(latlong.load_surface(path))
         np.testing.assert_allclose(got.vertices, geo.vertices, atol=1e-4)
         np.testing.assert_array_equal(got.faces, geo.faces)
         want = geo.face_boulder_id if suffix != ".obj" else np.full(len(geo.faces), -1)

@@ -16,7 +16,8 @@ import craters
 from craters._shared import ParameterError
 from latlong import LatLongGrid
 from latlong.sensors import Camera, Lambert, LommelSeeliger, Pose, RayMesh, radiance_factor
-from latlong.sensors.render import Sun, camera_inside, render, scene_mesh
+from latlong.sensors.render import Sun, camera_inside, render
+from latlong.sensors.scene_geometry import scene_mesh
 from latlong.sensors.sensor import Sensor, expose
 
 R = 1000.0
@@ -232,7 +233,7 @@ def test_inputs_and_helpers(sphere):
     with pytest.raises(ParameterError, match="sun_direction"):
         Sun([0.0, 0.0, 0.0])
     assert abs(Sun.at_distance([1, 0, 0], 1.0).angular_radius_deg - 0.2666) < 1e-3
-    with pytest.raises(TypeError, match="geometry"):
+    with pytest.raises(TypeError, match="model"):
         scene_mesh("model.ply")
     g = LatLongGrid(4)
     assert isinstance(scene_mesh((g.unit_vectors(), g.triangles())), RayMesh)

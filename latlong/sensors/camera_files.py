@@ -1,0 +1,232 @@
+"""Camera runs: :func:`camera_run` renders every pose of a trajectory and writes the
+frames and the ``frames.json`` manifest (issue 17's interface) into a run folder, as
+:func:`~latlong.sensors.lidar_files.lidar_run` does for the LIDAR; what the camera is
+and how its frames are written is one :class:`CameraSettings` record.
+
+* :func:`write_frame`: one frame's files, each written atomically: the image (16- or
+  8-bit PNG, or float32 TIFF for a float sensor), depth and range (float32 ``.tif`` or
+  ``.npy``), normals (float32 (H, W, 3) ``.npy``) and, on request, the other ground
+  truth (incidence / emission / phase angles, position, face id, lit fraction, as .npy);
+  the crater-id and boulder-id label images (int32, -1 = none, in the depth format) when
+  the frame has them.
+* :func:`manifest`: the ``frames.json`` document: ``{"intrinsics": {fx, fy, cx, cy, width,
+  height}, "frames": [{"time_s", "position_m", "quaternion_wxyz", "sun_direction",
+  "files": {"image", "depth", "range", "normals", "crater_id", "boulder_id", ...}}]}``,
+  file names relative to the folder (``crater_id`` / ``boulder_id`` null when the model
+  has no catalogs), and per frame the projected rim ellipses of the craters seen, plus
+  the distortion, the conventions and the settings used.
+
+The run is written into a hidden temporary folder next to the target, each file
+atomically, and moved into place at the end with ``frames.json`` last
+(:func:`~latlong.sensors.runs.run_folder`): an error leaves nothing behind.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import numpy as np
+
+from craters._shared import (
+    ParameterError,
+    atomic_path,
+    check_choice,
+    check_int,
+    check_range,
+    progress_bar,
+)
+
+from .albedo import ejecta_albedo
+from .camera import Camera
+from .engine import RayMesh
+from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
+from .photometry import REFLECTANCES, LommelSeeliger, Photometry
+from .poses import Poses
+from .render import Frame, Sun, render
+from .runs import check_output_folder, run_folder
+from .scene_geometry import ray_scene
+from .sensor import Sensor
+
+__all__ = ["DEPTH_FORMATS", "CameraSettings", "camera_run", "frame_entry", "manifest",
+           "write_frame", "write_manifest"]
+
+#: Formats of the float32 depth and range images (and the label images).
+DEPTH_FORMATS = ("tif", "npy")
+_NAMES = {model: name for name, model in REFLECTANCES.items()}
+
+CONVENTIONS = ("OpenCV camera frame (x right, y down, z forward); quaternion_wxyz rotates "
+               "camera-frame vectors into the body frame; position_m and sun_direction "
+               "(towards the sun) in the body frame; pixel centres at integer + 0.5 "
+               "(OpenCV's cx = cx - 0.5); depth = camera z, range = distance, metres, NaN "
+               "where no surface; normals = unit shading normals in the body frame.")
+
+
+def _save(path: Path, array: np.ndarray) -> None:
+    from PIL import Image
+
+    with atomic_path(path) as tmp:
+        if path.suffix == ".npy":
+            with open(tmp, "wb") as fh:
+                np.save(fh, array, allow_pickle=False)
+        elif path.suffix == ".tif":
+            kind = np.int32 if array.dtype == np.int32 else np.float32
+            Image.fromarray(np.ascontiguousarray(array, dtype=kind)).save(tmp, format="TIFF")
+        else:
+            Image.fromarray(np.ascontiguousarray(array)).save(tmp, format="PNG")
+
+
+def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
+                extra: bool = False) -> dict:
+    """Write frame ``index``'s files into ``folder``; their names (relative)."""
+    if depth_format not in DEPTH_FORMATS:
+        raise ParameterError("depth_format", f"must be tif or npy; got {depth_format!r}")
+    folder = Path(folder)
+    tag = f"{index:04d}"
+    image_name = f"image_{tag}.tif" if frame.image.dtype == np.float32 else f"image_{tag}.png"
+    files = {"image": image_name, "depth": f"depth_{tag}.{depth_format}",
+             "range": f"range_{tag}.{depth_format}", "normals": f"normals_{tag}.npy"}
+    arrays = {"image": frame.image, "depth": frame.depth_m, "range": frame.range_m,
+              "normals": frame.normals}
+    if extra:
+        for key, arr in (("incidence", frame.incidence_deg), ("emission", frame.emission_deg),
+                         ("phase", frame.phase_deg), ("position", frame.position_m),
+                         ("face", frame.face), ("sunlit", frame.sunlit)):
+            files[key] = f"{key}_{tag}.npy"
+            arrays[key] = arr
+    for key, arr in (("crater_id", frame.crater_id), ("boulder_id", frame.boulder_id)):
+        if arr is not None:
+            files[key] = f"{key}_{tag}.{depth_format}"
+            arrays[key] = arr
+    for key, name in files.items():
+        _save(folder / name, arrays[key])
+    return {"crater_id": None, "boulder_id": None, **files}
+
+
+def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
+    """The manifest's record of one frame; with the crater catalog, the projected rim
+    ellipses (pinhole, pixels) of the craters whose id is in the frame's label image,
+    their rims from ``rims`` (a :class:`~latlong.sensors.labels.FittedRims` shared by
+    the frames) when given, else the catalog rule."""
+    entry = {"time_s": frame.pose.time_s,
+             "position_m": [float(v) for v in frame.pose.position_m],
+             "quaternion_wxyz": [float(v) for v in frame.pose.quaternion_wxyz],
+             "sun_direction": [float(v) for v in frame.sun.direction],
+             "files": files}
+    if craters is not None and frame.crater_id is not None:
+        cam = frame.camera
+        seen = np.unique(frame.crater_id[frame.crater_id >= 0])
+        ell = rim_ellipses(craters, (cam.fx, cam.fy, cam.cx, cam.cy), frame.pose.position_m,
+                           frame.pose.quaternion_wxyz, ids=seen,
+                           rims=None if rims is None else rims(seen))
+        entry["rim_ellipses"] = [{k: (int(e[k]) if k == "crater_id" else float(e[k]))
+                                  for k in ELLIPSE_DTYPE.names} for e in ell]
+    return entry
+
+
+def manifest(camera: Camera, entries: list, **settings) -> dict:
+    """The ``frames.json`` document (module notes); ``settings`` are recorded as given."""
+    return {"intrinsics": camera.intrinsics(),
+            "distortion": dict(zip(("k1", "k2", "p1", "p2", "k3"), camera.distortion,
+                                   strict=True)),
+            "conventions": CONVENTIONS, "settings": settings, "frames": entries}
+
+
+def write_manifest(folder, document: dict) -> Path:
+    """Write ``frames.json`` atomically."""
+    path = Path(folder) / "frames.json"
+    with atomic_path(path) as tmp:
+        tmp.write_text(json.dumps(document, indent=1) + "\n")
+    return path
+
+
+@dataclass(frozen=True, slots=True)
+class CameraSettings:
+    """What the camera is and how its frames are written (the LIDAR's
+    :class:`~latlong.sensors.lidar.LidarSettings`)."""
+
+    camera: Camera
+    """Intrinsics and distortion."""
+    reflectance: Photometry = LommelSeeliger()
+    """The surface's reflectance model (:mod:`~latlong.sensors.photometry`)."""
+    sensor: Sensor = Sensor()
+    """Exposure, bit depth, noise and PSF of the detector."""
+    soft_shadow_samples: int = 0
+    """Shadow rays per pixel over the solar disk, [0, 1024] (0: hard shadows)."""
+    seed: int = 0
+    """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
+    bright_ejecta: float = 0.0
+    """Albedo contrast of fresh craters' ejecta (:func:`~latlong.sensors.albedo.
+    ejecta_albedo`), [0, 10] (0: off)."""
+    depth_format: str = "tif"
+    """Files of the float32 depth and range images and of the label images: tif or npy."""
+    all_ground_truth: bool = False
+    """Also write incidence, emission, phase, position, face and lit fraction (.npy)."""
+
+    def __post_init__(self):
+        for name, kind in (("camera", Camera), ("reflectance", Photometry),
+                           ("sensor", Sensor)):
+            if not isinstance(getattr(self, name), kind):
+                raise TypeError(f"`{name}` must be a {name} model of latlong.sensors; got "
+                                f"{type(getattr(self, name)).__name__}")
+        object.__setattr__(self, "soft_shadow_samples", check_int(
+            "soft_shadow_samples", self.soft_shadow_samples, 0, 1024))
+        object.__setattr__(self, "seed", check_int("seed", self.seed, 0, 2**63 - 1))
+        object.__setattr__(self, "bright_ejecta", check_range(
+            "bright_ejecta", self.bright_ejecta, 0.0, 10.0))
+        check_choice("depth_format", self.depth_format, DEPTH_FORMATS)
+        object.__setattr__(self, "all_ground_truth", bool(self.all_ground_truth))
+
+    def record(self, sun: Sun) -> dict:
+        """The ``settings`` of the manifest (without ``model``)."""
+        model = self.reflectance
+        return {"reflectance": _NAMES[type(model)],
+                "reflectance_parameters": {f.name: getattr(model, f.name)
+                                           for f in fields(model)},
+                "sun_angular_radius_deg": sun.angular_radius_deg,
+                "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
+                "sensor": {f.name: getattr(self.sensor, f.name)
+                           for f in fields(self.sensor)}}
+
+
+def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, craters=None,
+               force: bool = False, progress: bool = False, mesh: RayMesh | None = None,
+               model_name: str = "") -> dict:
+    """Render every frame of ``poses`` and write the run folder (module notes); the
+    ``frames.json`` document.
+
+    ``model`` is any surface (a body, a mesh surface or file, a DEM site) or its
+    :class:`~latlong.sensors.scene_geometry.SceneGeometry`; ``sun`` a :class:`Sun` or a
+    direction towards it; ``craters`` a catalog (or CSV) to label the frames instead of
+    the surface's own (:func:`~latlong.sensors.scene_geometry.scene_geometry`); ``mesh``
+    its :class:`RayMesh` if built already; ``model_name`` names the model in the manifest
+    (default: the surface's source). The same shape as
+    :func:`~latlong.sensors.lidar_files.lidar_run`.
+    """
+    if not isinstance(settings, CameraSettings):
+        raise TypeError(f"`settings` must be CameraSettings; got {type(settings).__name__}")
+    if not isinstance(poses, Poses):
+        raise TypeError(f"`poses` must be Poses; got {type(poses).__name__}")
+    sun = sun if isinstance(sun, Sun) else Sun(sun)
+    folder = check_output_folder(folder, force=force)
+    geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
+    albedo = ejecta_albedo(geometry, contrast=settings.bright_ejecta) \
+        if settings.bright_ejecta else None
+    rims = None  # the rims of the craters seen, fitted to the surface once each
+    if geometry.craters is not None and len(geometry.craters):
+        rims = FittedRims(geometry.craters, geometry)
+    with run_folder(folder, "frames.json") as tmp:
+        entries = []
+        for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
+            frame = render(mesh, settings.camera, poses[k], sun,
+                           reflectance=settings.reflectance, sensor=settings.sensor,
+                           soft_shadow_samples=settings.soft_shadow_samples,
+                           seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo)
+            files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
+                                extra=settings.all_ground_truth)
+            entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
+        doc = manifest(settings.camera, entries, model=model_name or geometry.source,
+                       **settings.record(sun))
+        write_manifest(tmp, doc)
+    return doc
