@@ -19,7 +19,6 @@ from __future__ import annotations
 import dataclasses
 import logging
 import math
-from pathlib import Path
 
 import numpy as np
 
@@ -35,8 +34,9 @@ from craters._shared import (
     progress_bar,
 )
 
-from ..meshio.writers import MESH_SUFFIXES, MeshSource, array_source, write_mesh
-from ..shapes import ShapeModel, read_shape_model
+from ..geometry.meshes import TriangleMeshSurface
+from ..meshio.writers import MESH_SUFFIXES, MeshSource, array_source
+from ..shapes import ShapeModel, as_shape_model
 from . import _kernels as _k
 from .distance import mesh_distance, smoothed_constraint
 from .gabor import GaborNoise, add_gabor, gabor_impulses
@@ -55,8 +55,10 @@ _TRIANGLES_PER_AREA = 3.1
 
 
 @dataclasses.dataclass(frozen=True)
-class ImplicitSurface:
-    """A marching-cubes mesh of an implicit body and the crater catalog that made it."""
+class ImplicitSurface(TriangleMeshSurface):
+    """A marching-cubes mesh of an implicit body and the crater catalog that made it: a
+    :class:`~latlong.geometry.surface.Surface` (normals, frames and measures:
+    :class:`~latlong.geometry.meshes.TriangleMeshSurface`)."""
 
     vertices: np.ndarray
     """(V, 3) float64 positions, metres, in the frame of the constraint moved so that its
@@ -93,16 +95,14 @@ class ImplicitSurface:
         return out
 
     @property
-    def volume_m3(self) -> float:
-        return ShapeModel(self.vertices, self.faces).volume_m3
+    def craters(self) -> np.ndarray:
+        """The crater catalog (:attr:`catalog`): the surface's craters."""
+        return self.catalog
 
     @property
-    def area_m2(self) -> float:
-        return ShapeModel(self.vertices, self.faces).area_m2
-
-    def to_pyvista(self):
-        """A ``pyvista.PolyData`` of the mesh."""
-        return ShapeModel(self.vertices, self.faces).to_pyvista()
+    def boulders(self) -> None:
+        """No boulders: the implicit backend places none."""
+        return None
 
     def is_watertight(self) -> bool:
         """Every edge belongs to exactly two faces, each direction once."""
@@ -116,11 +116,6 @@ class ImplicitSurface:
     def mesh_source(self) -> MeshSource:
         """The mesh for the shared mesh writers."""
         return array_source(self.vertices, self.faces, "craterform implicit body, metres")
-
-    def save(self, path, *, progress: bool = False) -> Path:
-        """Write the mesh to a file chosen by suffix (``.ply .obj .stl .vtp .vtk .glb``,
-        :mod:`latlong.meshio.writers`), atomically."""
-        return write_mesh(self.mesh_source(), path, progress=progress)
 
     def to_body(self, magnitude: int, *, crossings: str = "error"):
         """Cast the mesh onto a lat/long grid of ``magnitude`` from the origin.
@@ -193,10 +188,7 @@ def implicit_surface(constraint, layers=(), *, gabor=None, voxel_m: float | None
 
     times: dict[str, float] = {}
     t0 = time.perf_counter()
-    if not isinstance(constraint, ShapeModel):
-        if units is None:
-            raise ValueError("`units` (km or m) is required when reading a constraint file")
-        constraint = read_shape_model(constraint, units=units)
+    constraint = as_shape_model(constraint, units=units, what="constraint", name="constraint")
     layers = list(layers)
     for la in layers:
         if not isinstance(la, LcsnLayer):

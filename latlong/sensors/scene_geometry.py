@@ -10,7 +10,6 @@ a mesh file's ``boulder_id`` point array is kept when it has one.
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -22,6 +21,7 @@ from craters._shared.files import check_regular_file
 
 from ..body import Body, load
 from ..export import body_mesh_source
+from ..meshio.readers import read_mesh
 
 __all__ = ["MESH_SUFFIXES", "SceneGeometry", "scene_geometry"]
 
@@ -59,89 +59,9 @@ def _from_source(src, craters_, boulders, source) -> SceneGeometry:
                          source)
 
 
-_PLY_TYPES = {"float": "<f4", "float32": "<f4", "double": "<f8", "float64": "<f8",
-              "int": "<i4", "int32": "<i4", "uint": "<u4", "uint32": "<u4", "short": "<i2",
-              "int16": "<i2", "ushort": "<u2", "uint16": "<u2", "char": "i1", "int8": "i1",
-              "uchar": "u1", "uint8": "u1"}
-
-
-def _read_triangle_ply(path: Path):
-    """A binary little-endian PLY of triangles with scalar vertex properties (as the
-    craterform writers make them): ``(xyz, faces, {property: values})``, or None for any
-    other PLY (then pyvista reads it; VTK's reader drops the extra properties such as
-    ``boulder_id``)."""
-    with open(path, "rb") as fh:
-        if fh.readline().strip() != b"ply":
-            return None
-        elements, fmt = [], None
-        while True:
-            line = fh.readline()
-            if not line:
-                return None
-            words = line.decode("ascii", "replace").split()
-            if not words or words[0] in ("comment", "obj_info"):
-                continue
-            if words[0] == "format":
-                fmt = words[1]
-            elif words[0] == "element":
-                elements.append((words[1], int(words[2]), []))
-            elif words[0] == "property" and elements:
-                elements[-1][2].append(words[1:])
-            elif words[0] == "end_header":
-                break
-        names = [e[0] for e in elements]
-        if fmt != "binary_little_endian" or names != ["vertex", "face"]:
-            return None
-        (_, nv, vprops), (_, nf, fprops) = elements
-        if any(len(p) != 2 or p[0] not in _PLY_TYPES for p in vprops) or len(fprops) != 1 \
-                or fprops[0][0] != "list" or fprops[0][1] not in _PLY_TYPES \
-                or fprops[0][2] not in _PLY_TYPES:
-            return None
-        vdt = np.dtype([(p[1], _PLY_TYPES[p[0]]) for p in vprops])
-        fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]]), ("i", _PLY_TYPES[fprops[0][2]], 3)])
-        verts = np.fromfile(fh, dtype=vdt, count=nv)
-        faces = np.fromfile(fh, dtype=fdt, count=nf)
-    if len(verts) != nv or len(faces) != nf or not {"x", "y", "z"} <= set(vdt.names) \
-            or (faces["n"] != 3).any():
-        return None
-    xyz = np.stack([verts["x"], verts["y"], verts["z"]], 1).astype(np.float64)
-    return xyz, faces["i"].astype(np.int64), {k: verts[k] for k in vdt.names}
-
-
 def _read_mesh(path: Path, units: str) -> SceneGeometry:
-    if path.suffix.lower() == ".ply":
-        try:
-            ply = _read_triangle_ply(path)
-        except (OSError, ValueError):
-            ply = None
-        if ply is not None:
-            verts, faces, fields = ply
-            if len(faces) and (faces.min() < 0 or faces.max() >= len(verts)):
-                raise ValueError(f"cannot read mesh {str(path)!r}: face indices out of range")
-            return _mesh_geometry(verts * _UNITS[units], faces, fields, path)
-    import pyvista as pv
-    from vtkmodules.vtkCommonCore import vtkObject
-
-    shown = vtkObject.GetGlobalWarningDisplay()
-    vtkObject.GlobalWarningDisplayOff()  # a bad file: one line from us, not VTK's report
-    try:
-        with pv.vtk_verbosity("off"), warnings.catch_warnings():
-            warnings.simplefilter("error")
-            mesh = pv.read(path)
-    except Exception as exc:  # noqa: BLE001 - any reader failure is an unreadable mesh
-        raise ValueError(f"cannot read mesh {str(path)!r}: {exc}".splitlines()[0]) from None
-    finally:
-        vtkObject.SetGlobalWarningDisplay(shown)
-    if isinstance(mesh, pv.MultiBlock):
-        mesh = mesh.combine(merge_points=False)
-    if not isinstance(mesh, pv.PolyData):
-        mesh = mesh.extract_surface()
-    mesh = mesh.triangulate()
-    faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
-        else np.zeros((0, 3), np.int64)
-    return _mesh_geometry(np.asarray(mesh.points, dtype=np.float64) * _UNITS[units], faces,
-                          {k: np.asarray(mesh.point_data[k]) for k in mesh.point_data.keys()},
-                          path)
+    mesh = read_mesh(path, units=units)  # the mesh-reader registry (latlong.meshio)
+    return _mesh_geometry(mesh.vertices, mesh.faces, mesh.fields, path)
 
 
 def _mesh_geometry(verts, faces, fields, path) -> SceneGeometry:
