@@ -30,6 +30,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_range
 
+from ..geometry.surface import Surface
 from ._render_kernels import (
     _ground_truth_kernel,
     _shade_kernel,
@@ -130,27 +131,15 @@ class Frame:
 
 
 def scene_mesh(geometry, *, build_quality: str = "medium") -> RayMesh:
-    """A :class:`RayMesh` for a RayMesh (returned as is), a :class:`SceneGeometry`, a
-    ``latlong.Body`` (its mesh and its boulders), a ``latlong.ShapeModel`` or a
+    """A :class:`RayMesh` for a RayMesh (returned as is), any
+    :class:`~latlong.geometry.surface.Surface` (a :class:`SceneGeometry`, a
+    ``latlong.Body``, a ``latlong.ShapeModel`` ...: its mesh and its boulders) or a
     ``(vertices, faces)`` pair."""
     if isinstance(geometry, RayMesh):
         return geometry
-    if isinstance(geometry, SceneGeometry):
-        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
-    from ..body import Body
-    from ..shapes import ShapeModel
-
-    if isinstance(geometry, Body):
-        verts, faces = geometry.vertices(), geometry.grid.triangles()
-        if geometry.boulders is not None and len(geometry.boulders):
-            from craters.boulders import boulder_world_meshes
-
-            bv, bf = boulder_world_meshes(geometry.boulders)
-            faces = np.concatenate([faces, bf + len(verts)])
-            verts = np.concatenate([verts, bv])
-        return RayMesh(verts, faces, build_quality=build_quality)
-    if isinstance(geometry, ShapeModel):
-        return RayMesh(geometry.vertices, geometry.faces, build_quality=build_quality)
+    if isinstance(geometry, Surface):  # the surface and its boulders (a body's, a scene's)
+        vertices, faces, _ = geometry.mesh_source().arrays()
+        return RayMesh(vertices, faces, build_quality=build_quality)
     if isinstance(geometry, tuple) and len(geometry) == 2:
         return RayMesh(*geometry, build_quality=build_quality)
     raise TypeError("`geometry` must be a RayMesh, a Body, a ShapeModel or (vertices, faces);"

@@ -19,9 +19,12 @@ import craters
 from craters._shared import ParameterError, check_choice
 from craters._shared.files import check_regular_file
 
-from ..body import Body, load
+from ..body import load
 from ..export import body_mesh_source
+from ..geometry.meshes import TriangleMeshSurface
+from ..geometry.surface import Surface
 from ..meshio.readers import read_mesh
+from ..meshio.writers import MeshSource, array_source
 
 __all__ = ["MESH_SUFFIXES", "SceneGeometry", "scene_geometry"]
 
@@ -31,8 +34,9 @@ _UNITS = {"m": 1.0, "km": 1000.0}
 
 
 @dataclass(frozen=True, slots=True)
-class SceneGeometry:
-    """A triangle mesh in the body frame and the ground truth that labels it."""
+class SceneGeometry(TriangleMeshSurface):
+    """A triangle mesh in the body frame and the ground truth that labels it: a
+    :class:`~latlong.geometry.surface.Surface`."""
 
     vertices: np.ndarray
     """(n, 3) float64 positions, metres, body frame."""
@@ -46,6 +50,22 @@ class SceneGeometry:
     """The boulder catalog as placed or None."""
     source: str = ""
     """Where it came from."""
+
+    @property
+    def metadata(self) -> dict:
+        """``{"source": source}``."""
+        return {"source": self.source}
+
+    def mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """The vertices and the surface's faces (the boulders' left out)."""
+        return self.vertices, self.faces[self.face_boulder_id < 0]
+
+    def mesh_source(self) -> MeshSource:
+        """The whole scene (boulders with their ``boulder_id``) for the mesh writers."""
+        ids = np.full(len(self.vertices), -1, dtype=np.int32)
+        ids[self.faces] = self.face_boulder_id[:, None]
+        return array_source(self.vertices, self.faces, "craterform scene, metres",
+                            boulder_id=ids)
 
 
 def _from_source(src, craters_, boulders, source) -> SceneGeometry:
@@ -98,11 +118,10 @@ def scene_geometry(model, *, units: str = "m", craters=None, mesh=None) -> Scene
     check_choice("units", units, tuple(_UNITS))
     if isinstance(model, SceneGeometry):
         geo = model
-    elif isinstance(model, Body):
-        geo = _from_source(body_mesh_source(model), model.craters, model.boulders,
-                           repr(model))
     elif hasattr(model, "mesh_source") and hasattr(model, "faces"):
         geo = _from_source(model.mesh_source(), model.craters, model.boulders, "mesh surface")
+    elif isinstance(model, Surface):  # a body (and its boulders)
+        geo = _from_source(model.mesh_source(), model.craters, model.boulders, repr(model))
     elif isinstance(model, str | Path):
         path = Path(model)
         check_regular_file(path, "model file")
