@@ -218,7 +218,7 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     rim_tabs, seeds = req.draws(len(cat), normalize_rng(rng))
     radii, overwritten = _radii_to_stamp(body, overwrite_body)
     prof = stamping_profiles(cat, target, ejecta_edge=req.ejecta_edge)
-    gravity_up = slope_reference == "gravity" and len(cat) and req.slope_erosion
+    gravity_up = slope_reference == "gravity" and len(cat) > 0 and req.slope_erosion
     run = _BodyStamp.of(body, radii, cat, prof, rim_tabs, seeds, req, gravity_up)
     _stamp(run, body, cat, overwritten, progress)
     if len(cat) and any((radii[s:s + _CHUNK] <= 0).any() for s in range(0, len(radii), _CHUNK)):

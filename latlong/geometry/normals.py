@@ -168,7 +168,7 @@ def vertex_normals(vertices, faces, weighting: str = "area", *,
     >>> v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]])
     >>> f = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
     >>> vertex_normals(v, f, "area")[3].round(3).tolist()
-    [-0.408, -0.408, 0.816]
+    [0.0, 0.0, 1.0]
     """
     v = np.asarray(vertices, dtype=np.float64)
     if v.ndim == 3:
