@@ -119,7 +119,6 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         BoulderShape,
         boulder,
         boulder_meshes,
-        boulder_normals,
         parse_boulder_spec,
     )
     from .catalog import (
@@ -211,7 +210,6 @@ __all__ = [
     "as_stamped",
     "boulder",
     "boulder_meshes",
-    "boulder_normals",
     "cap_at_equilibrium",
     "crater_morphometry",
     "crater_tau",

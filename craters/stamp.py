@@ -46,8 +46,9 @@ from .targets import Target, get_target
 
 logger = logging.getLogger(__name__)
 
-__all__ = ["Crater", "Roughness", "StampingProfiles", "resolve_roughness", "rim_perturbations",
-           "stamp", "stamp_many", "stamping_profiles"]
+__all__ = ["Crater", "Roughness", "StampRequest", "StampingProfiles", "resolve_roughness",
+           "rim_perturbations", "stamp", "stamp_many", "stamp_request", "stamped_after",
+           "stamping_profiles"]
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown
@@ -144,6 +145,68 @@ def resolve_roughness(roughness) -> tuple[Roughness, bool]:
     if isinstance(roughness, Roughness):
         return roughness, True
     raise TypeError(f"`roughness` must be True, False or a Roughness; got {roughness!r}")
+
+
+@dataclasses.dataclass(frozen=True)
+class StampRequest:
+    """A crater catalog and the stamping options shared by every surface (a height grid,
+    :func:`stamp_many`; a lat/long body, :func:`latlong.stamp_craters`; a mesh,
+    :func:`latlong.mesh.stamp_mesh_craters`), checked once by :func:`stamp_request`."""
+
+    catalog: np.ndarray
+    """The catalog, validated, oldest first."""
+    roughness: Roughness
+    """Overlay amplitudes (zero without roughness)."""
+    irregularity: float
+    """Largest rim-radius perturbation used (0 without roughness: circular rims)."""
+    ejecta_edge: float
+    """Ejecta edge in crater radii."""
+    slope_erosion: bool
+    """Less relief on steep ground."""
+    onset_deg: float
+    """Slope where the relief starts to shrink, degrees."""
+    full_deg: float
+    """Slope of no relief (the crater is erased), degrees."""
+
+    @property
+    def rough_array(self) -> np.ndarray:
+        """Bowl, wall and ejecta amplitudes: the kernels' ``rough``."""
+        return np.array([self.roughness.bowl, self.roughness.wall, self.roughness.ejecta])
+
+    @property
+    def gain(self) -> float:
+        """The overlay's octave gain, 2^(F - 3)."""
+        return 2.0 ** (self.roughness.fractal_dimension - 3.0)
+
+    def draws(self, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+        """The random part of stamping ``n`` craters, in this order: rim perturbations
+        (n, 64) and overlay seeds (n,) uint64, from the Generator ``rng``."""
+        rim_tabs = rim_perturbations(n, self.irregularity, rng=rng)
+        return rim_tabs, rng.integers(0, 2**63, size=n, dtype=np.uint64)
+
+
+def stamp_request(catalog, *, columns: tuple[str, ...], onto: str, roughness=True,
+                  irregularity: float = 0.02, ejecta_edge: float = EJECTA_EDGE,
+                  slope_erosion: bool = True, onset_deg: float = 20.0,
+                  full_deg: float = 45.0) -> StampRequest:
+    """Check a stamping request once (see :func:`stamp_many` for the options): the catalog
+    validated and sorted oldest first, with the position ``columns`` stamping ``onto``
+    (``"a grid"``, ``"a body"``, ``"a mesh"``) needs; ``ValueError``/``TypeError``
+    naming the parameter otherwise."""
+    cat = sort_oldest_first(validate_catalog(catalog))
+    missing = [c for c in columns if c not in cat.dtype.names]
+    if missing:
+        raise ValueError(f"`catalog` needs {', '.join(columns)} columns to stamp on {onto}; "
+                         f"it has no {missing[0]!r}")
+    rough, irregular = resolve_roughness(roughness)
+    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
+    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
+    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
+    full = check_range("full_deg", full_deg, 0.0, 90.0)
+    if slope_erosion and full <= onset:
+        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
+    return StampRequest(cat, rough, irregularity if irregular else 0.0, ejecta_edge,
+                        bool(slope_erosion), onset, full)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -244,30 +307,21 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     """
     h = _check_heights(heights)
     pixel = check_positive("pixel_size_m", pixel_size_m)
-    cat = sort_oldest_first(validate_catalog(catalog))
-    if "x_m" not in cat.dtype.names:
-        raise ValueError("`catalog` needs planar positions x_m, y_m for stamping on a grid")
-    rough, irregular = resolve_roughness(roughness)
-    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
-    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
-    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
-    full = check_range("full_deg", full_deg, 0.0, 90.0)
-    if slope_erosion and full <= onset:
-        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
+    req = stamp_request(catalog, columns=("x_m", "y_m"), onto="a grid", roughness=roughness,
+                        irregularity=irregularity, ejecta_edge=ejecta_edge,
+                        slope_erosion=slope_erosion, onset_deg=onset_deg, full_deg=full_deg)
+    cat, ejecta_edge, onset, full = req.catalog, req.ejecta_edge, req.onset_deg, req.full_deg
     rng = normalize_rng(rng)
     n = len(cat)
     names = cat.dtype.names
     prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
-    irr = irregularity if irregular else 0.0
-    rim_tabs = rim_perturbations(n, irr, rng=rng)
-    seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
+    rim_tabs, seeds = req.draws(n, rng)
     cx = np.ascontiguousarray(cat["x_m"] / pixel, dtype=np.float64)
     cy = np.ascontiguousarray(cat["y_m"] / pixel, dtype=np.float64)
     diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
     scale, slope = np.ones(n), np.zeros(n)
     erased = np.zeros(n, dtype=np.bool_)
-    rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
-    gain = 2.0 ** (rough.fractal_dimension - 3.0)
+    rough_arr, gain = req.rough_array, req.gain
     _stamp_all((h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds,
                 ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain, scale, slope,
                 erased), progress)
@@ -372,6 +426,19 @@ def as_stamped(prof: StampingProfiles, scale: np.ndarray, diameter_m: np.ndarray
     degradation = np.clip(1.0 - depth / prof.fresh_depth_m, 0.0, 1.0)
     return {"degradation": degradation, "rim_radius_m": diameter_m / 2.0, "depth_m": depth,
             "rim_height_m": prof.rim_height_m * scale, **prof.extra}
+
+
+def stamped_after(previous, stamped: np.ndarray) -> np.ndarray:
+    """A surface's crater catalog after stamping: its ``previous`` craters (if any) then
+    the ``stamped`` ones, or only the stamped ones when the previous catalog has other
+    columns (logged)."""
+    if previous is None or not len(previous):
+        return stamped
+    try:
+        return np.concatenate([previous, stamped.astype(previous.dtype)])
+    except (TypeError, ValueError):
+        logger.warning("previous crater catalog has other columns; keeping only the new")
+        return stamped
 
 
 def stamp(heights, pixel_size_m: float, crater: Crater, *, roughness=True, rng=None,

@@ -26,7 +26,6 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import check_choice
 from latlong.meshio.writers import MeshSource
 
 from .io import read
@@ -115,11 +114,11 @@ class DemSurface:
         return self._mesh
 
     def vertex_normals(self, weighting: str = "area") -> np.ndarray:
-        """(V, 3) unit area-weighted vertex normals of :meth:`mesh` (up)."""
-        from latlong.mesh.topology import vertex_normals
+        """(V, 3) unit vertex normals of :meth:`mesh` with a named weighting
+        (:data:`latlong.geometry.normals.WEIGHTINGS`)."""
+        from latlong.geometry.normals import vertex_normals
 
-        check_choice("weighting", weighting, ("area",))
-        return vertex_normals(*self.mesh())
+        return vertex_normals(*self.mesh(), weighting)
 
     def local_frames(self, points) -> np.ndarray:
         """(n, 3, 3) frames at ``points``: rows east, north, up = the site's x, y, z."""

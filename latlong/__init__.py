@@ -261,7 +261,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         implicit_surface,
         sphere_packing,
     )
-    from .loader import MeshFile, load_surface
+    from .loader import MeshData, load_surface
     from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
     from .presets import PRESETS
     from .preview import PreviewSettings, render_preview
@@ -315,7 +315,7 @@ __all__ = [
     "ImplicitSurface",
     "LatLongGrid",
     "LcsnLayer",
-    "MeshFile",
+    "MeshData",
     "ShapeModel",
     "apply_faults",
     "area_mean",

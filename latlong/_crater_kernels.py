@@ -161,34 +161,118 @@ def _fill_rim_cells(grid, known, cy, cx, pixel, radius, rim_tab):
 PARALLEL_MIN = 20_000
 
 
+@njit(cache=True, inline="always")
+def _reach(radius, rim_tab, xe):
+    """Radius (metres) within which the crater changes anything: the ejecta edge at its
+    widest rim."""
+    rho_max = 0.0
+    for k in range(rim_tab.shape[0]):
+        rho_max = max(rho_max, rim_tab[k])
+    return xe * radius * (1.0 + rho_max)
+
+
+@njit(cache=True, inline="always")
+def _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta,
+                   p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves, gain, far):
+    """(inside the ejecta edge?, height change in metres) of gathered point ``q``: inside
+    the (irregular) rim the base quadric plus the profile, outside the terrain plus the
+    profile and the rim offset fading to the edge, with the roughness overlay. Beyond
+    ``far`` (the ejecta edge of the widest rim, :func:`_far`) nothing changes: no rim
+    lookup there (nor an azimuth: the body's local coordinates leave it 0)."""
+    if dist[q] > far:
+        return False, 0.0
+    x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
+    if not x < xe:
+        return False, 0.0
+    if x <= 1.0:
+        new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+               + scale * table_value(tab, x, xe))
+    else:
+        new = (hgt[q] + scale * table_value(tab, x, xe)
+               + table(delta, az[q]) * outer_weight(x, xe))
+    if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
+        amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
+        new += amp * fbm2(seed, xl[q], yl[q], wavelength, octaves, gain)
+    return True, new - hgt[q]
+
+
+@njit(cache=True, inline="always")
+def _far(radius, rim_tab, xe):
+    """The ejecta edge of the widest rim with a margin over rounding: no point beyond it
+    changes (:func:`_height_change`)."""
+    return _reach(radius, rim_tab, xe) * (1.0 + 1e-12)
+
+
+@njit(cache=True, inline="always")
+def _point_arrays(cnt):
+    """Work arrays of a crater's ``cnt`` candidate points: vertex, distance from the
+    centre (|position| on the body), distance in the crater's plane, azimuth, x, y and
+    height in its frame."""
+    return (np.empty(cnt, np.int64), np.empty(cnt), np.empty(cnt), np.empty(cnt),
+            np.empty(cnt), np.empty(cnt), np.empty(cnt))
+
+
+@njit(cache=True)
+def _residual_grid(xl, yl, hgt, keep, sp, limit, p0, gx, gy, qa, qb, qc):
+    """The local height grid of a crater's region: the first ``keep`` points' heights
+    relative to the base quadric, averaged in cells of ``sp`` metres over +-``limit``
+    (cell (nh, nh) at the centre). Returns (grid, known cells, nh)."""
+    nh = int(np.ceil(limit / sp)) + 1
+    g = 2 * nh + 1
+    acc = np.zeros((g, g))
+    num = np.zeros((g, g))
+    for q in range(keep):
+        gi = int(np.round(yl[q] / sp)) + nh
+        gj = int(np.round(xl[q] / sp)) + nh
+        if 0 <= gi < g and 0 <= gj < g:
+            acc[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
+            num[gi, gj] += 1.0
+    known = num > 0
+    for gi in range(g):
+        for gj in range(g):
+            if known[gi, gj]:
+                acc[gi, gj] /= num[gi, gj]
+    return acc, known, nh
+
+
+@njit(cache=True, inline="always")
+def _slope_deg(a0, a1, a2, e0, e1, e2, n0, n1, n2, gx, gy, r0, r1, r2):
+    """Angle (degrees) between the normal of the base plane (slopes gx, gy along east e and
+    north n of the frame with up a) and the reference direction r."""
+    l0 = a0 - gx * e0 - gy * n0
+    l1 = a1 - gx * e1 - gy * n1
+    l2 = a2 - gx * e2 - gy * n2
+    cr0 = l1 * r2 - l2 * r1
+    cr1 = l2 * r0 - l0 * r2
+    cr2 = l0 * r1 - l1 * r0
+    return np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                 l0 * r0 + l1 * r1 + l2 * r2))
+
+
+@njit(cache=True, inline="always")
+def _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert):
+    """Crater c's report: its slope-erosion factor, largest height change and the count
+    of points it wrote."""
+    big = 0.0
+    for q in range(keep):
+        big = max(big, abs(dh[q]))
+    out_scale[c] = scale
+    out_maxdh[c] = big
+    out_nvert[c] = keep
+
+
 @njit(cache=True)
 def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
                  rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves, gain,
                  dh_out):
-    """New radii for gathered vertices lo..hi-1 (each vertex written once)."""
-    # beyond the ejecta edge of the widest rim nothing changes: no rim lookup there (nor
-    # an azimuth: _local_coordinates leaves it 0 beyond this same bound)
-    far = 0.0
-    for k in range(rim_tab.shape[0]):
-        far = max(far, rim_tab[k])
-    far = xe * radius * (1.0 + far) * (1.0 + 1e-12)  # margin over rounding
+    """New radii for gathered vertices lo..hi-1 (each vertex written once): the radial
+    vector rescaled by the height change."""
+    far = _far(radius, rim_tab, xe)
     for q in range(lo, hi):
-        if dist[q] > far:
-            dh_out[q] = 0.0
-            continue
-        x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
-        dh = 0.0
-        if x < xe:
-            if x <= 1.0:
-                new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-                       + scale * table_value(tab, x, xe))
-            else:
-                new = (hgt[q] + scale * table_value(tab, x, xe)
-                       + table(delta, az[q]) * outer_weight(x, xe))
-            if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
-                amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
-                new += amp * fbm2(seed, xl[q], yl[q], wavelength, octaves, gain)
-            dh = new - hgt[q]
+        inside, dh = _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
+                                    rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed,
+                                    wavelength, octaves, gain, far)
+        if inside:
             i = idx[q]
             radii[i] = radii[i] * (pmag[q] + dh) / pmag[q]
         dh_out[q] = dh
@@ -243,10 +327,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     n1 = a2 * e0v - a0 * e2v
     n2 = a0 * e1v - a1 * e0v
     radius = 0.5 * diam[c]
-    rho_max = 0.0
-    for k in range(n_rim):
-        rho_max = max(rho_max, rim_tabs[c, k])
-    reach = xe * radius * (1.0 + rho_max)
+    reach = _reach(radius, rim_tabs[c], xe)
     nominal = rloc * np.pi / (2 * m)
     ang = min(np.pi, (reach + 2.0 * nominal) / rloc * smax / smin)
     if ang > ang_bound:
@@ -259,13 +340,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
         cand = np.empty(cnt, np.int64)
         _gather_kernel(m, ring_offsets, colat, lo, ang, cand, False)
     # local coordinates of the candidates
-    idx = np.empty(cnt, np.int64)
-    pmag = np.empty(cnt)
-    dist = np.empty(cnt)
-    az = np.empty(cnt)
-    xl = np.empty(cnt)
-    yl = np.empty(cnt)
-    hgt = np.empty(cnt)
+    idx, pmag, dist, az, xl, yl, hgt = _point_arrays(cnt)
     limit = reach + 2.0 * nominal
     keep, n_inside = _local_coordinates(cand, m, ring_offsets, radii, stretch, a0, a1, a2,
                                         e0v, e1v, e2v, n0, n1, n2, rloc, reach, limit, idx,
@@ -285,30 +360,13 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
                                                 max(radius, 2.0 * sp))
     # the local grid holds the terrain relative to that plane (binned at the local
     # vertex spacing, holes filled), from which the rim offsets are sampled
-    nh = int(np.ceil(limit / sp)) + 1
-    g = 2 * nh + 1
-    acc = np.zeros((g, g))
-    num = np.zeros((g, g))
-    for q in range(keep):
-        gi = int(np.round(yl[q] / sp)) + nh
-        gj = int(np.round(xl[q] / sp)) + nh
-        if 0 <= gi < g and 0 <= gj < g:
-            acc[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-            num[gi, gj] += 1.0
-    known = num > 0
-    for gi in range(g):
-        for gj in range(g):
-            if known[gi, gj]:
-                acc[gi, gj] /= num[gi, gj]
+    acc, known, nh = _residual_grid(xl, yl, hgt, keep, sp, limit, p0, gx, gy, qa, qb, qc)
     local = _fill_rim_cells(acc, known, float(nh), float(nh), sp, radius, rim_tabs[c])
     if stop_after == 2:
         return True
     # slope: angle between the local surface normal (from the fitted base) and the
     # normal of the reference body (the stretched sphere, S^-2 P_c; radial when
     # unstretched), so that an elongated body's shape is not mistaken for steep ground
-    l0 = a0 - gx * e0v - gy * n0
-    l1 = a1 - gx * e1v - gy * n1
-    l2 = a2 - gx * e2v - gy * n2
     if up.shape[0] > 0:  # the given "up" (e.g. against self-gravity on a shape model)
         r0 = up[c, 0]
         r1 = up[c, 1]
@@ -317,11 +375,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
         r0 = pc0 / (stretch[0] * stretch[0])
         r1 = pc1 / (stretch[1] * stretch[1])
         r2 = pc2 / (stretch[2] * stretch[2])
-    cr0 = l1 * r2 - l2 * r1
-    cr1 = l2 * r0 - l0 * r2
-    cr2 = l0 * r1 - l1 * r0
-    slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
-                                  l0 * r0 + l1 * r1 + l2 * r2))
+    slope = _slope_deg(a0, a1, a2, e0v, e1v, e2v, n0, n1, n2, gx, gy, r0, r1, r2)
     out_slope[c] = slope
     out_centre[c, 0] = pc0
     out_centre[c, 1] = pc1
@@ -344,12 +398,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
         _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
                      scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
                      rough, seeds[c], radius, octaves, gain, dh)
-    big = 0.0
-    for q in range(keep):
-        big = max(big, abs(dh[q]))
-    out_scale[c] = scale
-    out_maxdh[c] = big
-    out_nvert[c] = keep
+    _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)
     return True
 
 

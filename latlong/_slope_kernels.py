@@ -1,143 +1,13 @@
-"""Numba kernels for slopes and shading on the lat/long body: vertex normals (from a
-vertex array, or streamed band by band from the radii) and cap averages."""
+"""Numba kernels for slopes on the lat/long body and on meshes: per-ring prefix sums and
+cap averages over the grid, and cap sums over vertex directions (the vertex normals
+they average are :mod:`latlong.geometry.normals`')."""
 
 from __future__ import annotations
 
 import numpy as np
 from numba import njit, prange
 
-from ._grid_kernels import _lon_row, _ring_positions, _ring_size
-
-
-@njit(cache=True)
-def _vertex_normals_kernel(verts, tris, out, area):
-    """Add each triangle's area vector (cross product / 2) to its vertices' normals and
-    a third of its area to their areas (none when ``area`` is empty), triangle by
-    triangle: the one vertex-normal accumulation (``out`` may be float32: each addition
-    is done in float64 and stored)."""
-    with_area = area.shape[0] > 0
-    for t in range(tris.shape[0]):
-        a = tris[t, 0]
-        b = tris[t, 1]
-        c = tris[t, 2]
-        e1x = verts[b, 0] - verts[a, 0]
-        e1y = verts[b, 1] - verts[a, 1]
-        e1z = verts[b, 2] - verts[a, 2]
-        e2x = verts[c, 0] - verts[a, 0]
-        e2y = verts[c, 1] - verts[a, 1]
-        e2z = verts[c, 2] - verts[a, 2]
-        nx = 0.5 * (e1y * e2z - e1z * e2y)
-        ny = 0.5 * (e1z * e2x - e1x * e2z)
-        nz = 0.5 * (e1x * e2y - e1y * e2x)
-        third = np.sqrt(nx * nx + ny * ny + nz * nz) / 3.0 if with_area else 0.0
-        for v in (a, b, c):
-            out[v, 0] += nx
-            out[v, 1] += ny
-            out[v, 2] += nz
-            if with_area:
-                area[v] += third
-
-
-@njit(cache=True, inline="always")
-def _add_triangle_normal(pos, a, b, c, out):
-    """Add triangle (a, b, c)'s area vector to its vertices' normals: the arithmetic of
-    :func:`_vertex_normals_kernel` (without areas), one triangle."""
-    e1x = pos[b, 0] - pos[a, 0]
-    e1y = pos[b, 1] - pos[a, 1]
-    e1z = pos[b, 2] - pos[a, 2]
-    e2x = pos[c, 0] - pos[a, 0]
-    e2y = pos[c, 1] - pos[a, 1]
-    e2z = pos[c, 2] - pos[a, 2]
-    nx = 0.5 * (e1y * e2z - e1z * e2y)
-    ny = 0.5 * (e1z * e2x - e1x * e2z)
-    nz = 0.5 * (e1x * e2y - e1y * e2x)
-    for v in (a, b, c):
-        out[v, 0] += nx
-        out[v, 1] += ny
-        out[v, 2] += nz
-
-
-@njit(cache=True, inline="always")
-def _band_normals(pos, oa, na, ob, nb, south, out):
-    """Area vectors of a band's triangles, in :func:`_band_triangles_kernel`'s order and
-    winding (the same zipper), added to ``out`` as they are made (no triangle array)."""
-    if na == 1:  # pole fan
-        for j in range(nb):
-            if south:
-                _add_triangle_normal(pos, oa, ob + (j + 1) % nb, ob + j, out)
-            else:
-                _add_triangle_normal(pos, oa, ob + j, ob + (j + 1) % nb, out)
-        return
-    i = 0
-    j = 0
-    for _ in range(na + nb):
-        if i < na and (j >= nb or (i + 1) * nb <= (j + 1) * na):
-            p, q, r = oa + i, ob + j % nb, oa + (i + 1) % na
-            i += 1
-        else:
-            p, q, r = oa + i % na, ob + j, ob + (j + 1) % nb
-            j += 1
-        if south:
-            _add_triangle_normal(pos, p, r, q, out)
-        else:
-            _add_triangle_normal(pos, p, q, r, out)
-
-
-@njit(cache=True, inline="always")
-def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, base):
-    """Band ``band``'s two rings positioned locally (:func:`_ring_positions`; longitudes
-    from ``lon_table``, or computed when it is empty) and its triangles' area vectors
-    added to ``acc`` (row ``v - base`` is vertex v's)."""
-    if band < m:
-        ra, rb, south = band, band + 1, False
-    else:
-        ra, rb, south = band + 1, band, True
-    na = _ring_size(ra, m)
-    nb = _ring_size(rb, m)
-    oa = ring_offsets[ra]
-    ob = ring_offsets[rb]
-    lo = min(oa, ob)
-    pos = np.empty((na + nb, 3))
-    ta = _lon_row(m, ra, ring_offsets) if lon_table.shape[0] else 0
-    tb = _lon_row(m, rb, ring_offsets) if lon_table.shape[0] else 0
-    _ring_positions(m, ra, oa, radii, stretch, lon_table, ta, pos[oa - lo:oa - lo + na])
-    _ring_positions(m, rb, ob, radii, stretch, lon_table, tb, pos[ob - lo:ob - lo + nb])
-    _band_normals(pos, oa - lo, na, ob - lo, nb, south, acc[lo - base:lo - base + na + nb])
-
-
-@njit(cache=True, parallel=True)
-def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc):
-    """Area-weighted vertex normals of the body into ``acc``, streamed band by band (no
-    triangle or vertex array of the whole body): each band's two rings (consecutive
-    vertex numbers) are positioned locally and its triangles' area vectors added as the
-    zipper makes them (:func:`_band_normals`; 40 % less time than triangulating into an
-    array first, the same values). Even bands first, then odd bands: the bands of one
-    pass share no ring, so they run in parallel and every vertex receives its two bands'
-    contributions in a fixed order (deterministic). The longitudes' cosines and sines come
-    from ``lon_table`` (:func:`~latlong._grid_kernels.lon_table`)."""
-    n_bands = 2 * m
-    for parity in range(2):
-        for hb in prange((n_bands - parity + 1) // 2):
-            band = 2 * hb + parity
-            if band >= n_bands:
-                continue
-            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, 0)
-
-
-@njit(cache=True, parallel=True)
-def _normalize_rows_kernel(acc):
-    """Scale the float32 rows of ``acc`` to unit length in place: the norm in float64,
-    ``sqrt((x^2 + y^2) + z^2)``, rounded to float32 and divided into each component
-    (rows of norm 0 are left alone)."""
-    for i in prange(acc.shape[0]):
-        x = np.float64(acc[i, 0])
-        y = np.float64(acc[i, 1])
-        z = np.float64(acc[i, 2])
-        norm = np.sqrt((x * x + y * y) + z * z)
-        if norm > 0:
-            d = np.float32(norm)
-            for c in range(3):
-                acc[i, c] = acc[i, c] / d
+from ._grid_kernels import _ring_size
 
 
 @njit(cache=True, parallel=True)
@@ -309,10 +179,3 @@ def _direction_cap_sum_kernel(dirs, values, cells, keys, starts, cell_sums, nc, 
                     s += 1
         for c in range(k):
             out[i, c] = acc[c]
-
-
-@njit(cache=True)
-def _scatter_add_kernel(index, values, out):
-    """``out[index[t]] += values[t]`` in the order of t (``np.add.at``, (N,) or (N, k))."""
-    for t in range(index.shape[0]):
-        out[index[t]] += values[t]

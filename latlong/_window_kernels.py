@@ -5,7 +5,7 @@ The glTF export needs every vertex's float32 position and unit normal. Holding t
 the whole body costs 24 B a vertex (plus 8 B of longitude table): 16 GB at M = 8192.
 These kernels make them for a window of consecutive rings only, with the same values,
 bit for bit, as the whole-body kernels (:func:`~latlong._export_kernels._glb_positions_kernel`,
-:func:`~latlong._slope_kernels._normals_from_radii_kernel`): the longitudes' cosines and
+:func:`~latlong.geometry._normal_kernels._normals_from_radii_kernel`): the longitudes' cosines and
 sines are computed with the same expression as the table's, and a ring's normal receives
 the area vectors of its two bands in the same order (the even band first, each band's
 triangles in zipper order), so the export's bytes do not change.
@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._slope_kernels import _band_area_vectors
+from .geometry._normal_kernels import _band_area_vectors
 
 
 @njit(cache=True, parallel=True)

@@ -1,4 +1,8 @@
-"""The body: a lat/long grid with one radius per vertex, saved losslessly as .npz."""
+"""The body: a lat/long grid with one radius per vertex, saved losslessly as .npz.
+
+A :class:`Body` is a :class:`~latlong.geometry.surface.Surface` (its triangle mesh, vertex
+normals, local frames, mesh export) and :class:`~latlong.geometry.surface.Resamplable`
+(onto a coarser grid)."""
 
 from __future__ import annotations
 
@@ -19,6 +23,8 @@ from craters._shared import (
 from craters._shared.files import check_regular_file
 
 from .export import EXPORT_SUFFIXES, body_mesh_source, export_body
+from .geometry.meshes import polydata
+from .geometry.normals import lat_long_vertex_normals, tangent_frames, unit_rows, vertex_normals
 from .grid import LatLongGrid
 
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
@@ -233,25 +239,65 @@ class Body:
         u = self._grid.unit_vectors_range(lo, hi)
         return u * (self._radii[lo:hi, None] * self._stretch)
 
-    def vertex_normals(self) -> np.ndarray:
-        """Unit area-weighted vertex normals of the body's triangle mesh, float32 (N, 3),
-        computed band by band (:meth:`LatLongGrid.vertex_normals`)."""
-        return self._grid.vertex_normals(self._radii, self._stretch)
+    def mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(vertices, faces)``: (N, 3) float64 positions in metres and the grid's
+        (2N - 4, 3) triangles (boulders not included)."""
+        return self.vertices(), self._grid.triangles()
+
+    def vertex_normals(self, weighting: str = "area") -> np.ndarray:
+        """Unit vertex normals of the body's triangle mesh with a named weighting
+        (:data:`latlong.geometry.normals.WEIGHTINGS`): ``"area"`` float32 (N, 3), streamed
+        band by band (:func:`~latlong.geometry.normals.lat_long_vertex_normals`); the
+        others float64 from :meth:`mesh`."""
+        if weighting == "area":
+            return lat_long_vertex_normals(self._grid, self._radii, self._stretch)
+        return vertex_normals(*self.mesh(), weighting)
+
+    def local_frames(self, points) -> np.ndarray:
+        """(n, 3, 3) frames, rows east, north, up, at the surface under ``points`` (n, 3)
+        seen from the centre: up is the area-weighted vertex normals interpolated at the
+        points' grid directions (as boulders stand), east = z x up
+        (:func:`~latlong.geometry.normals.tangent_frames`)."""
+        q = np.asarray(points, dtype=np.float64).reshape(-1, 3) / self._stretch
+        r = np.linalg.norm(q, axis=1)
+        colat = np.arccos(np.clip(q[:, 2] / np.where(r > 0, r, 1.0), -1.0, 1.0))
+        lon = np.arctan2(q[:, 1], q[:, 0])
+        normals = self.vertex_normals("area").astype(np.float64)
+        up = np.stack([self._grid.interpolate(normals[:, c], colat, lon) for c in range(3)], 1)
+        return tangent_frames(unit_rows(up))
+
+    def mesh_source(self):
+        """The body and its placed boulders as a streamed
+        :class:`~latlong.meshio.writers.MeshSource` for the mesh writers
+        (:func:`latlong.export.body_mesh_source`)."""
+        return body_mesh_source(self)
+
+    def resampled(self, max_vertices: int) -> Body:
+        """This body on the largest grid of at most ``max_vertices`` vertices (itself when
+        it has no more): radii interpolated at the coarse grid's directions
+        (:meth:`LatLongGrid.interpolate`), reference radius, stretch and boulders kept."""
+        max_vertices = check_int("max_vertices", max_vertices, 8, 2**62)
+        if self.n_vertices <= max_vertices:
+            return self
+        small = LatLongGrid(int(np.sqrt((max_vertices - 2) / 6.0)))
+        radii = self._grid.interpolate(self._radii, (np.pi / 2) - small.latitudes(),
+                                       small.longitudes())
+        return Body(small, radii, radius_m=self._radius_m, stretch=self._stretch,
+                    boulders=self._boulders)
 
     def __repr__(self) -> str:
         return (f"Body(magnitude={self.magnitude}, n_vertices={self.n_vertices}, "
                 f"radius_m={self._radius_m:g}, stretch={self._stretch.tolist()})")
 
     # ------------------------------------------------------------------ I/O
-    def save(self, path) -> Path:
-        """Write the body losslessly to ``path`` (.npz, no pickles), atomically.
-
-        The bytes depend only on the body (fixed zip timestamps), so the same seed and
-        parameters give identical files.
-        """
+    def save(self, path, *, progress: bool = False) -> Path:
+        """Write the body to ``path``, atomically: losslessly as ``.npz`` (no pickles;
+        the bytes depend only on the body: fixed zip timestamps, so the same seed and
+        parameters give identical files), or as a mesh file chosen by its suffix
+        (:meth:`export`)."""
         path = Path(path)
         if path.suffix.lower() != ".npz":
-            raise ValueError(f"`path` must end in .npz; got {str(path)!r}")
+            return self.export(path, progress=progress)
         arrays = {
             "format": np.array(FORMAT),
             "magnitude": np.array(self.magnitude, dtype=np.int64),
@@ -285,19 +331,9 @@ class Body:
         """
         return export_body(self, path, progress=progress)
 
-    def mesh_source(self):
-        """The body with its placed boulders as a streamed mesh for the mesh writers
-        (:func:`latlong.export.body_mesh_source`)."""
-        return body_mesh_source(self)
-
     def to_pyvista(self):
         """A ``pyvista.PolyData`` with point array ``height_m`` (radius minus reference)."""
-        import pyvista as pv
-
-        faces = np.empty((self._grid.n_triangles, 4), dtype=np.int64)
-        faces[:, 0] = 3
-        faces[:, 1:] = self._grid.triangles()
-        mesh = pv.PolyData(self.vertices(), faces.ravel())
+        mesh = polydata(*self.mesh())
         mesh.point_data["height_m"] = self.heights_m
         return mesh
 

@@ -21,7 +21,6 @@ from craters.boulders import (
     BoulderShape,
     boulder,
     boulder_meshes,
-    boulder_normals,
     boulder_world_meshes,
     catalog_shape,
     draw_boulder_layer,
@@ -37,7 +36,7 @@ from .body import Body
 from .surface import band_areas, sample_surface_points
 
 __all__ = ["BoulderLayer", "BoulderNode", "BoulderShape", "boulder", "boulder_meshes",
-           "boulder_normals", "boulder_population", "boulder_world_meshes", "catalog_shape",
+           "boulder_population", "boulder_world_meshes", "catalog_shape",
            "iter_boulder_meshes", "parse_boulder_spec", "place_boulders"]
 
 
@@ -100,6 +99,21 @@ def _depths(body: Body, points: np.ndarray, nrm: np.ndarray) -> np.ndarray:
     return np.einsum("kci,ki->kc", under.reshape(points.shape) - points, nrm)
 
 
+def placement_request(catalog, shape, max_iterations: int,
+                      position: tuple[str, ...]) -> tuple[np.ndarray, BoulderShape]:
+    """Check a boulder placement once (a body's, a mesh's): ``(catalog, shape)`` with the
+    catalog's ``position`` columns and what placement reads; errors name the parameter."""
+    shape = BoulderShape() if shape is None else shape
+    if not isinstance(shape, BoulderShape):
+        raise TypeError(f"`shape` must be a BoulderShape; got {type(shape).__name__}")
+    cat = np.asarray(catalog)
+    for name in (*position, "diameter_m", "burial_frac", "azimuth_deg", "seed"):
+        if name not in (cat.dtype.names or ()):
+            raise ValueError(f"boulder catalog needs a {name!r} column")
+    check_int("max_iterations", max_iterations, 1, 100)
+    return cat, shape
+
+
 def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
                    max_iterations: int = 12) -> np.ndarray:
     """Place a boulder catalog on ``body``; returns the catalog with the placement.
@@ -117,14 +131,7 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     """
     if not isinstance(body, Body):
         raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
-    shape = BoulderShape() if shape is None else shape
-    if not isinstance(shape, BoulderShape):
-        raise TypeError(f"`shape` must be a BoulderShape; got {type(shape).__name__}")
-    cat = np.asarray(catalog)
-    for name in ("lat_deg", "lon_deg", "diameter_m", "burial_frac", "azimuth_deg", "seed"):
-        if name not in (cat.dtype.names or ()):
-            raise ValueError(f"boulder catalog needs a {name!r} column")
-    check_int("max_iterations", max_iterations, 1, 100)
+    cat, shape = placement_request(catalog, shape, max_iterations, ("lat_deg", "lon_deg"))
     n = len(cat)
     grid = body.grid
     stretch = np.asarray(body.stretch)
@@ -133,7 +140,7 @@ def place_boulders(body: Body, catalog, *, shape: BoulderShape | None = None,
     u = np.stack([np.sin(colat) * np.cos(lon), np.sin(colat) * np.sin(lon), np.cos(colat)], 1)
     # the surface is the triangle mesh itself (what a renderer draws), not an interpolation
     surface = grid.surface_radii(body.radii_m, colat, lon)[:, None] * u * stretch
-    normals = body.vertex_normals().astype(np.float64)
+    normals = body.vertex_normals("area").astype(np.float64)
     nrm = np.stack([grid.interpolate(normals[:, c], colat, lon) for c in range(3)], 1)
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     rot = orientations(nrm, np.radians(cat["azimuth_deg"]))

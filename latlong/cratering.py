@@ -1,7 +1,27 @@
-"""Crater-saturated bodies: stamping craters via local DEM mapping (Martin 2014, V.A)."""
+"""Crater-saturated bodies: stamping craters via local DEM mapping (Martin 2014, V.A).
+
+For each crater (:func:`stamp_craters`): the vertices of its region are gathered through
+the ring structure (no scan of the whole body); each gets its true distance from the
+crater centre (arc length at the local radius, measured between the actual surface
+directions, so stretched and irregular bodies work), its azimuth in the east/north
+frame at the centre, and its height radially relative to the centre's radius. The base
+of the obliterated region is a quadric fitted to those vertices (on a stretched or
+curved body radial heights are curved even where the surface is smooth; on flat ground
+it is the plane); the terrain relative to it is binned into a local height grid at the
+local vertex spacing (holes filled by 8-direction inverse-distance averages), from which
+the rim offsets are sampled. The slope used for slope erosion is the angle between the
+base's normal and the normal of the reference body (the stretched sphere; the radial
+direction when unstretched), so an elongated body's shape is not mistaken for steep
+ground. Then the crater (:mod:`craters` profile, irregular rim, roughness) is evaluated
+at every vertex with its true distance and azimuth, and the vertex's radial vector is
+rescaled by its height change. Works across the 0/360 degree seam and over the poles.
+The arguments every surface's stamping shares are checked once
+(:func:`craters.stamp.stamp_request`).
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numba
@@ -10,7 +30,13 @@ import numpy as np
 import craters as _craters
 from craters._shared import check_choice, check_range, normalize_rng, progress_bar
 from craters.profile import DEFAULT_EJECTA_EDGE
-from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
+from craters.stamp import (
+    StampRequest,
+    as_stamped,
+    stamp_request,
+    stamped_after,
+    stamping_profiles,
+)
 from craters.targets import Target
 
 from ._crater_kernels import _stamp_body_kernel
@@ -131,24 +157,8 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
                   target: str | Target = "moon", ejecta_edge: float = DEFAULT_EJECTA_EDGE,
                   too_large: str = "error", slope_reference: str = "body",
                   overwrite_body: bool = False) -> Body:
-    """Stamp a crater catalog on a body, oldest first; returns a new :class:`Body`.
-
-    For each crater (Martin 2014 V.A): the vertices of its region are gathered through
-    the ring structure (no scan of the whole body); each gets its true distance from the
-    crater centre (arc length at the local radius, measured between the actual surface
-    directions, so stretched and irregular bodies work), its azimuth in the east/north
-    frame at the centre, and its height radially relative to the centre's radius. The
-    base of the obliterated region is a quadric fitted to those vertices (on a stretched
-    or curved body radial heights are curved even where the surface is smooth; on flat
-    ground it is the plane); the terrain relative to it is binned into a local height
-    grid at the local vertex spacing (holes filled by 8-direction inverse-distance
-    averages), from which the rim offsets are sampled. The slope used for slope erosion
-    is the angle between the base's normal and the normal of the reference body (the
-    stretched sphere; the radial direction when unstretched), so an elongated body's
-    shape is not mistaken for steep ground. Then the crater (:mod:`craters` profile,
-    irregular rim, roughness) is evaluated at every vertex with its true distance and
-    azimuth, and the vertex's radial vector is rescaled by its
-    height change. Works across the 0/360 degree seam and over the poles.
+    """Stamp a crater catalog on a body, oldest first (the method: module notes); returns
+    a new :class:`Body`.
 
     Parameters
     ----------
@@ -190,107 +200,135 @@ def stamp_craters(body: Body, catalog, *, roughness=True, rng=None, progress: bo
     -------
     Body with the new radii and ``craters`` = the catalog as stamped (stamping order;
     craters on ground at or above ``full_deg`` are erased by mass wasting, not stamped,
-    and left out),
-    with the degradation actually used, ``rim_radius_m``, ``depth_m``, ``rim_height_m``,
-    ``slope_deg``, the 3-D centre ``centre_x_m, centre_y_m, centre_z_m``, ``seed``,
-    ``max_change_m`` (largest radial change) and ``n_vertices`` touched.
+    and left out), with the degradation actually used, ``rim_radius_m``, ``depth_m``,
+    ``rim_height_m``, ``slope_deg``, the 3-D centre ``centre_x_m, centre_y_m,
+    centre_z_m``, ``seed``, ``max_change_m`` (largest radial change) and ``n_vertices``
+    touched.
     """
     if not isinstance(body, Body):
         raise TypeError(f"`body` must be a Body; got {type(body).__name__}")
-    cat = _craters.sort_oldest_first(_craters.validate_catalog(catalog))
-    if "lat_deg" not in cat.dtype.names:
-        raise ValueError("`catalog` needs lat_deg, lon_deg columns to stamp on a body")
-    rough, irregular = resolve_roughness(roughness)
+    req = stamp_request(catalog, columns=("lat_deg", "lon_deg"), onto="a body",
+                        roughness=roughness, irregularity=irregularity,
+                        ejecta_edge=ejecta_edge, slope_erosion=slope_erosion,
+                        onset_deg=onset_deg, full_deg=full_deg)
     max_extent_deg = check_range("max_extent_deg", max_extent_deg, 1.0, 180.0)
-    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
-    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
-    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
-    full = check_range("full_deg", full_deg, 0.0, 90.0)
-    if slope_erosion and full <= onset:
-        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
-    irr = irregularity if irregular else 0.0
     check_choice("too_large", too_large, ("error", "skip"))
     check_choice("slope_reference", slope_reference, ("body", "gravity"))
-    if len(cat):
-        ext = crater_extents_deg(body, cat, ejecta_edge=ejecta_edge, irregularity=irr)
-        over = ext > max_extent_deg
-        if over.any() and too_large == "skip":
-            logger.warning("skipped %d of %d craters whose ejecta would span more than %g "
-                           "degrees of arc where they fall", int(over.sum()), len(cat),
-                           max_extent_deg)
-            cat, ext = cat[~over], ext[~over]
-        worst = int(np.argmax(ext)) if len(cat) else 0
-        if len(cat) and ext[worst] > max_extent_deg:
-            raise ValueError(
-                f"crater of diameter {cat['diameter_m'][worst]:.6g} m at lat "
-                f"{cat['lat_deg'][worst]:.3f}, lon {cat['lon_deg'][worst]:.3f} deg spans "
-                f"{ext[worst]:.1f} deg of arc (limit max_extent_deg = {max_extent_deg:g}): "
-                "too large for this body; lower the largest diameter"
-            )
-    n = len(cat)
-    rng = normalize_rng(rng)
-    rim_tabs = _craters.rim_perturbations(n, irr, rng=rng)
-    seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
+    cat = _within_extent(body, req, max_extent_deg, too_large)
+    rim_tabs, seeds = req.draws(len(cat), normalize_rng(rng))
     radii, overwritten = _radii_to_stamp(body, overwrite_body)
-    grid = body.grid
-    names = cat.dtype.names
-    prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
-    lat = np.ascontiguousarray(cat["lat_deg"], dtype=np.float64)
-    lon = np.ascontiguousarray(cat["lon_deg"], dtype=np.float64)
-    diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
-    outs = {k: np.zeros(n) for k in ("slope", "maxdh", "nvert", "sp")}
-    scale = np.ones(n)
-    centre = np.zeros((n, 3))
-    erased = np.zeros(n, dtype=np.bool_)
-    rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
-    gain = 2.0 ** (rough.fractal_dimension - 3.0)
-    # writeable copies: numba compiles read-only arrays as another type, and that
-    # specialisation of the parallel wave kernel ran ~50 % slower (issue 20)
-    stretch = np.array(body.stretch, dtype=np.float64)
-    unit = np.empty((0, 3))  # only the benchmark's naive gather uses it
-    offs = np.array(grid.ring_offsets())
-    up = _gravity_up(body, lat, lon) if slope_reference == "gravity" and n and slope_erosion \
-        else np.empty((0, 3))
-    args = (grid.magnitude, offs, radii, stretch, lat, lon, diam, prof.tables, prof.depth_m,
-            rim_tabs, seeds, ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain,
-            scale, outs["slope"], centre, outs["maxdh"], outs["nvert"], outs["sp"], erased, up)
-    done = False
-    if numba.get_num_threads() > 1 and n > 1:
-        done = _stamp_in_waves(body, cat, rim_tabs, ejecta_edge, args, progress)
-        if not done and overwritten:
-            raise WaveScheduleOutgrown(f"the parallel wave schedule of {n} craters was "
-                                       "outgrown and the body's radii were overwritten")
-        if not done:  # a surface moved more than the schedule allowed: redo serially
-            logger.info("wave schedule outgrown; stamping %d craters serially", n)
-            radii[:] = body.radii_m
-    if not done:
-        step = _BATCH if progress else max(n, 1)
-        for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
-            e = min(s + step, n)
-            _stamp_body_kernel(grid.magnitude, offs, unit, radii, stretch, lat[s:e], lon[s:e],
-                               diam[s:e], prof.tables[s:e], prof.depth_m[s:e],
-                               rim_tabs[s:e], seeds[s:e], ejecta_edge, bool(slope_erosion),
-                               onset, full, rough_arr, gain, scale[s:e], outs["slope"][s:e],
-                               centre[s:e], outs["maxdh"][s:e], outs["nvert"][s:e],
-                               outs["sp"][s:e], erased[s:e], up[s:e])
-    if n and any((radii[s:s + _CHUNK] <= 0).any() for s in range(0, len(radii), _CHUNK)):
+    prof = stamping_profiles(cat, target, ejecta_edge=req.ejecta_edge)
+    gravity_up = slope_reference == "gravity" and len(cat) > 0 and req.slope_erosion
+    run = _BodyStamp.of(body, radii, cat, prof, rim_tabs, seeds, req, gravity_up)
+    _stamp(run, body, cat, overwritten, progress)
+    if len(cat) and any((radii[s:s + _CHUNK] <= 0).any() for s in range(0, len(radii), _CHUNK)):
         raise ValueError("craters pushed the surface through the body centre; lower the "
                          "largest diameter or max_extent_deg")
-    cols = {k: cat[k] for k in names}
-    cols.update(as_stamped(prof, scale, diam), slope_deg=outs["slope"], centre_x_m=centre[:, 0],
-                centre_y_m=centre[:, 1], centre_z_m=centre[:, 2], seed=seeds,
-                max_change_m=outs["maxdh"], n_vertices=outs["nvert"].astype(np.int64),
-                spacing_m=outs["sp"])
-    stamped = _craters.make_catalog(**cols)[~erased]
-    if erased.any():
-        logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
-                    int(erased.sum()), n, full)
-    if body.craters is not None and len(body.craters):
-        try:
-            stamped = np.concatenate([body.craters, stamped.astype(body.craters.dtype)])
-        except (TypeError, ValueError):
-            logger.warning("previous crater catalog has other columns; keeping only the new")
-    return body.replace(radii_m=radii, craters=stamped, copy=False)
+    stamped = run.catalog(cat, prof, seeds)
+    return body.replace(radii_m=radii, craters=stamped_after(body.craters, stamped),
+                        copy=False)
+
+
+def _within_extent(body: Body, req: StampRequest, max_extent_deg: float,
+                   too_large: str) -> np.ndarray:
+    """The catalog's craters whose region spans at most ``max_extent_deg`` where they
+    fall (``too_large="skip"``: the others left out, logged); else ValueError."""
+    cat = req.catalog
+    if not len(cat):
+        return cat
+    ext = crater_extents_deg(body, cat, ejecta_edge=req.ejecta_edge,
+                             irregularity=req.irregularity)
+    over = ext > max_extent_deg
+    if over.any() and too_large == "skip":
+        logger.warning("skipped %d of %d craters whose ejecta would span more than %g "
+                       "degrees of arc where they fall", int(over.sum()), len(cat),
+                       max_extent_deg)
+        cat, ext = cat[~over], ext[~over]
+    worst = int(np.argmax(ext)) if len(cat) else 0
+    if len(cat) and ext[worst] > max_extent_deg:
+        raise ValueError(
+            f"crater of diameter {cat['diameter_m'][worst]:.6g} m at lat "
+            f"{cat['lat_deg'][worst]:.3f}, lon {cat['lon_deg'][worst]:.3f} deg spans "
+            f"{ext[worst]:.1f} deg of arc (limit max_extent_deg = {max_extent_deg:g}): "
+            "too large for this body; lower the largest diameter"
+        )
+    return cat
+
+
+@dataclasses.dataclass(frozen=True)
+class _BodyStamp:
+    """The arrays of one stamping run on a body, in the kernels' argument order: the grid
+    and radii (written), then per crater (catalog order) the inputs, the options and the
+    outputs (:func:`~latlong._crater_kernels._stamp_body_kernel`)."""
+
+    grid: tuple
+    """(magnitude, ring offsets, radii, stretch)."""
+    inputs: tuple
+    """(lat, lon, diameter, profile tables, depths, rim perturbations, seeds)."""
+    options: tuple
+    """(ejecta edge, slope erosion, onset, full, roughness amplitudes, gain)."""
+    outputs: tuple
+    """(scale, slope, centre, max change, vertices touched, spacing, erased)."""
+    up: np.ndarray
+    """(n, 3) the "up" each crater's slope is measured against, or (0, 3): the body's."""
+
+    @classmethod
+    def of(cls, body: Body, radii, cat, prof, rim_tabs, seeds, req: StampRequest,
+           gravity_up: bool) -> _BodyStamp:
+        n = len(cat)
+        lat = np.ascontiguousarray(cat["lat_deg"], dtype=np.float64)
+        lon = np.ascontiguousarray(cat["lon_deg"], dtype=np.float64)
+        # writeable copies: numba compiles read-only arrays as another type, and that
+        # specialisation of the parallel wave kernel ran ~50 % slower (issue 20)
+        stretch = np.array(body.stretch, dtype=np.float64)
+        grid = (body.grid.magnitude, np.array(body.grid.ring_offsets()), radii, stretch)
+        inputs = (lat, lon, np.ascontiguousarray(cat["diameter_m"], dtype=np.float64),
+                  prof.tables, prof.depth_m, rim_tabs, seeds)
+        options = (req.ejecta_edge, req.slope_erosion, req.onset_deg, req.full_deg,
+                   req.rough_array, req.gain)
+        outputs = (np.ones(n), np.zeros(n), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
+                   np.zeros(n), np.zeros(n, dtype=np.bool_))
+        up = _gravity_up(body, lat, lon) if gravity_up else np.empty((0, 3))
+        return cls(grid, inputs, options, outputs, up)
+
+    def args(self, s: int = 0, e: int | None = None) -> tuple:
+        """The kernels' arguments after the grid for craters s..e-1."""
+        return (*(a[s:e] for a in self.inputs), *self.options,
+                *(a[s:e] for a in self.outputs), self.up[s:e])
+
+    def catalog(self, cat, prof, seeds) -> np.ndarray:
+        """The catalog as stamped (erased craters left out, logged)."""
+        scale, slope, centre, maxdh, nvert, spacing, erased = self.outputs
+        cols = {k: cat[k] for k in cat.dtype.names}
+        cols.update(as_stamped(prof, scale, self.inputs[2]), slope_deg=slope,
+                    centre_x_m=centre[:, 0], centre_y_m=centre[:, 1], centre_z_m=centre[:, 2],
+                    seed=seeds, max_change_m=maxdh, n_vertices=nvert.astype(np.int64),
+                    spacing_m=spacing)
+        if erased.any():
+            logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
+                        int(erased.sum()), len(cat), self.options[3])
+        return _craters.make_catalog(**cols)[~erased]
+
+
+def _stamp(run: _BodyStamp, body: Body, cat, overwritten: bool, progress: bool) -> None:
+    """Stamp in parallel waves (more than one thread and crater), else (or when the wave
+    schedule is outgrown) serially, into ``run``'s radii."""
+    n = len(cat)
+    radii = run.grid[2]
+    if numba.get_num_threads() > 1 and n > 1:
+        if _stamp_in_waves(body, cat, run.inputs[5], run.options[0], (*run.grid, *run.args()),
+                           progress):
+            return
+        if overwritten:
+            raise WaveScheduleOutgrown(f"the parallel wave schedule of {n} craters was "
+                                       "outgrown and the body's radii were overwritten")
+        logger.info("wave schedule outgrown; stamping %d craters serially", n)
+        radii[:] = body.radii_m  # a surface moved more than the schedule allowed: redo
+    unit = np.empty((0, 3))  # only the benchmark's naive gather uses it
+    m, offs, _, stretch = run.grid
+    step = _BATCH if progress else max(n, 1)
+    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
+        _stamp_body_kernel(m, offs, unit, radii, stretch, *run.args(s, s + step))
 
 
 def _radii_to_stamp(body: Body, overwrite: bool) -> tuple[np.ndarray, bool]:

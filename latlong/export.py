@@ -18,15 +18,15 @@ triangle strips, manifest).
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import numpy as np
 
-from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
-
 from ._export_kernels import _ply_face_kernel, _ply_vertex_kernel
 from ._grid_kernels import lon_table
 from .gltf import export_glb
+from .meshio.boulders import BoulderMeshes, mesh_fields
 from .meshio.chunks import ordered_chunks
 from .meshio.writers import (
     MESH_SUFFIXES,
@@ -60,110 +60,107 @@ def _band_chunks(grid):
 def body_mesh_source(body) -> MeshSource:
     """The body (and its placed boulders) as a streamed mesh for the shared writers."""
     grid = body.grid
-    n, t = grid.n_vertices, grid.n_triangles
-    cat = body.boulders if body.boulders is not None and len(body.boulders) else None
-    top = catalog_shape(cat).levels[-1] if cat is not None else 0
-    nbv = 0 if cat is None else len(cat) * (10 * 4**top + 2)
-    nbt = 0 if cat is None else len(cat) * 20 * 4**top
+    n = grid.n_vertices
+    rocks = BoulderMeshes.of(body.boulders, n)
     stretch = np.array(body.stretch, dtype=np.float64)
 
-    def boulder_vertex_chunks():
-        for s0, world, _ in iter_boulder_meshes(cat):
-            k, nv = world.shape[:2]
-            v = world.reshape(-1, 3)
-            yield v, {"height_m": np.linalg.norm(v / stretch, axis=-1) - body.radius_m,
-                      "boulder_id": np.repeat(np.arange(s0, s0 + k, dtype=np.int32), nv)}
+    def rock_heights(_, world):  # above the reference radius, as the body's vertices
+        return np.linalg.norm(world.reshape(-1, 3) / stretch, axis=-1) - body.radius_m
 
     def vertex_chunks():
         heights = body.heights_m
         for s in range(0, n, _CHUNK):
             e = min(s + _CHUNK, n)
             values = {"height_m": heights[s:e]}
-            if cat is not None:
+            if rocks is not None:
                 values["boulder_id"] = np.full(e - s, -1, dtype=np.int32)
             yield body.vertices(s, e), values
-        if cat is not None:
-            yield from boulder_vertex_chunks()
-
-    def vertex_records(dtype):
-        # the body's records straight from a kernel, chunks made on worker threads
-        radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
-        # the longitude table (8 B a vertex) up to _TABLE_BYTES; past it the kernel
-        # computes the same cosines and sines itself (3.2 GB saved at M = 8192)
-        table = lon_table(grid.magnitude, grid.ring_offsets()) \
-            if 8 * n <= _TABLE_BYTES else np.empty((0, 2))
-
-        def make(s, buf):
-            e = min(s + _CHUNK, n)
-            _ply_vertex_kernel(grid.magnitude, grid.ring_offsets(), radii, body.radius_m,
-                               stretch, table, s, e, buf.view(np.float32).reshape(len(buf), -1))
-            rec = buf[:e - s]
-            if cat is not None:
-                rec["boulder_id"] = -1
-            return rec
-
-        yield from ordered_chunks(make, range(0, n, _CHUNK),
-                                  lambda: np.empty(min(n, _CHUNK), dtype=dtype))
-        if cat is not None:
-            for v, values in boulder_vertex_chunks():
-                yield pack_vertices(v, values, dtype)
-
-    def face_records(dtype):
-        ro, bo = grid.ring_offsets(), grid.band_offsets()
-        chunks = list(_band_chunks(grid))
-        size = max((int(bo[hi] - bo[lo]) for lo, hi in chunks), default=0)
-
-        def make(chunk, buf):
-            lo, hi = chunk
-            rec = buf[:int(bo[hi] - bo[lo])]
-            _ply_face_kernel(grid.magnitude, lo, hi, ro, bo, rec.view(np.uint8))
-            return rec
-
-        yield from ordered_chunks(make, chunks, lambda: np.empty(size, dtype=dtype))
-        if cat is not None:
-            for tri in boulder_face_chunks():
-                yield pack_faces(tri, dtype)
+        if rocks is not None:
+            yield from rocks.vertex_chunks(rock_heights)
 
     def body_faces():
         for lo, hi in _band_chunks(grid):
             yield grid.band_triangles(lo, hi)
 
-    def boulder_face_chunks():
-        faces = boulder_faces(top)
-        nv = 10 * 4**top + 2
-        for s0, world, _ in iter_boulder_meshes(cat):
-            offsets = n + (s0 + np.arange(len(world)))[:, None, None] * nv
-            yield (faces[None] + offsets).reshape(-1, 3)
-
     def face_groups():
-        if cat is None:
+        if rocks is None:
             yield None, body_faces()
         else:
             yield "body", body_faces()
-            yield "boulders", boulder_face_chunks()
+            yield "boulders", rocks.face_chunks()
 
     def facet_chunks():
         for tri in body_faces():
             vlo, vhi = int(tri.min()), int(tri.max()) + 1
             yield body.vertices(vlo, vhi)[tri - vlo]
-        if cat is not None:
-            for _, world, faces in iter_boulder_meshes(cat):
-                yield world[:, faces].reshape(-1, 3, 3)
+        if rocks is not None:
+            yield from rocks.facet_chunks()
 
-    comments = [f"magnitude {grid.magnitude}"]
-    if cat is not None:
-        comments.append(f"{len(cat)} boulders after the body, boulder_id = catalog row")
-    fields = [("height_m", "<f4")] + ([("boulder_id", "<i4")] if cat is not None else [])
-    return MeshSource(n + nbv, t + nbt, vertex_chunks, face_groups, facet_chunks,
-                      tuple(fields), "craterform lat/long body, metres", tuple(comments),
+    comments = (f"magnitude {grid.magnitude}",) + (
+        (rocks.comment("the body"),) if rocks is not None else ())
+    extra_v, extra_f = (0, 0) if rocks is None else (rocks.n_vertices, rocks.n_faces)
+    return MeshSource(n + extra_v, grid.n_triangles + extra_f, vertex_chunks,
+                      face_groups, facet_chunks, mesh_fields(rocks),
+                      "craterform lat/long body, metres", comments,
                       f"craterform lat/long body, magnitude {grid.magnitude}, metres",
-                      vertex_records=vertex_records, face_records=face_records)
+                      vertex_records=functools.partial(_vertex_records, body, rocks,
+                                                       rock_heights),
+                      face_records=functools.partial(_face_records, grid, rocks),
+                      own_writers={".glb": functools.partial(_write_glb, body)})
+
+
+def _write_glb(body, path, progress: bool) -> None:
+    """A body's ``.glb``: the patched-strip renderer export (:func:`latlong.export_glb`)."""
+    export_glb(body, path, progress=progress)
+
+
+def _vertex_records(body, rocks, rock_heights, dtype):
+    """The PLY writer's fast path (:attr:`MeshSource.vertex_records`): the body's records
+    straight from a kernel, chunks made on worker threads, then the boulders'."""
+    grid = body.grid
+    n = grid.n_vertices
+    radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
+    stretch = np.array(body.stretch, dtype=np.float64)
+    # the longitude table (8 B a vertex) up to _TABLE_BYTES; past it the kernel
+    # computes the same cosines and sines itself (3.2 GB saved at M = 8192)
+    table = lon_table(grid.magnitude, grid.ring_offsets()) \
+        if 8 * n <= _TABLE_BYTES else np.empty((0, 2))
+
+    def make(s, buf):
+        e = min(s + _CHUNK, n)
+        _ply_vertex_kernel(grid.magnitude, grid.ring_offsets(), radii, body.radius_m,
+                           stretch, table, s, e, buf.view(np.float32).reshape(len(buf), -1))
+        rec = buf[:e - s]
+        if rocks is not None:
+            rec["boulder_id"] = -1
+        return rec
+
+    yield from ordered_chunks(make, range(0, n, _CHUNK),
+                              lambda: np.empty(min(n, _CHUNK), dtype=dtype))
+    if rocks is not None:
+        for v, values in rocks.vertex_chunks(rock_heights):
+            yield pack_vertices(v, values, dtype)
+
+
+def _face_records(grid, rocks, dtype):
+    """The PLY writer's fast path (:attr:`MeshSource.face_records`): the body's triangles
+    packed by a kernel on worker threads, then the boulders'."""
+    ro, bo = grid.ring_offsets(), grid.band_offsets()
+    chunks = list(_band_chunks(grid))
+    size = max((int(bo[hi] - bo[lo]) for lo, hi in chunks), default=0)
+
+    def make(chunk, buf):
+        lo, hi = chunk
+        rec = buf[:int(bo[hi] - bo[lo])]
+        _ply_face_kernel(grid.magnitude, lo, hi, ro, bo, rec.view(np.uint8))
+        return rec
+
+    yield from ordered_chunks(make, chunks, lambda: np.empty(size, dtype=dtype))
+    if rocks is not None:
+        for tri in rocks.face_chunks():
+            yield pack_faces(tri, dtype)
 
 
 def export_body(body, path, *, progress: bool = False) -> Path:
     """Write ``body`` to a mesh file chosen by suffix (module notes), atomically."""
-    path = Path(path)
-    if path.suffix.lower() == ".glb":
-        export_glb(body, path, progress=progress)
-        return path
     return write_mesh(body_mesh_source(body), path, progress=progress)

@@ -47,8 +47,9 @@ from craters._shared import (
     replace_output,
     temp_file,
 )
-from craters.boulders import boulder_meshes, boulder_normals, catalog_shape, mesh_chunk
+from craters.boulders import boulder_meshes, catalog_shape, mesh_chunk
 
+from .geometry.normals import vertex_normals
 from .grid import LatLongGrid
 from .patchdata import leaf_metadata, write_leaf_data
 from .strips import patch_tree, triangle_strips
@@ -325,7 +326,7 @@ def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
         for s0 in range(0, len(cat), chunk):
             verts, _ = boulder_meshes(cat["seed"][s0:s0 + chunk], shape)
             v = verts[:, :nv]
-            nrm = boulder_normals(v, faces[lv]).astype(np.float32)
+            nrm = vertex_normals(v, faces[lv], "area", order="corners").astype(np.float32)
             v = v.astype(np.float32)
             for k in range(len(v)):
                 pos = view(v[k].tobytes(), _ARRAY_BUFFER)
@@ -372,7 +373,7 @@ def export_vtp_strips(body, path) -> Path:
     strips = triangle_strips(body.grid)
     cells = np.concatenate([np.concatenate([[len(s)], s]) for s in strips])
     mesh = pv.PolyData(body.vertices(), strips=cells)
-    mesh.point_data["Normals"] = body.vertex_normals()
+    mesh.point_data["Normals"] = body.vertex_normals("area")
     mesh.point_data["height_m"] = body.heights_m
     with atomic_path(path) as tmp:
         mesh.save(str(tmp), binary=True)

@@ -32,8 +32,10 @@ from craters._shared import ParameterError, check_positive
 
 from ._gravity_kernels import _local_linear_kernel
 from .body import Body
+from .geometry.meshes import volume_centroid
+from .geometry.normals import vertex_normals
+from .geometry.surface import Surface
 from .grid import LatLongGrid
-from .shapes import ShapeModel
 
 __all__ = ["GRAVITATIONAL_CONSTANT", "GravityField", "gravity", "polyhedron_gravity"]
 
@@ -148,15 +150,10 @@ def _body_field(body: Body, density, max_pairs, lod_magnitude):
     return pot_f, acc_f, centre, len(faces), len(verts)
 
 
-def _mesh_field(model: ShapeModel, density, max_pairs):
-    v, f = model.vertices, model.faces
+def _mesh_field(v: np.ndarray, f: np.ndarray, density, max_pairs):
     size = float(np.abs(v - v.mean(axis=0)).max())
-    normals = np.zeros_like(v)
-    tri = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    for k in range(3):
-        np.add.at(normals, f[:, k], tri)
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    centre = model.volume_centroid
+    normals = vertex_normals(v, f, "area", order="corners")
+    centre = volume_centroid(v, f)
     if float(len(f)) * len(v) <= max_pairs:
         pot, acc = polyhedron_gravity(v, f, density, v + _OFFSET * size * normals)
         return pot, acc, centre, len(f), len(v)
@@ -198,8 +195,10 @@ def gravity(body_or_mesh, density_kg_m3: float, period_h: float = math.inf, *,
 
     Parameters
     ----------
-    body_or_mesh : Body or ShapeModel
-        Coordinates in metres; the mass is the enclosed volume times the density.
+    body_or_mesh : Body, ShapeModel or another closed Surface
+        Coordinates in metres; the mass is the enclosed volume times the density. A
+        lat/long body is evaluated on a coarser grid of itself (module notes), any other
+        surface on its mesh (:meth:`~latlong.geometry.surface.Surface.mesh`).
     density_kg_m3 : float
         Constant bulk density (Eros: 2670 kg/m^3, Yeomans et al. 2000).
     period_h : float
@@ -233,12 +232,12 @@ def gravity(body_or_mesh, density_kg_m3: float, period_h: float = math.inf, *,
         pot, acc, centre, n_f, n_p = _body_field(body_or_mesh, density_kg_m3, max_pairs,
                                                   lod_magnitude)
         pos = body_or_mesh.vertices()
-    elif isinstance(body_or_mesh, ShapeModel):
-        pot, acc, centre, n_f, n_p = _mesh_field(body_or_mesh, density_kg_m3, max_pairs)
-        pos = body_or_mesh.vertices
+    elif isinstance(body_or_mesh, Surface):
+        pos, faces = body_or_mesh.mesh()
+        pot, acc, centre, n_f, n_p = _mesh_field(pos, faces, density_kg_m3, max_pairs)
     else:
-        raise TypeError("`body_or_mesh` must be a Body or ShapeModel; got "
-                        f"{type(body_or_mesh).__name__}")
+        raise TypeError("`body_or_mesh` must be a Body or ShapeModel (any closed Surface); "
+                        f"got {type(body_or_mesh).__name__}")
     omega = 0.0 if math.isinf(period_h) else 2.0 * math.pi / (period_h * 3600.0)
     x = pos - centre
     perp = x - np.outer(x @ axis, axis)

@@ -18,8 +18,7 @@ from ._grid_kernels import (
     _unit_range_kernel,
     _unit_range_serial,
 )
-from ._grid_kernels import lon_table as make_lon_table
-from ._slope_kernels import _normalize_rows_kernel, _normals_from_radii_kernel
+from .geometry.normals import lat_long_vertex_normals
 
 __all__ = ["BUILD_BASE_BYTES", "BUILD_BYTES_PER_VERTEX", "BUILD_BYTES_PER_VERTEX_THREAD",
            "LatLongGrid", "MAX_MAGNITUDE", "build_bytes_per_vertex"]
@@ -387,10 +386,10 @@ class LatLongGrid:
     def vertex_normals(self, radii, stretch=(1.0, 1.0, 1.0), *,
                        lon_table: np.ndarray | None = None) -> np.ndarray:
         """Unit area-weighted vertex normals, float32 (N, 3), of the mesh whose vertex
-        ``i`` is ``stretch * radii[i] * u_i``; accumulated band by band (12 B a vertex,
-        no triangle array, and 8 B a vertex of longitude cosines and sines while it
-        runs; pass ``lon_table`` - ``latlong._grid_kernels.lon_table(M, ring_offsets)`` -
-        to reuse one) and normalised in place.
+        ``i`` is ``stretch * radii[i] * u_i``
+        (:func:`latlong.geometry.normals.lat_long_vertex_normals`: band by band, 12 B a
+        vertex; ``lon_table`` - ``latlong._grid_kernels.lon_table(M, ring_offsets)`` -
+        reuses a longitude table).
 
         Examples
         --------
@@ -399,19 +398,7 @@ class LatLongGrid:
         >>> bool(np.allclose(n, g.unit_vectors(), atol=0.2))
         True
         """
-        radii = np.ascontiguousarray(radii, dtype=np.float64)
-        if radii.shape != (self.n_vertices,):
-            raise ValueError(f"`radii` must have shape ({self.n_vertices},); got {radii.shape}")
-        table = make_lon_table(self._m, self.ring_offsets()) if lon_table is None else lon_table
-        if table.shape != (3 * self._m * (self._m + 1), 2) or table.dtype != np.float64:
-            raise ValueError("`lon_table` must be the grid's longitude table "
-                             f"({3 * self._m * (self._m + 1)}, 2) float64")
-        acc = np.zeros((self.n_vertices, 3), dtype=np.float32)
-        _normals_from_radii_kernel(self._m, self.ring_offsets(), self.band_offsets(), radii,
-                                   np.ascontiguousarray(stretch, dtype=np.float64),
-                                   table, acc)
-        _normalize_rows_kernel(acc)
-        return acc
+        return lat_long_vertex_normals(self, radii, stretch, lon_table=lon_table)
 
     def _sample(self, kernel, name: str, values, colatitudes, longitudes) -> np.ndarray:
         """Run a per-point kernel(m, ring_offsets, values, colat, lon, out) after checks."""

@@ -32,8 +32,7 @@ from craters._shared import (
 )
 
 from ._preview_kernels import _extent_kernel
-from .body import Body
-from .grid import LatLongGrid
+from .geometry.surface import Resamplable, Surface
 
 __all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "preview_view",
            "render_preview", "sun_direction"]
@@ -41,6 +40,9 @@ __all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "preview_view",
 #: Bodies above this magnitude are resampled to it for pictures (a picture of a few
 #: thousand pixels cannot show more, and the renderer's memory stays bounded).
 PREVIEW_MAX_MAGNITUDE = 1000
+#: The vertices of that grid: surfaces that can resample themselves
+#: (:class:`~latlong.geometry.surface.Resamplable`) are resampled to at most these.
+PREVIEW_MAX_VERTICES = 6 * PREVIEW_MAX_MAGNITUDE**2 + 2
 #: The six views of a contact sheet: (label, view latitude, view longitude) in degrees.
 VIEW_DIRECTIONS = (("+x", 0.0, 0.0), ("-x", 0.0, 180.0), ("+y", 0.0, 90.0),
                    ("-y", 0.0, -90.0), ("+z", 90.0, 0.0), ("-z", -90.0, 0.0))
@@ -119,16 +121,6 @@ def sun_direction(azimuth_deg: float, elevation_deg: float, view_lat_deg: float 
     return math.cos(el) * (math.cos(az) * v + math.sin(az) * right) + math.sin(el) * up
 
 
-def _picture_body(body: Body) -> Body:
-    if body.magnitude <= PREVIEW_MAX_MAGNITUDE:
-        return body
-    small = LatLongGrid(PREVIEW_MAX_MAGNITUDE)
-    radii = body.grid.interpolate(body.radii_m, (np.pi / 2) - small.latitudes(),
-                                  small.longitudes())
-    return Body(small, radii, radius_m=body.radius_m, stretch=body.stretch,
-                boulders=body.boulders)
-
-
 #: The preview camera's vertical field of view, degrees.
 VIEW_ANGLE_DEG = 30.0
 #: The surface colour (RGB in [0, 1]) and the ambient share of the light.
@@ -171,27 +163,32 @@ def _render(mesh, *, sun, view, width_px, height_px, camera_distance_m) -> np.nd
 
 
 def _preview_mesh(body):
-    """The ray mesh of a Body (resampled to :data:`PREVIEW_MAX_MAGNITUDE`, with its
-    boulders), a ``pyvista.PolyData`` or a ``(vertices, faces)`` pair."""
-    from .sensors import RayMesh, scene_mesh
+    """The ray mesh of a surface with its boulders (resampled to at most
+    :data:`PREVIEW_MAX_VERTICES` when it can be), a ``pyvista.PolyData`` or a
+    ``(vertices, faces)`` pair."""
+    from .sensors import RayMesh
 
     # a preview traces one frame (or six): Embree's fastest (Morton) build pays off, 1.4 s
     # instead of 5.3 s for 12 M triangles here, for about the same frame time
-    if isinstance(body, Body):
-        return scene_mesh(_picture_body(body), build_quality="low")
+    if isinstance(body, Resamplable):
+        body = body.resampled(PREVIEW_MAX_VERTICES)
+    if isinstance(body, Surface):
+        vertices, faces, _ = body.mesh_source().arrays()
+        return RayMesh(vertices, faces, build_quality="low")
     if isinstance(body, tuple) and len(body) == 2:
         return RayMesh(*body, build_quality="low")
     if type(body).__name__ == "PolyData":
         mesh = body.triangulate()
         faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:]
         return RayMesh(np.asarray(mesh.points, dtype=np.float64), faces, build_quality="low")
-    raise TypeError(f"`body` must be a Body, a pyvista.PolyData or (vertices, faces); got "
-                    f"{type(body).__name__}")
+    raise TypeError(f"`body` must be a Body (any Surface), a pyvista.PolyData or (vertices, "
+                    f"faces); got {type(body).__name__}")
 
 
-def render_preview(body: Body, path, settings: PreviewSettings | None = None, **kwargs) -> Path:
-    """Render ``body`` (a Body, a closed ``pyvista.PolyData`` mesh or ``(vertices,
-    faces)`` in metres) to a PNG at ``path`` (atomic); see the module notes. The camera and
+def render_preview(body, path, settings: PreviewSettings | None = None, **kwargs) -> Path:
+    """Render ``body`` (a Body or any :class:`~latlong.geometry.surface.Surface`, a closed
+    ``pyvista.PolyData`` mesh or ``(vertices, faces)`` in metres) to a PNG at ``path``
+    (atomic); see the module notes. The camera and
     sun are ``settings`` (:class:`PreviewSettings`) or its fields as keyword arguments."""
     if settings is None:
         settings = PreviewSettings(**kwargs)

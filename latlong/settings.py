@@ -245,7 +245,7 @@ class ShapeBase:
     name = "shape"
 
     def __post_init__(self):
-        if not isinstance(self.model, ShapeModel):
+        if isinstance(self.model, str | Path):  # a file: read it
             if self.units not in ("km", "m"):
                 raise ParameterError("units", f"must be km or m with a shape model file; "
                                      f"got {self.units!r}")
@@ -256,6 +256,9 @@ class ShapeBase:
                 raise
             except ValueError as exc:
                 raise ParameterError("model", f"{self.model}: {exc}") from None
+        elif not isinstance(self.model, ShapeModel):
+            raise ParameterTypeError("model", f"must be a ShapeModel or a path; got "
+                                     f"{type(self.model).__name__}")
         check_choice("crossings", self.crossings, CROSSINGS)
         check_choice("smooth", self.smooth, ("butterfly", "linear", "loop", "none"))
         check_choice("surface", self.surface, SURFACES)
@@ -429,7 +432,7 @@ class ImplicitSettings:
     def __post_init__(self):
         from .implicit import GaborNoise, LcsnLayer, parse_gabor_spec, parse_lcsn_spec
 
-        if not isinstance(self.shape, ShapeModel):
+        if isinstance(self.shape, str | Path):  # a file: read it
             if self.units not in ("km", "m"):
                 raise ParameterError("units", f"must be km or m with a constraint file; "
                                      f"got {self.units!r}")
@@ -440,6 +443,9 @@ class ImplicitSettings:
                 raise
             except ValueError as exc:
                 raise ParameterError("shape", f"{self.shape}: {exc}") from None
+        elif not isinstance(self.shape, ShapeModel):
+            raise ParameterTypeError("shape", f"must be a ShapeModel or a path; got "
+                                     f"{type(self.shape).__name__}")
         _set(self, "layers", _layers(self.layers, LcsnLayer, parse_lcsn_spec, "layers"))
         if isinstance(self.gabor, str):
             try:

@@ -1,13 +1,10 @@
 """Real shape models as the base of a lat/long body: readers and ray-cast import.
 
-Readers: Wavefront OBJ and PDS plate models (``.tab``/``.plt``/``.obj``: ``v``/``f``
-lines, or the count header format ``NV NF`` then ``index x y z`` and
-``index i j k`` lines; 0- or 1-based indices detected and checked) are parsed here;
-PLY, STL and VTK formats go through pyvista. Units are explicit (``units="km"`` or
-``"m"``; bodies are built in metres). Meshes are checked: non-empty, finite, triangles
-(polygons are fanned), closed and 2-manifold (every edge in exactly two faces);
-coincident vertices are merged (STL stores them per facet) and inward-facing models are
-flipped.
+Reading (:func:`read_shape_model`): any mesh file of the reader registry
+(:func:`latlong.meshio.readers.read_mesh`: OBJ, PDS plate models, PLY, STL, VTK, glTF). Units
+are explicit (``units="km"`` or ``"m"``; bodies are built in metres). Meshes are checked:
+non-empty, finite, closed and 2-manifold (every edge in exactly two faces); coincident
+vertices are merged (STL stores them per facet) and inward-facing models are flipped.
 
 Import (:func:`from_shape_model`): the model is moved so that the chosen centre (its
 volume centroid by default) is the origin, optionally smoothed by interpolating
@@ -21,24 +18,24 @@ from __future__ import annotations
 
 import dataclasses
 import logging
-import re
-from pathlib import Path
+import os
 
 import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int
-from craters._shared.files import check_regular_file
 
 from ._shape_kernels import _brute_force_kernel, _raycast_kernel
 from .body import Body
+from .geometry.meshes import PlainMeshSurface, centre_point, polydata
+from .geometry.surface import Surface
 from .grid import LatLongGrid
-from .meshio.checks import check_mesh_file
+from .meshio.readers import read_mesh
+from .meshio.writers import MeshSource, array_source
 
-__all__ = ["ShapeModel", "cast_radii", "from_shape_model", "mean_surface_distance",
-           "read_shape_model", "sample_surface"]
+__all__ = ["ShapeModel", "as_shape_model", "cast_radii", "from_shape_model",
+           "mean_surface_distance", "read_shape_model", "sample_surface"]
 
 logger = logging.getLogger(__name__)
-UNITS = {"km": 1000.0, "m": 1.0}
 #: Share of the grid directions that may cross a model more than once and still be cast
 #: with ``crossings="error"`` (the outermost crossing kept, with a warning): below one
 #: grid vertex in 10^4 (a Eros plate model's 2 vertices of 2.9e5) is a pinhole in the
@@ -47,13 +44,13 @@ NON_STAR_TOLERANCE = 1e-4
 #: Extent a shape model may span, metres (a boulder to a gas giant): the geometry
 #: (volumes ~ extent^3, edge lengths) stays within float64 and divides safely.
 SIZE_RANGE_M = (1e-3, 1e9)
-_PYVISTA_SUFFIXES = (".ply", ".stl", ".vtk", ".vtp")
-_TEXT_SUFFIXES = (".obj", ".tab", ".plt", ".txt")
 
 
 @dataclasses.dataclass(frozen=True)
-class ShapeModel:
-    """A closed, outward-oriented triangle mesh in metres."""
+class ShapeModel(PlainMeshSurface):
+    """A closed, outward-oriented triangle mesh in metres: a
+    :class:`~latlong.geometry.surface.Surface` with no catalogs (its measures, normals and
+    writing: :class:`~latlong.geometry.meshes.PlainMeshSurface`)."""
 
     vertices: np.ndarray
     """(V, 3) float64 positions, metres."""
@@ -62,123 +59,12 @@ class ShapeModel:
     source: str = ""
     """Where it came from (path or description)."""
 
-    @property
-    def volume_m3(self) -> float:
-        """Enclosed volume (divergence theorem over the triangles)."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6.0)
-
-    @property
-    def area_m2(self) -> float:
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        return float(0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum())
-
-    @property
-    def volume_centroid(self) -> np.ndarray:
-        """Centroid of the enclosed volume (sum of signed tetrahedra), metres."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        vol = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
-        return ((a + b + c) / 4.0 * vol[:, None]).sum(axis=0) / vol.sum()
-
-    @property
-    def area_centroid(self) -> np.ndarray:
-        """Centroid of the surface (area-weighted triangle centroids), metres."""
-        a, b, c = (self.vertices[self.faces[:, k]] for k in range(3))
-        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
-        return ((a + b + c) / 3.0 * area[:, None]).sum(axis=0) / area.sum()
-
-    @property
-    def mean_edge_m(self) -> float:
-        """Mean edge length, metres: the model's resolution."""
-        e = _edges(self.faces)
-        return float(np.linalg.norm(self.vertices[e[:, 0]] - self.vertices[e[:, 1]],
-                                    axis=1).mean())
-
-    def to_pyvista(self):
-        import pyvista as pv
-
-        cells = np.hstack([np.full((len(self.faces), 1), 3), self.faces]).ravel()
-        return pv.PolyData(self.vertices.copy(), cells)
+    def mesh_source(self) -> MeshSource:
+        """The mesh for the shared mesh writers."""
+        return array_source(self.vertices, self.faces, "craterform shape model, metres")
 
 
 # --------------------------------------------------------------------------- readers
-def _parse_index(token: str) -> int:
-    return int(token.split("/")[0])
-
-
-def _read_text_mesh(path: Path):
-    """OBJ or PDS plate text: ``v``/``f`` lines, or the ``NV NF`` count format."""
-    verts, faces = [], []
-    with open(path, encoding="ascii", errors="replace") as fh:
-        lines = [ln.split("#", 1)[0].strip() for ln in fh]
-    lines = [ln for ln in lines if ln]
-    if not lines:
-        raise ValueError(f"shape model {str(path)!r} is empty")
-    if lines[0].split()[0].lower() in ("v", "vn", "vt", "f", "o", "g", "s", "mtllib",
-                                       "usemtl"):
-        for ln in lines:
-            parts = ln.split()
-            key = parts[0].lower()
-            if key == "v":
-                verts.append([float(x) for x in parts[1:4]])
-            elif key == "f":
-                idx = [_parse_index(p) for p in parts[1:]]
-                for k in range(1, len(idx) - 1):  # fan polygons into triangles
-                    faces.append([idx[0], idx[k], idx[k + 1]])
-        return np.array(verts, dtype=np.float64), np.array(faces, dtype=np.int64), "vf"
-    # PDS count format: "NV NF" (or "NV" then later "NF"), indexed rows
-    head = [int(float(x)) for x in re.split(r"[\s,]+", lines[0]) if x]
-    nv = head[0]
-    rows = [re.split(r"[\s,]+", ln) for ln in lines[1:]]
-    vrows, rest = rows[:nv], rows[nv:]
-    if rest and len(rest[0]) == 1:  # a separate facet-count line
-        nf = int(float(rest[0][0]))
-        rest = rest[1:]
-    else:
-        nf = head[1] if len(head) > 1 else len(rest)
-    frows = rest[:nf]
-    if len(vrows) != nv or len(frows) != nf:
-        raise ValueError(f"shape model {str(path)!r}: header says {nv} vertices and {nf} "
-                         f"facets; found {len(vrows)} and {len(frows)}")
-    verts = [[float(x) for x in r[-3:]] for r in vrows]
-    faces = [[int(float(x)) for x in r[-3:]] for r in frows]
-    return np.array(verts, dtype=np.float64), np.array(faces, dtype=np.int64), "counts"
-
-
-def _zero_based(faces: np.ndarray, n_verts: int, fmt: str, path) -> np.ndarray:
-    """Detect 0- or 1-based (or negative, OBJ-relative) indices and check them."""
-    if faces.size == 0:
-        return faces
-    if (faces < 0).any():
-        if fmt != "vf" or (faces > 0).any():
-            raise ValueError(f"shape model {str(path)!r}: negative and positive facet "
-                             "indices mixed")
-        faces = faces + n_verts  # OBJ relative indices (all of them negative)
-        lo, hi = faces.min(), faces.max()
-    else:
-        lo, hi = faces.min(), faces.max()
-        if fmt == "vf" and lo >= 1 and str(path).lower().endswith(".obj"):
-            faces = faces - 1  # OBJ is 1-based by definition
-        elif lo == 0 and hi <= n_verts - 1:
-            pass
-        elif lo >= 1 and hi == n_verts:
-            faces = faces - 1
-        elif lo == 0 and hi == n_verts:
-            raise ValueError(f"shape model {str(path)!r}: facet indices run from 0 to {hi} "
-                             f"for {n_verts} vertices: neither 0- nor 1-based")
-        lo, hi = faces.min(), faces.max()
-    if lo < 0 or hi >= n_verts:
-        raise ValueError(f"shape model {str(path)!r}: facet indices out of range "
-                         f"[{lo}, {hi}] for {n_verts} vertices")
-    return faces
-
-
-def _edges(faces: np.ndarray) -> np.ndarray:
-    e = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    e.sort(axis=1)
-    return np.unique(e, axis=0)
-
-
 def _check_and_orient(verts: np.ndarray, faces: np.ndarray, source: str) -> ShapeModel:
     if len(verts) == 0 or len(faces) == 0:
         raise ValueError(f"shape model {source!r} is empty (no vertices or no faces)")
@@ -226,7 +112,8 @@ def _check_and_orient(verts: np.ndarray, faces: np.ndarray, source: str) -> Shap
 
 
 def read_shape_model(path, *, units: str) -> ShapeModel:
-    """Read a closed triangle mesh (OBJ, PDS plate ``.tab``/``.plt``, PLY, STL, VTK).
+    """Read a closed triangle mesh (OBJ, PDS plate ``.tab``/``.plt``, PLY, STL, VTK, glTF:
+    :func:`latlong.meshio.readers.read_mesh`) as a shape model.
 
     Parameters
     ----------
@@ -236,44 +123,24 @@ def read_shape_model(path, *, units: str) -> ShapeModel:
 
     Returns
     -------
-    ShapeModel in metres, outward-oriented, with merged coincident vertices.
+    ShapeModel in metres, outward-oriented, with merged coincident vertices; a mesh that
+    is empty, not finite, open or not 2-manifold is refused (``ValueError``).
     """
-    units = check_choice("units", units, tuple(UNITS))
-    path = Path(path)
-    check_regular_file(path, "shape model")
-    suffix = path.suffix.lower()
-    if suffix in _PYVISTA_SUFFIXES:
-        import pyvista as pv
+    mesh = read_mesh(path, units=units, what="shape model")
+    return _check_and_orient(mesh.vertices, mesh.faces, mesh.source)
 
-        check_mesh_file(path, "shape model")
-        try:
-            mesh = pv.read(path)
-        except Exception as exc:  # noqa: BLE001 - VTK raises many kinds
-            raise ValueError(f"cannot read shape model {str(path)!r}: {exc}") from None
-        if not isinstance(mesh, pv.PolyData):
-            mesh = mesh.extract_surface(algorithm="dataset_surface")
-        mesh = mesh.triangulate()
-        verts = np.asarray(mesh.points, dtype=np.float64)
-        faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if (
-            mesh.n_cells) else np.zeros((0, 3), np.int64)
-        if faces.size and (faces.min() < 0 or faces.max() >= len(verts)):
-            raise ValueError(f"shape model {str(path)!r}: facet indices out of range "
-                             f"[{faces.min()}, {faces.max()}] for {len(verts)} vertices")
-    elif suffix in _TEXT_SUFFIXES:
-        try:
-            verts, faces, fmt = _read_text_mesh(path)
-        except (ValueError, IndexError) as exc:
-            raise ValueError(f"cannot parse shape model {str(path)!r}: {exc}") from None
-        except OverflowError:
-            raise ValueError(f"cannot parse shape model {str(path)!r}: a count or facet "
-                             f"index is not a finite integer below 2**63") from None
-        if verts.ndim != 2 or (len(verts) and verts.shape[1] != 3):
-            raise ValueError(f"shape model {str(path)!r}: vertices need three coordinates")
-        faces = _zero_based(faces, len(verts), fmt, path)
-    else:
-        raise ValueError(f"shape model {str(path)!r}: unknown format {suffix!r}; allowed: "
-                         f"{' '.join(_TEXT_SUFFIXES + _PYVISTA_SUFFIXES)}")
-    return _check_and_orient(verts * UNITS[units], faces, str(path))
+
+def as_shape_model(model, *, units: str | None = None, what: str = "shape model",
+                   name: str = "model") -> ShapeModel:
+    """``model`` itself, or a path read with :func:`read_shape_model` (which needs
+    ``units``; ``what`` names the file in messages)."""
+    if isinstance(model, str | os.PathLike):
+        if units is None:
+            raise ParameterError("units", f"(km or m) is required when reading a {what} file")
+        return read_shape_model(model, units=units)
+    if not isinstance(model, ShapeModel):
+        raise TypeError(f"`{name}` must be a ShapeModel or a path; got {type(model).__name__}")
+    return model
 
 
 # --------------------------------------------------------------------------- import
@@ -299,21 +166,6 @@ def cast_radii(model: ShapeModel, grid: LatLongGrid, *, brute_force: bool = Fals
         _raycast_kernel(grid.magnitude, grid.ring_offsets(), unit, verts, faces, margin,
                         count, tmin, tmax)
     return count, tmin, tmax
-
-
-def _centre(model: ShapeModel, center) -> np.ndarray:
-    if isinstance(center, str):
-        check_choice("center", center, ("volume-centroid", "area-centroid", "origin"))
-        if center == "volume-centroid":
-            return model.volume_centroid
-        if center == "area-centroid":
-            return model.area_centroid
-        return np.zeros(3)
-    c = np.asarray(center, dtype=np.float64).reshape(-1)
-    if c.shape != (3,) or not np.isfinite(c).all():
-        raise ValueError("`center` must be a name or three finite coordinates (m); "
-                         f"got {center!r}")
-    return c
 
 
 def _smoothed(model: ShapeModel, smooth: str, subdivisions: int) -> ShapeModel:
@@ -364,15 +216,12 @@ def from_shape_model(model, magnitude: int, *, units: str | None = None,
     Body with one radius per grid direction; metadata holds the source, centre, non-star
     area fraction and the model's resolution (mean edge length).
     """
-    if not isinstance(model, ShapeModel):
-        if units is None:
-            raise ValueError("`units` (km or m) is required when reading a shape model file")
-        model = read_shape_model(model, units=units)
+    model = as_shape_model(model, units=units)
     magnitude = check_int("magnitude", magnitude, 1, 100_000)
     check_choice("crossings", crossings, ("error", "outermost", "innermost"))
     check_choice("smooth", smooth, ("butterfly", "loop", "linear", "none"))
     subdivisions = check_int("subdivisions", subdivisions, 0, 5)
-    c = _centre(model, center)
+    c = centre_point(model, center)
     resolution = model.mean_edge_m
     moved = ShapeModel(model.vertices - c, model.faces, model.source)
     cast = _smoothed(moved, smooth, subdivisions)
@@ -416,15 +265,16 @@ def from_shape_model(model, magnitude: int, *, units: str | None = None,
 def _as_polydata(obj):
     import pyvista as pv
 
-    if isinstance(obj, Body | ShapeModel):
-        return obj.to_pyvista()
+    if isinstance(obj, Surface):
+        return polydata(*obj.mesh())
     if isinstance(obj, pv.PolyData):
         return obj
-    raise TypeError(f"expected a Body, ShapeModel or pyvista.PolyData; got {type(obj).__name__}")
+    raise TypeError(f"expected a Surface (Body, ShapeModel ...) or pyvista.PolyData; got "
+                    f"{type(obj).__name__}")
 
 
 def sample_surface(mesh, n: int, *, rng=None) -> np.ndarray:
-    """``n`` points uniform on a triangle surface (Body, ShapeModel or PolyData), (n, 3)."""
+    """``n`` points uniform on a triangle surface (any Surface or a PolyData), (n, 3)."""
     from craters._shared import normalize_rng
 
     rng = normalize_rng(rng)

@@ -4,11 +4,12 @@ Slope on a small body: the angle between the local surface normal and the radial
 direction (from the centre to the point). The paper's per-vertex slope averages the
 surface normal over everything within 3 degrees of arc of the vertex first, which
 takes out the mesh-scale noise. Here a vertex normal is the area-weighted sum of its
-triangles' normals; the cap average uses each vertex's normal weighted by its area
-(``weighted=True``) or unweighted; caps are taken around the grid direction of each
-vertex and summed ring by ring from prefix sums, so the cost does not grow with the
-cap size. Real meshes (:class:`~latlong.shapes.ShapeModel`) get the same measure with
-a k-d tree over the vertex directions seen from the centre.
+triangles' normals (:mod:`latlong.geometry.normals`, weighting ``"area"``); the cap
+average uses each vertex's normal weighted by its area (``weighted=True``) or
+unweighted; caps are taken around the grid direction of each vertex and summed ring by
+ring from prefix sums, so the cost does not grow with the cap size. Real meshes
+(:class:`~latlong.shapes.ShapeModel`) get the same measure with cap sums over the vertex
+directions seen from the centre.
 
 The radius spectrum is the degree variance of the radius field's spherical-harmonic
 expansion, ``S_l = sum_m |a_lm|^2`` (m^2), computed with an FFT along each ring and
@@ -23,14 +24,11 @@ import numpy as np
 
 from craters._shared import check_int, check_range
 
-from ._slope_kernels import (
-    _cap_average_kernel,
-    _direction_cap_sum_kernel,
-    _ring_prefix_kernel,
-    _scatter_add_kernel,
-    _vertex_normals_kernel,
-)
+from ._slope_kernels import _cap_average_kernel, _direction_cap_sum_kernel, _ring_prefix_kernel
 from .body import Body
+from .geometry.meshes import centre_point
+from .geometry.normals import vertex_areas, vertex_normals_and_areas
+from .geometry.normals import vertex_normals as mesh_vertex_normals
 from .geometry.stats import area_slope_summary
 from .shapes import ShapeModel
 
@@ -52,19 +50,15 @@ def _check_body(body) -> Body:
 
 
 def vertex_normals(body: Body) -> tuple[np.ndarray, np.ndarray]:
-    """Unit vertex normals (area-weighted triangle normals) and vertex areas (m^2, a
-    third of each incident triangle)."""
+    """Unit vertex normals (area-weighted triangle normals, float64, summed triangle after
+    triangle: :func:`latlong.geometry.normals.vertex_normals_and_areas`) and vertex areas
+    (m^2, a third of each incident triangle)."""
     body = _check_body(body)
     grid = body.grid
-    verts = body.vertices()
-    acc = np.zeros((grid.n_vertices, 3))
-    area = np.zeros(grid.n_vertices)
     step = max(1, (2 * grid.magnitude) // 16)
-    for lo in range(0, 2 * grid.magnitude, step):
-        hi = min(lo + step, 2 * grid.magnitude)
-        _vertex_normals_kernel(verts, grid.band_triangles(lo, hi), acc, area)
-    norm = np.linalg.norm(acc, axis=1, keepdims=True)
-    return acc / np.where(norm > 0, norm, 1.0), area
+    bands = (grid.band_triangles(lo, min(lo + step, 2 * grid.magnitude))
+             for lo in range(0, 2 * grid.magnitude, step))
+    return vertex_normals_and_areas(body.vertices(), bands)
 
 
 def _angle_deg(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -161,28 +155,10 @@ def mesh_slopes(model: ShapeModel, radius_deg: float = 3.0, *, weighted: bool = 
     if not isinstance(model, ShapeModel):
         raise TypeError(f"`model` must be a ShapeModel; got {type(model).__name__}")
     radius_deg = check_range("radius_deg", radius_deg, 0.0, 90.0)
-    if isinstance(center, str):
-        c = {"volume-centroid": lambda: model.volume_centroid,
-             "area-centroid": lambda: model.area_centroid,
-             "origin": lambda: np.zeros(3)}.get(center, lambda: None)()
-        if c is None:
-            raise ValueError("`center` must be volume-centroid, area-centroid, origin or "
-                             f"(x, y, z); got {center!r}")
-    else:
-        c = np.asarray(center, dtype=np.float64)
-    v = model.vertices - c
+    v = model.vertices - centre_point(model, center)
     f = model.faces
-    tri_n = 0.5 * np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    third = np.linalg.norm(tri_n, axis=1) / 3.0
-    normals = np.zeros_like(v)
-    area = np.zeros(len(v))
-    for k in range(3):  # np.add.at / np.bincount's order, column by column (same bytes)
-        col = np.ascontiguousarray(f[:, k])
-        _scatter_add_kernel(col, tri_n, normals)
-        part = np.zeros(len(v))
-        _scatter_add_kernel(col, third, part)
-        area += part
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    normals = mesh_vertex_normals(v, f, "area", order="corners")
+    area = vertex_areas(v, f)
     up = _down(gravity, v)
     if radius_deg == 0:
         return _angle_deg(normals, up), area

@@ -15,7 +15,10 @@
 * the top level holds only the packages, tests, examples, README, licence, pyproject and
   dotfiles (.ci/, .gitignore): no top-level module;
 * importing the packages loads neither numba nor numpy (lazy ``__init__``, PEP 562), so
-  the commands can start without tracebacks (craters.cli.start).
+  the commands can start without tracebacks (craters.cli.start);
+* callers do not ask which kind of surface they hold (a lat/long body, a mesh surface, an
+  implicit surface, a shape model ...): they use the ``Surface`` protocol's members; at
+  most :data:`MAX_KIND_CHECKS` tests of a concrete kind decide what to do.
 """
 
 from __future__ import annotations
@@ -264,3 +267,73 @@ def test_every_option_help_shows_its_default(package):
                for a in p._actions if a.option_strings and not isinstance(a, argparse._HelpAction)
                and not any(w in (a.help or "") for w in ("default", "required"))]
     assert not missing, missing
+
+
+#: The concrete kinds of surface (and the sensors' meshes) a caller could ask about.
+SURFACE_KINDS = {"Body", "MeshSurface", "ImplicitSurface", "ShapeModel", "MeshData",
+                 "RayMesh", "SceneGeometry"}
+#: Issue 31: at most this many kind checks in the three packages (26 in 10 modules before).
+MAX_KIND_CHECKS = 3
+
+
+def _names_in(node: ast.AST) -> set[str]:
+    return {n.id if isinstance(n, ast.Name) else n.attr for n in ast.walk(node)
+            if isinstance(n, ast.Name | ast.Attribute)}
+
+
+def _is_validation(call: ast.Call, parents: dict) -> bool:
+    """``if not isinstance(x, K): raise ...`` (also inside ``and``/``or``): the one type a
+    function takes, named in its TypeError; not a decision between kinds."""
+    up = parents.get(call)
+    if not (isinstance(up, ast.UnaryOp) and isinstance(up.op, ast.Not)):
+        return False
+    node = up
+    while isinstance(parents.get(node), ast.BoolOp):
+        node = parents[node]
+    branch = parents.get(node)
+    return (isinstance(branch, ast.If) and branch.test is node
+            and all(isinstance(stmt, ast.Raise) for stmt in branch.body))
+
+
+def kind_checks() -> list[str]:
+    """``module:line`` of every ``isinstance``/``issubclass`` test against a concrete kind
+    of surface that decides what to do with it (argument validation, see
+    :func:`_is_validation`, and tests against the ``Surface`` protocol are not kind
+    checks)."""
+    found = []
+    for module, path in SOURCES.items():
+        tree = ast.parse(path.read_text())
+        parents = {child: node for node in ast.walk(tree) for child in ast.iter_child_nodes(node)}
+        for node in ast.walk(tree):
+            if (isinstance(node, ast.Call) and isinstance(node.func, ast.Name)
+                    and node.func.id in ("isinstance", "issubclass") and len(node.args) == 2
+                    and _names_in(node.args[1]) & SURFACE_KINDS
+                    and not _is_validation(node, parents)):
+                found.append(f"{module}:{node.lineno}")
+    return found
+
+
+def test_callers_do_not_ask_which_kind_of_surface_they_hold():
+    found = kind_checks()
+    assert len(found) <= MAX_KIND_CHECKS, "\n".join(found)
+
+
+def test_the_kind_check_count_sees_decisions_not_validation():
+    code = """
+def f(body, other):
+    if not isinstance(body, Body):
+        raise TypeError("body")
+    if other is not None and not isinstance(other, RayMesh):
+        raise TypeError("other")
+    if isinstance(body, Body | ShapeModel):
+        return 1
+    return body if isinstance(body, latlong.ShapeModel) else isinstance(body, Surface)
+"""
+    tree = ast.parse(code)
+    parents = {child: node for node in ast.walk(tree) for child in ast.iter_child_nodes(node)}
+    calls = [n for n in ast.walk(tree) if isinstance(n, ast.Call)
+             and isinstance(n.func, ast.Name) and n.func.id == "isinstance"]
+    kinds = sorted((c for c in calls if _names_in(c.args[1]) & SURFACE_KINDS),
+                   key=lambda c: c.lineno)
+    assert len(kinds) == 4 and len(calls) == 5
+    assert [_is_validation(c, parents) for c in kinds] == [True, True, False, False]

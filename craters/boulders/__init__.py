@@ -16,7 +16,6 @@ from .meshes import (
     boulder,
     boulder_faces,
     boulder_meshes,
-    boulder_normals,
     boulder_world_meshes,
     catalog_shape,
     iter_boulder_meshes,
@@ -34,7 +33,7 @@ from .placement import (
 )
 
 __all__ = ["MIN_BURIAL", "BoulderLayer", "BoulderNode", "BoulderShape", "boulder",
-           "boulder_faces", "boulder_meshes", "boulder_normals", "boulder_world_meshes",
+           "boulder_faces", "boulder_meshes", "boulder_world_meshes",
            "catalog_shape", "draw_boulder_layer", "iter_boulder_meshes", "mesh_chunk",
            "orientations", "parse_boulder_spec", "placed_columns", "quaternions",
            "rest_on_ground"]

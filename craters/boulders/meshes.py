@@ -24,7 +24,7 @@ from .._boulder_kernels import _noise_kernel
 from .._shared import check_int, check_range, normalize_rng
 
 __all__ = ["BoulderNode", "BoulderShape", "boulder", "boulder_faces", "boulder_meshes",
-           "boulder_normals", "boulder_world_meshes", "catalog_shape", "iter_boulder_meshes",
+           "boulder_world_meshes", "catalog_shape", "iter_boulder_meshes",
            "mesh_chunk"]
 
 _PHI = (1.0 + 5.0**0.5) / 2.0
@@ -206,23 +206,6 @@ def boulder(*, rng=None, shape: BoulderShape = BoulderShape()) -> BoulderNode:
     if isinstance(node, tuple):  # a single level
         return BoulderNode(shape.base_level, node, None)
     return node
-
-
-def boulder_normals(vertices, faces) -> np.ndarray:
-    """Unit area-weighted vertex normals of boulder meshes: vertices (n, V, 3) or (V, 3),
-    faces (F, 3) shared by all; same shape as ``vertices``."""
-    v = np.asarray(vertices, dtype=np.float64)
-    single = v.ndim == 2
-    if single:
-        v = v[None]
-    f = np.asarray(faces)
-    a, b, c = v[:, f[:, 0]], v[:, f[:, 1]], v[:, f[:, 2]]
-    fn = np.cross(b - a, c - a)  # twice the area along the face normal
-    acc = np.zeros_like(v)
-    for k in range(3):
-        np.add.at(acc, (slice(None), f[:, k]), fn)
-    acc /= np.linalg.norm(acc, axis=2, keepdims=True)
-    return acc[0] if single else acc
 
 
 def catalog_shape(catalog) -> BoulderShape:

@@ -7,7 +7,10 @@ plot with a legend and listed in one CSV and one summary table.
 
 from __future__ import annotations
 
+import functools
 import textwrap
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -22,8 +25,6 @@ from craters.cli.report import (
     write_csv,
 )
 from latlong import (
-    Body,
-    ShapeModel,
     from_shape_model,
     gravity,
     load,
@@ -37,13 +38,33 @@ from latlong import (
 from ..slopes import SLOPE_BIN_DEG
 
 
-def _load_input(path: str, units: str | None):
+@dataclass(frozen=True)
+class _Input:
+    """An input as loaded: the surface and what each command does with it (a body .npz
+    and a mesh file are measured differently: slopes over grid caps or direction caps)."""
+
+    surface: object
+    """The Body or ShapeModel."""
+    slopes: Callable
+    """``(radius_deg, weighted=, gravity=) -> (slopes_deg, areas_m2)``."""
+    radii_m: Callable
+    """``() -> distances (m) of the vertices from the centre the caps are taken around``."""
+    as_body: Callable
+    """``magnitude -> Body`` (a body: itself; a mesh: cast onto that grid)."""
+
+
+def _load_input(path: str, units: str | None) -> _Input:
     p = Path(path)
     if p.suffix.lower() == ".npz":
-        return load(p)
+        body = load(p)
+        return _Input(body, functools.partial(slopes_and_areas, body),
+                      lambda: np.linalg.norm(body.vertices(), axis=1), lambda _: body)
     if units is None:
         raise CliError(f"{path}: a mesh file needs --shape-units km or m")
-    return read_shape_model(p, units=units)
+    model = read_shape_model(p, units=units)
+    return _Input(model, functools.partial(mesh_slopes, model),
+                  lambda: np.linalg.norm(model.vertices - model.volume_centroid, axis=1),
+                  lambda m: from_shape_model(model, m, crossings="outermost", smooth="linear"))
 
 
 def _labels(inputs, labels) -> list[str]:
@@ -57,19 +78,6 @@ def _labels(inputs, labels) -> list[str]:
 
 
 # --------------------------------------------------------------------------- slopes
-def _slopes_of(obj, radius_deg: float, weighted: bool, field=None):
-    if isinstance(obj, Body):
-        return slopes_and_areas(obj, radius_deg, weighted=weighted, gravity=field)
-    return mesh_slopes(obj, radius_deg, weighted=weighted, gravity=field)
-
-
-def _mean_radius_m(obj) -> float:
-    """Mean distance of the vertices from the centre the caps are taken around."""
-    if isinstance(obj, Body):
-        return float(np.linalg.norm(obj.vertices(), axis=1).mean())
-    return float(np.linalg.norm(obj.vertices - obj.volume_centroid, axis=1).mean())
-
-
 def _gravity_args(args):
     """(density, period, spin axis) from the flags, or None for geometric slopes."""
     if args.density_kg_m3 is None:
@@ -104,10 +112,11 @@ def cmd_slopes(args) -> int:
     objs = [_load_input(p, args.shape_units) for p in inputs]
     results, baselines = [], []
     for label, obj in zip(labels, objs, strict=True):
-        field = None if grav is None else gravity(obj, grav[0], grav[1], spin_axis=grav[2])
-        s, a = _slopes_of(obj, args.radius_deg, not args.unweighted, field)
+        field = None if grav is None else gravity(obj.surface, grav[0], grav[1],
+                                                  spin_axis=grav[2])
+        s, a = obj.slopes(args.radius_deg, weighted=not args.unweighted, gravity=field)
         results.append((label, slope_summary(s, a, bin_deg=SLOPE_BIN_DEG)))
-        baselines.append(np.radians(args.radius_deg) * _mean_radius_m(obj))
+        baselines.append(np.radians(args.radius_deg) * float(obj.radii_m().mean()))
     if grav is None:
         kind, against = "geometric", "radial"
     else:
@@ -139,13 +148,6 @@ def cmd_slopes(args) -> int:
 
 
 # --------------------------------------------------------------------------- spectrum
-def _as_body(obj, magnitude: int) -> Body:
-    if isinstance(obj, Body):
-        return obj
-    assert isinstance(obj, ShapeModel)
-    return from_shape_model(obj, magnitude, crossings="outermost", smooth="linear")
-
-
 def cmd_spectrum(args) -> int:
     inputs = [args.input, *(args.compare or [])]
     labels = _labels(inputs, args.label)
@@ -154,7 +156,7 @@ def cmd_spectrum(args) -> int:
     if args.l_max is not None and args.l_max < 1:
         raise CliError(f"--l-max must be >= 1; got {args.l_max}")
     check_report_outputs(args, [("input", p) for p in inputs])
-    bodies = [_as_body(_load_input(p, args.shape_units), args.magnitude) for p in inputs]
+    bodies = [_load_input(p, args.shape_units).as_body(args.magnitude) for p in inputs]
     results = []
     for label, body in zip(labels, bodies, strict=True):
         l_max = args.l_max or (2 * body.magnitude) // 3

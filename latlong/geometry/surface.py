@@ -1,10 +1,18 @@
 """The one interface of every surface craterform makes or reads: :class:`Surface`.
 
 Lat/long bodies (:class:`latlong.Body`), cratered meshes (:class:`latlong.mesh.MeshSurface`),
-implicit bodies (:class:`latlong.ImplicitSurface`) and DEM sites (``dem``'s surfaces of a
-DEM or a layer stack) all implement it, so that what uses a surface (sensors, writers,
-slopes, stamping) never asks which kind it holds. It is a :class:`typing.Protocol`:
+implicit bodies (:class:`latlong.ImplicitSurface`), shape models
+(:class:`latlong.ShapeModel`), mesh files as read
+(:class:`latlong.meshio.readers.MeshData`) and DEM sites (``dem``'s surfaces of a DEM or a
+layer stack) all implement it, so that what uses a surface (sensors, writers, previews,
+gravity) never asks which kind it holds. It is a :class:`typing.Protocol`:
 a class implements it by having these members, without inheriting from it.
+
+What is not common to every kind stays with the kind: a lat/long body's grid, a mesh
+surface's refinement; a capability some kinds have is a protocol of its own
+(:class:`Resamplable`). Normals are named by their weighting
+(:mod:`latlong.geometry.normals`); meshes held as arrays share their members through
+:class:`latlong.geometry.meshes.TriangleMeshSurface`.
 
 Frames and units: positions in metres in the surface's own frame (body-fixed, origin at
 the body's centre; for a DEM site the site's local frame, x east, y north, z up, metres
@@ -21,7 +29,7 @@ if TYPE_CHECKING:
 
     from ..meshio.writers import MeshSource
 
-__all__ = ["Surface"]
+__all__ = ["Resamplable", "Surface"]
 
 
 @runtime_checkable
@@ -66,4 +74,15 @@ class Surface(Protocol):
 
     def save(self, path, *, progress: bool = False) -> Path:
         """Write the surface to a file chosen by suffix, atomically; the path written."""
+        ...
+
+
+@runtime_checkable
+class Resamplable(Protocol):
+    """A surface that can put itself on a coarser mesh cheaply (a lat/long body onto a
+    coarser grid), for pictures and quick looks."""
+
+    def resampled(self, max_vertices: int) -> Surface:
+        """This surface with at most ``max_vertices`` vertices (itself when it has no
+        more), its catalogs kept."""
         ...

@@ -33,7 +33,7 @@ from craters._shared import (
     progress_bar,
 )
 
-from ..shapes import ShapeModel, read_shape_model
+from ..shapes import ShapeModel, as_shape_model
 from . import _kernels as _k
 from .distance import mesh_distance, smoothed_constraint
 from .gabor import GaborNoise, add_gabor, gabor_impulses
@@ -178,10 +178,7 @@ class _Plan:
 def _checked_inputs(constraint, layers, gabor, units):
     """The constraint as a ShapeModel (read from a file in ``units``) and the layers as
     a list, with the kinds of ``layers`` and ``gabor`` checked."""
-    if not isinstance(constraint, ShapeModel):
-        if units is None:
-            raise ValueError("`units` (km or m) is required when reading a constraint file")
-        constraint = read_shape_model(constraint, units=units)
+    constraint = as_shape_model(constraint, units=units, what="constraint", name="constraint")
     layers = list(layers)
     for la in layers:
         if not isinstance(la, LcsnLayer):

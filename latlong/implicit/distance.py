@@ -24,6 +24,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int, check_positive
 
+from ..geometry.normals import face_normals, vertex_normal_sums
 from ..shapes import ShapeModel
 from . import _distance_kernels as _dk
 from . import _kernels as _k
@@ -67,21 +68,10 @@ def smoothed_constraint(model: ShapeModel, voxel_m: float, *, smooth: str = "but
 
 def _normals(verts: np.ndarray, faces: np.ndarray):
     """Unit face normals, per-face edge pseudo-normals (ab, bc, ca) and angle-weighted
-    vertex pseudo-normals (Baerentzen & Aanaes 2005)."""
-    corners = [verts[faces[:, k]] for k in range(3)]
-    cross = np.cross(corners[1] - corners[0], corners[2] - corners[0])
-    norm = np.linalg.norm(cross, axis=1, keepdims=True)
-    face_n = np.where(norm > 0, cross / np.where(norm > 0, norm, 1.0), 0.0)
-    vert_n = np.zeros_like(verts)
-    for k in range(3):
-        u = corners[(k + 1) % 3] - corners[k]
-        v = corners[(k + 2) % 3] - corners[k]
-        cosang = np.einsum("ij,ij->i", u, v) / np.maximum(
-            np.linalg.norm(u, axis=1) * np.linalg.norm(v, axis=1), 1e-300)
-        angle = np.arccos(np.clip(cosang, -1.0, 1.0))
-        for axis in range(3):
-            vert_n[:, axis] += np.bincount(faces[:, k], weights=angle * face_n[:, axis],
-                                           minlength=len(verts))
+    vertex pseudo-normals (Baerentzen & Aanaes 2005; :mod:`latlong.geometry.normals`,
+    weighting ``"angle"``, not normalised: only their sign is used)."""
+    face_n = face_normals(verts, faces, unit=True)
+    vert_n = vertex_normal_sums(verts, faces, "angle", order="corner-sums")
     edges = np.stack([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]], axis=1)
     key = np.sort(edges.reshape(-1, 2), axis=1)
     _, inverse = np.unique(key[:, 0] * len(verts) + key[:, 1], return_inverse=True)

@@ -25,7 +25,7 @@ import numpy as np
 
 from craters._shared import check_int, check_range, normalize_rng
 
-from ..shapes import ShapeModel
+from ..geometry.surface import Surface
 
 __all__ = ["ShapeFidelity", "shape_fidelity"]
 
@@ -62,9 +62,7 @@ class ShapeFidelity:
 
 
 def _faces(mesh):
-    if isinstance(mesh, ShapeModel):
-        return np.asarray(mesh.vertices, np.float64), np.asarray(mesh.faces, np.int64)
-    verts, faces = mesh
+    verts, faces = mesh.mesh() if isinstance(mesh, Surface) else mesh
     return np.asarray(verts, np.float64), np.asarray(faces, np.int64)
 
 
@@ -114,7 +112,7 @@ def shape_fidelity(surface, constraint, *, n_points: int = 20000, fine: float = 
     """Distances and slope-distribution distance between ``surface`` and ``constraint``
     (module notes).
 
-    ``surface`` and ``constraint`` are ShapeModels or ``(vertices, faces)`` pairs in the
+    ``surface`` and ``constraint`` are surfaces (ShapeModel ...) or ``(vertices, faces)`` in the
     same frame (:attr:`ImplicitSurface.base_vertices` are in the frame of the constraint
     moved to its volume centroid). ``fine`` and ``smooth`` are fractions of the
     constraint's longest axis.

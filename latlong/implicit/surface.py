@@ -11,11 +11,11 @@ the implicit backend meets the lat/long grid.
 from __future__ import annotations
 
 import dataclasses
-from pathlib import Path
 
 import numpy as np
 
-from ..meshio.writers import MESH_SUFFIXES, MeshSource, array_source, write_mesh
+from ..geometry.meshes import TriangleMeshSurface
+from ..meshio.writers import MESH_SUFFIXES, MeshSource, array_source
 from ..shapes import ShapeModel
 from . import _kernels as _k
 from .metaballs import Metaballs
@@ -25,8 +25,10 @@ __all__ = ["MESH_SUFFIXES", "ImplicitSurface"]
 
 
 @dataclasses.dataclass(frozen=True)
-class ImplicitSurface:
-    """A marching-cubes mesh of an implicit body and the crater catalog that made it."""
+class ImplicitSurface(TriangleMeshSurface):
+    """A marching-cubes mesh of an implicit body and the crater catalog that made it: a
+    :class:`~latlong.geometry.surface.Surface` (normals, frames and measures:
+    :class:`~latlong.geometry.meshes.TriangleMeshSurface`)."""
 
     vertices: np.ndarray
     """(V, 3) float64 positions, metres, in the frame of the constraint moved so that its
@@ -63,16 +65,14 @@ class ImplicitSurface:
         return out
 
     @property
-    def volume_m3(self) -> float:
-        return ShapeModel(self.vertices, self.faces).volume_m3
+    def craters(self) -> np.ndarray:
+        """The crater catalog (:attr:`catalog`): the surface's craters."""
+        return self.catalog
 
     @property
-    def area_m2(self) -> float:
-        return ShapeModel(self.vertices, self.faces).area_m2
-
-    def to_pyvista(self):
-        """A ``pyvista.PolyData`` of the mesh."""
-        return ShapeModel(self.vertices, self.faces).to_pyvista()
+    def boulders(self) -> None:
+        """No boulders: the implicit backend places none."""
+        return None
 
     def is_watertight(self) -> bool:
         """Every edge belongs to exactly two faces, each direction once."""
@@ -86,11 +86,6 @@ class ImplicitSurface:
     def mesh_source(self) -> MeshSource:
         """The mesh for the shared mesh writers."""
         return array_source(self.vertices, self.faces, "craterform implicit body, metres")
-
-    def save(self, path, *, progress: bool = False) -> Path:
-        """Write the mesh to a file chosen by suffix (``.ply .obj .stl .vtp .vtk .glb``,
-        :mod:`latlong.meshio.writers`), atomically."""
-        return write_mesh(self.mesh_source(), path, progress=progress)
 
     def to_body(self, magnitude: int, *, crossings: str = "error"):
         """Cast the mesh onto a lat/long grid of ``magnitude`` from the origin.

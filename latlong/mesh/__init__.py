@@ -47,9 +47,9 @@ from .boulders import mesh_boulder_population, place_mesh_boulders
 from .cratering import mesh_crater_population, sample_mesh_points, stamp_mesh_craters
 from .refine import refine_mesh, refinement_plan
 from .surface import MeshSurface, lat_lon_deg, mesh_surface, with_detail
-from .topology import TriangleGrid, adjacency, mesh_checks, vertex_normals
+from .topology import TriangleGrid, adjacency, mesh_checks
 
 __all__ = ["MeshSurface", "TriangleGrid", "adjacency", "lat_lon_deg", "mesh_boulder_population",
            "mesh_checks", "mesh_crater_population", "mesh_surface", "place_mesh_boulders",
            "refine_mesh", "refinement_plan", "sample_mesh_points", "stamp_mesh_craters",
-           "vertex_normals", "with_detail"]
+           "with_detail"]

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ..geometry._normal_kernels import _triangle_edges
+
 
 # --------------------------------------------------------------------------- refinement
 @njit(cache=True)
@@ -86,6 +88,27 @@ def _dist3(pos, i, j):
     return np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
+@njit(cache=True, inline="always")
+def _heap_push(hk, hv, size, key, value):
+    """Push (key, value) on the binary min-heap of keys ``hk`` and values ``hv`` holding
+    ``size`` entries (doubled when full; sift up); returns (hk, hv, size)."""
+    if size == hk.shape[0]:
+        hk = np.concatenate((hk, np.empty(size)))
+        hv = np.concatenate((hv, np.empty(size, np.int64)))
+    k = size
+    size += 1
+    while k > 0:
+        p = (k - 1) // 2
+        if hk[p] <= key:
+            break
+        hk[k] = hk[p]
+        hv[k] = hv[p]
+        k = p
+    hk[k] = key
+    hv[k] = value
+    return hk, hv, size
+
+
 @njit(cache=True)
 def _geodesic_gather(pos, voff, vnbr, seed_v, seed_d, limit, mark, gdist, epoch):
     """Vertices within graph distance ``limit`` of the seeds (Dijkstra over the edges at
@@ -109,20 +132,7 @@ def _geodesic_gather(pos, voff, vnbr, seed_v, seed_d, limit, mark, gdist, epoch)
             continue
         mark[v] = seen
         gdist[v] = d
-        if size == hk.shape[0]:
-            hk = np.concatenate((hk, np.empty(size)))
-            hv = np.concatenate((hv, np.empty(size, np.int64)))
-        k = size  # sift up
-        size += 1
-        while k > 0:
-            p = (k - 1) // 2
-            if hk[p] <= d:
-                break
-            hk[k] = hk[p]
-            hv[k] = hv[p]
-            k = p
-        hk[k] = d
-        hv[k] = v
+        hk, hv, size = _heap_push(hk, hv, size, d, v)
     while size > 0:
         d = hk[0]
         v = hv[0]
@@ -162,20 +172,7 @@ def _geodesic_gather(pos, voff, vnbr, seed_v, seed_d, limit, mark, gdist, epoch)
                 continue
             mark[w] = seen
             gdist[w] = nd
-            if size == hk.shape[0]:
-                hk = np.concatenate((hk, np.empty(size)))
-                hv = np.concatenate((hv, np.empty(size, np.int64)))
-            k = size
-            size += 1
-            while k > 0:
-                p = (k - 1) // 2
-                if hk[p] <= nd:
-                    break
-                hk[k] = hk[p]
-                hv[k] = hv[p]
-                k = p
-            hk[k] = nd
-            hv[k] = w
+            hk, hv, size = _heap_push(hk, hv, size, nd, w)
     return out[:n_out], od[:n_out]
 
 
@@ -230,12 +227,7 @@ def _closest_on_triangle(px, py, pz, pos, faces, f):
     a = faces[f, 0]
     b = faces[f, 1]
     c = faces[f, 2]
-    ab0 = pos[b, 0] - pos[a, 0]
-    ab1 = pos[b, 1] - pos[a, 1]
-    ab2 = pos[b, 2] - pos[a, 2]
-    ac0 = pos[c, 0] - pos[a, 0]
-    ac1 = pos[c, 1] - pos[a, 1]
-    ac2 = pos[c, 2] - pos[a, 2]
+    ab0, ab1, ab2, ac0, ac1, ac2 = _triangle_edges(pos, a, b, c)
     ap0 = px - pos[a, 0]
     ap1 = py - pos[a, 1]
     ap2 = pz - pos[a, 2]
@@ -325,14 +317,7 @@ def _closest_points_kernel(points, pos, faces, lo, h, dims, offsets, items, out_
 def _line_hit(px, py, pz, n0, n1, n2, pos, faces, f):
     """t with p + t n on face f (the line through p along n, both ways), or NaN."""
     a = faces[f, 0]
-    b = faces[f, 1]
-    c = faces[f, 2]
-    e10 = pos[b, 0] - pos[a, 0]
-    e11 = pos[b, 1] - pos[a, 1]
-    e12 = pos[b, 2] - pos[a, 2]
-    e20 = pos[c, 0] - pos[a, 0]
-    e21 = pos[c, 1] - pos[a, 1]
-    e22 = pos[c, 2] - pos[a, 2]
+    e10, e11, e12, e20, e21, e22 = _triangle_edges(pos, a, faces[f, 1], faces[f, 2])
     h0 = n1 * e22 - n2 * e21
     h1 = n2 * e20 - n0 * e22
     h2 = n0 * e21 - n1 * e20

@@ -14,18 +14,21 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import (
-    fbm2,
-    outer_weight,
-    rim_offsets,
-    roughness_amp,
-    roughness_octaves,
-    slope_factor,
-    table,
-    table_value,
-)
+from craters.kernels import rim_offsets, roughness_octaves, slope_factor
 
-from .._crater_kernels import PARALLEL_MIN, _fill_holes, _fit_quadric_points, _quadric
+from .._crater_kernels import (
+    PARALLEL_MIN,
+    _far,
+    _fill_holes,
+    _fit_quadric_points,
+    _height_change,
+    _point_arrays,
+    _reach,
+    _record,
+    _residual_grid,
+    _slope_deg,
+)
+from ..geometry._normal_kernels import _triangle_cross
 from ._kernels import _geodesic_gather
 
 #: Graph distance over straight-line distance allowed when gathering a region: mesh
@@ -39,22 +42,14 @@ def _write_range(lo, hi, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, t
                  depth, xe, rim_tab, delta, quad, rough, seed, wavelength, octaves, gain,
                  dh_out):
     """Move gathered vertices lo..hi-1 along ``up`` by their height change (each vertex
-    written once)."""
-    p0, gx, gy, qa, qb, qc = quad[0], quad[1], quad[2], quad[3], quad[4], quad[5]
+    written once; the change: :func:`~latlong._crater_kernels._height_change`)."""
+    far = _far(radius, rim_tab, xe)
     for q in range(lo, hi):
-        x = dist[q] / (radius * (1.0 + table(rim_tab, az[q])))
-        dh = 0.0
-        if x < xe:
-            if x <= 1.0:
-                new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-                       + scale * table_value(tab, x, xe))
-            else:
-                new = (hgt[q] + scale * table_value(tab, x, xe)
-                       + table(delta, az[q]) * outer_weight(x, xe))
-            if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
-                amp = roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
-                new += amp * fbm2(seed, xl[q], yl[q], wavelength, octaves, gain)
-            dh = new - hgt[q]
+        inside, dh = _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
+                                    rim_tab, delta, quad[0], quad[1], quad[2], quad[3],
+                                    quad[4], quad[5], rough, seed, wavelength, octaves, gain,
+                                    far)
+        if inside:
             i = idx[q]
             pos[i, 0] += dh * up[0]
             pos[i, 1] += dh * up[1]
@@ -75,20 +70,10 @@ def _write_parallel(pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tab, s
                      wavelength, octaves, gain, dh_out)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _face_normal_sum(pos, faces, f, acc):
-    a = faces[f, 0]
-    b = faces[f, 1]
-    c = faces[f, 2]
-    u0 = pos[b, 0] - pos[a, 0]
-    u1 = pos[b, 1] - pos[a, 1]
-    u2 = pos[b, 2] - pos[a, 2]
-    v0 = pos[c, 0] - pos[a, 0]
-    v1 = pos[c, 1] - pos[a, 1]
-    v2 = pos[c, 2] - pos[a, 2]
-    acc[0] = u1 * v2 - u2 * v1
-    acc[1] = u2 * v0 - u0 * v2
-    acc[2] = u0 * v1 - u1 * v0
+    """``acc`` = face f's cross product (twice its area along its normal)."""
+    acc[0], acc[1], acc[2] = _triangle_cross(pos, faces[f, 0], faces[f, 1], faces[f, 2])
 
 
 @njit(cache=True)
@@ -161,10 +146,7 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
             d2 = pos[a, 2] - pc2
             seed_d[k] = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         radius = 0.5 * diam[c]
-        rho_max = 0.0
-        for k in range(n_rim):
-            rho_max = max(rho_max, rim_tabs[c, k])
-        reach = xe * radius * (1.0 + rho_max)
+        reach = _reach(radius, rim_tabs[c], xe)
         epoch[0] += 1
         cand, gd = _geodesic_gather(pos, voff, vnbr, seed_v, seed_d,
                                     GATHER_FACTOR * (reach + 2.0 * edge) + edge, mark, gdist,
@@ -196,12 +178,7 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
         e0, e1, e2, n0, n1, n2 = _frame(up[0], up[1], up[2])
         # positions in the crater's frame
         limit = reach + 2.0 * sp
-        idx = np.empty(cnt, np.int64)
-        dist = np.empty(cnt)
-        az = np.empty(cnt)
-        xl = np.empty(cnt)
-        yl = np.empty(cnt)
-        hgt = np.empty(cnt)
+        idx, _, dist, az, xl, yl, hgt = _point_arrays(cnt)
         keep = 0
         n_inside = 0
         folded = False
@@ -243,34 +220,11 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
         r_fit = max(radius, 2.0 * sp)
         p0, gx, gy, qa, qb, qc = _fit_quadric_points(xl, yl, hgt, dist, keep, r_fit)
         quad[0], quad[1], quad[2], quad[3], quad[4], quad[5] = p0, gx, gy, qa, qb, qc
-        nh = int(np.ceil(limit / sp)) + 1
-        g = 2 * nh + 1
-        grid = np.zeros((g, g))
-        num = np.zeros((g, g))
-        for q in range(keep):
-            gi = int(np.round(yl[q] / sp)) + nh
-            gj = int(np.round(xl[q] / sp)) + nh
-            if 0 <= gi < g and 0 <= gj < g:
-                grid[gi, gj] += hgt[q] - _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-                num[gi, gj] += 1.0
-        known = num > 0
-        for gi in range(g):
-            for gj in range(g):
-                if known[gi, gj]:
-                    grid[gi, gj] /= num[gi, gj]
+        grid, known, nh = _residual_grid(xl, yl, hgt, keep, sp, limit, p0, gx, gy, qa, qb, qc)
         local = _fill_holes(grid, known)
         # slope: the fitted base's normal against the crater's vertical (-gravity)
-        l0 = up[0] - gx * e0 - gy * n0
-        l1 = up[1] - gx * e1 - gy * n1
-        l2 = up[2] - gx * e2 - gy * n2
-        v0 = vertical[c, 0]
-        v1 = vertical[c, 1]
-        v2 = vertical[c, 2]
-        cr0 = l1 * v2 - l2 * v1
-        cr1 = l2 * v0 - l0 * v2
-        cr2 = l0 * v1 - l1 * v0
-        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
-                                      l0 * v0 + l1 * v1 + l2 * v2))
+        slope = _slope_deg(up[0], up[1], up[2], e0, e1, e2, n0, n1, n2, gx, gy,
+                           vertical[c, 0], vertical[c, 1], vertical[c, 2])
         out_slope[c] = slope
         out_spacing[c] = sp
         if slope_erosion and slope >= full_deg:
@@ -288,12 +242,7 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
             _write_range(0, keep, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tabs[c],
                          scale, depths[c], xe, rim_tabs[c], delta, quad, rough, seeds[c],
                          radius, octaves, gain, dh)
-        big = 0.0
-        for q in range(keep):
-            big = max(big, abs(dh[q]))
-        out_scale[c] = scale
-        out_maxdh[c] = big
-        out_nvert[c] = keep
+        _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)
 
 
 @njit(cache=True, parallel=True)

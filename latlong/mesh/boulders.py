@@ -16,7 +16,7 @@ import functools
 import numpy as np
 
 import craters as _craters
-from craters._shared import check_int, normalize_rng
+from craters._shared import normalize_rng
 from craters.boulders import (
     BoulderLayer,
     BoulderShape,
@@ -28,6 +28,7 @@ from craters.boulders import (
     rest_on_ground,
 )
 
+from ..boulders import placement_request
 from .cratering import sample_mesh_points
 from .surface import MeshSurface, lat_lon_deg
 from .topology import TriangleGrid
@@ -96,22 +97,15 @@ def place_mesh_boulders(surface: MeshSurface, catalog, *, shape: BoulderShape | 
     """
     if not isinstance(surface, MeshSurface):
         raise TypeError(f"`surface` must be a MeshSurface; got {type(surface).__name__}")
-    shape = BoulderShape() if shape is None else shape
-    if not isinstance(shape, BoulderShape):
-        raise TypeError(f"`shape` must be a BoulderShape; got {type(shape).__name__}")
-    cat = np.asarray(catalog)
-    for name in ("ground_x_m", "ground_y_m", "ground_z_m", "diameter_m", "burial_frac",
-                 "azimuth_deg", "seed"):
-        if name not in (cat.dtype.names or ()):
-            raise ValueError(f"boulder catalog needs a {name!r} column")
-    check_int("max_iterations", max_iterations, 1, 100)
+    cat, shape = placement_request(catalog, shape, max_iterations,
+                                   ("ground_x_m", "ground_y_m", "ground_z_m"))
     n = len(cat)
     v, f = surface.vertices, surface.faces
     grid = TriangleGrid.build(v, f)
     face, uv, _ = grid.closest(np.stack([cat["ground_x_m"], cat["ground_y_m"],
                                          cat["ground_z_m"]], 1))
     ground = _points(v, f, face, uv)
-    vn = surface.vertex_normals()
+    vn = surface.vertex_normals("area")
     w = np.stack([1.0 - uv.sum(axis=1), uv[:, 0], uv[:, 1]], 1)
     nrm = np.einsum("kc,kci->ki", w, vn[f[face]])
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)

@@ -1,9 +1,29 @@
 """Craters on any closed triangle mesh: populations on its true surface and stamping via
 local height grids over the mesh's own neighbourhoods (:mod:`latlong.mesh._stamp_kernels`).
+
+Stamping (:func:`stamp_mesh_craters`): each crater is centred at the surface point
+closest to its ``centre_x_m, centre_y_m, centre_z_m`` (found on the surface as given,
+then followed as earlier craters move it). Its region is the set of vertices within
+graph distance of the centre (Dijkstra over the mesh edges: geodesic reach, never the
+other side of a neck or a thin part), in a frame whose up axis is the surface normal
+averaged over the obliterated region; each vertex gets its true distance and azimuth in
+that plane and its height along up. Then as on the lat/long body
+(:func:`latlong.stamp_craters`, Martin 2014 V.A): a quadric base fitted to the
+obliterated region, a local height grid at the local vertex spacing for the rim
+offsets, slope erosion (the base's normal against the vertical: the direction of the
+body's constant-density self-gravity at the centre, :func:`down_directions`, not the
+radial direction, which on a body that is not star-shaped can lie along the surface),
+the profile of :func:`craters.stamping_profiles` (fresh morphology by size on
+``target``, diffusion degradation by age), irregular rim and roughness; vertices move
+along up by their height change. A crater whose region holds a face turned more than
+``max_tilt_deg`` from up (a fold or an edge within its reach: no height field) is left
+out and counted (``metadata["craters_skipped_no_height_field"]``). The arguments every
+surface's stamping shares are checked once (:func:`craters.stamp.stamp_request`).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 
 import numpy as np
@@ -11,12 +31,19 @@ import numpy as np
 import craters as _craters
 from craters._shared import check_range, normalize_rng, progress_bar
 from craters.profile import DEFAULT_EJECTA_EDGE
-from craters.stamp import as_stamped, resolve_roughness, stamping_profiles
+from craters.stamp import (
+    StampingProfiles,
+    as_stamped,
+    stamp_request,
+    stamped_after,
+    stamping_profiles,
+)
 from craters.targets import Target
 
+from ..geometry.normals import face_normals
 from ._stamp_kernels import _point_mass_kernel, _stamp_mesh_kernel
 from .surface import MeshSurface, lat_lon_deg
-from .topology import TriangleGrid, adjacency, face_normals
+from .topology import TriangleGrid, adjacency
 
 __all__ = ["down_directions", "mesh_crater_population", "sample_mesh_points", "stamp_mesh_craters"]
 
@@ -104,25 +131,8 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
                        full_deg: float = 45.0, target: str | Target = "moon",
                        ejecta_edge: float = DEFAULT_EJECTA_EDGE,
                        max_tilt_deg: float = 75.0) -> MeshSurface:
-    """Stamp a crater catalog on a mesh surface, oldest first; returns a new surface.
-
-    Each crater is centred at the surface point closest to its ``centre_x_m,
-    centre_y_m, centre_z_m`` (found on the surface as given, then followed as earlier
-    craters move it). Its region is the set of vertices within graph distance of the
-    centre (Dijkstra over the mesh edges: geodesic reach, never the other side of a
-    neck or a thin part), in a frame whose up axis is the surface normal averaged over
-    the obliterated region; each vertex gets its true distance and azimuth in that
-    plane and its height along up. Then as on the lat/long body
-    (:func:`latlong.stamp_craters`, Martin 2014 V.A): a quadric base fitted to the
-    obliterated region, a local height grid at the local vertex spacing for the rim
-    offsets, slope erosion (the base's normal against the vertical: the direction of
-    the body's constant-density self-gravity at the centre, :func:`down_directions`,
-    not the radial direction, which on a body that is not star-shaped can lie along the
-    surface), the profile of :func:`craters.stamping_profiles` (fresh morphology by size
-    on ``target``, diffusion degradation by age), irregular rim and roughness; vertices
-    move along up by their height change. A crater whose region holds a face turned
-    more than ``max_tilt_deg`` from up (a fold or an edge within its reach: no height
-    field) is left out and counted (``metadata["craters_skipped_no_height_field"]``).
+    """Stamp a crater catalog on a mesh surface, oldest first (the method: module notes);
+    returns a new surface.
 
     Parameters
     ----------
@@ -141,82 +151,99 @@ def stamp_mesh_craters(surface: MeshSurface, catalog, *, roughness=True, rng=Non
     :func:`latlong.stamp_craters`: the degradation used, rim radius, depth, rim height,
     slope, 3-D centre, ``normal_x, normal_y, normal_z`` (the up axis), seed,
     ``max_change_m``, ``n_vertices``, ``spacing_m``), ``lat_deg, lon_deg`` of the centre
-    as stamped seen from the origin.
+    as stamped seen from the origin; craters erased on steep ground or left out where
+    their region folds are counted in its metadata (``craters_erased_steep``,
+    ``craters_skipped_no_height_field``).
     """
     if not isinstance(surface, MeshSurface):
         raise TypeError(f"`surface` must be a MeshSurface; got {type(surface).__name__}")
     if surface.boulders is not None and len(surface.boulders):
         raise ValueError("`surface` has placed boulders: stamp the craters first, then place "
                          "the boulders (latlong.mesh.place_mesh_boulders)")
-    cat = _craters.sort_oldest_first(_craters.validate_catalog(catalog))
-    names = cat.dtype.names
-    if not all(k in names for k in ("centre_x_m", "centre_y_m", "centre_z_m")):
-        raise ValueError("`catalog` needs centre_x_m, centre_y_m, centre_z_m columns (the 3-D "
-                         "centres) to stamp on a mesh")
-    rough, irregular = resolve_roughness(roughness)
-    irregularity = check_range("irregularity", irregularity, 0.0, 0.3)
-    ejecta_edge = check_range("ejecta_edge", ejecta_edge, 1.5, 20.0)
-    onset = check_range("onset_deg", onset_deg, 0.0, 90.0)
-    full = check_range("full_deg", full_deg, 0.0, 90.0)
+    req = stamp_request(catalog, columns=("centre_x_m", "centre_y_m", "centre_z_m"),
+                        onto="a mesh", roughness=roughness, irregularity=irregularity,
+                        ejecta_edge=ejecta_edge, slope_erosion=slope_erosion,
+                        onset_deg=onset_deg, full_deg=full_deg)
     tilt = check_range("max_tilt_deg", max_tilt_deg, 1.0, 90.0)
-    if slope_erosion and full <= onset:
-        raise ValueError(f"`full_deg` must be > onset_deg ({onset}); got {full}")
-    irr = irregularity if irregular else 0.0
-    n = len(cat)
-    rng = normalize_rng(rng)
-    rim_tabs = _craters.rim_perturbations(n, irr, rng=rng)
-    seeds = rng.integers(0, 2**63, size=n, dtype=np.uint64)
-    pos = np.array(surface.vertices, dtype=np.float64, copy=True)
-    heights = np.array(surface.heights_m, dtype=np.float64, copy=True)
-    faces = np.ascontiguousarray(surface.faces)
-    centres = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
-    face_of, uv, _ = TriangleGrid.build(pos, faces).closest(centres)
-    vertical = -down_directions(pos, faces, _points(pos, faces, face_of, uv))
-    voff, vnbr, foff, fids = adjacency(faces, len(pos))
-    prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
-    diam = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
-    outs = {k: np.zeros(n) for k in ("slope", "maxdh", "nvert", "sp")}
-    scale = np.ones(n)
-    centre = np.zeros((n, 3))
-    normal = np.zeros((n, 3))
-    state = np.zeros(n, dtype=np.int64)
-    rough_arr = np.array([rough.bowl, rough.wall, rough.ejecta])
-    gain = 2.0 ** (rough.fractal_dimension - 3.0)
-    mark = np.zeros(len(pos), dtype=np.int64)
-    gdist = np.zeros(len(pos))
-    epoch = np.zeros(1, dtype=np.int64)
+    cat = req.catalog
+    rim_tabs, seeds = req.draws(len(cat), normalize_rng(rng))
+    run = _MeshStamp.of(surface, cat, stamping_profiles(cat, target, ejecta_edge=req.ejecta_edge),
+                        rim_tabs, seeds, req)
     cos_tilt = float(np.cos(np.radians(tilt)))
-    step = _BATCH if progress else max(n, 1)
-    for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
-        e = min(s + step, n)
-        _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of[s:e], uv[s:e],
-                           vertical[s:e], diam[s:e], prof.tables[s:e], prof.depth_m[s:e],
-                           rim_tabs[s:e], seeds[s:e], ejecta_edge, bool(slope_erosion), onset,
-                           full, rough_arr, gain, cos_tilt, mark, gdist, epoch, scale[s:e],
-                           outs["slope"][s:e], centre[s:e], normal[s:e], outs["maxdh"][s:e],
-                           outs["nvert"][s:e], outs["sp"][s:e], state[s:e])
-    cols = {k: cat[k] for k in names}
-    lat, lon = lat_lon_deg(centre)
-    cols.update(as_stamped(prof, scale, diam), lat_deg=lat, lon_deg=lon, slope_deg=outs["slope"],
-                centre_x_m=centre[:, 0], centre_y_m=centre[:, 1], centre_z_m=centre[:, 2],
-                normal_x=normal[:, 0], normal_y=normal[:, 1], normal_z=normal[:, 2], seed=seeds,
-                max_change_m=outs["maxdh"], n_vertices=outs["nvert"].astype(np.int64),
-                spacing_m=outs["sp"])
-    stamped = _craters.make_catalog(**cols)[state == 0]
-    erased, skipped = int((state == 1).sum()), int((state == 2).sum())
-    if erased:
-        logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
-                    erased, n, full)
-    if skipped:
-        logger.info("%d of %d craters left out: their region folds more than %g deg from "
-                    "their plane (no height field)", skipped, n, tilt)
-    if surface.craters is not None and len(surface.craters):
-        try:
-            stamped = np.concatenate([surface.craters, stamped.astype(surface.craters.dtype)])
-        except (TypeError, ValueError):
-            logger.warning("previous crater catalog has other columns; keeping only the new")
-    meta = {**surface.metadata,
-            "craters_erased_steep": surface.metadata.get("craters_erased_steep", 0) + erased,
-            "craters_skipped_no_height_field":
-                surface.metadata.get("craters_skipped_no_height_field", 0) + skipped}
-    return surface.replace(vertices=pos, heights_m=heights, craters=stamped, metadata=meta)
+    step = _BATCH if progress else max(len(cat), 1)
+    for s in progress_bar(range(0, len(cat), step), enabled=progress, desc="craters"):
+        _stamp_mesh_kernel(*run.mesh, *run.args(s, s + step, cos_tilt))
+    return run.result(surface, cat, seeds, tilt)
+
+
+@dataclasses.dataclass(frozen=True)
+class _MeshStamp:
+    """The arrays of one stamping run on a mesh, in the kernel's argument order: the mesh
+    (positions and heights written) and its adjacency, then per crater (catalog order)
+    the inputs, the options, the work arrays and the outputs
+    (:func:`~latlong.mesh._stamp_kernels._stamp_mesh_kernel`)."""
+
+    mesh: tuple
+    """(positions, heights, faces, vertex -> neighbours and vertex -> faces (CSR))."""
+    inputs: tuple
+    """(centre face, centre uv, vertical, diameter, profile tables, depths, rim
+    perturbations, seeds)."""
+    options: tuple
+    """(ejecta edge, slope erosion, onset, full, roughness amplitudes, gain)."""
+    work: tuple
+    """(vertex marks, graph distances, gather count)."""
+    outputs: tuple
+    """(scale, slope, centre, normal, max change, vertices touched, spacing, state)."""
+    profiles: StampingProfiles
+    """The catalog's profile tables and what the catalog reports of them."""
+
+    @classmethod
+    def of(cls, surface: MeshSurface, cat, prof, rim_tabs, seeds, req) -> _MeshStamp:
+        n = len(cat)
+        pos = np.array(surface.vertices, dtype=np.float64, copy=True)
+        faces = np.ascontiguousarray(surface.faces)
+        centres = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
+        face_of, uv, _ = TriangleGrid.build(pos, faces).closest(centres)
+        vertical = -down_directions(pos, faces, _points(pos, faces, face_of, uv))
+        mesh = (pos, np.array(surface.heights_m, dtype=np.float64, copy=True), faces,
+                *adjacency(faces, len(pos)))
+        inputs = (face_of, uv, vertical, np.ascontiguousarray(cat["diameter_m"], dtype=np.float64),
+                  prof.tables, prof.depth_m, rim_tabs, seeds)
+        options = (req.ejecta_edge, req.slope_erosion, req.onset_deg, req.full_deg,
+                   req.rough_array, req.gain)
+        work = (np.zeros(len(pos), dtype=np.int64), np.zeros(len(pos)),
+                np.zeros(1, dtype=np.int64))
+        outputs = (np.ones(n), np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n),
+                   np.zeros(n), np.zeros(n), np.zeros(n, dtype=np.int64))
+        return cls(mesh, inputs, options, work, outputs, prof)
+
+    def args(self, s: int, e: int, cos_tilt: float) -> tuple:
+        """The kernel's arguments after the mesh for craters s..e-1."""
+        return (*(a[s:e] for a in self.inputs), *self.options, cos_tilt, *self.work,
+                *(a[s:e] for a in self.outputs))
+
+    def result(self, surface: MeshSurface, cat, seeds, tilt: float) -> MeshSurface:
+        """The stamped surface: moved vertices and heights, the catalog as stamped after
+        the surface's previous craters, the erased and skipped craters counted."""
+        scale, slope, centre, normal, maxdh, nvert, spacing, state = self.outputs
+        cols = {k: cat[k] for k in cat.dtype.names}
+        lat, lon = lat_lon_deg(centre)
+        cols.update(as_stamped(self.profiles, scale, self.inputs[3]), lat_deg=lat, lon_deg=lon,
+                    slope_deg=slope, centre_x_m=centre[:, 0], centre_y_m=centre[:, 1],
+                    centre_z_m=centre[:, 2], normal_x=normal[:, 0], normal_y=normal[:, 1],
+                    normal_z=normal[:, 2], seed=seeds, max_change_m=maxdh,
+                    n_vertices=nvert.astype(np.int64), spacing_m=spacing)
+        stamped = _craters.make_catalog(**cols)[state == 0]
+        erased, skipped = int((state == 1).sum()), int((state == 2).sum())
+        if erased:
+            logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
+                        erased, len(cat), self.options[3])
+        if skipped:
+            logger.info("%d of %d craters left out: their region folds more than %g deg from "
+                        "their plane (no height field)", skipped, len(cat), tilt)
+        meta = {**surface.metadata,
+                "craters_erased_steep": surface.metadata.get("craters_erased_steep", 0) + erased,
+                "craters_skipped_no_height_field":
+                    surface.metadata.get("craters_skipped_no_height_field", 0) + skipped}
+        return surface.replace(vertices=self.mesh[0], heights_m=self.mesh[1], metadata=meta,
+                               craters=stamped_after(surface.craters, stamped))

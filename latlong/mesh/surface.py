@@ -15,19 +15,19 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-from pathlib import Path
 
 import numpy as np
 
 from craters import validate_catalog
-from craters._shared import ParameterError, check_finite, check_int, check_positive
-from craters.boulders import boulder_faces, catalog_shape, iter_boulder_meshes
+from craters._shared import check_finite, check_int, check_positive
 
-from ..meshio.writers import MeshSource, write_mesh
+from ..geometry.meshes import TriangleMeshSurface, centre_point
+from ..meshio.boulders import BoulderMeshes, mesh_fields
+from ..meshio.writers import MeshSource
 from ..perlin import fbm3, random_rotation
-from ..shapes import ShapeModel, read_shape_model
+from ..shapes import ShapeModel, as_shape_model
 from .refine import refine_mesh
-from .topology import mesh_checks, vertex_normals
+from .topology import mesh_checks
 
 __all__ = ["MeshSurface", "lat_lon_deg", "mesh_surface"]
 
@@ -48,9 +48,11 @@ def _frozen(a, dtype) -> np.ndarray:
 
 
 @dataclasses.dataclass(frozen=True, eq=False)
-class MeshSurface:
+class MeshSurface(TriangleMeshSurface):
     """A closed triangle mesh in metres (origin = the model's volume centroid), what was
-    added to it and how it was made. Immutable: operations return new surfaces."""
+    added to it and how it was made. Immutable: operations return new surfaces. A
+    :class:`~latlong.geometry.surface.Surface` (normals, frames and measures:
+    :class:`~latlong.geometry.meshes.TriangleMeshSurface`)."""
 
     vertices: np.ndarray
     """(V, 3) float64 positions, metres, read-only."""
@@ -110,21 +112,10 @@ class MeshSurface:
         return ShapeModel(self.vertices, self.faces, self.metadata.get("source", ""))
 
     @property
-    def area_m2(self) -> float:
-        return self.shape_model().area_m2
-
-    @property
-    def volume_m3(self) -> float:
-        return self.shape_model().volume_m3
-
-    @property
     def mean_edge_m(self) -> float:
+        """Mean length of the faces' edges (each edge once per face), metres."""
         e = self.vertices[self.faces[:, [1, 2, 0]]] - self.vertices[self.faces]
         return float(np.linalg.norm(e, axis=2).mean())
-
-    def vertex_normals(self) -> np.ndarray:
-        """Unit area-weighted vertex normals, (V, 3)."""
-        return vertex_normals(self.vertices, self.faces)
 
     def checks(self) -> dict:
         """Closed 2-manifold and topology figures (:func:`latlong.mesh.mesh_checks`)."""
@@ -140,61 +131,45 @@ class MeshSurface:
     # ------------------------------------------------------------------ outputs
     def mesh_source(self) -> MeshSource:
         """The surface, boulders merged at their finest level after it (``boulder_id``
-        per vertex: -1 on the surface, else the catalog row), for the mesh writers."""
-        n, t = len(self.vertices), len(self.faces)
-        cat = self.boulders if self.boulders is not None and len(self.boulders) else None
-        top = catalog_shape(cat).levels[-1] if cat is not None else 0
-        nv = 10 * 4**top + 2
-        nbv = 0 if cat is None else len(cat) * nv
-        nbt = 0 if cat is None else len(cat) * 20 * 4**top
+        per vertex: -1 on the surface, else the catalog row;
+        :class:`~latlong.meshio.boulders.BoulderMeshes`), for the mesh writers."""
+        n = len(self.vertices)
+        rocks = BoulderMeshes.of(self.boulders, n)
+        cat = self.boulders
+
+        def rock_heights(s0, world):  # height above the ground under each rock
+            k = world.shape[0]
+            centre = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
+            up = np.stack([cat["normal_x"], cat["normal_y"], cat["normal_z"]], 1)
+            h = np.einsum("kvi,ki->kv", world - centre[s0:s0 + k, None, :], up[s0:s0 + k])
+            return h - (h.min(axis=1, keepdims=True) + cat["burial_m"][s0:s0 + k, None])
 
         def vertex_chunks():
             values = {"height_m": self.heights_m}
-            if cat is not None:
+            if rocks is not None:
                 values["boulder_id"] = np.full(n, -1, dtype=np.int32)
             yield self.vertices, values
-            if cat is not None:  # boulder vertices: height above the ground under them
-                centre = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
-                up = np.stack([cat["normal_x"], cat["normal_y"], cat["normal_z"]], 1)
-                for s0, world, _ in iter_boulder_meshes(cat):
-                    k = world.shape[0]
-                    h = np.einsum("kvi,ki->kv", world - centre[s0:s0 + k, None, :],
-                                  up[s0:s0 + k])
-                    h -= h.min(axis=1, keepdims=True) + cat["burial_m"][s0:s0 + k, None]
-                    yield world.reshape(-1, 3), {
-                        "height_m": h.ravel(),
-                        "boulder_id": np.repeat(np.arange(s0, s0 + k, dtype=np.int32), nv)}
-
-        def boulder_chunks():
-            faces = boulder_faces(top)
-            for s0, world, _ in iter_boulder_meshes(cat):
-                offsets = n + (s0 + np.arange(len(world)))[:, None, None] * nv
-                yield (faces[None] + offsets).reshape(-1, 3)
+            if rocks is not None:
+                yield from rocks.vertex_chunks(rock_heights)
 
         def face_groups():
-            if cat is None:
+            if rocks is None:
                 yield None, [self.faces]
             else:
                 yield "body", [self.faces]
-                yield "boulders", boulder_chunks()
+                yield "boulders", rocks.face_chunks()
 
         def facet_chunks():
             yield self.vertices[self.faces]
-            if cat is not None:
-                for _, world, faces in iter_boulder_meshes(cat):
-                    yield world[:, faces].reshape(-1, 3, 3)
+            if rocks is not None:
+                yield from rocks.facet_chunks()
 
-        fields = [("height_m", "<f4")] + ([("boulder_id", "<i4")] if cat is not None else [])
         comments = (f"{n} surface vertices",) + (
-            (f"{len(cat)} boulders after the surface, boulder_id = catalog row",) if cat
-            is not None else ())
-        return MeshSource(n + nbv, t + nbt, vertex_chunks, face_groups, facet_chunks,
-                          tuple(fields), "craterform mesh surface, metres", comments)
-
-    def save(self, path, *, progress: bool = False) -> Path:
-        """Write the mesh (boulders merged) to a file chosen by suffix (``.ply .obj .stl
-        .vtp .vtk .glb``), atomically."""
-        return write_mesh(self.mesh_source(), path, progress=progress)
+            (rocks.comment("the surface"),) if rocks is not None else ())
+        extra_v, extra_f = (0, 0) if rocks is None else (rocks.n_vertices, rocks.n_faces)
+        return MeshSource(n + extra_v, len(self.faces) + extra_f, vertex_chunks, face_groups,
+                          facet_chunks, mesh_fields(rocks), "craterform mesh surface, metres",
+                          comments)
 
     def to_pyvista(self, *, boulders: bool = True):
         """A ``pyvista.PolyData`` with point array ``height_m`` (boulders merged)."""
@@ -214,21 +189,6 @@ class MeshSurface:
 
 
 # --------------------------------------------------------------------------- building
-def _centre_of(model: ShapeModel, center) -> np.ndarray:
-    if isinstance(center, str):
-        named = {"volume-centroid": lambda: model.volume_centroid,
-                 "area-centroid": lambda: model.area_centroid, "origin": lambda: np.zeros(3)}
-        if center not in named:
-            raise ParameterError("center", f"must be volume-centroid, area-centroid, origin or "
-                                 f"(x, y, z) metres; got {center!r}")
-        return np.asarray(named[center](), dtype=np.float64)
-    c = np.asarray(center, dtype=np.float64).reshape(-1)
-    if c.shape != (3,) or not np.isfinite(c).all():
-        raise ParameterError("center", f"must be a name or three finite coordinates (m); "
-                             f"got {center!r}")
-    return c
-
-
 def fbm_detail(vertices, faces, frequency: float, octaves: int, persistence: float,
                lacunarity: float, amplitude_m: float, *, scale_m: float, rng) -> np.ndarray:
     """Heights (metres) of 3-D Perlin fBm at the vertex positions / ``scale_m``
@@ -267,11 +227,8 @@ def mesh_surface(model, spacing_m: float, *, units: str | None = None,
     >>> s.checks()["euler_characteristic"], s.metadata["refinement"]["butterfly_levels"]
     (2, 1)
     """
-    if not isinstance(model, ShapeModel):
-        if units is None:
-            raise ParameterError("units", "(km or m) is required when reading a shape model file")
-        model = read_shape_model(model, units=units)
-    c = _centre_of(model, center)
+    model = as_shape_model(model, units=units)
+    c = centre_point(model, center)
     moved = ShapeModel(model.vertices - c, model.faces, model.source)
     fine = refine_mesh(moved, spacing_m, smooth=smooth)
     from .refine import refinement_plan
@@ -298,5 +255,5 @@ def with_detail(surface: MeshSurface, frequency: float, octaves: int, persistenc
     scale = (3.0 * abs(surface.volume_m3) / (4.0 * math.pi)) ** (1.0 / 3.0)
     h = fbm_detail(surface.vertices, surface.faces, frequency, octaves, persistence,
                    lacunarity, amplitude_m, scale_m=scale, rng=rng)
-    v = surface.vertices + h[:, None] * surface.vertex_normals()
+    v = surface.vertices + h[:, None] * surface.vertex_normals("area")
     return surface.replace(vertices=v, heights_m=surface.heights_m + h)

@@ -8,6 +8,8 @@
   for closest points (:meth:`TriangleGrid.closest`) and line casts along a normal
   (:meth:`TriangleGrid.depths`), with no O(n^2) anywhere.
 * :func:`mesh_checks`: closed 2-manifold, orientation, Euler characteristic.
+
+Face and vertex normals are :mod:`latlong.geometry.normals`'.
 """
 
 from __future__ import annotations
@@ -18,7 +20,7 @@ import numpy as np
 
 from ._kernels import _closest_points_kernel, _depths_kernel, _grid_kernel
 
-__all__ = ["TriangleGrid", "adjacency", "face_normals", "mesh_checks", "vertex_normals"]
+__all__ = ["TriangleGrid", "adjacency", "mesh_checks"]
 
 #: Cells of a TriangleGrid at most this many per face.
 MAX_CELLS_PER_FACE = 4
@@ -39,23 +41,6 @@ def adjacency(faces: np.ndarray, n_vertices: int):
     vnbr = np.ascontiguousarray(head[order])
     fids = np.ascontiguousarray(order // 3)
     return voff, vnbr, voff.copy(), fids
-
-
-def face_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Unnormalised face normals (twice the area), (F, 3)."""
-    a, b, c = (vertices[faces[:, k]] for k in range(3))
-    return np.cross(b - a, c - a)
-
-
-def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Unit area-weighted vertex normals, (V, 3)."""
-    fn = face_normals(vertices, faces)
-    acc = np.zeros_like(vertices)
-    for k in range(3):
-        for d in range(3):
-            acc[:, d] += np.bincount(faces[:, k], weights=fn[:, d], minlength=len(vertices))
-    norm = np.linalg.norm(acc, axis=1, keepdims=True)
-    return acc / np.where(norm > 0, norm, 1.0)
 
 
 def mesh_checks(vertices: np.ndarray, faces: np.ndarray) -> dict:

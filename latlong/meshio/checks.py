@@ -2,15 +2,15 @@
 
 VTK trusts the element counts of a PLY header: a header declaring 10^8 vertices over a
 few kilobytes of data makes it read past its buffers (a segmentation fault, not an
-exception). :func:`check_mesh_file` compares the counts with the file's size first and
-raises a one-line ``ValueError`` instead.
+exception). :func:`ply_size_problem` compares the counts with the file's size first, so
+that :func:`latlong.meshio.readers.read_mesh` raises a one-line ``ValueError`` instead.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
 
-__all__ = ["MAX_HEADER_BYTES", "check_mesh_file", "ply_min_bytes"]
+__all__ = ["MAX_HEADER_BYTES", "check_mesh_file", "ply_min_bytes", "ply_size_problem"]
 
 #: Longest PLY header read (bytes); real headers are a few hundred bytes.
 MAX_HEADER_BYTES = 1 << 16
@@ -63,27 +63,35 @@ def ply_min_bytes(header: str) -> int:
     return total + close()
 
 
-def check_mesh_file(path, what: str = "mesh file") -> None:
-    """Refuse a PLY file whose header declares more elements than its size can hold
-    (one-line ``ValueError``); other formats pass unchanged."""
+def ply_size_problem(path) -> str | None:
+    """Why a PLY file cannot hold what its header declares (one line), or None (also for
+    any other format)."""
     path = Path(path)
     if path.suffix.lower() != ".ply":
-        return
+        return None
     size = path.stat().st_size
     with open(path, "rb") as fh:
         head = fh.read(MAX_HEADER_BYTES)
     end = head.find(b"end_header")
     if not head.startswith(b"ply") or end < 0:
-        raise ValueError(f"{what} {str(path)!r} is not a PLY file (no 'ply' ... 'end_header' "
-                         f"header in its first {MAX_HEADER_BYTES} bytes)")
+        return (f"it is not a PLY file (no 'ply' ... 'end_header' header in its first "
+                f"{MAX_HEADER_BYTES} bytes)")
     stop = head.find(b"\n", end)
     data_start = (stop + 1) if stop >= 0 else len(head)
     try:
         need = ply_min_bytes(head[:end].decode("ascii", errors="replace"))
     except ValueError as exc:
-        raise ValueError(f"{what} {str(path)!r}: {exc}") from None
+        return str(exc)
     have = size - data_start
     if need > have:
-        raise ValueError(f"{what} {str(path)!r}: its header declares elements that need at "
-                         f"least {need} bytes; the file holds {have} after the header "
-                         f"(truncated or corrupt)")
+        return (f"its header declares elements that need at least {need} bytes; the file "
+                f"holds {have} after the header (truncated or corrupt)")
+    return None
+
+
+def check_mesh_file(path, what: str = "mesh file") -> None:
+    """Refuse a PLY file whose header declares more elements than its size can hold
+    (one-line ``ValueError``, :func:`ply_size_problem`); other formats pass unchanged."""
+    problem = ply_size_problem(path)
+    if problem:
+        raise ValueError(f"{what} {str(Path(path))!r}: {problem}")

@@ -27,7 +27,7 @@ import io
 import json
 import struct
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -83,11 +83,28 @@ class MeshSource:
     """Optional fast path of the PLY writer: yields the faces, in order, as records of
     the given dtype (``n`` = 3, ``v`` = the three indices), as :func:`pack_faces`
     makes of ``faces``; buffers alternate as in ``vertex_records``."""
+    own_writers: dict[str, Callable[[Path, bool], object]] = field(default_factory=dict)
+    """Writers of this mesh that replace the shared one for a suffix:
+    ``{suffix: writer(path, progress)}`` writing the file atomically (a lat/long body's
+    ``.glb`` is its patched-strip glTF, :func:`latlong.export_glb`)."""
 
     def faces(self) -> Iterator[np.ndarray]:
         """Every face chunk, groups in order."""
         for _, chunks in self.face_groups():
             yield from chunks
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+        """The whole mesh in memory: vertices (n, 3) float64 metres, faces (m, 3) int64
+        and the per-vertex fields ``{name: (n,) values}``."""
+        xyz, values = [], {name: [] for name, _ in self.fields}
+        for chunk, vals in self.vertex_chunks():
+            xyz.append(np.asarray(chunk, dtype=np.float64))
+            for name, parts in values.items():
+                parts.append(np.asarray(vals[name]))
+        faces = [np.asarray(f, dtype=np.int64) for f in self.faces()]
+        return (np.concatenate(xyz) if xyz else np.zeros((0, 3)),
+                np.concatenate(faces) if faces else np.zeros((0, 3), np.int64),
+                {k: np.concatenate(v) for k, v in values.items()})
 
 
 def array_source(vertices, faces, title: str, **fields) -> MeshSource:
@@ -347,9 +364,14 @@ MESH_SUFFIXES = tuple(MESH_WRITERS)
 
 
 def write_mesh(src: MeshSource, path, *, progress: bool = False) -> Path:
-    """Write ``src`` to ``path`` in the format of its suffix (:data:`MESH_WRITERS`),
-    atomically; returns the path."""
+    """Write ``src`` to ``path`` in the format of its suffix (:data:`MESH_WRITERS`, or the
+    source's own writer for it: :attr:`MeshSource.own_writers`), atomically; returns the
+    path."""
     path = Path(path)
+    own = src.own_writers.get(path.suffix.lower())
+    if own is not None:
+        own(path, progress)
+        return path
     writer = MESH_WRITERS.get(path.suffix.lower())
     if writer is None:
         raise ValueError(f"`path` {str(path)!r}: unknown mesh format {path.suffix or '(none)'!r}; "

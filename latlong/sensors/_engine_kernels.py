@@ -168,40 +168,6 @@ def _occluded_kernel(occluded1, scene, origins, directions, t_min, t_max, centre
             out[i] = buf[8] < 0.0  # Embree 4 sets tfar = -inf on occlusion
 
 
-@njit(cache=True)
-def _vertex_normals_kernel(vertices, faces, out):
-    """Vertex normals with Max's (1999) weights: the sum over the incident faces of the
-    cross product of the two edges at the vertex divided by the product of their squared
-    lengths (exact for vertices on a sphere), normalised."""
-    out[:] = 0.0
-    for f in range(faces.shape[0]):
-        a, b, c = faces[f, 0], faces[f, 1], faces[f, 2]
-        abx = vertices[b, 0] - vertices[a, 0]
-        aby = vertices[b, 1] - vertices[a, 1]
-        abz = vertices[b, 2] - vertices[a, 2]
-        acx = vertices[c, 0] - vertices[a, 0]
-        acy = vertices[c, 1] - vertices[a, 1]
-        acz = vertices[c, 2] - vertices[a, 2]
-        bcx, bcy, bcz = acx - abx, acy - aby, acz - abz
-        nx = aby * acz - abz * acy
-        ny = abz * acx - abx * acz
-        nz = abx * acy - aby * acx
-        lab = abx * abx + aby * aby + abz * abz
-        lbc = bcx * bcx + bcy * bcy + bcz * bcz
-        lca = acx * acx + acy * acy + acz * acz
-        for v, den in ((a, lab * lca), (b, lab * lbc), (c, lbc * lca)):
-            if den > 0.0:
-                out[v, 0] += nx / den
-                out[v, 1] += ny / den
-                out[v, 2] += nz / den
-    for v in range(out.shape[0]):
-        n = np.sqrt(out[v, 0] ** 2 + out[v, 1] ** 2 + out[v, 2] ** 2)
-        if n > 0.0:
-            out[v, 0] /= n
-            out[v, 1] /= n
-            out[v, 2] /= n
-
-
 @njit(cache=True, parallel=True)
 def _unit_kernel(directions, out):
     """Unit copies of the directions; the index of the first zero or non-finite one

@@ -42,12 +42,13 @@ import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError
 
+from ..geometry.normals import triangle_normals
+from ..geometry.normals import vertex_normals as weighted_vertex_normals
 from ._engine_kernels import (
     _intersect_kernel,
     _occluded_kernel,
     _shift_kernel,
     _unit_kernel,
-    _vertex_normals_kernel,
 )
 
 __all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
@@ -271,11 +272,8 @@ class RayMesh:
             n = np.empty((len(self._index), 3))
             step = 1 << 20
             for lo in range(0, len(self._index), step):
-                tri = self._vertices[self._index[lo:lo + step]]
-                c = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
-                norm = np.linalg.norm(c, axis=1)
-                norm[norm == 0] = 1.0
-                n[lo:lo + step] = c / norm[:, None]
+                n[lo:lo + step] = triangle_normals(self._vertices[self._index[lo:lo + step]],
+                                                   unit=True)
             n.flags.writeable = False
             self._face_normals = n
         return self._face_normals
@@ -287,8 +285,7 @@ class RayMesh:
         vertices on a sphere), computed once; they follow the faces' orientation; smooth
         shading blends them."""
         if self._vertex_normals is None:
-            out = np.empty_like(self._vertices)
-            _vertex_normals_kernel(self._vertices, self._index, out)
+            out = weighted_vertex_normals(self._vertices, self._index, "max")
             out.flags.writeable = False
             self._vertex_normals = out
         return self._vertex_normals

@@ -43,9 +43,9 @@ import numpy as np
 
 from craters._shared import ParameterError
 
+from ..geometry.surface import Surface
 from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kernel
 from .camera import quaternion_to_matrix
-from .scene_geometry import SceneGeometry
 
 __all__ = ["ELLIPSE_DTYPE", "FittedRims", "boulder_labels", "crater_labels", "rim_curves",
            "rim_ellipses", "surface_tree"]
@@ -216,9 +216,9 @@ def surface_tree(surface):
 
 
 def _surface_vertices(surface) -> np.ndarray:
-    if isinstance(surface, SceneGeometry):
-        used = np.unique(surface.faces[surface.face_boulder_id < 0])
-        return surface.vertices[used]
+    if isinstance(surface, Surface):  # a SceneGeometry ...: the boulders' left out
+        vertices, faces = surface.mesh()
+        return vertices[np.unique(faces)]
     verts = np.asarray(surface, dtype=np.float64)
     if verts.ndim != 2 or verts.shape[1] != 3:
         raise ParameterError("surface", f"must be a SceneGeometry or (n, 3) vertices; got "

@@ -26,6 +26,8 @@ import numpy as np
 import craters
 from craters._shared import ParameterError
 
+from ..geometry.meshes import TriangleMeshSurface
+from ..meshio.writers import MeshSource, array_source
 from .engine import RayMesh
 
 if TYPE_CHECKING:
@@ -39,8 +41,10 @@ SURFACE_MEMBERS = ("mesh_source", "craters", "boulders", "metadata")
 
 
 @dataclass(frozen=True, slots=True)
-class SceneGeometry:
-    """A triangle mesh in the surface's frame and the ground truth that labels it."""
+class SceneGeometry(TriangleMeshSurface):
+    """A triangle mesh in the surface's frame and the ground truth that labels it: a
+    :class:`~latlong.geometry.surface.Surface` (normals, frames, measures and ``save``:
+    :class:`~latlong.geometry.meshes.TriangleMeshSurface`)."""
 
     vertices: np.ndarray
     """(n, 3) float64 positions, metres, the surface's frame."""
@@ -55,16 +59,31 @@ class SceneGeometry:
     source: str = ""
     """Where it came from."""
 
+    @property
+    def metadata(self) -> dict:
+        """``{"source": source}``."""
+        return {"source": self.source}
+
+    def mesh(self) -> tuple[np.ndarray, np.ndarray]:
+        """The vertices and the surface's faces (the boulders' left out)."""
+        return self.vertices, self.faces[self.face_boulder_id < 0]
+
+    def mesh_source(self) -> MeshSource:
+        """The whole scene (boulders with their ``boulder_id``) for the mesh writers."""
+        ids = np.full(len(self.vertices), -1, dtype=np.int32)
+        ids[self.faces] = self.face_boulder_id[:, None]
+        return array_source(self.vertices, self.faces, "craterform scene, metres",
+                            boulder_id=ids)
+
 
 def _is_surface(model) -> bool:
     """``model`` has the members of a surface the sensors use."""
     return all(hasattr(model, k) for k in SURFACE_MEMBERS)
 
 
-def _of_surface(model: Surface | SceneGeometry) -> SceneGeometry:
-    """The mesh and the surface's own catalogs (map catalogs not placed yet)."""
-    if isinstance(model, SceneGeometry):
-        return model
+def _of_surface(model: Surface) -> SceneGeometry:
+    """The mesh and the surface's own catalogs (map catalogs not placed yet); a
+    SceneGeometry, a surface too, gives an equal copy of itself."""
     if not _is_surface(model):
         raise TypeError("`model` must be a surface (latlong.geometry.Surface: a Body, a "
                         "mesh surface, a mesh file from latlong.load_surface, a dem "
@@ -88,7 +107,7 @@ def scene_geometry(model, *, craters=None, mesh: RayMesh | None = None) -> Scene
     ----------
     model : Surface or SceneGeometry
         A surface (module notes; :func:`latlong.load_surface` reads one from a file), or
-        a geometry made already (returned with ``craters`` applied).
+        a geometry made already (an equal copy, ``craters`` applied).
     craters : structured array or path, optional
         A crater catalog (CSV or array with ``centre_x_m, centre_y_m, centre_z_m`` and
         ``rim_radius_m`` or ``diameter_m``) to use instead of the surface's own; a map
@@ -96,7 +115,12 @@ def scene_geometry(model, *, craters=None, mesh: RayMesh | None = None) -> Scene
     mesh : RayMesh, optional
         The model's ray mesh if built already (places a map catalog; else one is built).
     """
-    geo = _of_surface(model)
+    return _labelled(_of_surface(model), craters, mesh)
+
+
+def _labelled(geo: SceneGeometry, craters, mesh: RayMesh | None) -> SceneGeometry:
+    """``geo`` with the catalog ``craters`` instead of its own (if given), a map catalog
+    draped on its surface (on ``mesh`` if built)."""
     catalog = geo.craters
     if craters is not None:
         catalog = np.asarray(craters_catalog(craters) if isinstance(craters, str | Path)
@@ -115,7 +139,7 @@ def ray_scene(model, *, craters=None, mesh: RayMesh | None = None,
     geo = _of_surface(model)
     if mesh is None:
         mesh = RayMesh(geo.vertices, geo.faces, build_quality=build_quality)
-    return scene_geometry(geo, craters=craters, mesh=mesh), mesh
+    return _labelled(geo, craters, mesh), mesh
 
 
 def scene_mesh(model, *, build_quality: str = "medium") -> RayMesh:
@@ -126,7 +150,7 @@ def scene_mesh(model, *, build_quality: str = "medium") -> RayMesh:
         return model
     if isinstance(model, tuple) and len(model) == 2:
         return RayMesh(*model, build_quality=build_quality)
-    if not (isinstance(model, SceneGeometry) or _is_surface(model)):
+    if not _is_surface(model):
         raise TypeError("`model` must be a RayMesh, a surface, a SceneGeometry or "
                         f"(vertices, faces); got {type(model).__name__}")
     geo = _of_surface(model)
@@ -144,11 +168,11 @@ def traced_model(model, ground_truth: SceneGeometry | None = None
     if ground_truth is not None and not isinstance(ground_truth, SceneGeometry):
         raise TypeError("`ground_truth` must be a SceneGeometry; got "
                         f"{type(ground_truth).__name__}")
-    if isinstance(model, RayMesh) or isinstance(model, tuple):
-        mesh = scene_mesh(model)
-    else:
+    if _is_surface(model):
         geo, mesh = ray_scene(model)
         ground_truth = geo if ground_truth is None else ground_truth
+    else:  # a traced mesh: labelled by ground_truth only
+        mesh = scene_mesh(model)
     if ground_truth is not None and len(ground_truth.faces) != len(mesh.faces):
         raise ParameterError("ground_truth", f"must describe the traced mesh: "
                              f"{len(ground_truth.faces)} triangles, not {len(mesh.faces)}")

@@ -79,7 +79,7 @@ def test_a_site_implements_the_surface_protocol(stack, tmp_path):
     assert site.save(tmp_path / "a.ply").read_bytes() == \
         dem.to_mesh(stack, tmp_path / "b.ply").read_bytes()
     with pytest.raises(ValueError, match="weighting"):
-        site.vertex_normals("angle")
+        site.vertex_normals("cotangent")
 
 
 def test_the_camera_renders_a_stack_and_a_body_through_the_same_call(stack, body, tmp_path):

@@ -108,7 +108,7 @@ def test_unreadable_model_and_bad_poses(run_cli, tmp_path):
     r = run_cli("latlong", "lidar", str(bad), "-o", str(tmp_path / "o"), "--position-m", POS,
                 "--quaternion", Q)
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
-    assert "cannot read mesh" in r.stderr
+    assert "cannot read model file" in r.stderr
     poses = tmp_path / "p.csv"
     poses.write_text("t,x,y,z\n0,1,2,3\n")
     r = run_cli("latlong", "lidar", str(bad), "-o", str(tmp_path / "o"), "--poses", str(poses))

@@ -26,9 +26,9 @@ def test_a_body_file_is_a_body_and_a_mesh_file_a_surface(rocky, tmp_path):
     body, npz, ply = rocky
     assert isinstance(latlong.load_surface(npz), latlong.Body)
     mesh = latlong.load_surface(ply)
-    assert isinstance(mesh, latlong.MeshFile) and isinstance(mesh, Surface)
+    assert isinstance(mesh, latlong.MeshData) and isinstance(mesh, Surface)
     assert mesh.craters is None and mesh.boulders is None
-    assert mesh.metadata == {"source": str(ply), "units": "m"}
+    assert mesh.metadata == {"source": str(ply), "fields": ["boulder_id", "height_m"]}
     ids = mesh.fields["boulder_id"]
     assert (ids[:body.n_vertices] == -1).all() and set(ids[body.n_vertices:]) == set(range(5))
     verts, faces = mesh.mesh()  # the surface without the boulders
@@ -54,7 +54,7 @@ def test_units_and_errors(rocky, tmp_path):
     np.testing.assert_allclose(km.vertices, 1000.0 * latlong.load_surface(ply).vertices)
     with pytest.raises(ParameterError, match="units"):
         latlong.load_surface(ply, units="mm")
-    text = tmp_path / "model.txt"
+    text = tmp_path / "model.xyz"
     text.write_text("1 2 3\n")
     with pytest.raises(ParameterError, match="model"):
         latlong.load_surface(text)

@@ -152,7 +152,7 @@ def test_unreadable_mesh(run_cli, tmp_path):
                    "-3000,0,0", "--quaternion", Q, *BASE)
     assert proc.returncode == 2
     lines = proc.stderr.strip().splitlines()
-    assert len(lines) == 1 and "cannot read mesh" in lines[0]
+    assert len(lines) == 1 and "cannot read model file" in lines[0]
     assert not out.exists()
     bad_csv = tmp_path / "p.csv"
     bad_csv.write_text("t,x,y,z\n0,1,2,3\n")

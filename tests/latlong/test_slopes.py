@@ -21,8 +21,6 @@ from latlong import (
     slopes_and_areas,
     vertex_normals,
 )
-from latlong._grid_kernels import lon_table
-from latlong._slope_kernels import _normals_from_radii_kernel, _vertex_normals_kernel
 from latlong.shapes import ShapeModel
 from latlong.slopes import direction_cap_sums
 
@@ -138,46 +136,6 @@ def test_bad_inputs():
         slopes(Body.sphere(LatLongGrid(3), 1.0), -1.0)
 
 
-def reference_vertex_normals(verts, tris):
-    """Pure numpy: half cross products summed at the corners; a third of each area."""
-    a, b, c = verts[tris[:, 0]], verts[tris[:, 1]], verts[tris[:, 2]]
-    fn = 0.5 * np.cross(b - a, c - a)
-    acc = np.zeros_like(verts)
-    area = np.zeros(len(verts))
-    for k in range(3):
-        np.add.at(acc, tris[:, k], fn)
-        np.add.at(area, tris[:, k], np.linalg.norm(fn, axis=1) / 3.0)
-    return acc, area
-
-
-def test_vertex_normals_kernel_matches_numpy(rng):
-    verts = rng.normal(size=(30, 3))
-    tris = rng.integers(0, 30, size=(80, 3))
-    tris = tris[(tris[:, 0] != tris[:, 1]) & (tris[:, 1] != tris[:, 2])
-                & (tris[:, 0] != tris[:, 2])]
-    acc, area = np.zeros((30, 3)), np.zeros(30)
-    _vertex_normals_kernel(verts, tris, acc, area)
-    want_acc, want_area = reference_vertex_normals(verts, tris)
-    np.testing.assert_allclose(acc, want_acc, rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(area, want_area, rtol=1e-12, atol=1e-12)
-    # without areas, into float32: the same sums, rounded at every addition
-    acc32 = np.zeros((30, 3), dtype=np.float32)
-    _vertex_normals_kernel(verts, tris, acc32, np.empty(0))
-    np.testing.assert_allclose(acc32, want_acc, rtol=1e-5, atol=1e-5)
-
-
-@pytest.mark.parametrize("m", [1, 2, 5, 12])
-def test_streamed_normals_match_the_vertex_array(rng, m):
-    grid = LatLongGrid(m)
-    body = Body(grid, 50.0 + rng.uniform(0, 5, grid.n_vertices), stretch=(1.0, 1.3, 0.8))
-    acc = np.zeros((grid.n_vertices, 3))
-    _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), body.radii_m,
-                               np.asarray(body.stretch), lon_table(m, grid.ring_offsets()),
-                               acc)
-    want, _ = reference_vertex_normals(body.vertices(), grid.triangles())
-    np.testing.assert_allclose(acc, want, rtol=1e-10, atol=1e-9)
-
-
 def reference_direction_cap_sums(dirs, values, chord):
     """Pure numpy: every point against every other point (small sets only)."""
     d2 = ((dirs[:, None, :] - dirs[None, :, :]) ** 2).sum(axis=2)
@@ -237,15 +195,3 @@ def test_radius_spectrum_recovers_a_known_spectrum():
     assert np.abs(power[1:21] / want - 1).max() < 0.02
     assert power[21:].sum() < 1e-3 * want.sum()
     assert power[0] == pytest.approx(4 * np.pi * 1000.0**2, rel=1e-6)
-
-
-def test_normalised_rows_match_numpy(rng):
-    from latlong._slope_kernels import _normalize_rows_kernel
-
-    acc = (rng.normal(size=(5000, 3)) * 10.0 ** rng.uniform(-6, 6, (5000, 1))).astype(np.float32)
-    acc[:7] = 0.0
-    want = acc.copy()  # the numpy normalisation the kernel replaced
-    norm = np.sqrt((want.astype(np.float64) ** 2).sum(axis=1))
-    want /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
-    _normalize_rows_kernel(acc)
-    assert np.array_equal(acc, want)
