@@ -32,7 +32,7 @@ from .validation import (
     check_range,
 )
 
-__all__ = ["Setting", "check_declared", "declared", "setting"]
+__all__ = ["Setting", "by_key", "check_declared", "declared", "setting"]
 
 _KINDS = {"bool": bool, "int": int, "float": float, "str": str}
 
@@ -106,9 +106,10 @@ class Setting:
 
 
 def setting(default=None, help: str | None = None, **kw) -> Any:
-    """A dataclass field with its declaration (:class:`Setting`; ``kw`` its attributes)."""
-    return dataclasses.field(default=default,
-                             metadata={"setting": Setting(default, help, **kw)})
+    """A dataclass field with its declaration (:class:`Setting`; ``kw`` its attributes);
+    ``dataclasses.MISSING``: a field without a default."""
+    decl = Setting(None if default is dataclasses.MISSING else default, help, **kw)
+    return dataclasses.field(default=default, metadata={"setting": decl})
 
 
 def _kind(field: dataclasses.Field, decl: Setting) -> type | None:
@@ -129,6 +130,14 @@ def declared(cls) -> dict[str, Setting]:
             out[f.name] = dataclasses.replace(decl, key=decl.key or f.name,
                                               kind=_kind(f, decl))
     return out
+
+
+def by_key(source) -> dict[str, Setting]:
+    """{key: setting} of a record's declared fields (:func:`declared`) or of a table of
+    settings by key (their ``key`` filled in)."""
+    if isinstance(source, dict):
+        return {k: dataclasses.replace(s, key=k) for k, s in source.items()}
+    return {s.key: s for s in declared(source).values()}
 
 
 def check_declared(obj, *, keep: tuple[str, ...] = ()) -> None:

@@ -41,13 +41,13 @@ import math
 from collections.abc import Callable, Iterator, Mapping
 
 from .._shared.files import load_toml
-from .._shared.settings import Setting, declared
+from .._shared.settings import Setting, by_key
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 from .kit import CliError
 
-__all__ = ["BATCH_FLAGS", "CONFIG", "FORCE", "QUIET", "REPORT", "Setting", "Values",
-           "add_options", "batch_options", "command", "declared_keys", "flag_of", "main_parser",
-           "help_text", "parse_vary", "read_config", "shown_value", "values_of"]
+__all__ = ["CONFIG", "FORCE", "QUIET", "REPORT", "Setting", "Values", "add_options",
+           "batch_error", "batch_options", "command", "declared_keys", "default_of", "flag_of",
+           "help_text", "main_parser", "parse_vary", "read_config", "shown_value", "values_of"]
 
 
 # --------------------------------------------------------------------------- text -> value
@@ -88,30 +88,42 @@ def _text_parser(s: Setting) -> Callable[[str], object]:
 # --------------------------------------------------------------------------- declarations
 def declared_keys(*sources, **overrides) -> dict[str, Setting]:
     """{key: setting} of the declared fields of the records ``sources`` (or tables of
-    settings by key), one a key: the declaration with the help; another record's field
-    of that key (help None) with a different default and a ``when`` adds its default to
-    the help (``default: 10; 6 with a shape base``). ``overrides``: key -> attributes to
-    change (``output={"required": True}``)."""
+    settings by key; a ``(group, source)`` pair puts them in a group), one a key: the
+    declaration with the help; another record's field of that key (help None) with a
+    different default and a ``when`` adds its default to the help (``default: 10; 6 with
+    a shape base``). ``overrides``: key -> attributes to change (``output={"required":
+    True}``)."""
     out: dict[str, Setting] = {}
     extra: dict[str, list[Setting]] = {}
     for source in sources:
-        table = source if isinstance(source, Mapping) else {
-            s.key: s for s in declared(source).values()}
-        for key, s in table.items():
+        group, source = source if isinstance(source, tuple) else (None, source)
+        for key, s in by_key(source).items():
             if s.help is None:
                 extra.setdefault(key, []).append(s)
             elif key in out:
                 raise ValueError(f"setting {key!r} is declared twice")
             else:
-                out[key] = s
+                out[key] = dataclasses.replace(s, group=s.group or group)
     for key, s in out.items():
-        shown = [f"{shown_value(o.default)} {o.when}" for o in extra.get(key, ())
+        shown = [f"{_shown_default(o)} {o.when}" for o in extra.get(key, ())
                  if o.when and o.default != s.default]
-        if shown and s.default_text is None:
-            s = dataclasses.replace(s, default_text="; ".join([shown_value(s.default),
-                                                               *shown]))
+        if shown:
+            s = dataclasses.replace(s, default_text="; ".join([_shown_default(s), *shown]))
         out[key] = dataclasses.replace(s, **overrides.get(key, {}))
     return out
+
+
+def _shown_default(s: Setting) -> str:
+    shown = s.default_text() if callable(s.default_text) else s.default_text
+    return shown_value(s.default) if shown is None else shown
+
+
+def default_of(func, parameter: str):
+    """The default of a library function's ``parameter`` (an option's default, written
+    once: in the function's signature)."""
+    import inspect
+
+    return inspect.signature(func).parameters[parameter].default
 
 
 def flag_of(key: str, s: Setting) -> str:
@@ -148,28 +160,28 @@ def _range_text(s: Setting) -> str | None:
 def help_text(s: Setting) -> str:
     """The help of an option: what it is, its unit and range, then ``(default: ...)`` or
     ``(required)``."""
-    text = ", ".join(p for p in (s.help, s.unit) if p)
+    text = s.help or ""
+    if s.unit:  # after the first clause: "surface gravity, m/s^2: transition ..."
+        cut = min((i for i in (text.find(": "), text.find(" (")) if i > 0), default=len(text))
+        text = f"{text[:cut]}, {s.unit}{text[cut:]}"
     if _range_text(s):
         text += f"; {_range_text(s)}"
     if _negated(s):
         text += "; this switch turns it off"
     if s.required:
         return f"{text} (required)"
-    shown = s.default_text() if callable(s.default_text) else s.default_text
-    return f"{text} (default: {shown_value(s.default) if shown is None else shown})"
+    return f"{text} (default: {_shown_default(s)})"
 
 
 def add_options(parser, options: Mapping[str, Setting],
                 groups: Mapping[str, str] | None = None) -> None:
     """Add one argparse option a setting (module notes); ``groups``: group name -> title
     of the setting groups that get their own section; nothing given stays None."""
-    sections: dict = {}
+    used = {s.group for s in options.values()}
+    sections = {g: parser.add_argument_group(title) for g, title in (groups or {}).items()
+                if g in used}
     for key, s in options.items():
-        where = parser
-        if groups and s.group in groups:
-            if s.group not in sections:
-                sections[s.group] = parser.add_argument_group(groups[s.group])
-            where = sections[s.group]
+        where = sections.get(s.group, parser)
         kw: dict = {"help": help_text(s), "default": None}
         flag = flag_of(key, s)
         if flag.isupper():  # a positional argument
@@ -181,8 +193,10 @@ def add_options(parser, options: Mapping[str, Setting],
             if s.kind is bool and not s.many:
                 kw["action"] = "store_false" if _negated(s) else "store_true"
                 del kw["metavar"]
-        if "action" not in kw:
-            kw.update(type=_text_parser(s), choices=s.choices)
+        if "action" not in kw:  # choices are the library's (or the kit's) to check
+            kw["type"] = _text_parser(s)
+            if s.choices and not s.metavar:
+                kw["metavar"] = "{" + ",".join(s.choices) + "}"
             if s.many:
                 kw.update({"action": "append"} if s.many == "append" else {"nargs": "+"})
         where.add_argument(*names, **kw)
@@ -217,26 +231,35 @@ def read_config(path, options: Mapping[str, Setting], command: str) -> dict:
             if s.many == "append":
                 what += " or a list of them"
             raise CliError(f"config {str(path)!r}: key {key!r} must be {what}; got {value!r}")
-        out[key] = [value] if s.many == "append" and isinstance(value, str) else value
+        out[key] = [value] if s.run and s.many == "append" and isinstance(value, str) \
+            else value
     return out
 
 
 class Values(dict):
-    """The values of a command's options (key -> value): defaults, then the config file,
-    then the command line; knows which were given and where each came from."""
+    """The values of a command's options (key -> value; ``values.key`` too): defaults,
+    then the config file, then the command line; knows which were ``given`` (by the file
+    or the line), which came ``from_config`` and the file (``config_file``)."""
 
     def __init__(self, command: str, options: Mapping[str, Setting], values: dict,
                  config=None, from_config=frozenset(), given=frozenset()):
         super().__init__(values)
-        self.command, self.options, self.config = command, options, config
+        self.command, self.options, self.config_file = command, options, config
         self.from_config, self.given = set(from_config), set(given)
+
+    def __getattr__(self, key: str):
+        """``values.csv`` for ``values["csv"]``."""
+        try:
+            return self[key]
+        except KeyError:
+            raise AttributeError(key) from None
 
     def where(self, parameter: str | None) -> str | None:
         """How to name the option that sets a library ``parameter`` (None: none does)."""
         for key, s in self.options.items():
             if parameter in (key, *s.also):
                 if key in self.from_config:
-                    return f"config {str(self.config)!r}: key {key!r}"
+                    return f"config {str(self.config_file)!r}: key {key!r}"
                 return flag_of(key, s)
         return None
 
@@ -256,11 +279,12 @@ class Values(dict):
             raise CliError(f"{where}: {exc}") from None
 
 
-def values_of(args: argparse.Namespace, command: str, options: Mapping[str, Setting]) -> Values:
-    """Defaults, then the config file (``args.config``), then the command line; run
-    options checked against their declared kind, range and choices."""
+def values_of(args: argparse.Namespace, command: str, options: Mapping[str, Setting], *,
+              config_file: bool = False) -> Values:
+    """Defaults, then the config file (``args.config`` with ``config_file``), then the
+    command line; run options checked against their declared kind, range and choices."""
     values = {key: s.default for key, s in options.items()}
-    config = getattr(args, "config", None)
+    config = getattr(args, "config", None) if config_file else None
     from_file = read_config(config, options, command) if config else {}
     typed = {key for key in options if getattr(args, key, None) is not None}
     values.update(from_file)
@@ -286,10 +310,11 @@ def command(sub, name: str, run: Callable[[Values], int | None],
     label = f"{prog} {name}".strip()
 
     def call(args: argparse.Namespace) -> int:
-        values = values_of(args, label, options)
+        values = values_of(args, label, options, config_file=config)
         with values.named_errors():
             return int(run(values) or 0)
 
+    call.options = dict(options)  # the table of the flags and config keys, for tests
     p.set_defaults(func=call)
     return p
 
@@ -337,6 +362,22 @@ def _vary_value(key: str, s: Setting, text: str):
     return [value] if s.many == "append" else value
 
 
+def batch_error(exc: Exception, v: Values, config) -> CliError:
+    """A library error of a batch as one line: under its option, else under the key of
+    the file ``config`` it is about."""
+    def name_of(key):
+        return v.where(key) or f"key {key!r}"
+
+    def where(key):
+        return v.where(key) or f"config {str(config)!r}: key {key!r}"
+
+    if isinstance(exc, ParameterError | ParameterTypeError):
+        return CliError(exc.shown_as(where(exc.name), name_of))
+    if parameter_of(exc) is not None:
+        return CliError(f"{where(parameter_of(exc))}: {exc}")
+    return CliError(str(exc))
+
+
 # --------------------------------------------------------------------------- run options
 #: ``--config``: a TOML file of option keys.
 CONFIG = Setting(help="TOML file whose keys are the option names; options given here "
@@ -354,12 +395,6 @@ REPORT = {
                      flag="-q/--quiet", run=True),
 }
 
-#: Parameters of ``latlong.batch`` / ``dem.batch`` -> the flags of the batch commands.
-BATCH_FLAGS = {"seeds": "--seeds", "vary": "--vary", "out": "-o/--output",
-               "scheduler": "--scheduler", "workers": "--workers", "resume": "--resume",
-               "force": "--force"}
-
-
 def batch_options(what: str) -> dict[str, Setting]:
     """The options of ``latlong batch`` and ``dem batch`` (``what``: a variant's output)."""
     return {
@@ -370,7 +405,7 @@ def batch_options(what: str) -> dict[str, Setting]:
                         "hold commas (crater specs, X,Y,Z) are separated by ';' (repeatable)",
                         many="append", metavar="KEY=V1,V2,...", run=True),
         "output": Setting(help=f"batch folder: {what}, and index.csv", flag="-o/--output",
-                          metavar="FOLDER", required=True, run=True),
+                          metavar="FOLDER", required=True, run=True, also=("out",)),
         "scheduler": Setting(help="a running dask scheduler, e.g. tcp://127.0.0.1:8786",
                              metavar="ADDRESS", run=True,
                              default_text="a local cluster on 127.0.0.1, one "

@@ -108,10 +108,10 @@ def test_errors_name_the_setting(settings, name, text):
 
 
 def test_every_setting_is_an_option_and_a_toml_key():
-    from latlong.cli.options import BUILD_OPTIONS, OUTPUT_KEYS
+    from latlong.cli.build import OPTIONS
+    from latlong.outputs import OUTPUT_SETTINGS
 
-    keys = {o.key for o in BUILD_OPTIONS}
-    assert keys == set(SETTINGS) | set(OUTPUT_KEYS)
+    assert set(OPTIONS) == set(SETTINGS) | set(OUTPUT_SETTINGS) | {"quiet", "force"}
 
 
 def test_help_shows_every_default(capsys):
