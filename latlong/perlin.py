@@ -126,7 +126,8 @@ class FbmParams:
     """Amplitude ratio between successive octaves."""
     lacunarity: float = setting(1.75, "frequency ratio per octave", range=(1.0, None))
     """Frequency ratio between successive octaves."""
-    amplitude: float = setting(0.4, range=">=0")
+    amplitude: float = setting(0.4, "fBm height scale as a fraction of the body radius "
+                               "(--amplitude-m, in metres, wins)", range=">=0")
     """Height scale as a fraction of the body radius: heights = amplitude * R * fbm."""
     amplitude_m: float | None = setting(None, "fBm height scale", unit="m", range=">=0",
                                         default_text="the preset's fraction of the radius")
