@@ -70,6 +70,15 @@ def test_from_settings_applies_presets_then_the_given_values():
     assert s.base.amplitude_m == pytest.approx(40.0)
 
 
+def test_amplitude_is_a_fraction_of_the_radius_and_the_metres_win():
+    s = Scene.from_settings({"base": "fbm", "magnitude": 8, "radius_m": 200, "amplitude": 0.1})
+    assert s.base.amplitude_m == pytest.approx(20.0)
+    s = Scene.from_settings({"magnitude": 8, "amplitude": 0.1, "amplitude_m": 3.0})
+    assert s.base.amplitude_m == 3.0
+    with pytest.raises(ValueError, match="applies to"):
+        Scene.from_settings({"base": "sphere", "magnitude": 8, "amplitude": 0.1})
+
+
 def test_a_toml_scene(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text('magnitude = 16\nbase = "sphere"\nradius_m = 100\nseed = 5\n'
