@@ -44,22 +44,20 @@ class Setting:
     default: Any = None
     """The value when none is given (None: not given; the record or command decides)."""
     help: str | None = None
-    """What it is, without default, unit or range (they are added). None: the same
-    setting as another record's field of this ``key`` (which has the help)."""
+    """What it is, without default, unit or range (help texts add them); None: the same
+    setting as another record's field of this ``key``, or a field without an option."""
     unit: str | None = None
     """Unit of the value (``m``, ``deg``, ``kg/m^3`` ...)."""
     range: tuple | str | None = None
-    """Allowed values: ``(lo, hi)`` (None = open; an integer range for ``int``), ``">0"``,
-    ``">=0"`` or ``"finite"``."""
+    """``(lo, hi)`` (None open; integers for ``int``), ``">0"``, ``">=0"`` or ``"finite"``."""
     choices: tuple[str, ...] | None = None
     """The allowed words."""
     kind: type | None = None
-    """``bool``, ``int``, ``float`` or ``str`` (default: from the field's type)."""
+    """``bool``, ``int``, ``float`` or ``str`` (default: the default's or field's type)."""
     key: str | None = None
     """The flat / TOML key (default: the field's name)."""
     flag: str | None = None
-    """The command-line flag (default: ``--key`` with dashes; ``-o/--output`` with a short
-    form; an upper-case word such as ``MODEL`` for a positional argument)."""
+    """The flag (default ``--key`` with dashes; ``-o/--output``; ``MODEL``: positional)."""
     parse: Callable[[str], Any] | None = None
     """Command-line text -> value (default: by ``kind``); ValueError for bad text."""
     many: str | None = None
@@ -69,12 +67,11 @@ class Setting:
     required: bool = False
     """The command line needs it."""
     run: bool = False
-    """A run option of a command (a file, a switch): its TOML value is checked by the
-    command line, not by a library record."""
+    """A command's own option (a file, a switch): checked by the command line."""
     metavar: str | None = None
     """The value's name in help texts."""
     default_text: str | Callable[[], str] | None = None
-    """How help texts say the default when the value does not (None -> "the preset's")."""
+    """How help texts say the default when the value does not."""
     when: str | None = None
     """Where this field's default applies, for a key that several records share."""
     also: tuple[str, ...] = ()

@@ -1,7 +1,9 @@
 """Command-line plumbing shared by the ``latlong``, ``dem`` and ``craters`` commands.
 
 Only command-line modules import this (it loads argparse): one-line errors with exit
-code 2, the ``--seed`` type, and the report options of the analysis commands.
+code 2 (:func:`run_cli`), the ``--seed`` type, the checks of outputs before any work, the
+lines a batch prints. The options themselves come from declared settings
+(:mod:`craters.cli.options`).
 """
 
 from __future__ import annotations

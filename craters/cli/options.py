@@ -5,31 +5,46 @@ library error is shown under come from one declaration, a
 
 How to declare a command's options
 ----------------------------------
-A setting of a library record is declared on the record's field (``setting(...)``, see
-:mod:`craters._shared.settings`) and listed with :func:`~craters._shared.settings.declared`;
-a command's own options (outputs, ``--force``, ``--quiet``, an input) are ``Setting``
-records in a table of the command's module, with ``run=True`` (the command line, not a
-library record, checks their values); :data:`FORCE`, :data:`QUIET`, :data:`REPORT` and
-:func:`batch_options` are ready-made. Then one call registers the command::
+1. A setting of a library record is declared on the record's field, once::
 
-    OPTIONS = {"model": Setting(help="a .npz written by latlong build", flag="MODEL",
-                                required=True, run=True),
-               "lod": Setting(0, "coarsest level of detail", range=(0, 20), run=True),
-               **declared_keys(PreviewSettings), "force": FORCE, "quiet": QUIET}
+       width_px: int = setting(1024, "picture width", unit="px", range=(16, 8192))
 
-    def run(v: Values) -> int:           # v["lod"], v["model"] ...; v.where("lod")
-        ...
+   and the record's ``__post_init__`` calls ``check_declared(self)`` (the range check;
+   :mod:`craters._shared.settings`). ``declared_keys(Record)`` (or ``(group, Record)``
+   pairs) lists them by key for a command; the record's defaults are the options'.
+2. A command's own options (an input, outputs, ``--force``, ``--quiet``, switches that
+   only the command line reads) are ``Setting`` records in a table of the command's
+   module, with ``run=True``: the kit checks their values (declared range and choices;
+   a config file's value type). Ready-made: :data:`FORCE`, :data:`QUIET`,
+   :data:`REPORT`, :func:`batch_options`. A library function's default is read from its
+   signature, :func:`default_of`, not written again.
+3. One module a command registers its table::
 
-    def register(sub) -> None:
-        command(sub, "render", run, OPTIONS, help="render a saved body to a PNG")
+       OPTIONS = {"model": Setting(help="a .npz written by latlong build", flag="MODEL",
+                                   required=True, run=True),
+                  "output": Setting(help="PNG to write", flag="-o/--output",
+                                    required=True, run=True),
+                  **declared_keys(("render", PreviewSettings)), "force": FORCE,
+                  "quiet": QUIET}
 
-:func:`command` adds one argparse option a setting (``--key`` with dashes unless
-``flag`` says otherwise; a ``bool`` is a switch, ``--no-key`` when its default is on),
-and ``--config TOML`` with ``config=True`` (keys: the option keys; unknown keys are
-errors). At run time the values (defaults < config file < command line) reach
-``run`` as :class:`Values`, and a library error about a setting's key (or a parameter of
-its ``also``) is one line under its flag, or under the file's key when the value came
-from the file. :func:`parse_vary` reads ``--vary KEY=V1,V2`` with the same parsers.
+       def run(v: Values) -> int:      # v["width_px"] or v.width_px; v.given ...
+           ...
+
+       def register(sub) -> None:
+           command(sub, "render", run, OPTIONS, prog="latlong",
+                   groups={"render": "preview picture"}, help="render a saved body")
+
+:func:`command` adds one argparse option a setting: ``--key`` with dashes unless
+``flag`` says otherwise (``-o/--output``; an upper-case word, ``MODEL``, is a positional
+argument), a ``bool`` is a switch (``--no-key`` when its default is on), ``many`` makes it
+repeatable (``append``) or a list (``+``), ``choices`` show in the usage and are checked
+by the library (or the kit, ``run``); with ``config=True`` it adds ``--config TOML``, whose
+keys are the option keys (unknown keys are errors). At run time the values (defaults <
+config file < command line) reach ``run`` as :class:`Values`, and a library error about a
+setting's key, or a parameter named in its ``also`` (``also=("fx", "fy")``), is one line
+under the flag, or under the file's key when the value came from the file. Batches read
+``--vary KEY=V1,V2`` with the same parsers (:func:`parse_vary`; ``commas=True`` for a
+setting whose one value holds commas).
 """
 
 from __future__ import annotations
