@@ -41,6 +41,7 @@ from .presets import DEFAULT_PRESET, PRESETS, RENAMED_PRESETS
 from .preview import PreviewSettings
 from .settings import (
     DEFAULT_RADIUS_M,
+    NO_STRETCH,
     BodySettings,
     BoulderSettings,
     CraterSettings,
@@ -57,7 +58,7 @@ __all__ = ["SETTINGS", "SETTING_DEFAULTS", "SETTING_PARTS", "Scene"]
 _CHOICES = {
     "base": Setting(None, "base shape: sphere, faulting, fbm or shape:PATH (a real shape "
                     "model: OBJ, PDS plate .tab/.plt, PLY, STL)",
-                    default_text="fbm (preset fig5a)"),
+                    default_text=f"fbm (preset {DEFAULT_PRESET['fbm']})"),
     "backend": Setting("latlong", "latlong (the lat/long mesh) or implicit (Li et al.: "
                        "metaballs over a sphere packing of --shape, LCSN craters, Gabor "
                        "detail, marching cubes)", choices=("latlong", "implicit")),
@@ -135,7 +136,7 @@ class Scene:
                                      f"ShapeBase; got {type(base).__name__}")
         body, resolution = self.body, None
         if isinstance(base, ShapeBase):
-            own = {"radius_m": base.radius_m, "stretch": (1.0, 1.0, 1.0)}
+            own = {"radius_m": base.radius_m, "stretch": NO_STRETCH}
             for key, value in own.items():
                 if getattr(body, key) not in (None, value):
                     raise ParameterError(key, "does not apply to a shape base (the model "
@@ -145,7 +146,7 @@ class Scene:
         else:
             stretch = body.stretch
             if stretch is None:  # a faulting set carries its body's stretch (the paper's 2,1,1)
-                stretch = base.stretch if isinstance(base, FaultingParams) else (1.0, 1.0, 1.0)
+                stretch = base.stretch if isinstance(base, FaultingParams) else NO_STRETCH
             body = dataclasses.replace(
                 body, radius_m=DEFAULT_RADIUS_M if body.radius_m is None else body.radius_m,
                 stretch=stretch)
@@ -247,7 +248,7 @@ SETTINGS: tuple[str, ...] = tuple(_OWN)
 #: The default of every setting without a preset (None: none, or it depends on the
 #: preset or base); the faulting and fBm values are the paper's / Fig. 5a's.
 SETTING_DEFAULTS: dict[str, object] = {**{k: s.default for k, s in _OWN.items()},
-                                       "radius_m": DEFAULT_RADIUS_M, "stretch": (1.0, 1.0, 1.0)}
+                                       "radius_m": DEFAULT_RADIUS_M, "stretch": NO_STRETCH}
 
 
 def _keys(kind) -> tuple[str, ...]:

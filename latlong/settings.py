@@ -13,12 +13,12 @@ from pathlib import Path
 
 import craters as _craters
 from craters._shared import ParameterError, ParameterTypeError, physical_memory_bytes
-from craters._shared.settings import check_declared, setting
+from craters._shared.settings import check_declared, default_of, setting
 
 from .memory import MEMORY_SHARE, RADII_ON_DISK, check_memory
 from .shapes import SIZE_RANGE_M, ShapeModel, read_shape_model
 
-__all__ = ["BASES", "DEFAULT_RADIUS_M", "SURFACES", "BodySettings", "BoulderSettings",
+__all__ = ["BASES", "DEFAULT_RADIUS_M", "NO_STRETCH", "SURFACES", "BodySettings", "BoulderSettings",
            "CraterSettings", "GaborExample", "ImplicitSettings", "ShapeBase", "SphereBase"]
 
 #: Names of the base shapes (``shape`` takes a model file).
@@ -28,6 +28,8 @@ BASES = ("sphere", "faulting", "fbm", "shape")
 RADIUS_RANGE_M = SIZE_RANGE_M
 #: The reference radius of a body without a shape base when none is given, metres.
 DEFAULT_RADIUS_M = 50.0
+#: The stretch of a body when none is given (the faulting presets have their own).
+NO_STRETCH = (1.0, 1.0, 1.0)
 CROSSINGS = ("error", "outermost", "innermost")
 #: Where a shape base is cratered: the lat/long grid or the model's own mesh.
 SURFACES = ("latlong", "mesh")
@@ -64,7 +66,8 @@ class BodySettings:
     """Reference radius, metres; default 50 m (a shape base sets its own)."""
     stretch: tuple[float, float, float] | None = setting(
         None, "scale factors X,Y,Z applied to the body (e.g. 2,1,1)", parse=parse_stretch,
-        commas=True, metavar="X,Y,Z", default_text="1,1,1; a faulting preset's: 2,1,1")
+        commas=True, metavar="X,Y,Z",
+        default_text=",".join(f"{x:g}" for x in NO_STRETCH) + "; a faulting preset's: 2,1,1")
     """Scale factors along x, y, z; default 1, 1, 1 (a shape base sets its own)."""
     target: str = setting(
         "small-body", "what kind of body the craters are on (morphology, transition "
@@ -81,7 +84,8 @@ class BodySettings:
     """Bulk density of a small body, kg/m^3."""
     crater_depth_ratio: float | None = setting(
         None, "fresh crater depth/diameter on a small body", range=(0.01, 0.5),
-        default_text="0.2, Marchi et al. 2015; Bennu's measured 0.10")
+        default_text=f"{default_of(_craters.small_body, 'depth_ratio'):g}, Marchi et al. "
+        "2015; Bennu's measured 0.10")
     """Fresh crater depth/diameter of a small body, [0.01, 0.5]; default 0.2 (Marchi et
     al. 2015); e.g. Bennu 0.10 (Daly et al. 2020)."""
     max_memory_gb: float | None = setting(

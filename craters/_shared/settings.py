@@ -32,7 +32,7 @@ from .validation import (
     check_range,
 )
 
-__all__ = ["Setting", "by_key", "check_declared", "declared", "setting"]
+__all__ = ["Setting", "by_key", "check_declared", "declared", "default_of", "setting"]
 
 _KINDS = {"bool": bool, "int": int, "float": float, "str": str}
 
@@ -107,6 +107,14 @@ def setting(default=None, help: str | None = None, **kw) -> Any:
     ``dataclasses.MISSING``: a field without a default."""
     decl = Setting(None if default is dataclasses.MISSING else default, help, **kw)
     return dataclasses.field(default=default, metadata={"setting": decl})
+
+
+def default_of(func, parameter: str):
+    """The default of a function's ``parameter``: a setting's default written once, in the
+    library function's signature."""
+    import inspect
+
+    return inspect.signature(func).parameters[parameter].default
 
 
 def _kind(field: dataclasses.Field, decl: Setting) -> type | None:

@@ -56,7 +56,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping
 
 from .._shared.files import load_toml
-from .._shared.settings import Setting, by_key
+from .._shared.settings import Setting, by_key, default_of
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 from .kit import CliError
 
@@ -131,14 +131,6 @@ def declared_keys(*sources, **overrides) -> dict[str, Setting]:
 def _shown_default(s: Setting) -> str:
     shown = s.default_text() if callable(s.default_text) else s.default_text
     return shown_value(s.default) if shown is None else shown
-
-
-def default_of(func, parameter: str):
-    """The default of a library function's ``parameter`` (an option's default, written
-    once: in the function's signature)."""
-    import inspect
-
-    return inspect.signature(func).parameters[parameter].default
 
 
 def flag_of(key: str, s: Setting) -> str:

@@ -7,9 +7,9 @@ import numpy as np
 
 from .._shared import atomic_path, check_output_path
 from ..profile import crater_morphometry, radial_profile
-from ..targets import TARGETS, get_target
+from ..targets import TARGETS, get_target, small_body
 from .kit import CliError
-from .options import FORCE, QUIET, Setting, Values, command, default_of
+from .options import FORCE, QUIET, Setting, Values, command, default_of, shown_value
 from .report import save_figure
 
 __all__ = ["BODY", "register"]
@@ -25,7 +25,8 @@ BODY = {
     "body_radius_m": Setting(help="radius of a small-body", unit="m", kind=float,
                              also=("radius_m",)),
     "density_kg_m3": Setting(help="bulk density of a small-body", unit="kg/m^3", kind=float,
-                             default_text="2000"),
+                             default_text=shown_value(default_of(small_body,
+                                                                 "density_kg_m3"))),
 }
 OPTIONS = {
     "diameter_m": Setting(help="rim diameter", unit="m", kind=float, range=">0",

@@ -7,7 +7,7 @@ from __future__ import annotations
 from craters.cli.options import Setting, Values, default_of
 
 from ..core import parse_region
-from ..expansion import expand_to_file
+from ..expansion import TILE_PX, expand_to_file
 from .options import DEM, DEM_OUTPUT, INPUT, READ, RUN, begin, dem_command, read_input, summary
 
 __all__ = ["register"]
@@ -19,7 +19,7 @@ OPTIONS = {
                       metavar="N"),
     "tile_px": Setting(help="largest side of an output tile in pixels (>= 3): the unit of "
                        "memory and of work (one dask task a tile)", kind=int, metavar="PX",
-                       default_text="2049, about 80 MB a tile"),
+                       default_text=f"{TILE_PX}, about 80 MB a tile"),
     "scheduler": Setting(help="expand the tiles as tasks on the dask scheduler at ADDRESS, "
                          "e.g. tcp://127.0.0.1:8786 (its workers must see the input and "
                          "output paths; the same bytes)", metavar="ADDRESS",

@@ -9,7 +9,7 @@ from craters.cli.options import Setting, Values, default_of
 from ..frame import crater_target
 from ..gaps import fill_gaps
 from ..io import write
-from ..tiledfill import fill_to_file, fits_whole, raster_shape
+from ..tiledfill import MEMORY_SHARE, fill_to_file, fits_whole, raster_shape
 from .options import DEM, DEM_OUTPUT, INPUT, READ, RUN, begin, dem_command, read_input, summary
 
 __all__ = ["register"]
@@ -26,7 +26,7 @@ OPTIONS = {
                              "would need more is filled tile by tile from the file (the same "
                              "bytes); a gap too large to fill within it is refused", unit="GB",
                              kind=float, metavar="GB",
-                             default_text="0.8 x this machine's memory"),
+                             default_text=f"{MEMORY_SHARE:g} x this machine's memory"),
     **{k: DEM[k] for k in ("fractal_dimension", "roughness", "seed")},
     **READ, "gravity_m_s2": DEM["gravity_m_s2"], **RUN,
 }
