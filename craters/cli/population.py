@@ -62,9 +62,10 @@ OPTIONS = {
     "output": Setting(help="catalog: .csv, or .scc (craterstats spatial crater count: area in "
                       "km^2, diameters in km, lon/lat)", flag="-o/--output", required=True,
                       run=True),
-    "columns": Setting("craterform", "CSV column names: craterform (units in the names) or "
-                       "robbins (LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG in km, as the "
-                       "Robbins 2019 lunar crater database)", choices=CATALOG_COLUMNS,
+    "columns": Setting(default_of(write_catalog, "columns"), "CSV column names: craterform "
+                       "(units in the names) or robbins (LAT_CIRC_IMG, LON_CIRC_IMG, "
+                       "DIAM_CIRC_IMG in km, as the Robbins 2019 lunar crater database)",
+                       choices=CATALOG_COLUMNS,
                        run=True),
     "plot": Setting(help="PNG of the cumulative SFD against the requested law", run=True),
     "force": FORCE, "quiet": QUIET,

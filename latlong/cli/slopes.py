@@ -23,6 +23,17 @@ from .inputs import INPUTS, labels, load_input
 
 __all__ = ["register"]
 
+def _axis(text: str) -> tuple[float, float, float]:
+    """``X,Y,Z``: a rotation axis, three finite numbers, not all zero."""
+    try:
+        axis = tuple(float(x) for x in text.split(","))
+    except ValueError:
+        axis = ()
+    if len(axis) != 3 or not np.all(np.isfinite(axis)) or not any(axis):
+        raise ValueError(f"must be three numbers x,y,z, not all zero; got {text!r}")
+    return axis
+
+
 OPTIONS = {
     **INPUTS,
     "radius_deg": Setting(default_of(slopes_and_areas, "radius_deg"), "averaging cap radius",
@@ -36,8 +47,8 @@ OPTIONS = {
                              "direction"),
     "period_h": Setting(help="rotation period, for the centrifugal part", unit="h",
                         range=">0", kind=float, run=True, default_text="none, not rotating"),
-    "spin_axis": Setting(help="rotation axis in the body frame", metavar="X,Y,Z", run=True,
-                         default_text="0,0,1"),
+    "spin_axis": Setting(default_of(gravity, "spin_axis"), "rotation axis in the body frame",
+                         parse=_axis, commas=True, metavar="X,Y,Z", run=True),
     **REPORT,
 }
 
@@ -58,21 +69,11 @@ def _mean_radius_m(obj) -> float:
 def _gravity_args(v: Values):
     """(density, period, spin axis) from the flags, or None for geometric slopes."""
     if v.density_kg_m3 is None:
-        for flag, value in (("--period-h", v.period_h), ("--spin-axis", v.spin_axis)):
-            if value is not None:
-                raise CliError(f"{flag} needs --density-kg-m3 (gravitational slopes)")
+        for key in ("period_h", "spin_axis"):
+            if key in v.given:
+                raise CliError(f"{v.where(key)} needs --density-kg-m3 (gravitational slopes)")
         return None
-    period = np.inf if v.period_h is None else v.period_h
-    axis = (0.0, 0.0, 1.0)
-    if v.spin_axis is not None:
-        try:
-            axis = tuple(float(x) for x in v.spin_axis.split(","))
-        except ValueError:
-            axis = ()
-        if len(axis) != 3 or not np.all(np.isfinite(axis)) or not any(axis):
-            raise CliError(f"--spin-axis must be three numbers x,y,z, not all zero; got "
-                           f"{v.spin_axis!r}")
-    return v.density_kg_m3, period, axis
+    return v.density_kg_m3, np.inf if v.period_h is None else v.period_h, v.spin_axis
 
 
 def _slopes(v: Values) -> int:
