@@ -7,7 +7,7 @@ from __future__ import annotations
 from craters._shared import ParameterError
 from craters.cli.kit import CliError, check_report_outputs
 from craters.cli.options import Values
-from craters.cli.report import save_figure, series_colors, write_csv
+from craters.cli.report import plot_spectra, write_csv
 
 from ..fractal import dimension_warning
 from ..terrain import power_spectrum, spectral_exponent
@@ -43,25 +43,11 @@ def _spectrum(v: Values) -> int:
                    "heights (plane removed, Hann window), m^2 per (cycle/m)^2 = m^4, against "
                    "wavelength in metres", cols, rows)
     if v.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 5))
-        for (label, wl, p, beta, px), color in zip(results, series_colors(len(results)),
-                                                   strict=True):
-            ax.loglog(wl, p, ".-", ms=3, color=color,
-                      label=f"{legend(label, px)} (beta {beta:.2f})")
-        ax.invert_xaxis()
-        ax.set_xlabel("wavelength (m)")
-        ax.set_ylabel("power spectral density (m$^4$)")
-        ax.set_title("radially averaged power spectrum")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        save_figure(fig, v.plot)
-        plt.close(fig)
+        plot_spectra(v.plot, [(f"{legend(label, px)} (beta {beta:.2f})", wl, p)
+                              for label, wl, p, beta, px in results],
+                     xlabel="wavelength (m)", ylabel="power spectral density (m$^4$)",
+                     title="radially averaged power spectrum", fmt=".-", ms=3,
+                     invert_x=True)
     if not v.quiet:
         print(f"{'input':<28} {'pixel_m':>9} {'beta':>6} {'F=(8-beta)/2':>12}")
         notes = []

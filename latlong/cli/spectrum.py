@@ -10,7 +10,7 @@ import numpy as np
 
 from craters.cli.kit import check_report_outputs
 from craters.cli.options import REPORT, Setting, Values, command
-from craters.cli.report import save_figure, series_colors, write_csv
+from craters.cli.report import plot_spectra, write_csv
 from latlong import Body, ShapeModel, from_shape_model, radius_spectrum
 
 from .inputs import INPUTS, labels, load_input
@@ -61,22 +61,9 @@ def _spectrum(v: Values) -> int:
                    "radius (metres) with orthonormal spherical harmonics; wavelength "
                    "2 pi R / sqrt(l(l+1)) at the mean radius R", cols, rows)
     if v.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, ax = plt.subplots(figsize=(7, 5))
-        for (label, d, p, _), color in zip(results, series_colors(len(results)), strict=True):
-            ax.loglog(d[1:], p[1:], label=label, color=color)
-        ax.set_xlabel("spherical-harmonic degree l")
-        ax.set_ylabel("degree variance S_l (m$^2$)")
-        ax.set_title("radius power spectrum")
-        ax.grid(True, which="both", alpha=0.3)
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        save_figure(fig, v.plot)
-        plt.close(fig)
+        plot_spectra(v.plot, [(label, d[1:], p[1:]) for label, d, p, _ in results],
+                     xlabel="spherical-harmonic degree l", ylabel="degree variance S_l "
+                     "(m$^2$)", title="radius power spectrum")
     if not v.quiet:
         print(f"{'input':<28} {'mean_radius_m':>13} {'rms_relief_m':>12} {'slope_l>=2':>10}")
         for label, d, p, r in results:
