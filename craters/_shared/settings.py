@@ -146,12 +146,13 @@ def by_key(source) -> dict[str, Setting]:
 
 
 def check_declared(obj, *, keep: tuple[str, ...] = ()) -> None:
-    """Check every declared field of the dataclass ``obj`` (a value of None where the
-    default is None means "not given") and store the cleaned value (an integer ``3.0``
-    as ``3``, a number as a float) but in the fields of ``keep`` (kept as given)."""
+    """Check every declared field of the dataclass ``obj`` (None passes where the field's
+    type or default allows it) and store the cleaned value (an integer ``3.0`` as ``3``,
+    a number as a float) but in the fields of ``keep`` (kept as given)."""
+    types = {f.name: str(f.type) for f in dataclasses.fields(obj)}
     for name, decl in declared(type(obj)).items():
         value = getattr(obj, name)
-        if value is None and decl.default is None:
+        if value is None and (decl.default is None or "None" in types[name]):
             continue
         clean = decl.check(name, value)
         if name not in keep:
