@@ -27,16 +27,16 @@ from craters._shared import (
     ParameterError,
     ParameterTypeError,
     about,
-    check_choice,
     check_int,
     check_positive,
     check_range,
     parse_spec,
 )
+from craters._shared.settings import check_declared, setting
 
 from .fractal import MAX_ROUGHNESS
 
-__all__ = ["EnhanceConfig", "SourceCraterLayer", "parse_source_spec"]
+__all__ = ["EnhanceConfig", "SourceCraterLayer", "parse_source_spec", "parse_xy"]
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -103,6 +103,22 @@ def _parse_crater_spec(spec: str):
 
 # keys of ``dem enhance`` that are not part of a stack's description
 _RUN_KEYS = ("output", "force", "quiet")
+#: Fields the manifest records as given (a TOML integer stays an integer), checked only.
+_AS_GIVEN = ("fractal_dimension", "roughness", "seed", "band", "pixel_size_m", "body_radius_m",
+             "gravity_m_s2", "body")
+
+
+def parse_xy(text) -> tuple[float, float]:
+    """``X,Y``: two finite numbers (world coordinates, CRS units)."""
+    parts = str(text).split(",")
+    try:
+        if len(parts) == 2:
+            x, y = (float(p) for p in parts)
+            if math.isfinite(x) and math.isfinite(y):
+                return x, y
+    except ValueError:
+        pass
+    raise ValueError(f"expected X,Y in world coordinates; got {text!r}")
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -120,52 +136,90 @@ class EnhanceConfig:
     craters._shared.validation.ParameterError: `size` must be 2^n + 1 pixels, 5..16385 (5, ...
     """
 
-    input: str | None = None
+    input: str | None = setting(None, "input DEM (GeoTIFF, PDS .lbl/.img)", flag="INPUT",
+                                default_text="none: the config file's `input`")
     """Base DEM file (GeoTIFF or PDS3 .lbl/.img); or pass the Dem to :func:`dem.enhance`."""
-    target: tuple[float, float] | None = None
+    target: tuple[float, float] | None = setting(
+        None, "site in world coordinates (CRS units), X,Y", parse=parse_xy, commas=True,
+        metavar="X,Y", default_text="the base DEM's centre")
     """Site in world coordinates (CRS units, X then Y); default: the base DEM's centre."""
-    layers: int = 11
+    layers: int = setting(11, "number of layers, each 2x finer", range=(1, 24), metavar="N")
     """Number of layers, 1..24 (layer k has pixels 2^k finer than the base)."""
-    size: int = 1025
+    size: int = setting(1025, "pixels per side of every layer, 2^n + 1", kind=int,
+                        metavar="W")
     """Pixels per side of every layer: 2^n + 1, 5..16385."""
-    craters: tuple[str | CraterLayer | ModelAgeLayer | SourceCraterLayer, ...] = ()
+    craters: tuple[str | CraterLayer | ModelAgeLayer | SourceCraterLayer, ...] = setting(
+        (), "crater layer: a power law c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr=..,"
+        "age_max_gyr=..,degradation=..,kind=..] (the fields of craters.CraterLayer; N_cum = "
+        "c D^k per m^2, D in metres, ages in Gyr) or a model age npf=moon,age_gyr=..,"
+        "d_min_m=..,d_max_m=..[,equilibrium=trask|hartmann,degradation=..,kind=..] "
+        "(craters.ModelAgeLayer: the body's production function and chronology) or "
+        "source[,d_min_m=..,age_min_gyr=..,age_max_gyr=..] (the source DEM's own crater "
+        "density, measured, continued below what it resolves); repeat for several. Each "
+        "layer's crater count is also written as craters_NN.scc (craterstats)",
+        many="append", metavar="SPEC")
     """Crater layers: power laws ``c=..,k=..,d_min_m=..,d_max_m=..[,age_min_gyr,age_max_gyr,
     degradation,kind]`` (metres, Gyr; :class:`craters.CraterLayer`), model ages
     ``npf=moon,age_gyr=..,d_min_m=..,d_max_m=..[,equilibrium,degradation,kind]``
     (:class:`craters.ModelAgeLayer`) or the source's own density continued below its
     resolution, ``source[,d_min_m=..,...]`` (:class:`SourceCraterLayer`), as specs or
     records."""
-    min_crater_px: float = 2.0
+    min_crater_px: float = setting(2.0, "smallest crater diameter a layer takes, in its "
+                                   "pixels", unit="px", range=(1.0, 1e6), metavar="PX")
     """Smallest crater diameter a layer takes, in its pixels (>= 1)."""
-    source_crater_px: float | None = 4.0
+    source_crater_px: float | None = setting(
+        4.0, "synthetic craters stay below this many source (layer-0) pixels: the source's "
+        "own craters are the truth above (0: no limit)", unit="px", range=(1.0, 1e6),
+        metavar="PX")
     """Synthetic craters stay smaller than this many pixels of the source DEM (layer 0):
     larger craters are resolved by the source itself, whose real ones are the truth
     (Pike-style counts on DEMs need ~4 pixels across a crater). None or 0: no limit (a
     synthetic or smoothed base)."""
-    boulders: tuple[str | BoulderLayer, ...] = ()
+    boulders: tuple[str | BoulderLayer, ...] = setting(
+        (), "boulder layer c=..,k=..,d_min_m=..,d_max_m=..[,burial_max=..] (N_cum = c D^k per "
+        "m^2, D in metres; burial_max = largest buried fraction of the height); stamped as a "
+        "heightfield maximum in the finest layer holding each; repeat for several",
+        many="append", metavar="SPEC")
     """Boulder layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,burial,near]`` (metres; ``near``
     is ignored on DEMs) or :class:`craters.BoulderLayer` objects."""
-    min_boulder_px: float = 2.0
+    min_boulder_px: float = setting(2.0, "smallest boulder a layer takes, in its pixels",
+                                    unit="px", range=(1.0, 1e6), metavar="PX")
     """Smallest boulder a layer takes, in its pixels (>= 1)."""
-    smooth_craters: bool = False
+    smooth_craters: bool = setting(False, "ideal craters: no fractal overlay, circular rims")
     """Ideal craters: no fractal overlay, circular rims."""
-    fractal_dimension: float | None = None
+    fractal_dimension: float | None = setting(None, "fractal dimension F", range=(2.0, 3.0),
+                                              metavar="F", default_text="estimated from the "
+                                              "input")
     """F in [2, 3] of the expansion; default: estimated on layer 0."""
-    roughness: float | None = None
+    roughness: float | None = setting(
+        None, "RMS slope between neighbouring pixels", unit="m/m", range=(0.0, MAX_ROUGHNESS),
+        metavar="R", default_text="from the input; for expand and enhance the local relief "
+        "of each input pixel")
     """Uniform RMS neighbour slope (m/m) of the expansion; default: local relief."""
-    seed: int | None = None
+    seed: int | None = setting(None, "random seed, a non-negative integer",
+                               range=(0, 2**63 - 1), metavar="S", also=("rng",),
+                               default_text="a fresh one, recorded in the outputs")
     """Seed of everything random, in [0, 2^63) (a fresh one is drawn and recorded if
     None)."""
-    band: int = 1
+    band: int = setting(1, "band of the input (1-based)", range=(1, None), metavar="B")
     """Band of the input file (1-based)."""
-    pixel_size_m: float | None = None
+    pixel_size_m: float | None = setting(None, "pixel size (for inputs without a CRS)",
+                                         unit="m", range=">0", metavar="M")
     """Pixel size in metres, for inputs without a CRS."""
-    body_radius_m: float | None = None
+    body_radius_m: float | None = setting(
+        None, "body radius (for inputs with a geographic CRS, e.g. 1737400 for the Moon)",
+        unit="m", range=">0", metavar="M", default_text="from the file's tags or PDS label")
     """Body radius in metres, for inputs with a geographic CRS."""
-    body: str | None = None
+    body: str | None = setting(
+        None, "the DEM's body: the craters' target (morphology, transition diameters, "
+        "diffusivity) and, for a geographic CRS the file gives no radius for, its mean "
+        "radius", choices=tuple(TARGETS), metavar="NAME",
+        default_text="the body the DEM's CRS names, else moon")
     """The target body of the craters (:data:`craters.TARGETS`: morphology, transition
     diameters, diffusivity); default: the body the DEM's CRS names, else the Moon."""
-    gravity_m_s2: float | None = None
+    gravity_m_s2: float | None = setting(
+        None, "surface gravity: crater transition diameters scale as 1/g", unit="m/s^2",
+        range=">0", metavar="G", default_text="the body's")
     """Surface gravity, m/s^2 (crater transition diameters scale as 1/g); default: the
     body's."""
     crater_layers: tuple[CraterLayer | ModelAgeLayer | SourceCraterLayer, ...] = dataclasses.field(
@@ -179,6 +233,9 @@ class EnhanceConfig:
         def put(name, value):
             object.__setattr__(self, name, value)
 
+        if self.source_crater_px == 0:
+            put("source_crater_px", None)
+        check_declared(self, keep=_AS_GIVEN)
         with about("input"):
             if self.input is not None and (not isinstance(self.input, str) or not self.input):
                 raise ParameterTypeError("input", f"must be a file name; got {self.input!r}")
@@ -193,8 +250,6 @@ class EnhanceConfig:
                 if not all(math.isfinite(v) for v in t):
                     raise ParameterError("target", f"must be finite; got {t!r}")
                 put("target", (float(t[0]), float(t[1])))
-        with about("layers"):
-            put("layers", check_int("layers", self.layers, 1, 24))
         with about("size"):
             size = check_int("size", self.size)
             if size < 5 or size > 16385 or (size - 1) & (size - 2):
@@ -222,37 +277,6 @@ class EnhanceConfig:
                     parsed.append(spec if isinstance(spec, kind) else parse(spec))
                 put(name, tuple(specs))
                 put(f"{name[:-1]}_layers", tuple(parsed))
-        for name in ("min_crater_px", "min_boulder_px"):
-            with about(name):
-                put(name, check_range(name, getattr(self, name), 1.0, 1e6))
-        if self.source_crater_px == 0:
-            put("source_crater_px", None)
-        if self.source_crater_px is not None:
-            with about("source_crater_px"):
-                put("source_crater_px", check_range("source_crater_px",
-                                                    self.source_crater_px, 1.0, 1e6))
-        with about("smooth_craters"):
-            if not isinstance(self.smooth_craters, bool):
-                raise ParameterTypeError("smooth_craters", f"must be true or false; got "
-                                         f"{self.smooth_craters!r}")
-        if self.fractal_dimension is not None:
-            with about("fractal_dimension"):
-                check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)
-        if self.roughness is not None:
-            with about("roughness"):
-                check_range("roughness", self.roughness, 0.0, MAX_ROUGHNESS)
-        if self.seed is not None:
-            with about("seed"):
-                check_int("seed", self.seed, 0, 2**63 - 1)
-        with about("band"):
-            check_int("band", self.band, 1)
-        for name in ("pixel_size_m", "body_radius_m", "gravity_m_s2"):
-            if getattr(self, name) is not None:
-                with about(name):
-                    check_positive(name, getattr(self, name))
-        if self.body is not None:
-            with about("body"):
-                check_choice("body", self.body, tuple(TARGETS))
 
     @classmethod
     def keys(cls) -> tuple[str, ...]:

@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 import logging
 
 import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, normalize_rng, progress_bar
+from craters._shared.settings import check_declared, setting
 
 from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid
@@ -158,17 +158,20 @@ def poisson_faulting(grid: LatLongGrid, n_faults: int, max_fault_m: float, *, rn
 class FaultingParams:
     """Parameters of two-phase Poisson faulting (Martin et al. 2014, IV.A)."""
 
-    n_faults_1: int = 1000
+    n_faults_1: int = setting(1000, "phase-1 fault count", key="faults_1",
+                              range=(0, 100_000_000))
     """Faults in phase 1 (large faults: the overall lumpy form)."""
-    max_fault_1_m: float = 5.0
+    max_fault_1_m: float = setting(5.0, "largest phase-1 fault offset", unit="m", range=">=0")
     """Largest phase-1 fault offset, metres."""
-    smooth_width_m: float = 20.0
+    smooth_width_m: float = setting(20.0, "smoothing filter width (Gaussian FWHM)", unit="m",
+                                    range=">=0")
     """Smoothing filter width between the phases (Gaussian FWHM, metres on the body)."""
-    smooth_passes: int = 3
+    smooth_passes: int = setting(3, "smoothing passes", range=(0, 1000))
     """Number of smoothing passes (0 = no smoothing)."""
-    n_faults_2: int = 20000
+    n_faults_2: int = setting(20000, "phase-2 fault count", key="faults_2",
+                              range=(0, 100_000_000))
     """Faults in phase 2 (small faults: surface roughness)."""
-    max_fault_2_m: float = 0.03
+    max_fault_2_m: float = setting(0.03, "largest phase-2 fault offset", unit="m", range=">=0")
     """Largest phase-2 fault offset, metres."""
     stretch: tuple[float, float, float] = (1.0, 1.0, 1.0)
     """Final stretch of the body along x, y, z (applied by :class:`~latlong.Body`; in a
@@ -176,15 +179,11 @@ class FaultingParams:
     name = "faulting"  # the base shape's name in a scene (not a field)
 
     def __post_init__(self):
-        put = functools.partial(object.__setattr__, self)
-        put("n_faults_1", check_int("n_faults_1", self.n_faults_1, 0, 100_000_000))
-        put("n_faults_2", check_int("n_faults_2", self.n_faults_2, 0, 100_000_000))
-        for key in ("max_fault_1_m", "max_fault_2_m", "smooth_width_m"):
-            put(key, check_positive(key, getattr(self, key), allow_zero=True))
-        put("smooth_passes", check_int("smooth_passes", self.smooth_passes, 0, 1000))
+        check_declared(self)
         if isinstance(self.stretch, str) or len(self.stretch) != 3:
             raise ParameterError("stretch", f"must have three factors; got {self.stretch!r}")
-        put("stretch", tuple(check_positive("stretch", v) for v in self.stretch))
+        object.__setattr__(self, "stretch",
+                           tuple(check_positive("stretch", v) for v in self.stretch))
 
 
 #: Named parameter sets, both stretched 2x along x. ``paper``: the asteroid of Martin

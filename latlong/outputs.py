@@ -24,6 +24,7 @@ from craters._shared import (
     check_suffix,
     same_file,
 )
+from craters._shared.settings import by_key, check_declared, setting
 
 from .body import EXPORT_SUFFIXES
 from .implicit import MESH_SUFFIXES
@@ -35,8 +36,6 @@ from .surface import band_areas
 __all__ = ["OUTPUT_SETTINGS", "Outputs", "companions", "output_kind", "scene_inputs",
            "write_outputs"]
 
-#: The keys of a scene file that say what to write (not what to make).
-OUTPUT_SETTINGS = ("output", "catalog", "boulder_catalog", "preview", "catalog_columns")
 
 _SUFFIXES = {"latlong": (".npz", *EXPORT_SUFFIXES), "implicit": (".npz", *MESH_SUFFIXES),
              "mesh": MESH_SUFFIXES}
@@ -54,18 +53,28 @@ def output_kind(scene: Scene) -> str:
 class Outputs:
     """The files of one build (None or empty: not written)."""
 
-    output: tuple[str, ...] = ()
+    output: tuple[str, ...] = setting(
+        (), "output file, format by suffix: " + " ".join((".npz", *EXPORT_SUFFIXES)) + " "
+        "(repeatable; .glb is the patched strip export with its .json manifest, full "
+        "resolution only - `latlong export` adds levels of detail)", flag="-o/--output",
+        many="append")
     """Bodies and meshes, format by suffix (.npz and the :data:`~latlong.EXPORT_SUFFIXES`)."""
-    catalog: str | None = None
+    catalog: str | None = setting(
+        None, "write the ground-truth crater catalog as stamped: .csv, or .scc (craterstats "
+        "spatial crater count: the body's area in km^2, diameters in km, lon/lat)")
     """The crater catalog as stamped: .csv or .scc (craterstats)."""
-    boulder_catalog: str | None = None
+    boulder_catalog: str | None = setting(None, "write the boulder catalog as placed (CSV)")
     """The boulder catalog as placed (.csv)."""
-    preview: str | None = None
+    preview: str | None = setting(None, "write a preview picture (PNG)")
     """A preview picture (.png)."""
-    catalog_columns: str = "craterform"
+    catalog_columns: str = setting(
+        "craterform", "column names of a CSV catalog: craterform (units in the names) or "
+        "robbins (LAT_CIRC_IMG, LON_CIRC_IMG, DIAM_CIRC_IMG in km, as the Robbins 2019 lunar "
+        "crater database)", choices=craters.CATALOG_COLUMNS)
     """Column names of a CSV catalog (:data:`craters.CATALOG_COLUMNS`)."""
 
     def __post_init__(self):
+        check_declared(self)
         out = self.output
         if isinstance(out, str | Path):
             out = (out,)
@@ -78,10 +87,6 @@ class Outputs:
             if value is not None and not isinstance(value, str | Path):
                 raise ParameterTypeError(key, f"must be a file name; got {value!r}")
             object.__setattr__(self, key, None if value is None else str(value))
-        if self.catalog_columns not in craters.CATALOG_COLUMNS:
-            raise ParameterError("catalog_columns", f"must be one of "
-                                 f"{', '.join(craters.CATALOG_COLUMNS)}; got "
-                                 f"{self.catalog_columns!r}")
         if self.catalog_columns != "craterform" and not str(self.catalog or "").lower(
                 ).endswith(".csv"):
             raise ParameterError("catalog_columns", "applies to a CSV {}", see=("catalog",))
@@ -149,6 +154,10 @@ class Outputs:
                 if extra.is_dir() or (os.path.lexists(extra) and not force):
                     raise ParameterError(key, f"{str(path)!r} also writes {str(extra)!r}, "
                                          f"which exists; use --force to overwrite")
+
+
+#: The keys of a scene file that say what to write (not what to make).
+OUTPUT_SETTINGS = tuple(by_key(Outputs))
 
 
 def companions(path) -> list[Path]:

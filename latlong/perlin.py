@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 
 import numpy as np
@@ -13,10 +12,10 @@ from craters._shared import (
     check_finite,
     check_int,
     check_positive,
-    check_range,
     normalize_rng,
     progress_bar,
 )
+from craters._shared.settings import check_declared, declared, setting
 
 from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
 from .grid import LatLongGrid
@@ -29,9 +28,11 @@ _CHUNK = 1 << 20
 
 
 def _check_noise_params(octaves, persistence, lacunarity, base):
-    octaves = check_int("octaves", octaves, 1, _MAX_OCTAVES)
-    persistence = check_positive("persistence", persistence)
-    lacunarity = check_range("lacunarity", lacunarity, 1.0, None)
+    """The declared ranges of :class:`FbmParams` and the limits of the noise's numbers."""
+    declared_ = declared(FbmParams)
+    octaves = declared_["octaves"].check("octaves", octaves)
+    persistence = declared_["persistence"].check("persistence", persistence)
+    lacunarity = declared_["lacunarity"].check("lacunarity", lacunarity)
     base = check_int("base", base, 0, 255)
     if (octaves - 1) * math.log2(lacunarity) + 10 >= 31:  # in logs: no overflow
         top = 2.0 ** (21 / (octaves - 1))
@@ -117,32 +118,26 @@ def random_rotation(rng=None) -> np.ndarray:
 class FbmParams:
     """Parameters of a Perlin fBm base shape sampled on the unit sphere."""
 
-    frequency: float = 1.5
+    frequency: float = setting(1.5, "first-octave frequency on the unit sphere", range=">0")
     """Frequency of the first octave on the unit sphere (cycles per unit length)."""
-    octaves: int = 10
+    octaves: int = setting(10, "number of octaves", range=(1, _MAX_OCTAVES))
     """Number of octaves."""
-    persistence: float = 0.5
+    persistence: float = setting(0.5, "amplitude ratio per octave", range=">0")
     """Amplitude ratio between successive octaves."""
-    lacunarity: float = 1.75
+    lacunarity: float = setting(1.75, "frequency ratio per octave", range=(1.0, None))
     """Frequency ratio between successive octaves."""
-    amplitude: float = 0.4
+    amplitude: float = setting(0.4, "fBm height scale as a fraction of the body radius "
+                               "(--amplitude-m, in metres, wins)", range=">=0")
     """Height scale as a fraction of the body radius: heights = amplitude * R * fbm."""
-    amplitude_m: float | None = None
+    amplitude_m: float | None = setting(None, "fBm height scale", unit="m", range=">=0",
+                                        default_text="the preset's fraction of the radius")
     """Height scale in metres, instead of ``amplitude`` x the radius (a
     :class:`~latlong.Scene` sets it from ``amplitude`` when it is None)."""
     name = "fbm"  # the base shape's name in a scene (not a field)
 
     def __post_init__(self):
-        put = functools.partial(object.__setattr__, self)
-        put("frequency", check_positive("frequency", self.frequency))
-        octaves, persistence, lacunarity, _ = _check_noise_params(
-            self.octaves, self.persistence, self.lacunarity, 0)
-        put("octaves", octaves)
-        put("persistence", persistence)
-        put("lacunarity", lacunarity)
-        put("amplitude", check_positive("amplitude", self.amplitude, allow_zero=True))
-        if self.amplitude_m is not None:
-            put("amplitude_m", check_positive("amplitude_m", self.amplitude_m, allow_zero=True))
+        check_declared(self)
+        _check_noise_params(self.octaves, self.persistence, self.lacunarity, 0)
 
 
 #: The three parameter sets of Martin 2014, Fig. 5 (10 octaves each).

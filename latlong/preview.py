@@ -22,14 +22,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import (
-    ParameterError,
-    atomic_path,
-    check_finite,
-    check_int,
-    check_positive,
-    check_range,
-)
+from craters._shared import ParameterError, atomic_path, check_finite
+from craters._shared.settings import check_declared, setting
 
 from ._preview_kernels import _extent_kernel
 from .geometry.surface import Resamplable, Surface
@@ -52,37 +46,36 @@ VIEW_DIRECTIONS = (("+x", 0.0, 0.0), ("-x", 0.0, 180.0), ("+y", 0.0, 90.0),
 class PreviewSettings:
     """Camera, sun and size of a preview picture (module notes)."""
 
-    sun_azimuth_deg: float = 60.0
+    sun_azimuth_deg: float = setting(
+        60.0, "sun azimuth from the viewer (0 = behind the camera, 90 = from the right)",
+        unit="deg", range="finite")
     """Sun azimuth from the viewer, degrees (0 = behind the camera, 90 = from the right)."""
-    sun_elevation_deg: float = 20.0
+    sun_elevation_deg: float = setting(
+        20.0, "sun elevation above the picture's horizontal plane", unit="deg",
+        range=(-90.0, 90.0))
     """Sun elevation above the picture's horizontal plane, degrees, [-90, 90]."""
-    view_lon_deg: float = -90.0
+    view_lon_deg: float = setting(-90.0, "longitude of the camera direction (body-fixed)",
+                                  unit="deg", range="finite")
     """Longitude of the camera direction (body-fixed), degrees."""
-    view_lat_deg: float = 0.0
+    view_lat_deg: float = setting(0.0, "latitude of the camera direction", unit="deg",
+                                  range=(-90.0, 90.0))
     """Latitude of the camera direction, degrees, [-90, 90]."""
-    camera_distance_m: float | None = None
+    camera_distance_m: float | None = setting(
+        None, "camera distance from the body centre", unit="m", range=">0",
+        default_text="frame the body")
     """Camera distance from the body centre, metres (default: frame the body)."""
-    width_px: int = 1024
+    width_px: int = setting(1024, "picture width", unit="px", range=(16, 8192))
     """Picture width, pixels, [16, 8192]."""
-    height_px: int = 768
+    height_px: int = setting(768, "picture height", unit="px", range=(16, 8192))
     """Picture height, pixels, [16, 8192]."""
-    views: int = 1
+    views: int = setting(1, "1 = one view; 6 = a contact sheet from +x, -x, +y, -y, +z, -z",
+                         range=(1, 6))
     """1 = one view; 6 = a contact sheet from +x, -x, +y, -y, +z, -z."""
 
     def __post_init__(self):
-        for key in ("sun_azimuth_deg", "view_lon_deg"):
-            object.__setattr__(self, key, check_finite(key, getattr(self, key)))
-        for key in ("sun_elevation_deg", "view_lat_deg"):
-            object.__setattr__(self, key, check_range(key, getattr(self, key), -90.0, 90.0))
-        if self.camera_distance_m is not None:
-            object.__setattr__(self, "camera_distance_m",
-                               check_positive("camera_distance_m", self.camera_distance_m))
-        for key in ("width_px", "height_px"):
-            object.__setattr__(self, key, check_int(key, getattr(self, key), 16, 8192))
-        views = check_int("views", self.views, 1, 6)
-        if views not in (1, 6):
-            raise ParameterError("views", f"must be 1 or 6; got {views}")
-        object.__setattr__(self, "views", views)
+        check_declared(self)
+        if self.views not in (1, 6):
+            raise ParameterError("views", f"must be 1 or 6; got {self.views}")
 
 
 def camera_frame(view_lat_deg: float = 0.0, view_lon_deg: float = -90.0):

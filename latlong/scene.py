@@ -30,82 +30,47 @@ from craters._shared import (
     ParameterError,
     ParameterTypeError,
     check_choice,
-    check_int,
     load_toml,
 )
+from craters._shared.settings import Setting, by_key, check_declared, declared, setting
 
 from .faulting import FaultingParams
+from .memory import check_memory, expected_counts
 from .perlin import FbmParams
 from .presets import DEFAULT_PRESET, PRESETS, RENAMED_PRESETS
 from .preview import PreviewSettings
 from .settings import (
+    DEFAULT_RADIUS_M,
+    NO_STRETCH,
     BodySettings,
     BoulderSettings,
     CraterSettings,
+    GaborExample,
     ImplicitSettings,
     ShapeBase,
     SphereBase,
-    check_memory,
-    expected_counts,
 )
 from .shapes import read_shape_model
 
-__all__ = ["SETTINGS", "SETTING_DEFAULTS", "Scene"]
+__all__ = ["SETTINGS", "SETTING_DEFAULTS", "SETTING_PARTS", "Scene"]
 
-# flat setting -> (part, field) of the scene; a part's error is shown under the setting
-_BODY = {"magnitude": "magnitude", "radius_m": "radius_m", "stretch": "stretch",
-         "body": "target", "gravity_m_s2": "gravity_m_s2", "density_kg_m3": "density_kg_m3",
-         "crater_depth_ratio": "crater_depth_ratio", "max_memory_gb": "max_memory_gb",
-         "radii_on_disk": "radii_on_disk"}
-_FAULTING = {"faults_1": "n_faults_1", "max_fault_1_m": "max_fault_1_m",
-             "smooth_width_m": "smooth_width_m", "smooth_passes": "smooth_passes",
-             "faults_2": "n_faults_2", "max_fault_2_m": "max_fault_2_m"}
-_FBM = {k: k for k in ("frequency", "octaves", "persistence", "lacunarity", "amplitude_m")}
-_SHAPE = {"shape_units": "units", "shape_center": "center", "shape_crossings": "crossings",
-          "shape_smooth": "smooth", "surface": "surface", "spacing_m": "spacing_m",
-          **{k: f"detail_{k}" for k in _FBM}}
-_CRATERS = {"craters": "layers", "crater_roughness": "roughness",
-            "max_crater_extent_deg": "max_extent_deg"}
-_BOULDER_SHAPE = {"boulder_flatten": "flatten", "boulder_elongation": "elongation",
-                  "boulder_roughness": "roughness"}
-_IMPLICIT = {"shape": "shape", "shape_units": "units", "lcsn": "layers", "gabor": "gabor",
-             "polygons": "polygons", "voxel_m": "voxel_m", "packing_voxels": "packing_voxels",
-             "min_sphere_m": "min_sphere_m", "cell_m": "cell_m",
-             "constraint_weight": "constraint_weight",
-             "shape_crossings": "crossings"}
-_EXAMPLE = ("gabor_example", "gabor_pixel_m", "gabor_amplitude_m")
-_PREVIEW = {f.name: f.name for f in dataclasses.fields(PreviewSettings)}
-_SCENE = ("preset", "base", "seed", "backend")
-
-#: Every setting of :meth:`Scene.from_settings` (the TOML keys of a scene file).
-SETTINGS: tuple[str, ...] = tuple(dict.fromkeys(
-    [*_SCENE, *_BODY, *_FAULTING, *_FBM, *_SHAPE, *_CRATERS, "boulders", *_BOULDER_SHAPE,
-     *_IMPLICIT, *_EXAMPLE, *_PREVIEW]))
-
-
-
-def _field_defaults(kind, names: dict) -> dict:
-    fields = {f.name: f for f in dataclasses.fields(kind)}
-    out = {}
-    for key, name in names.items():
-        f = fields.get(name)
-        if f is not None and f.default is not dataclasses.MISSING:
-            out[key] = f.default
-        elif f is not None and f.default_factory is not dataclasses.MISSING:
-            out[key] = f.default_factory()
-    return out
-
-
-#: The default of every setting that has one without a preset (None: none or it depends
-#: on the preset or base); the faulting and fBm values are the paper's / Fig. 5a's.
-SETTING_DEFAULTS: dict[str, object] = {
-    **_field_defaults(BodySettings, _BODY), "radius_m": 50.0, "stretch": (1.0, 1.0, 1.0),
-    **_field_defaults(FaultingParams, _FAULTING), **_field_defaults(FbmParams, _FBM),
-    **_field_defaults(ShapeBase, _SHAPE), **_field_defaults(CraterSettings, _CRATERS),
-    **_field_defaults(_craters.BoulderShape, _BOULDER_SHAPE), "backend": "latlong",
-    **_field_defaults(ImplicitSettings, _IMPLICIT), **_field_defaults(PreviewSettings, _PREVIEW),
+#: The settings that choose what a scene is made of (no record field holds them as given).
+_CHOICES = {
+    "base": Setting(None, "base shape: sphere, faulting, fbm or shape:PATH (a real shape "
+                    "model: OBJ, PDS plate .tab/.plt, PLY, STL)",
+                    default_text=f"fbm (preset {DEFAULT_PRESET['fbm']})"),
+    "backend": Setting("latlong", "latlong (the lat/long mesh) or implicit (Li et al.: "
+                       "metaballs over a sphere packing of --shape, LCSN craters, Gabor "
+                       "detail, marching cubes)", choices=("latlong", "implicit")),
 }
-
+_BOULDER_HELP = {"flatten": "boulder up-axis scale relative to its width",
+                 "elongation": "boulder length relative to its width",
+                 "roughness": "boulder midpoint-displacement amplitude (fraction of the edge "
+                              "length)"}
+#: The boulders' shape (:class:`craters.BoulderShape`, whose fields check themselves) as
+#: settings ``boulder_<field>``.
+_BOULDER_SHAPE = {f"boulder_{f.name}": Setting(f.default, _BOULDER_HELP[f.name])
+                  for f in dataclasses.fields(_craters.BoulderShape) if f.name in _BOULDER_HELP}
 
 def _ellipsoid_area(body: BodySettings) -> float:
     """The stretched sphere's area (Knud Thomsen's formula, within 1.1 %)."""
@@ -139,15 +104,18 @@ class Scene:
     """The implicit backend (Li et al.) instead of the lat/long base and craters."""
     preview: PreviewSettings = dataclasses.field(default_factory=PreviewSettings)
     """Camera and light of a preview picture."""
-    seed: int | None = None
+    seed: int | None = setting(None, "random seed (non-negative integer)",
+                               range=(0, 2**63 - 1),
+                               default_text="a fresh one, recorded in the model")
     """Seed of everything random, [0, 2**63); None draws a fresh one (kept here)."""
-    preset: str | None = None
+    preset: str | None = setting(None, "named scene (see `latlong presets`): sets the base "
+                                 "and its parameters, the body and crater layers")
     """The preset the scene came from (recorded in the body's metadata)."""
 
     def __post_init__(self):
-        seed = int(np.random.SeedSequence().entropy % (2**63)) if self.seed is None \
-            else check_int("seed", self.seed, 0, 2**63 - 1)
-        object.__setattr__(self, "seed", seed)
+        check_declared(self)
+        if self.seed is None:
+            object.__setattr__(self, "seed", int(np.random.SeedSequence().entropy % (2**63)))
         for name, kind in (("body", BodySettings), ("craters", CraterSettings),
                            ("boulders", BoulderSettings), ("preview", PreviewSettings)):
             if not isinstance(getattr(self, name), kind):
@@ -168,7 +136,7 @@ class Scene:
                                      f"ShapeBase; got {type(base).__name__}")
         body, resolution = self.body, None
         if isinstance(base, ShapeBase):
-            own = {"radius_m": base.radius_m, "stretch": (1.0, 1.0, 1.0)}
+            own = {"radius_m": base.radius_m, "stretch": NO_STRETCH}
             for key, value in own.items():
                 if getattr(body, key) not in (None, value):
                     raise ParameterError(key, "does not apply to a shape base (the model "
@@ -178,9 +146,9 @@ class Scene:
         else:
             stretch = body.stretch
             if stretch is None:  # a faulting set carries its body's stretch (the paper's 2,1,1)
-                stretch = base.stretch if isinstance(base, FaultingParams) else (1.0, 1.0, 1.0)
+                stretch = base.stretch if isinstance(base, FaultingParams) else NO_STRETCH
             body = dataclasses.replace(
-                body, radius_m=50.0 if body.radius_m is None else body.radius_m,
+                body, radius_m=DEFAULT_RADIUS_M if body.radius_m is None else body.radius_m,
                 stretch=stretch)
         if isinstance(base, FaultingParams):
             base = dataclasses.replace(base, stretch=body.stretch)
@@ -262,9 +230,41 @@ class Scene:
         return cls.from_settings(load_toml(Path(path)))
 
 
-def _part(factory, names: dict, values: dict, **fixed):
+#: (group, record or table of settings) of every flat setting, in the order of
+#: :data:`SETTINGS`: the records :meth:`Scene.from_settings` makes and the group each
+#: setting is listed in by ``latlong build --help``.
+SETTING_PARTS = (
+    ("body", {"preset": declared(Scene)["preset"], "base": _CHOICES["base"],
+              "seed": declared(Scene)["seed"]}),
+    ("implicit", {"backend": _CHOICES["backend"]}), ("body", BodySettings),
+    ("faulting", FaultingParams), ("fbm", FbmParams), ("shape", ShapeBase),
+    ("craters", CraterSettings), ("boulders", BoulderSettings), ("boulders", _BOULDER_SHAPE),
+    ("implicit", ImplicitSettings), ("implicit", GaborExample), ("render", PreviewSettings))
+_OWN = {k: s for _, part in SETTING_PARTS for k, s in by_key(part).items() if s.help is not None}
+
+#: Every setting of :meth:`Scene.from_settings` (the TOML keys of a scene file).
+SETTINGS: tuple[str, ...] = tuple(_OWN)
+
+#: The default of every setting without a preset (None: none, or it depends on the
+#: preset or base); the faulting and fBm values are the paper's / Fig. 5a's.
+SETTING_DEFAULTS: dict[str, object] = {**{k: s.default for k, s in _OWN.items()},
+                                       "radius_m": DEFAULT_RADIUS_M, "stretch": NO_STRETCH}
+
+
+def _keys(kind) -> tuple[str, ...]:
+    return tuple(by_key(kind))
+
+
+def _names(kind) -> dict[str, str]:
+    """Setting -> field of a record's declared fields."""
+    return {s.key: name for name, s in declared(kind).items()}
+
+
+def _part(factory, values: dict, names: dict | None = None, **fixed):
     """``factory(**fixed, **{field: values[key]})`` for the settings of ``names`` (setting
-    -> field) present in ``values``; an error of a field is shown under its setting."""
+    -> field; default: the record's declared fields) present in ``values``; an error of a
+    field is shown under its setting."""
+    names = _names(factory) if names is None else names
     kwargs = {field: values[key] for key, field in names.items() if key in values}
     try:
         return factory(**fixed, **kwargs)
@@ -277,13 +277,9 @@ def _part(factory, names: dict, values: dict, **fixed):
         raise
 
 
-def _preview(given: dict) -> PreviewSettings:
-    return _part(PreviewSettings, _PREVIEW, given)
-
-
-_SHAPE_ONLY = ("shape_units", "shape_center", "shape_crossings", "shape_smooth", "surface",
-               "spacing_m")
-_GROUPS = {"faulting": tuple(_FAULTING), "fbm": tuple(_FBM), "shape:PATH": _SHAPE_ONLY}
+_IMPLICIT, _EXAMPLE, _PREVIEW = _keys(ImplicitSettings), _keys(GaborExample), _keys(PreviewSettings)
+_SHAPE_ONLY = tuple(k for k in _keys(ShapeBase) if k not in _keys(FbmParams))
+_GROUPS = {"faulting": _keys(FaultingParams), "fbm": _keys(FbmParams), "shape:PATH": _SHAPE_ONLY}
 _GROUPS_OF_BASE = {"faulting": ("faulting",), "fbm": ("fbm",), "sphere": (),
                    "shape": ("fbm", "shape:PATH")}
 
@@ -328,21 +324,23 @@ def _latlong_scene(cls, given: dict) -> Scene:
                 raise ParameterError(key, f"applies to {{}} {group}, not {{}} {base}",
                                      see=("base", "base"))
     merged = {**(p.settings if p else {}), **given}
-    body = _part(BodySettings, _BODY, merged)
+    body = _part(BodySettings, merged)
     if base == "faulting":
-        part = _part(FaultingParams, _FAULTING, merged)
-    elif base == "fbm":
-        extra = {} if p is None or p.amplitude_fraction is None else {
+        part = _part(FaultingParams, merged)
+    elif base == "fbm":  # a preset's height scale is a fraction of the radius
+        fraction = {} if p is None or p.amplitude_fraction is None else {
             "amplitude": p.amplitude_fraction}
-        part = _part(FbmParams, _FBM, merged, **extra)
+        part = _part(FbmParams, {**fraction, **merged})
     elif base == "sphere":
         part = SphereBase()
     else:
-        part = _part(ShapeBase, {**_SHAPE, "base": "model"}, {**merged, "base": shape_path})
-    shape = _part(_craters.BoulderShape, _BOULDER_SHAPE, merged)
-    return cls(body=body, base=part, craters=_part(CraterSettings, _CRATERS, merged),
-               boulders=_part(BoulderSettings, {"boulders": "layers"}, merged, shape=shape),
-               preview=_preview(given), seed=given.get("seed"), preset=preset)
+        part = _part(ShapeBase, {**merged, "base": shape_path},
+                     {**_names(ShapeBase), "base": "model"})
+    shape = _part(_craters.BoulderShape, merged,
+                  {k: k[len("boulder_"):] for k in _BOULDER_SHAPE})
+    return cls(body=body, base=part, craters=_part(CraterSettings, merged),
+               boulders=_part(BoulderSettings, merged, shape=shape),
+               preview=_part(PreviewSettings, given), seed=given.get("seed"), preset=preset)
 
 
 def _implicit_scene(cls, given: dict) -> Scene:
@@ -361,37 +359,9 @@ def _implicit_scene(cls, given: dict) -> Scene:
     for key in ("gabor_pixel_m", "gabor_amplitude_m"):
         if key in given and example is None:
             raise ParameterError(key, "applies to {}", see=("gabor_example",))
-    settings = _part(ImplicitSettings, _IMPLICIT, given)
+    settings = _part(ImplicitSettings, given)
     if example is not None:
-        settings = dataclasses.replace(settings, gabor=_fit_example(given))
-    body = _part(BodySettings, _BODY, given)
-    return cls(body=body, implicit=settings, preview=_preview(given), seed=given.get("seed"))
-
-
-def _fit_example(given: dict):
-    """Gabor noise fitted to ``gabor_example`` at ``gabor_pixel_m`` (module
-    :mod:`latlong.implicit`)."""
-    from craters._shared import check_positive, check_range
-
-    from .implicit import fit_gabor, read_example
-
-    if given.get("gabor_pixel_m") is None:
-        raise ParameterError("gabor_example", "needs {} (the example's pixel size on the "
-                             "body, metres)", see=("gabor_pixel_m",))
-    pixel = check_positive("gabor_pixel_m", given["gabor_pixel_m"])
-    amplitude = given.get("gabor_amplitude_m")
-    if amplitude is not None:
-        amplitude = check_range("gabor_amplitude_m", amplitude, 0.0, None)
-    try:
-        image, is_heights = read_example(given["gabor_example"])
-        if not is_heights and amplitude is None:
-            raise ParameterError("gabor_example", "is a picture (grey levels, not metres): "
-                                 "give {}", see=("gabor_amplitude_m",))
-        return fit_gabor(image, pixel, amplitude_m=amplitude)
-    except ParameterError:
-        raise
-    except FileNotFoundError as exc:  # kept (Python), tagged (the command's flag)
-        exc.parameter = "gabor_example"
-        raise
-    except ValueError as exc:
-        raise ParameterError("gabor_example", f"{given['gabor_example']}: {exc}") from None
+        settings = dataclasses.replace(settings, gabor=_part(GaborExample, given).fit())
+    body = _part(BodySettings, given)
+    return cls(body=body, implicit=settings, preview=_part(PreviewSettings, given),
+               seed=given.get("seed"))

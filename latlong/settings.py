@@ -12,107 +12,27 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import craters as _craters
-from craters._shared import (
-    ParameterError,
-    ParameterTypeError,
-    check_choice,
-    check_finite,
-    check_int,
-    check_positive,
-    check_range,
-    physical_memory_bytes,
-)
+from craters._shared import ParameterError, ParameterTypeError, physical_memory_bytes
+from craters._shared.settings import check_declared, default_of, setting
 
-from .grid import BUILD_BASE_BYTES, LatLongGrid, build_bytes_per_vertex
+from .memory import MEMORY_SHARE, RADII_ON_DISK, check_memory
 from .shapes import SIZE_RANGE_M, ShapeModel, read_shape_model
 
-__all__ = ["BASES", "MEMORY_SHARE", "RADII_ON_DISK", "BodySettings", "BoulderSettings",
-           "CraterSettings", "ImplicitSettings", "SURFACES", "ShapeBase", "SphereBase",
-           "check_memory", "expected_counts"]
+__all__ = ["BASES", "DEFAULT_RADIUS_M", "NO_STRETCH", "SURFACES", "BodySettings", "BoulderSettings",
+           "CraterSettings", "GaborExample", "ImplicitSettings", "ShapeBase", "SphereBase"]
 
-#: Peak memory of a build per crater of its catalog (the catalog, the stamping profile
-#: tables, the wave schedule), bytes. Measured (/usr/bin/time -v, 2 threads): M = 100,
-#: R = 50 m, c=0.5,k=-2,d_max_m=15: 0.71 GB with 8.9e4 craters, 3.54 GB with 8.9e5,
-#: 3.5 kB a crater; rounded up.
-BUILD_BYTES_PER_CRATER = 4.0e3
-#: ... per boulder (catalog, rock meshes' bookkeeping), bytes. Measured the same way:
-#: M = 40, R = 50 m sphere, c=0.5,k=-2,d_max_m=2: 0.71 GB with 8.9e4 boulders, 0.97 GB
-#: with 8.9e5, 0.33 kB a boulder; rounded up.
-BUILD_BYTES_PER_BOULDER = 0.4e3
 #: Names of the base shapes (``shape`` takes a model file).
 BASES = ("sphere", "faulting", "fbm", "shape")
-#: The share of this machine's memory a build may use unless ``max_memory_gb`` is given.
-MEMORY_SHARE = 0.8
-#: Where a lat/long build keeps its radii (:func:`check_memory`, :mod:`latlong.scratch`).
-RADII_ON_DISK = ("auto", "yes", "no")
-#: The radii's share of :func:`~latlong.grid.build_bytes_per_vertex` (one float64).
-RADII_BYTES_PER_VERTEX = 8.0
 #: Mean radius a body may have, metres: the range of shape models (a boulder to a gas
 #: giant), so radii, areas and volumes stay finite in float64.
 RADIUS_RANGE_M = SIZE_RANGE_M
+#: The reference radius of a body without a shape base when none is given, metres.
+DEFAULT_RADIUS_M = 50.0
+#: The stretch of a body when none is given (the faulting presets have their own).
+NO_STRETCH = (1.0, 1.0, 1.0)
 CROSSINGS = ("error", "outermost", "innermost")
 #: Where a shape base is cratered: the lat/long grid or the model's own mesh.
 SURFACES = ("latlong", "mesh")
-
-
-def check_memory(magnitude: int, max_memory_gb: float | None = None, *,
-                 n_craters: float = 0.0, n_boulders: float = 0.0,
-                 radii_on_disk: str = "auto", disk_ok: bool = True) -> bool:
-    """Refuse up front a build that would need more than ``max_memory_gb`` GB (1e9
-    bytes; default :data:`MEMORY_SHARE` of this machine's memory), with the estimate:
-    the grid's (:meth:`LatLongGrid.estimate_bytes`), then with the expected numbers of
-    craters and boulders (:data:`BUILD_BYTES_PER_CRATER`, :data:`BUILD_BYTES_PER_BOULDER`)
-    refused under ``craters`` / ``boulders``.
-
-    ``radii_on_disk`` (:data:`RADII_ON_DISK`): ``"yes"`` counts the radii (8 B a vertex)
-    as kept in a scratch file (:mod:`latlong.scratch`), ``"no"`` in memory, ``"auto"`` in
-    memory when that fits, else on disk if ``disk_ok`` (the base can be made on disk).
-    Returns whether the radii go on disk."""
-    check_choice("radii_on_disk", radii_on_disk, RADII_ON_DISK)
-    if radii_on_disk == "yes" and not disk_ok:
-        raise ParameterError("radii_on_disk", "= yes needs a sphere or fbm base on the "
-                             "lat/long grid")
-    bpv = build_bytes_per_vertex()
-    if max_memory_gb is None:
-        have = physical_memory_bytes()
-        limit = MEMORY_SHARE * have
-        whose = f" (the default: {MEMORY_SHARE:g} x this machine's {have / 1e9:.3g} GB)"
-    else:
-        limit, whose = max_memory_gb * 1e9, ""
-    counts = n_craters * BUILD_BYTES_PER_CRATER + n_boulders * BUILD_BYTES_PER_BOULDER
-    on_disk = radii_on_disk == "yes"
-    if radii_on_disk == "auto" and disk_ok:
-        on_disk = LatLongGrid.estimate_bytes(magnitude, bpv) + counts > limit
-    if on_disk:
-        bpv -= RADII_BYTES_PER_VERTEX
-    need = LatLongGrid.estimate_bytes(magnitude, bpv)
-    if need > limit:
-        n = 6 * magnitude * magnitude + 2
-        where = " with the radii on disk" if on_disk else ""
-        raise ParameterError(
-            "magnitude", f"{magnitude} needs about {need / 1e9:.3g} GB of memory{where} "
-            f"({n:.3g} vertices x {bpv:g} B + {BUILD_BASE_BYTES / 1e9:.3g} GB), more than "
-            f"{{}} = {limit / 1e9:.3g} GB{whose}", see=("max_memory_gb",))
-    for name, count, each in (("craters", n_craters, BUILD_BYTES_PER_CRATER),
-                              ("boulders", n_boulders, BUILD_BYTES_PER_BOULDER)):
-        if need + count * each > limit:
-            raise ParameterError(
-                name, f": about {count:.3g} {name} need about {count * each / 1e9:.3g} GB of "
-                f"memory ({each / 1e3:g} kB each) besides the {need / 1e9:.3g} GB of "
-                f"magnitude {magnitude} and what comes before: more than {{}} = "
-                f"{limit / 1e9:.3g} GB{whose}; raise d_min_m or lower c",
-                see=("max_memory_gb",))
-        need += count * each
-    return on_disk
-
-
-def expected_counts(craters: CraterSettings, boulders: BoulderSettings,
-                    area_m2: float) -> tuple[float, float]:
-    """The mean numbers of craters and boulders the layers draw on ``area_m2``."""
-    n_craters = sum(float(la.expected_count(area_m2)) for la in craters.layers)
-    n_boulders = sum(area_m2 * la.c * (la.d_min_m ** la.k - la.d_max_m ** la.k)
-                     for la in boulders.layers)
-    return n_craters, n_boulders
 
 
 def _set(obj, name, value) -> None:
@@ -138,49 +58,60 @@ def parse_stretch(value) -> tuple[float, float, float]:
 class BodySettings:
     """The lat/long body: grid, size and stretch."""
 
-    magnitude: int = 200
+    magnitude: int = setting(200, "grid magnitude M (6M^2+2 vertices)", range=(1, 10**9))
     """Grid magnitude M >= 1 (6M^2+2 vertices); refused up front if it cannot fit."""
-    radius_m: float | None = None
+    radius_m: float | None = setting(
+        None, "reference radius", unit="m", range=RADIUS_RANGE_M,
+        default_text=f"{DEFAULT_RADIUS_M:g}; a shape base: the model's")
     """Reference radius, metres; default 50 m (a shape base sets its own)."""
-    stretch: tuple[float, float, float] | None = None
+    stretch: tuple[float, float, float] | None = setting(
+        None, "scale factors X,Y,Z applied to the body (e.g. 2,1,1)", parse=parse_stretch,
+        commas=True, metavar="X,Y,Z",
+        default_text=",".join(f"{x:g}" for x in NO_STRETCH) + "; a faulting preset's: 2,1,1")
     """Scale factors along x, y, z; default 1, 1, 1 (a shape base sets its own)."""
-    target: str = "small-body"
+    target: str = setting(
+        "small-body", "what kind of body the craters are on (morphology, transition "
+        "diameters, diffusivity): small-body (gravity from its size and density) or a named "
+        "body", key="body", choices=(*_craters.TARGETS, "small-body"))
     """The body's kind for crater morphology and diffusivity: ``small-body`` (its gravity
     from its size and ``density_kg_m3``) or a name of :data:`craters.TARGETS`."""
-    gravity_m_s2: float | None = None
+    gravity_m_s2: float | None = setting(
+        None, "surface gravity: crater transition diameters scale as 1/g", unit="m/s^2",
+        range=">0", default_text="the body's")
     """Surface gravity, m/s^2 (default: the target's; a small body's from its size)."""
-    density_kg_m3: float = 2000.0
+    density_kg_m3: float = setting(2000.0, "bulk density of a small body (its gravity from "
+                                   "its size)", unit="kg/m^3", range=(10.0, 30_000.0))
     """Bulk density of a small body, kg/m^3."""
-    crater_depth_ratio: float | None = None
+    crater_depth_ratio: float | None = setting(
+        None, "fresh crater depth/diameter on a small body", range=(0.01, 0.5),
+        default_text=f"{default_of(_craters.small_body, 'depth_ratio'):g}, Marchi et al. "
+        "2015; Bennu's measured 0.10")
     """Fresh crater depth/diameter of a small body, [0.01, 0.5]; default 0.2 (Marchi et
     al. 2015); e.g. Bennu 0.10 (Daly et al. 2020)."""
-    max_memory_gb: float | None = None
+    max_memory_gb: float | None = setting(
+        None, "memory the build may use (1e9 bytes): a magnitude whose estimate (radii and "
+        "bounded buffers, written as .npz) is larger is refused up front, or built with its "
+        "radii on disk (radii_on_disk auto)", unit="GB", range=">0",
+        default_text=lambda: f"{MEMORY_SHARE:g} x this machine's memory, "
+        f"{MEMORY_SHARE * physical_memory_bytes() / 1e9:.3g} GB")
     """Memory the build may use, GB (1e9 bytes); a magnitude whose estimate
     (:func:`check_memory`) is larger is refused up front. Default: :data:`MEMORY_SHARE`
     of this machine's memory."""
-    radii_on_disk: str = "auto"
+    radii_on_disk: str = setting(
+        "auto", "keep the body's radii in a memory-mapped scratch file beside the first "
+        "output (bodies bigger than memory; the same bytes): auto = when the in-memory "
+        "estimate exceeds max_memory_gb (sphere and fbm bases), yes, no",
+        choices=RADII_ON_DISK)
     """Keep the radii in a memory-mapped scratch file (:mod:`latlong.scratch`; bodies
     bigger than memory, the same bytes): ``auto`` when the in-memory estimate exceeds
     ``max_memory_gb`` (sphere and fbm bases), ``yes``, ``no``."""
 
     def __post_init__(self):
-        _set(self, "magnitude", check_int("magnitude", self.magnitude, 1, 10**9))
-        check_choice("target", self.target, (*_craters.TARGETS, "small-body"))
-        if self.gravity_m_s2 is not None:
-            _set(self, "gravity_m_s2", check_positive("gravity_m_s2", self.gravity_m_s2))
-        _set(self, "density_kg_m3", check_range("density_kg_m3", self.density_kg_m3,
-                                                10.0, 30_000.0))
-        if self.crater_depth_ratio is not None:
-            if self.target != "small-body":
-                raise ParameterError("crater_depth_ratio", f"applies to small-body only (the "
-                                     f"{self.target}'s crater depths follow its published laws)")
-            _set(self, "crater_depth_ratio", check_range("crater_depth_ratio",
-                                                         self.crater_depth_ratio, 0.01, 0.5))
-        if self.max_memory_gb is not None:
-            _set(self, "max_memory_gb", check_positive("max_memory_gb", self.max_memory_gb))
+        check_declared(self)
+        if self.crater_depth_ratio is not None and self.target != "small-body":
+            raise ParameterError("crater_depth_ratio", f"applies to small-body only (the "
+                                 f"{self.target}'s crater depths follow its published laws)")
         check_memory(self.magnitude, self.max_memory_gb, radii_on_disk=self.radii_on_disk)
-        if self.radius_m is not None:
-            _set(self, "radius_m", check_range("radius_m", self.radius_m, *RADIUS_RANGE_M))
         if self.stretch is not None:
             _set(self, "stretch", parse_stretch(self.stretch))
 
@@ -193,23 +124,6 @@ class SphereBase:
     name = "sphere"
 
 
-def _check_fbm(obj, prefix: str = "") -> None:
-    """frequency > 0, octaves in [1, 30], persistence > 0, lacunarity >= 1 (the fields of
-    an fBm record whose names start with ``prefix``)."""
-    key = prefix + "frequency"
-    if getattr(obj, key) is not None:
-        _set(obj, key, check_positive(key, getattr(obj, key)))
-    key = prefix + "octaves"
-    _set(obj, key, check_int(key, getattr(obj, key), 1, 30))
-    key = prefix + "persistence"
-    _set(obj, key, check_positive(key, getattr(obj, key)))
-    key = prefix + "lacunarity"
-    lac = check_finite(key, getattr(obj, key))
-    if lac < 1:
-        raise ParameterError(key, f"must be >= 1; got {lac!r}")
-    _set(obj, key, lac)
-
-
 @dataclass(frozen=True, slots=True)
 class ShapeBase:
     """A real shape model ray-cast onto the grid (:func:`latlong.from_shape_model`),
@@ -217,34 +131,54 @@ class ShapeBase:
 
     model: ShapeModel | str | Path
     """The model, or its file (OBJ, PDS plate .tab/.plt, PLY, STL; needs ``units``)."""
-    units: str | None = None
+    units: str | None = setting(
+        None, "units of the shape model file (required with --base shape:PATH and "
+        "--backend implicit)", key="shape_units", choices=("km", "m"))
     """Units of the file: ``km`` or ``m``."""
-    center: str | tuple[float, float, float] = "volume-centroid"
+    center: str | tuple[float, float, float] = setting(
+        "volume-centroid", "ray origin: volume-centroid, area-centroid, origin or X,Y,Z in "
+        "metres", key="shape_center", commas=True)
     """Ray origin: volume-centroid, area-centroid, origin or (x, y, z) metres."""
-    crossings: str = "error"
+    crossings: str = setting("error", "where a ray crosses the surface more than once",
+                             key="shape_crossings", choices=CROSSINGS)
     """Where a ray crosses the surface more than once: error, outermost, innermost."""
-    smooth: str = "butterfly"
+    smooth: str = setting(
+        "butterfly", "subdivision before casting: butterfly (interpolating), linear (keep "
+        "the facets), loop, none (--surface mesh: butterfly or linear)", key="shape_smooth",
+        choices=("butterfly", "linear", "loop", "none"))
     """Subdivision before casting: butterfly, linear, loop, none."""
-    detail_frequency: float | None = None
+    detail_frequency: float | None = setting(
+        None, key="frequency", range=">0", when="with a shape base",
+        default_text="wavelength = the model's resolution")
     """fBm detail frequency on the unit sphere; default: wavelength = the resolution."""
-    detail_octaves: int = 6
+    detail_octaves: int = setting(6, key="octaves", range=(1, 30), when="with a shape base")
     """fBm detail octaves."""
-    detail_persistence: float = 0.5
+    detail_persistence: float = setting(0.5, key="persistence", range=">0",
+                                        when="with a shape base")
     """fBm detail amplitude ratio per octave."""
-    detail_lacunarity: float = 2.0
+    detail_lacunarity: float = setting(2.0, key="lacunarity", range=(1.0, None),
+                                       when="with a shape base")
     """fBm detail frequency ratio per octave."""
-    detail_amplitude_m: float = 0.0
+    detail_amplitude_m: float = setting(0.0, key="amplitude_m", range=">=0",
+                                        when="with a shape base")
     """fBm detail height scale, metres (0 = no detail)."""
-    surface: str = "latlong"
+    surface: str = setting(
+        "latlong", "where a shape model is cratered: latlong (ray-cast onto the lat/long "
+        "grid; the model must be star-shaped from its centre) or mesh (its own refined "
+        "triangle mesh: any closed shape, e.g. Itokawa; outputs .ply .obj .stl .vtp .vtk "
+        ".glb)", choices=SURFACES)
     """``latlong``: ray-cast onto the lat/long grid (the body must be star-shaped from
     the centre); ``mesh``: cratered on the model's own refined mesh (:mod:`latlong.mesh`;
     any closed shape, e.g. Itokawa's neck)."""
-    spacing_m: float | None = None
+    spacing_m: float | None = setting(
+        None, "mean edge of the refined mesh with --surface mesh", unit="m", range=">0",
+        default_text="the lat/long spacing at --magnitude, (pi/2) R / M")
     """Mean edge of the refined mesh with ``surface="mesh"``, metres; default: the
     lat/long grid's spacing at the scene's magnitude, (pi / 2) R / M."""
     name = "shape"
 
     def __post_init__(self):
+        check_declared(self)
         if isinstance(self.model, str | Path):  # a file: read it
             if self.units not in ("km", "m"):
                 raise ParameterError("units", f"must be km or m with a shape model file; "
@@ -259,23 +193,14 @@ class ShapeBase:
         elif not isinstance(self.model, ShapeModel):
             raise ParameterTypeError("model", f"must be a ShapeModel or a path; got "
                                      f"{type(self.model).__name__}")
-        check_choice("crossings", self.crossings, CROSSINGS)
-        check_choice("smooth", self.smooth, ("butterfly", "linear", "loop", "none"))
-        check_choice("surface", self.surface, SURFACES)
         if self.surface == "mesh" and self.smooth not in ("butterfly", "linear"):
             raise ParameterError("smooth", f"must be butterfly or linear with {{}} mesh; got "
                                  f"{self.smooth!r}", see=("surface",))
-        if self.spacing_m is not None:
-            if self.surface != "mesh":
-                raise ParameterError("spacing_m", "applies to {} mesh", see=("surface",))
-            _set(self, "spacing_m", check_positive("spacing_m", self.spacing_m))
+        if self.spacing_m is not None and self.surface != "mesh":
+            raise ParameterError("spacing_m", "applies to {} mesh", see=("surface",))
         _set(self, "center", _center(self.center))
         if self.detail_frequency is None:
             _set(self, "detail_frequency", self.radius_m / self.model.mean_edge_m)
-        _check_fbm(self, "detail_")
-        _set(self, "detail_amplitude_m", check_positive("detail_amplitude_m",
-                                                        self.detail_amplitude_m,
-                                                        allow_zero=True))
 
     @property
     def radius_m(self) -> float:
@@ -337,25 +262,29 @@ class CraterSettings:
     """Crater layers on the body and how they are stamped (:func:`latlong.stamp_craters`;
     their shapes and degradation follow the body's target, :class:`BodySettings`)."""
 
-    layers: tuple[_craters.CraterLayer | _craters.ModelAgeLayer, ...] = ()
+    layers: tuple[_craters.CraterLayer | _craters.ModelAgeLayer, ...] = setting(
+        (), "crater layer: a power law c=0.5,k=-2,d_min_m=2,d_max_m=50[,age_min_gyr=0,"
+        "age_max_gyr=3.5,degradation=0.2,kind=mare] (the fields of craters.CraterLayer): "
+        "N_cum = c D^k per m^2, D in metres, ages in Gyr; or a model age npf=moon,age_gyr="
+        "3.8,d_min_m=100,d_max_m=5000[,equilibrium=trask|hartmann,degradation,kind] "
+        "(craters.ModelAgeLayer: the body's production function and chronology, npf one "
+        "of craters.CHRONOLOGY_SYSTEMS) (repeatable)", key="craters", many="append",
+        metavar="SPEC")
     """Crater layers: power laws (:class:`craters.CraterLayer`) or model ages
     (:class:`craters.ModelAgeLayer`), as records, spec strings or tables."""
-    roughness: bool = True
+    roughness: bool = setting(True, "fractal overlay and irregular rims (off: ideal "
+                              "craters)", key="crater_roughness")
     """Fractal overlay and irregular rims (False: ideal craters)."""
-    max_extent_deg: float = 60.0
-    """Largest angular size of a crater's ejecta blanket, degrees of arc, (0, 180]."""
+    max_extent_deg: float = setting(60.0, "largest angular size of a crater's ejecta "
+                                    "blanket, degrees of arc", key="max_crater_extent_deg",
+                                    unit="deg", range=(0.0, 180.0))
+    """Largest angular size of a crater's ejecta blanket, degrees of arc, [0, 180]."""
 
     def __post_init__(self):
+        check_declared(self)
         _set(self, "layers", _layers(self.layers, _craters.LAYER_TYPES,
                                      _craters.parse_layer_spec, "layers",
                                      table=_craters.as_crater_layer))
-        if not isinstance(self.roughness, bool):
-            raise ParameterTypeError("roughness", f"must be true or false; got "
-                                     f"{self.roughness!r}")
-        ext = check_positive("max_extent_deg", self.max_extent_deg)
-        if ext > 180:
-            raise ParameterError("max_extent_deg", f"must be <= 180; got {ext!r}")
-        _set(self, "max_extent_deg", ext)
 
     def check_fits(self, smallest_radius_m: float, resolution_m: float | None) -> None:
         """Refuse layers whose craters cannot fit on the body (ejecta 3 D across within
@@ -379,7 +308,11 @@ class CraterSettings:
 class BoulderSettings:
     """Boulder layers and the boulders' shape (:func:`latlong.place_boulders`)."""
 
-    layers: tuple[_craters.BoulderLayer, ...] = ()
+    layers: tuple[_craters.BoulderLayer, ...] = setting(
+        (), "boulder layer c=0.05,k=-3,d_min_m=0.5,d_max_m=10[,burial_max=0.5,near=0.3] (the "
+        "fields of craters.BoulderLayer): N_cum = c D^k per m^2, D in metres; burial_max = "
+        "largest buried fraction of the height (<= 0.9); near = share around crater rims "
+        "(repeatable)", key="boulders", many="append", metavar="SPEC")
     """Power-law layers (:class:`craters.BoulderLayer`, spec strings or tables)."""
     shape: _craters.BoulderShape = dataclasses.field(default_factory=_craters.BoulderShape)
     """Flattening, elongation and roughness of the procedural rocks."""
@@ -405,33 +338,51 @@ class ImplicitSettings:
     """The implicit backend (Li et al.; :func:`latlong.implicit_surface`): metaballs over a
     sphere packing of a constraint mesh, LCSN craters, Gabor detail, marching cubes."""
 
-    shape: ShapeModel | str | Path
+    shape: ShapeModel | str | Path = setting(
+        dataclasses.MISSING, "constraint mesh of --backend implicit (OBJ, PDS plate "
+        ".tab/.plt, PLY, STL, VTK; units from --shape-units)", default_text="none")
     """The constraint mesh, or its file (needs ``units``)."""
-    units: str | None = None
+    units: str | None = setting(None, key="shape_units", choices=("km", "m"))
     """Units of the constraint file: ``km`` or ``m``."""
-    layers: tuple = ()
+    layers: tuple = setting(
+        (), "LCSN crater layer kernel=NAME,d_min_m=M,d_max_m=M[,exponent=3,probability=0.5,"
+        "weight=1,depth_ratio=LO:HI] (the fields of latlong.LcsnLayer): NAME of "
+        "craters.LCSN_PRESETS scaled to D in [d_min_m, d_max_m] (metres), N(>D) ~ "
+        "D^-exponent, probability = impulse chance per surface cell, depth_ratio = "
+        "depth/diameter (repeatable)", key="lcsn", many="append", metavar="SPEC")
     """LCSN crater layers (:class:`latlong.LcsnLayer` or spec strings)."""
-    gabor: object | None = None
+    gabor: object | None = setting(
+        None, "Gabor micro-detail frequency=CYCLES_PER_M,bandwidth=PER_M,amplitude_m=RMS_M"
+        "[,orientation_deg=DEG,density=N]", commas=True, metavar="SPEC")
     """Gabor micro-detail (:class:`latlong.GaborNoise` or a spec string)."""
-    polygons: int = 200_000
+    polygons: int = setting(200_000, "about how many triangles the implicit mesh has",
+                            range=(100, 10**9))
     """About how many triangles the mesh has (when ``voxel_m`` is not given)."""
-    voxel_m: float | None = None
+    voxel_m: float | None = setting(None, "marching-cubes spacing (instead of --polygons)",
+                                    unit="m", range=">0")
     """Marching-cubes spacing, metres."""
-    packing_voxels: int = 128
+    packing_voxels: int = setting(128, "voxels along the constraint's longest side for the "
+                                  "sphere packing", range=(8, 1024))
     """Voxels along the constraint's longest side for the sphere packing, [8, 1024]."""
-    min_sphere_m: float | None = None
+    min_sphere_m: float | None = setting(None, "smallest packed sphere", unit="m", range=">0",
+                                         default_text="2 packing voxels")
     """Smallest packed sphere, metres (default 2 packing voxels)."""
-    constraint_weight: float = 1.0
+    constraint_weight: float = setting(
+        1.0, "weight of the constraint's own signed distance in the coarse field: 1 follows "
+        "the constraint (smooth where it is smooth), 0 the bare metaballs over the packing "
+        "(one dome per ball)", range=(0.0, 1.0))
     """Weight of the constraint's own signed distance in the coarse field, [0, 1]: 1
     follows the constraint, 0 is the bare metaball surface (one dome per packed ball)."""
-    cell_m: float | None = None
+    cell_m: float | None = setting(None, "cell size of grid level 0", unit="m", range=">0",
+                                   default_text="the largest d_max_m")
     """Cell size of grid level 0, metres (default: the largest d_max_m); >= every d_max_m."""
-    crossings: str = "error"
+    crossings: str = setting("error", key="shape_crossings", choices=CROSSINGS)
     """Casting onto a lat/long grid where a ray crosses twice: error, outermost, innermost."""
 
     def __post_init__(self):
         from .implicit import GaborNoise, LcsnLayer, parse_gabor_spec, parse_lcsn_spec
 
+        check_declared(self)
         if isinstance(self.shape, str | Path):  # a file: read it
             if self.units not in ("km", "m"):
                 raise ParameterError("units", f"must be km or m with a constraint file; "
@@ -455,16 +406,50 @@ class ImplicitSettings:
         elif self.gabor is not None and not isinstance(self.gabor, GaborNoise):
             raise ParameterTypeError("gabor", f"must be a GaborNoise or a spec string; got "
                                      f"{type(self.gabor).__name__}")
-        _set(self, "polygons", check_int("polygons", self.polygons, 100, 10**9))
-        _set(self, "packing_voxels", check_int("packing_voxels", self.packing_voxels, 8, 1024))
-        _set(self, "constraint_weight",
-             check_range("constraint_weight", self.constraint_weight, 0.0, 1.0))
-        for key in ("voxel_m", "min_sphere_m", "cell_m"):
-            if getattr(self, key) is not None:
-                _set(self, key, check_positive(key, getattr(self, key)))
-        check_choice("crossings", self.crossings, CROSSINGS)
         if self.layers and self.cell_m is not None:
             biggest = max(la.d_max_m for la in self.layers)
             if self.cell_m < biggest:
                 raise ParameterError("cell_m", f"{self.cell_m:g} is smaller than the largest "
                                      f"crater (d_max_m {biggest:g} m): level-0 cells must hold it")
+
+
+@dataclass(frozen=True, slots=True)
+class GaborExample:
+    """Gabor micro-detail of the implicit backend fitted to an example
+    (:func:`latlong.implicit.fit_gabor`): heights in metres (.npy) or a picture."""
+
+    gabor_example: str = setting(
+        dataclasses.MISSING, "fit the Gabor noise to an example (.npy heights in metres, or "
+        "a .png/.jpg/.tif picture)", default_text="none")
+    """The example file."""
+    gabor_pixel_m: float | None = setting(None, "pixel size of --gabor-example on the body",
+                                          unit="m", range=">0", default_text="none")
+    """The example's pixel size on the body, metres (required)."""
+    gabor_amplitude_m: float | None = setting(
+        None, "rms of the fitted Gabor noise", unit="m", range=">=0",
+        default_text="the .npy example's")
+    """The rms of the fitted noise, metres (a picture's grey levels need it)."""
+
+    def __post_init__(self):
+        check_declared(self)
+        if self.gabor_pixel_m is None:
+            raise ParameterError("gabor_example", "needs {} (the example's pixel size on "
+                                 "the body, metres)", see=("gabor_pixel_m",))
+
+    def fit(self):
+        """The :class:`~latlong.implicit.GaborNoise` fitted to the example."""
+        from .implicit import fit_gabor, read_example
+
+        try:
+            image, is_heights = read_example(self.gabor_example)
+            if not is_heights and self.gabor_amplitude_m is None:
+                raise ParameterError("gabor_example", "is a picture (grey levels, not "
+                                     "metres): give {}", see=("gabor_amplitude_m",))
+            return fit_gabor(image, self.gabor_pixel_m, amplitude_m=self.gabor_amplitude_m)
+        except ParameterError:
+            raise
+        except FileNotFoundError as exc:  # kept (Python), tagged (the command's flag)
+            exc.parameter = "gabor_example"
+            raise
+        except ValueError as exc:
+            raise ParameterError("gabor_example", f"{self.gabor_example}: {exc}") from None

@@ -306,7 +306,6 @@ def test_dem_stack_plots_distinct_colours_and_pixel_sizes(tmp_path, monkeypatch)
     import matplotlib.pyplot as plt
 
     import craters.cli.report as report
-    import dem.cli.analysis as analysis
     from dem.cli import main
 
     site = tmp_path / "site"
@@ -320,7 +319,6 @@ def test_dem_stack_plots_distinct_colours_and_pixel_sizes(tmp_path, monkeypatch)
         plt.close(fig)
 
     monkeypatch.setattr(report, "save_figure", keep)
-    monkeypatch.setattr(analysis, "save_figure", keep)
     manifest = str(site / "manifest.json")
     assert main(["slopes", manifest, "--plot", str(tmp_path / "s.png"), "-q"]) == 0
     assert main(["spectrum", manifest, "--plot", str(tmp_path / "p.png"), "-q"]) == 0

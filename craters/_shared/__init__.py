@@ -21,7 +21,6 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         load_toml,
     )
     from .outputs import (
-        check_not_input,
         check_outside_folder,
         output_group,
         replace_output,
@@ -49,7 +48,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
 
 __all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
-           "check_not_input", "check_outside_folder",
+           "check_outside_folder",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
            "load_toml", "normalize_rng", "package_version", "parameter_of",
            "parse_spec",

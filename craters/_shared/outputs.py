@@ -30,7 +30,7 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["TEMP_MAX_AGE_S", "check_not_input", "check_outside_folder", "output_group",
+__all__ = ["TEMP_MAX_AGE_S", "check_outside_folder", "output_group",
            "replace_output", "same_file", "sweep_temporaries", "temp_file", "temp_folder"]
 
 logger = logging.getLogger(__name__)
@@ -247,15 +247,6 @@ def same_file(a, b) -> bool:
         return os.path.samefile(a, b)
     except OSError:
         return False
-
-
-def check_not_input(output, inputs: Iterable, *, flag: str = "-o/--output") -> None:
-    """Raise a one-line ValueError if ``output`` is one of ``inputs`` (pairs of (what,
-    path); None paths skipped): inputs are never modified."""
-    for what, inp in inputs:
-        if inp is not None and str(inp) and same_file(output, inp):
-            raise ValueError(f"{flag} {str(output)!r} is the input {what} {str(inp)!r}; "
-                             f"inputs are never modified")
 
 
 def check_outside_folder(folder, inputs: Iterable, *, flag: str = "-o/--output") -> None:

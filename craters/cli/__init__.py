@@ -1,7 +1,9 @@
-"""Command lines: the ``craters`` command (:mod:`.commands`) and the kit the three
-commands ``latlong``, ``dem`` and ``craters`` share (:mod:`.kit`: one-line errors and exit
-codes, the shared options; :mod:`.report`: the tables and plots of the analysis commands;
-:mod:`.start`: start-up without tracebacks). The libraries never import it.
+"""Command lines: the ``craters`` command (:mod:`.commands`, one module a command:
+:mod:`.profile`, :mod:`.population`) and the kit the three commands ``latlong``, ``dem``
+and ``craters`` share (:mod:`.options`: every option from a declared setting; :mod:`.kit`:
+one-line errors and exit codes, output checks; :mod:`.report`: the tables and plots of the
+analysis commands; :mod:`.start`: start-up without tracebacks). The libraries never import
+it.
 
 This ``__init__`` imports nothing, so that :mod:`.start` loads before numpy and numba.
 """

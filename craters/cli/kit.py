@@ -1,7 +1,9 @@
 """Command-line plumbing shared by the ``latlong``, ``dem`` and ``craters`` commands.
 
 Only command-line modules import this (it loads argparse): one-line errors with exit
-code 2, the ``--seed`` type, and the report options of the analysis commands.
+code 2 (:func:`run_cli`), the ``--seed`` type, the checks of outputs before any work, the
+lines a batch prints. The options themselves come from declared settings
+(:mod:`craters.cli.options`).
 """
 
 from __future__ import annotations
@@ -13,15 +15,14 @@ import os
 import signal
 import sys
 import threading
-from collections.abc import Callable, Collection, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 
 from .._shared.files import check_output_path
-from .._shared.outputs import check_not_input, output_group
+from .._shared.outputs import output_group, same_file
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
-__all__ = ["BATCH_FLAGS", "CliError", "OneLineParser", "add_batch_arguments",
-           "add_report_arguments", "batch_error", "batch_reporter", "batch_summary",
-           "check_report_outputs", "parse_seed", "parse_vary", "run_cli"]
+__all__ = ["CliError", "OneLineParser", "batch_reporter", "batch_summary", "check_not_input",
+           "check_report_outputs", "parse_seed", "run_cli"]
 
 
 class CliError(Exception):
@@ -109,16 +110,13 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
         return 130
 
 
-def add_report_arguments(parser) -> None:
-    """The output options every analysis command has: --csv, --plot, --force, --quiet."""
-    parser.add_argument("--csv", help="write the table (CSV, units in the header) "
-                        "(default: none)")
-    parser.add_argument("--plot", help="write the plot (PNG) (default: none)")
-    parser.add_argument("--force", action="store_true",
-                        help="overwrite existing outputs (default: off)")
-    parser.add_argument("-q", "--quiet", action="store_true",
-                        help="no progress bars or messages, the summary table included "
-                        "(default: off)")
+def check_not_input(output, inputs, *, flag: str = "-o/--output") -> None:
+    """Raise a one-line ValueError if ``output`` is one of ``inputs`` (pairs of (what,
+    path); None paths skipped): inputs are never modified."""
+    for what, inp in inputs:
+        if inp is not None and str(inp) and same_file(output, inp):
+            raise ValueError(f"{flag} {str(output)!r} is the input {what} {str(inp)!r}; "
+                             f"inputs are never modified")
 
 
 def check_report_outputs(args, inputs=()) -> None:
@@ -135,89 +133,6 @@ def check_report_outputs(args, inputs=()) -> None:
 
 
 # --------------------------------------------------------------------------- batches
-#: Parameters of ``latlong.batch`` / ``dem.batch`` -> the flags of the batch commands.
-BATCH_FLAGS = {"seeds": "--seeds", "vary": "--vary", "out": "-o/--output",
-               "scheduler": "--scheduler", "workers": "--workers", "resume": "--resume",
-               "force": "--force"}
-
-
-def add_batch_arguments(parser, what: str) -> None:
-    """The options of ``latlong batch`` and ``dem batch`` (``what``: a variant's output)."""
-    parser.add_argument("--seeds", required=True, metavar="SEEDS",
-                        help="seeds: a range 1-1000, a list 1,5,9 or both 1-3,7 (required)")
-    parser.add_argument("--vary", action="append", metavar="KEY=V1,V2,...",
-                        help="build every value of a setting (a key of the file, dashes or "
-                        "underscores); several --vary make a cartesian product; values that "
-                        "hold commas (crater specs, X,Y,Z) are separated by ';' (repeatable; "
-                        "default: none)")
-    parser.add_argument("-o", "--output", required=True, metavar="FOLDER",
-                        help=f"batch folder: {what}, and index.csv (required)")
-    parser.add_argument("--scheduler", metavar="ADDRESS",
-                        help="a running dask scheduler, e.g. tcp://127.0.0.1:8786 (default: a "
-                        "local cluster on 127.0.0.1, one single-threaded worker process per "
-                        "core)")
-    parser.add_argument("--workers", type=int, metavar="N",
-                        help="worker processes of the local cluster (default: one per core)")
-    parser.add_argument("--resume", action="store_true",
-                        help="keep the variants index.csv lists as done whose files still "
-                        "have their sha256; redo the others (default: off)")
-    parser.add_argument("--force", action="store_true",
-                        help="redo every variant in a folder that holds a batch (default: off)")
-    parser.add_argument("-q", "--quiet", action="store_true",
-                        help="no progress bar, lines or summary; failures still reported "
-                        "(default: off)")
-
-
-def parse_vary(items, convert: Callable[[str, str], object], keys: Collection[str],
-               comma_keys: Collection[str] = ()) -> dict[str, list]:
-    """``--vary KEY=V1,V2`` options -> {key: [values]}: the key with dashes or underscores,
-    each value through ``convert(key, text)``; values separated by ``;`` when the text
-    holds one, else by ``,`` (a key of ``comma_keys``, whose values hold commas, takes the
-    whole text as one value)."""
-    out: dict[str, list] = {}
-    for item in items or ():
-        key, sep, text = item.partition("=")
-        key = key.strip().lstrip("-").replace("-", "_")
-        if not sep or not text.strip():
-            raise CliError(f"--vary {item!r}: expected KEY=V1,V2,...")
-        if key == "seed":
-            raise CliError("--vary seed: give the seeds with --seeds")
-        if key not in keys:
-            raise CliError(f"--vary {item!r}: unknown key {key!r}; allowed: "
-                           f"{', '.join(sorted(keys))}")
-        if key in out:
-            raise CliError(f"--vary {key} is given twice; give its values in one --vary")
-        if ";" in text:
-            texts = text.split(";")
-        else:
-            texts = [text] if key in comma_keys else text.split(",")
-        values = []
-        for t in (t.strip() for t in texts):
-            try:
-                values.append(convert(key, t))
-            except (argparse.ArgumentTypeError, ValueError, TypeError) as exc:
-                raise CliError(f"--vary {key}={t}: {exc}") from None
-        out[key] = values
-    return out
-
-
-def batch_error(exc: Exception, config) -> CliError:
-    """A library error of a batch as one line: under its flag, else under the key of the
-    file ``config`` it is about."""
-    name = parameter_of(exc)
-
-    def name_of(key):
-        return BATCH_FLAGS.get(key, f"key {key!r}")
-
-    if isinstance(exc, ParameterError | ParameterTypeError):
-        where = BATCH_FLAGS.get(exc.name) or f"config {str(config)!r}: key {exc.name!r}"
-        return CliError(exc.shown_as(where, name_of))
-    if name is not None:
-        return CliError(f"{BATCH_FLAGS.get(name) or f'config {str(config)!r}: key {name!r}'}: "
-                        f"{exc}")
-    return CliError(str(exc))
-
-
 def batch_reporter(quiet: bool):
     """(progress, on_done) of a batch command: a bar on a terminal, else one line per
     finished variant on stderr; nothing with ``quiet``."""

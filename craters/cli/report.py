@@ -13,8 +13,8 @@ import numpy as np
 
 from .._shared.files import atomic_path
 
-__all__ = ["plot_slopes", "save_figure", "series_colors", "slope_csv", "slope_table",
-           "write_csv"]
+__all__ = ["plot_slopes", "plot_spectra", "save_figure", "series_colors", "slope_csv",
+           "slope_table", "write_csv"]
 
 
 def write_csv(path, comment: str, columns, rows) -> None:
@@ -95,6 +95,30 @@ def plot_slopes(path, results, *, xlabel: str, ylabel: str, title: str,
         ax.legend(fontsize=8)
         if full_range:
             ax.set_xlim(0, 90)
+    fig.tight_layout()
+    save_figure(fig, path)
+    plt.close(fig)
+
+
+def plot_spectra(path, series, *, xlabel: str, ylabel: str, title: str, fmt: str = "-",
+                 invert_x: bool = False, **style) -> None:
+    """Log-log power spectra of every input in one plot (``series``: (legend label, x, y)
+    triples; colours from :func:`series_colors`; ``fmt`` and ``style`` for every line)."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 5))
+    for (label, x, y), color in zip(series, series_colors(len(series)), strict=True):
+        ax.loglog(x, y, fmt, **style, color=color, label=label)
+    if invert_x:
+        ax.invert_xaxis()
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
     fig.tight_layout()
     save_figure(fig, path)
     plt.close(fig)

@@ -1,13 +1,13 @@
-"""The ``dem`` command line: ``dem info``, ``convert``, ``fill``, ``expand`` (:mod:`.raster`),
-``enhance``, ``mesh`` (:mod:`.stack`), ``batch`` (:mod:`.batch`), ``slopes`` and ``spectrum``
-(:mod:`.analysis`), ``camera`` and ``lidar`` (:mod:`.sensors`: latlong's sensor commands
-over a site).
+"""The ``dem`` command line, one module a command: ``dem info``, ``convert``, ``fill``,
+``expand``, ``enhance``, ``mesh``, ``batch``, ``slopes`` and ``spectrum``; ``camera`` and
+``lidar`` (:mod:`.sensors`: latlong's sensor commands over a site).
 
 Every command takes its input (a DEM, or for ``mesh``, ``slopes`` and ``spectrum`` also
 a stack manifest) as its positional argument, or as the key ``input`` of a TOML file
 given with ``--config`` whose keys are the option names (dashes -> underscores); options
 on the command line override the file, file names are relative to the working folder.
-One table drives the options of every command (:mod:`.options`). ``-q/--quiet``
+Every option comes from a declared setting (:mod:`craters.cli.options`; the stack's on
+:class:`dem.EnhanceConfig`, the shared ones in :mod:`.options`). ``-q/--quiet``
 silences progress bars and messages everywhere; ``--help`` shows every default. Errors
 are one line ``error: ...`` with exit code 2, and nothing is written.
 
@@ -18,22 +18,21 @@ from __future__ import annotations
 
 import sys
 
-from craters._shared import package_version
-from craters.cli.kit import OneLineParser, run_cli
+from craters.cli.kit import run_cli
+from craters.cli.options import main_parser
 
-from . import analysis, batch, raster, sensors, stack
+from . import batch, convert, enhance, expand, fill, info, mesh, sensors, slopes, spectrum
 
 __all__ = ["build_parser", "main"]
 
 
-def build_parser() -> OneLineParser:
+def build_parser():
     """The ``dem`` argument parser with every command."""
-    parser = OneLineParser(prog="dem", description="DEMs: gap filling, RMD expansion, "
-                                                   "layer stacks with craters, meshes, info.")
-    parser.add_argument("--version", action="version", version=f"craterform {package_version()}")
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
-    for group in (raster, stack, batch, analysis, sensors):
-        group.register(sub)
+    parser, sub = main_parser("dem", "DEMs: gap filling, RMD expansion, layer stacks with "
+                              "craters, meshes, info.")
+    for command in (info, convert, fill, expand, enhance, mesh, batch, slopes, spectrum,
+                    sensors):
+        command.register(sub)
     return parser
 
 

@@ -9,62 +9,52 @@ in index.csv and makes the exit code 1.
 
 from __future__ import annotations
 
-import argparse
-
-from craters.cli.kit import (
-    add_batch_arguments,
+from craters.cli.kit import batch_reporter, batch_summary
+from craters.cli.options import (
+    Setting,
+    Values,
     batch_error,
-    batch_reporter,
-    batch_summary,
+    batch_options,
+    command,
     parse_vary,
+    read_config,
 )
-from latlong import SETTINGS
 from latlong import batch as run_batch
 
-from .options import BUILD_OPTIONS, OUTPUT_KEYS, read_config
+from ..outputs import OUTPUT_SETTINGS
+from ..scene import SETTINGS
+from .build import OPTIONS as BUILD_OPTIONS
 
-__all__ = ["add_batch_parser"]
+__all__ = ["register"]
 
-_OPTS = {o.key: o for o in BUILD_OPTIONS if o.key in SETTINGS and o.key != "seed"}
-#: Settings whose one value holds commas (a whole --vary text is one value without ';').
-_COMMA_KEYS = ("stretch", "craters", "boulders", "lcsn", "gabor", "shape_center")
-
-
-def _value(key: str, text: str):
-    """A --vary value as the option of the same key parses it (a layer: a list of one)."""
-    opt = _OPTS[key]
-    if opt.action in ("store_true", "store_false"):
-        if text.lower() not in ("true", "false"):
-            raise argparse.ArgumentTypeError(f"expected true or false; got {text!r}")
-        return text.lower() == "true"
-    value = opt.parse(text)
-    return [value] if opt.action == "append" else value
+OPTIONS = {
+    "scene": Setting(help="scene file (TOML): the keys of `latlong build --config`, outputs "
+                     f"({', '.join(OUTPUT_SETTINGS)}) included", flag="SCENE", required=True,
+                     run=True),
+    **batch_options("each variant's files named seedNNNN[_KEY=VALUE...][_FILE]"),
+}
+#: The settings a batch varies: every scene setting but the seed.
+VARY = {k: s for k, s in BUILD_OPTIONS.items() if k in SETTINGS and k != "seed"}
 
 
-def cmd_batch(args) -> int:
-    scene = read_config(args.scene)
-    vary = parse_vary(args.vary, _value, _OPTS, _COMMA_KEYS)
-    progress, on_done = batch_reporter(args.quiet)
+def _batch(v: Values) -> int:
+    scene = read_config(v.scene, BUILD_OPTIONS, "latlong build")
+    vary = parse_vary(v.vary, VARY)
+    progress, on_done = batch_reporter(v.quiet)
     try:
-        result = run_batch(scene, args.seeds, vary=vary, out=args.output, scheduler=args.scheduler,
-                           workers=args.workers, resume=args.resume, force=args.force,
+        result = run_batch(scene, v.seeds, vary=vary, out=v.output, scheduler=v.scheduler,
+                           workers=v.workers, resume=v.resume, force=v.force,
                            progress=progress, on_done=on_done)
     except (TypeError, ValueError) as exc:
-        raise batch_error(exc, args.scene) from None
-    return batch_summary(result, args.quiet)
+        raise batch_error(exc, v, v.scene) from None
+    return batch_summary(result, v.quiet)
 
 
-def add_batch_parser(sub) -> None:
+def register(sub) -> None:
     """Register ``latlong batch``."""
-    b = sub.add_parser(
-        "batch", help="build every variant of a scene (seeds x --vary) on dask.distributed",
-        description="Build a scene file for every seed and every combination of --vary "
-        "values, one dask task per variant (a local cluster, or --scheduler), and write each "
-        "variant's outputs (the scene's, else .npz and the crater catalog) under its name "
-        "into the folder, with index.csv (files, sha256, seconds, peak MB, status).")
-    b.add_argument("scene", metavar="SCENE",
-                   help="scene file (TOML): the keys of `latlong build --config`, outputs "
-                   f"({', '.join(k for k in OUTPUT_KEYS if k not in ('quiet', 'force'))}) "
-                   "included")
-    add_batch_arguments(b, "each variant's files named seedNNNN[_KEY=VALUE...][_FILE]")
-    b.set_defaults(func=cmd_batch)
+    command(sub, "batch", _batch, OPTIONS, prog="latlong",
+            help="build every variant of a scene (seeds x --vary) on dask.distributed",
+            description="Build a scene file for every seed and every combination of --vary "
+            "values, one dask task per variant (a local cluster, or --scheduler), and write "
+            "each variant's outputs (the scene's, else .npz and the crater catalog) under its "
+            "name into the folder, with index.csv (files, sha256, seconds, peak MB, status).")

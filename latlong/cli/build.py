@@ -15,31 +15,34 @@ import numpy as np
 
 from craters._shared import human_bytes, progress_bar
 from craters.cli.kit import CliError
+from craters.cli.options import FORCE, QUIET, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
 
 from ..outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
-from .options import BUILD_OPTIONS, OUTPUT_KEYS, given_options, read_config, shown
+from ..scene import SETTING_PARTS, SETTINGS
 
-__all__ = ["add_build_parser"]
+__all__ = ["GROUPS", "OPTIONS", "register"]
+
+#: Every option of ``latlong build`` (the scene's settings, the outputs, --quiet,
+#: --force): also the keys of a scene file.
+OPTIONS = declared_keys(*SETTING_PARTS, ("output", Outputs),
+                        ("output", {"quiet": QUIET, "force": FORCE}))
+#: The titles of the option groups of ``latlong build --help``.
+GROUPS = {"body": "body", "faulting": "two-phase faulting (--base faulting)",
+          "fbm": "Perlin fBm (--base fbm; detail on --base shape)",
+          "shape": "shape models (--base shape:PATH)", "craters": "craters",
+          "boulders": "boulders", "implicit": "implicit backend (--backend implicit)",
+          "output": "output", "render": "preview picture"}
 
 
-def _settings(args) -> tuple[dict, dict, set]:
-    """(scene settings, run options, keys that came from the config file)."""
-    from_file = read_config(args.config) if args.config else {}
-    given = {**from_file, **given_options(args, BUILD_OPTIONS)}
-    run = {k: given.pop(k) for k in OUTPUT_KEYS if k in given}
-    file_keys = {k for k in from_file if k not in given_options(args, BUILD_OPTIONS)}
-    return given, run, file_keys
-
-
-def _outputs(scene: Scene, run: dict, config=None) -> Outputs:
+def _outputs(scene: Scene, v: Values) -> Outputs:
     """The run's outputs, checked against the scene before any work (something to write,
     known suffixes, folders writable, nothing overwritten without --force)."""
-    outputs = Outputs.from_settings({k: run.get(k) for k in OUTPUT_SETTINGS})
+    outputs = Outputs.from_settings({k: v[k] for k in OUTPUT_SETTINGS})
     if not outputs.files():
         raise CliError("nothing to write: give -o/--output, --catalog or --preview")
-    outputs.check(scene, force=bool(run.get("force")),
-                  inputs=[("config", config)] if config else ())
+    outputs.check(scene, force=v["force"],
+                  inputs=[("config", v.config_file)] if v.config_file else ())
     return outputs
 
 
@@ -79,15 +82,11 @@ def _distance_range(body) -> tuple[float, float]:
     return lo, hi
 
 
-def cmd_build(args) -> int:
-    settings, run, from_file = _settings(args)
-    try:
-        scene = Scene.from_settings(settings)
-    except (ValueError, TypeError) as exc:
-        raise CliError(shown(exc, from_file, args.config)) from None
-    outputs = _outputs(scene, run, args.config)
+def _build(v: Values) -> int:
+    scene = Scene.from_settings({k: v[k] for k in SETTINGS if k in v.given})
+    outputs = _outputs(scene, v)
     files = outputs.files()
-    show = not run.get("quiet")
+    show = not v["quiet"]
     bar = progress_bar(total=1 + len(files), enabled=show, desc="build")
     bar.set_description("body")
     scratch = None
@@ -108,12 +107,9 @@ def cmd_build(args) -> int:
     return 0
 
 
-def add_build_parser(sub, add_groups) -> None:
-    """Register ``latlong build`` (``add_groups(parser)`` makes the option groups)."""
-    b = sub.add_parser("build", help="generate a body and write meshes / catalogs / pictures",
-                       description="Generate a body (base shape, craters, boulders) or an "
-                       "implicit body and write it.")
-    b.add_argument("--config", metavar="TOML",
-                   help="scene file; options override its keys (default: none)")
-    add_groups(b, BUILD_OPTIONS)
-    b.set_defaults(func=cmd_build)
+def register(sub) -> None:
+    """Register ``latlong build``."""
+    command(sub, "build", _build, OPTIONS, groups=GROUPS, config=True, prog="latlong",
+            help="generate a body and write meshes / catalogs / pictures",
+            description="Generate a body (base shape, craters, boulders) or an implicit body "
+            "and write it.")

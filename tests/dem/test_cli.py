@@ -248,10 +248,18 @@ def test_config_file(run_cli, capsys, tmp_path, tiny_geotiff):
 COMMANDS = ("info", "fill", "expand", "enhance", "mesh", "slopes", "spectrum")
 
 
+def options_for(command: str) -> dict:
+    """The options of ``dem COMMAND`` by key: the table that makes its flags, help texts
+    and config keys (:func:`craters.cli.options.command`)."""
+    from dem.cli import build_parser
+
+    return build_parser()._subparsers._group_actions[0].choices[command].get_default(
+        "func").options
+
+
 @pytest.mark.parametrize("command", COMMANDS)
 def test_every_option_has_a_config_key_and_shows_its_default(command):
     from dem.cli import build_parser
-    from dem.cli.options import options_for
 
     sub = build_parser()._subparsers._group_actions[0].choices[command]
     actions = [a for a in sub._actions if a.dest != "help"]
@@ -262,10 +270,8 @@ def test_every_option_has_a_config_key_and_shows_its_default(command):
 
 
 def test_quiet_means_the_same_everywhere():
-    from dem.cli.options import options_for
-
     quiet = {options_for(c)["quiet"] for c in COMMANDS if "quiet" in options_for(c)}
-    assert len(quiet) == 1 and next(iter(quiet)).flags == ("-q", "--quiet")
+    assert len(quiet) == 1 and next(iter(quiet)).flag == "-q/--quiet"
     assert {c for c in COMMANDS if "quiet" not in options_for(c)} == {"info"}
 
 
@@ -427,8 +433,6 @@ def test_mesh_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, lola_c
 
 
 def test_enhance_options_are_the_config_plus_the_run_options():
-    from dem.cli.options import options_for
-
     assert set(options_for("enhance")) == {*dem.EnhanceConfig.keys(), "output", "force",
                                            "quiet"}
 
@@ -437,7 +441,8 @@ def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_pa
                                                                  monkeypatch):
     import collections
 
-    import dem.cli.stack
+    import craters._shared.settings
+    import dem.cli.enhance
     import dem.config
 
     calls = collections.Counter()
@@ -454,8 +459,8 @@ def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_pa
 
     counted(dem.config, "parse_layer_spec")
     counted(dem.config, "parse_boulder_spec")
-    counted(dem.config, "check_int", only=lambda name, *_: name == "seed")
-    counted(dem.cli.stack, "check_stack_folder")
+    counted(craters._shared.settings, "check_int", only=lambda name, *_: name == "seed")
+    counted(dem.cli.enhance, "check_stack_folder")
     scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
     proc = InProcess(capsys)("dem", "enhance", "--config", str(scene), "--seed", "3", "-q",
                              "--boulders", "c=0.00001,k=-3,d_min_m=300,d_max_m=2000")

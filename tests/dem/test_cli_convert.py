@@ -98,11 +98,11 @@ def test_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, pds, case, 
 
 def test_every_option_has_a_config_key_and_shows_its_default():
     from dem.cli import build_parser
-    from dem.cli.options import options_for
 
     sub = build_parser()._subparsers._group_actions[0].choices["convert"]
     actions = [a for a in sub._actions if a.dest != "help"]
-    assert {a.dest for a in actions} - {"config"} == set(options_for("convert"))
+    options = sub.get_default("func").options  # the table of the flags and config keys
+    assert {a.dest for a in actions} - {"config"} == set(options)
     for action in actions:
         assert "(default: " in action.help, action.dest
 

@@ -157,12 +157,13 @@ def test_config_file(run_cli, tmp_path):
 
 
 def test_every_option_has_a_config_key():
-    from latlong.cli import BUILD_OPTIONS, build_parser
+    from latlong.cli import build_parser
+    from latlong.cli.build import OPTIONS
 
     parser = build_parser()
     build = parser._subparsers._group_actions[0].choices["build"]
     dests = {a.dest for a in build._actions} - {"help", "config"}
-    assert dests == {o.key for o in BUILD_OPTIONS}
+    assert dests == set(OPTIONS)
 
 
 def test_info(run_cli, tmp_path):

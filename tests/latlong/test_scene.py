@@ -70,6 +70,15 @@ def test_from_settings_applies_presets_then_the_given_values():
     assert s.base.amplitude_m == pytest.approx(40.0)
 
 
+def test_amplitude_is_a_fraction_of_the_radius_and_the_metres_win():
+    s = Scene.from_settings({"base": "fbm", "magnitude": 8, "radius_m": 200, "amplitude": 0.1})
+    assert s.base.amplitude_m == pytest.approx(20.0)
+    s = Scene.from_settings({"magnitude": 8, "amplitude": 0.1, "amplitude_m": 3.0})
+    assert s.base.amplitude_m == 3.0
+    with pytest.raises(ValueError, match="applies to"):
+        Scene.from_settings({"base": "sphere", "magnitude": 8, "amplitude": 0.1})
+
+
 def test_a_toml_scene(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text('magnitude = 16\nbase = "sphere"\nradius_m = 100\nseed = 5\n'
@@ -108,10 +117,10 @@ def test_errors_name_the_setting(settings, name, text):
 
 
 def test_every_setting_is_an_option_and_a_toml_key():
-    from latlong.cli.options import BUILD_OPTIONS, OUTPUT_KEYS
+    from latlong.cli.build import OPTIONS
+    from latlong.outputs import OUTPUT_SETTINGS
 
-    keys = {o.key for o in BUILD_OPTIONS}
-    assert keys == set(SETTINGS) | set(OUTPUT_KEYS)
+    assert set(OPTIONS) == set(SETTINGS) | set(OUTPUT_SETTINGS) | {"quiet", "force"}
 
 
 def test_help_shows_every_default(capsys):

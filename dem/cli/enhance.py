@@ -1,29 +1,36 @@
-"""``dem enhance`` and ``dem mesh``: layer stacks around a site and their meshes."""
+"""``dem enhance``: a stack of layers around a site, each 2x finer, with craters (and
+boulders) per layer, written layer by layer into a folder (:func:`dem.enhance`); its
+options are the fields of :class:`dem.EnhanceConfig`."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from craters._shared import about
 from craters.cli.kit import CliError
+from craters.cli.options import Values
 
 from ..config import EnhanceConfig
 from ..enhancefile import enhance_to_folder
-from ..mesh import MESH_SUFFIXES, to_mesh
-from ..stack import check_stack_folder, read_stack
-from .options import Settings, add_command, check_output, read_input
+from ..stack import check_stack_folder
+from .options import DEM, RUN, dem_command, output
+
+__all__ = ["OPTIONS", "register"]
+
+OPTIONS = {"input": DEM["input"], "output": output(
+    "output folder of the stack (layer GeoTIFFs, crater catalogs, manifest.json)", "DIR"),
+    **DEM, **RUN}
 
 
-def _enhance(s: Settings) -> int:
+def _enhance(v: Values) -> int:
     # the stack's description is validated once, here (every spec parsed once), and the
     # output folder checked once, before any work
-    if not s["output"]:
+    if not v["output"]:
         raise CliError("nothing to write: give -o/--output")
-    cfg = EnhanceConfig.from_mapping({key: s[key] for key in EnhanceConfig.keys()})
+    cfg = EnhanceConfig.from_mapping({key: v[key] for key in EnhanceConfig.keys()})
     with about("output"):
-        folder = check_stack_folder(s["output"], force=s["force"],
-                                    inputs=(("DEM", s["input"]), ("config", s.config)))
-    show = not s["quiet"]
+        folder = check_stack_folder(v["output"], force=v["force"],
+                                    inputs=(("DEM", v["input"]),
+                                            ("config", v.config_file)))
+    show = not v["quiet"]
     # layer by layer into the folder (the bytes of enhance + write_stack; memory for
     # about two layers, not all of them)
     stack, manifest = enhance_to_folder(cfg, folder, progress=show)
@@ -48,24 +55,7 @@ def _enhance(s: Settings) -> int:
     return 0
 
 
-def _mesh(s: Settings) -> int:
-    check_output(s, MESH_SUFFIXES)
-    show = not s["quiet"]
-    if Path(s["input"]).suffix.lower() == ".json":
-        src = read_stack(s["input"], progress=show)
-    else:
-        src = read_input(s)
-    path = to_mesh(src, s["output"], progress=show, boulders=not s["no_boulders"])
-    if show:
-        n = len(src) if hasattr(src, "layers") else 1
-        print(f"dem mesh: {n} layer(s), {path.stat().st_size / 2**20:.1f} MiB")
-        print(f"wrote {path}")
-    return 0
-
-
 def register(sub) -> None:
-    """Add ``enhance`` and ``mesh`` to the sub-command parser."""
-    add_command(sub, "enhance", _enhance,
+    """Register ``dem enhance``."""
+    dem_command(sub, "enhance", _enhance, OPTIONS,
                 "build a stack of layers around a site, each 2x finer, with craters per layer")
-    add_command(sub, "mesh", _mesh,
-                "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP")

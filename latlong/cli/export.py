@@ -1,0 +1,63 @@
+"""``latlong export MODEL -o OUT``: the renderer export of a saved body (patched triangle
+strips as .glb with a JSON manifest and nested levels of detail, or a VTP with native
+strips)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from craters._shared import check_output_path, human_bytes
+from craters.cli.kit import CliError, check_not_input
+from craters.cli.options import FORCE, QUIET, Setting, Values, command, default_of
+from latlong import export_glb, export_vtp_strips, load
+
+from .inputs import MODEL
+
+__all__ = ["register"]
+
+OPTIONS = {
+    "model": MODEL,
+    "output": Setting(help="out.glb or out.vtp", flag="-o/--output", required=True,
+                      run=True),
+    "patch_k": Setting(default_of(export_glb, "patch_k"), "patch tree parameter K",
+                       range=(2, 1_000_000), run=True),
+    "lod": Setting(default_of(export_glb, "lod"), "coarsest level of detail (M / 2^lod), 0 = "
+                   "the body only", range=(0, 20), run=True),
+    "force": FORCE, "quiet": QUIET,
+}
+
+
+def _export(v: Values) -> int:
+    out = Path(v["output"])
+    suffix = out.suffix.lower()
+    if suffix not in (".glb", ".vtp"):
+        raise CliError(f"-o/--output must end in .glb or .vtp; got {str(out)!r}")
+    check_output_path(out, force=v["force"], suffixes=(".glb", ".vtp"))
+    if suffix == ".glb":
+        check_output_path(out.with_suffix(".json"), force=v["force"], suffixes=(".json",))
+        for level in range(v["lod"] + 1):  # external buffers of exports past 4 GiB
+            check_output_path(out.with_name(f"{out.stem}.lod{level}.bin"), force=v["force"])
+    for written in (out, out.with_suffix(".json")):
+        check_not_input(written, [("MODEL", v["model"])])
+    body = load(v["model"])
+    if body.magnitude % (2 ** v["lod"]):
+        raise CliError(f"--lod {v['lod']} needs a magnitude divisible by {2 ** v['lod']}; "
+                       f"{v['model']} has M = {body.magnitude}")
+    if suffix == ".glb":
+        man = export_glb(body, out, patch_k=v["patch_k"], lod=v["lod"],
+                         progress=not v["quiet"])
+        summary = ", ".join(f"LOD {lv['level']}: M={lv['magnitude']} "
+                            f"{len(lv['patches'])} patches" for lv in man["levels"])
+    else:
+        export_vtp_strips(body, out)
+        summary = f"{2 * body.magnitude} strips"
+    if not v["quiet"]:
+        print(f"wrote {out} ({human_bytes(out.stat().st_size)}): {summary}")
+    return 0
+
+
+def register(sub) -> None:
+    """Register ``latlong export``."""
+    command(sub, "export", _export, OPTIONS, prog="latlong",
+            help="renderer export: patched triangle strips (.glb, with a JSON manifest, "
+            "nested LODs) or a VTP with native strips")

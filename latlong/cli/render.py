@@ -1,0 +1,38 @@
+"""``latlong render MODEL -o PNG``: a saved body rendered off-screen."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from craters._shared import check_output_path, human_bytes
+from craters.cli.kit import check_not_input
+from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
+from latlong import PreviewSettings, load, render_preview
+
+from .inputs import MODEL
+
+__all__ = ["register"]
+
+OPTIONS = {
+    "model": MODEL,
+    "output": Setting(help="PNG to write", flag="-o/--output", required=True, run=True),
+    "force": FORCE, "quiet": QUIET,
+    **declared_keys(("render", PreviewSettings)),
+}
+
+
+def _render(v: Values) -> int:
+    settings = PreviewSettings(**{k: v[k] for k in declared_keys(PreviewSettings)})
+    check_not_input(v["output"], [("MODEL", v["model"])])
+    check_output_path(v["output"], force=v["force"], suffixes=(".png",))
+    body = load(v["model"])
+    render_preview(body, v["output"], settings)
+    if not v["quiet"]:
+        print(f"wrote {v['output']} ({human_bytes(Path(v['output']).stat().st_size)})")
+    return 0
+
+
+def register(sub) -> None:
+    """Register ``latlong render``."""
+    command(sub, "render", _render, OPTIONS, groups={"render": "preview picture"},
+            prog="latlong", help="render a saved body to a PNG (off-screen)")
