@@ -16,7 +16,7 @@ from craters._shared import ParameterError, ParameterTypeError, physical_memory_
 from craters._shared.settings import check_declared, default_of, setting
 
 from .memory import MEMORY_SHARE, RADII_ON_DISK, check_memory
-from .shapes import SIZE_RANGE_M, ShapeModel, read_shape_model
+from .shapes import SIZE_RANGE_M, ShapeModel, as_shape_model
 
 __all__ = ["BASES", "DEFAULT_RADIUS_M", "NO_STRETCH", "SURFACES", "BodySettings", "BoulderSettings",
            "CraterSettings", "GaborExample", "ImplicitSettings", "ShapeBase", "SphereBase"]
@@ -117,6 +117,25 @@ class BodySettings:
 
 
 # --------------------------------------------------------------------------- bases
+def _read_shape(record, name: str, what: str) -> None:
+    """The field ``name`` of ``record``: a ShapeModel, or a path read in ``record.units``
+    (``what`` names the file in messages; errors named by the field)."""
+    value = getattr(record, name)
+    if isinstance(value, str | Path) and record.units not in ("km", "m"):
+        raise ParameterError("units", f"must be km or m with a {what} file; got "
+                             f"{record.units!r}")
+    if not isinstance(value, str | Path | ShapeModel):
+        raise ParameterTypeError(name, f"must be a ShapeModel or a path; got "
+                                 f"{type(value).__name__}")
+    try:
+        _set(record, name, as_shape_model(value, units=record.units, what=what, name=name))
+    except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
+        exc.parameter = name
+        raise
+    except ValueError as exc:
+        raise ParameterError(name, f"{value}: {exc}") from None
+
+
 @dataclass(frozen=True, slots=True)
 class SphereBase:
     """A plain sphere (craters and boulders only)."""
@@ -179,20 +198,7 @@ class ShapeBase:
 
     def __post_init__(self):
         check_declared(self)
-        if isinstance(self.model, str | Path):  # a file: read it
-            if self.units not in ("km", "m"):
-                raise ParameterError("units", f"must be km or m with a shape model file; "
-                                     f"got {self.units!r}")
-            try:
-                _set(self, "model", read_shape_model(self.model, units=self.units))
-            except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
-                exc.parameter = "model"
-                raise
-            except ValueError as exc:
-                raise ParameterError("model", f"{self.model}: {exc}") from None
-        elif not isinstance(self.model, ShapeModel):
-            raise ParameterTypeError("model", f"must be a ShapeModel or a path; got "
-                                     f"{type(self.model).__name__}")
+        _read_shape(self, "model", "shape model")
         if self.surface == "mesh" and self.smooth not in ("butterfly", "linear"):
             raise ParameterError("smooth", f"must be butterfly or linear with {{}} mesh; got "
                                  f"{self.smooth!r}", see=("surface",))
@@ -383,20 +389,7 @@ class ImplicitSettings:
         from .implicit import GaborNoise, LcsnLayer, parse_gabor_spec, parse_lcsn_spec
 
         check_declared(self)
-        if isinstance(self.shape, str | Path):  # a file: read it
-            if self.units not in ("km", "m"):
-                raise ParameterError("units", f"must be km or m with a constraint file; "
-                                     f"got {self.units!r}")
-            try:
-                _set(self, "shape", read_shape_model(self.shape, units=self.units))
-            except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
-                exc.parameter = "shape"
-                raise
-            except ValueError as exc:
-                raise ParameterError("shape", f"{self.shape}: {exc}") from None
-        elif not isinstance(self.shape, ShapeModel):
-            raise ParameterTypeError("shape", f"must be a ShapeModel or a path; got "
-                                     f"{type(self.shape).__name__}")
+        _read_shape(self, "shape", "constraint")
         _set(self, "layers", _layers(self.layers, LcsnLayer, parse_lcsn_spec, "layers"))
         if isinstance(self.gabor, str):
             try:
