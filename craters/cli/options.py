@@ -189,7 +189,7 @@ def add_options(parser, options: Mapping[str, Setting],
                 if g in used}
     for key, s in options.items():
         where = sections.get(s.group, parser)
-        kw: dict = {"help": help_text(s), "default": None}
+        kw: dict = {"help": help_text(s).replace("%", "%%"), "default": None}  # argparse
         flag = flag_of(key, s)
         if flag.isupper():  # a positional argument
             names = [key]

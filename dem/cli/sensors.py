@@ -2,7 +2,7 @@
 over a site, a layer stack (its folder or ``manifest.json``, as ``dem enhance`` writes it)
 or one DEM file, without meshing it to a file first (:class:`dem.DemSurface`).
 
-The options and the steps are latlong's (:mod:`latlong.cli.camera`,
+The option tables and the steps are latlong's (:mod:`latlong.cli.camera`,
 :mod:`latlong.cli.lidar`: ``dem -> latlong``); here MODEL is a site, the crater catalog
 is the stack's own (every layer's, draped on the surface), a generated approach's local
 vertical is the site's up (0,0,1) and there is no ``--units`` (sites are in metres).
@@ -10,27 +10,27 @@ vertical is the site's up (0,0,1) and there is no ``--units`` (sites are in metr
 
 from __future__ import annotations
 
-from latlong.cli.camera import add_camera_options, run_camera
-from latlong.cli.lidar import add_lidar_options, run_lidar
-from latlong.cli.sensor_options import add_sensor_command
+from latlong.cli import camera, lidar
+from latlong.cli.sensor_options import sensor_command
 
 __all__ = ["register"]
 
+_SITE = {"units": False, "vertical": (0.0, 0.0, 1.0)}
 _MODEL = "a layer stack (its folder or manifest.json) or a DEM file"
-_SITE = {"model_help": _MODEL, "units": False, "vertical": (0.0, 0.0, 1.0)}
 
 
-def _load(args):
+def _load(v):
     from ..surface import DemSurface
 
-    return DemSurface.read(args.model, progress=not args.quiet)
+    return DemSurface.read(v.model, progress=not v.quiet)
 
 
 def register(sub) -> None:
     """Add ``camera`` and ``lidar`` to the sub-command parser."""
-    add_sensor_command(sub, "camera", "render camera frames (image, depth, range, normals, "
-                       "crater and boulder ids) of a stack or a DEM, with a frames.json "
-                       "manifest", add_camera_options, run_camera, _load, **_SITE)
-    add_sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a stack or "
-                       "a DEM: LAS 1.4 point clouds, range images and lidar.json",
-                       add_lidar_options, run_lidar, _load, **_SITE)
+    sensor_command(sub, "camera", "render camera frames (image, depth, range, normals, "
+                   "crater and boulder ids) of a stack or a DEM, with a frames.json manifest",
+                   camera.camera_options(_MODEL, **_SITE), camera.run_camera, _load,
+                   camera.GROUPS)
+    sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a stack or a DEM: "
+                   "LAS 1.4 point clouds, range images and lidar.json",
+                   lidar.lidar_options(_MODEL, **_SITE), lidar.run_lidar, _load, lidar.GROUPS)

@@ -14,20 +14,16 @@ import sys
 from craters.cli.kit import run_cli
 from craters.cli.options import flag_of, main_parser
 
-from . import batch, build, export, info, presets, render, slopes, spectrum
-from .camera import add_camera_parser
-from .lidar import FLAGS as LIDAR_FLAGS
-from .lidar import add_lidar_parser
+from . import batch, build, camera, export, info, lidar, presets, render, slopes, spectrum
 
 __all__ = ["build_parser", "main"]
 
 
 def build_parser() -> argparse.ArgumentParser:
     parser, sub = main_parser("latlong", "Asteroid bodies on the lat/long mesh.")
-    for command in (build, batch, info, presets, render, export, slopes, spectrum):
+    for command in (build, batch, info, presets, render, export, slopes, spectrum, camera,
+                    lidar):
         command.register(sub)
-    add_camera_parser(sub)
-    add_lidar_parser(sub)
     return parser
 
 
@@ -35,8 +31,6 @@ def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     flags = {k: flag_of(k, s) for k, s in build.OPTIONS.items()}
-    if args.command == "lidar":
-        flags = LIDAR_FLAGS
     return run_cli(lambda: args.func(args), flags=flags, atomic=args.command != "batch")
 
 

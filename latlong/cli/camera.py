@@ -3,163 +3,162 @@ their ground truth and the ``frames.json`` manifest (:func:`latlong.sensors.came
 
 Every input is checked before anything is written (a camera inside the model, a pose
 that is not a unit quaternion, a zero sun vector, an unknown reflectance, a mesh that
-cannot be read: one line ``error: ...``, exit code 2, no files). The options and the
-steps are shared with ``dem camera`` (:func:`add_camera_options`, :func:`run_camera`),
-which sees a DEM or a layer stack.
+cannot be read: one line ``error: ...``, exit code 2, no files). The options (one table,
+:func:`camera_options`: the settings of :class:`~latlong.sensors.CameraSettings` and the
+defaults of the detector, the sun and the pose functions) and the steps
+(:func:`run_camera`) are shared with ``dem camera``, which sees a DEM or a layer stack.
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 from craters.cli.kit import CliError, parse_seed
+from craters.cli.options import Setting, Values, declared_keys, default_of, shown_value
+from latlong.sensors import (
+    HAPKE_PRESETS,
+    REFLECTANCES,
+    CameraSettings,
+    LommelSeeliger,
+    Sensor,
+    Sun,
+)
 
 from .sensor_options import (
-    MODEL_FLAGS,
-    add_model_options,
-    add_pose_options,
-    add_run_options,
-    add_sensor_command,
-    flagged,
+    RUN,
     load_model,
+    model_options,
     model_scene,
     numbers,
     output_folder,
-    poses_from_args,
+    pose_options,
+    poses_of,
     refuse_inside,
+    sensor_command,
     wxh,
 )
 
-__all__ = ["FLAGS", "add_camera_options", "add_camera_parser", "run_camera"]
+__all__ = ["GROUPS", "camera_options", "register", "run_camera"]
 
-#: Library parameter -> flag, for messages.
-FLAGS = {"quaternion_wxyz": "--quaternion", "position_m": "--position-m",
-         "sun_direction": "--sun-direction", "fov_deg": "--fov-deg", "fx": "--intrinsics",
-         "fy": "--intrinsics", "width": "--size", "height": "--size",
-         "reflectance": "--reflectance", "albedo": "--albedo", "preset": "--hapke-preset",
-         "angular_radius_deg": "--sun-angular-radius-deg",
-         "soft_shadow_samples": "--soft-shadow-samples", "exposure_s": "--exposure-s",
-         "flux_e_per_s": "--flux-e-per-s", "full_well_e": "--full-well-e", "gain": "--gain",
-         "bits": "--bits", "read_noise_e": "--read-noise-e", "psf_sigma_px": "--psf-sigma-px",
-         "k1": "--distortion", "k2": "--distortion", "p1": "--distortion",
-         "p2": "--distortion", "k3": "--distortion", "poses": "--poses",
-         "bright_ejecta": "--bright-ejecta", "seed": "--seed", **MODEL_FLAGS}
+#: The sections of the camera's options.
+GROUPS = {"pose": "pose (body frame; camera-to-body rotation, OpenCV camera frame)",
+          "intrinsics": "intrinsics (pixel centres at integer + 0.5)",
+          "light": "light and surface", "sensor": "sensor", "output": "output"}
+_DISTORTION = ("k1", "k2", "p1", "p2", "k3")
 
 
-def _camera(args):
+def _detector(key: str, help: str, **kw) -> Setting:
+    return Setting(default_of(Sensor, key), help, group="sensor", **kw)
+
+
+#: The detector's settings (:class:`~latlong.sensors.Sensor`, whose defaults they take).
+SENSOR = {
+    "exposure_s": _detector("exposure_s", "exposure time", unit="s"),
+    "flux_e_per_s": _detector("flux_e_per_s", "photo-electrons per second of a pixel seeing "
+                              "I/F = 1", unit="e/s"),
+    "full_well_e": _detector("full_well_e", "full well", unit="electrons"),
+    "gain": _detector("gain", "gain relative to full well = full scale"),
+    "bits": _detector("bits", "8 or 16 (PNG) or 32 (float32 I/F TIFF)"),
+    "photon_noise": _detector("photon_noise", "Poisson photon noise"),
+    "read_noise_e": _detector("read_noise_e", "Gaussian read noise", unit="electrons RMS"),
+    "psf_sigma_px": _detector("psf_sigma_px", "Gaussian PSF sigma (0: none)", unit="px"),
+}
+
+
+def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dict[str, Setting]:
+    """The options of a camera command (``latlong camera``, ``dem camera``)."""
+    def into(group, s):
+        return dataclasses.replace(s, group=group)
+
+    own = declared_keys(CameraSettings)
+    reflectance = default_of(CameraSettings, "reflectance")
+    return {
+        **model_options("frames", model_help, units=units),
+        **pose_options("camera", vertical=vertical),
+        "size": Setting(help="image size WxH", unit="px", parse=wxh("in pixels", "1024x768"),
+                        metavar="WxH", required=True, also=("width", "height"),
+                        group="intrinsics"),
+        "fov_deg": Setting(help="horizontal field of view, centred square pixels", unit="deg",
+                           kind=float, default_text="none; or --intrinsics",
+                           group="intrinsics"),
+        "intrinsics": Setting(help="fx,fy,cx,cy", unit="px", parse=numbers(4, "fx,fy,cx,cy"),
+                              metavar="FX,FY,CX,CY", also=("fx", "fy", "cx", "cy"),
+                              group="intrinsics"),
+        "distortion": Setting(help="Brown-Conrady coefficients k1,k2,p1,p2,k3 as OpenCV",
+                              parse=numbers(5, "k1,k2,p1,p2,k3"), metavar="K1,K2,P1,P2,K3",
+                              also=_DISTORTION, group="intrinsics"),
+        "sun_direction": Setting(help="direction towards the sun X,Y,Z, body frame",
+                                 parse=numbers(3, "X,Y,Z"), metavar="X,Y,Z", required=True,
+                                 group="light"),
+        "sun_angular_radius_deg": Setting(default_of(Sun, "angular_radius_deg"),
+                                          "angular radius of the sun (0.2666 at 1 au)",
+                                          unit="deg", also=("angular_radius_deg",),
+                                          group="light"),
+        "soft_shadow_samples": into("light", own["soft_shadow_samples"]),
+        "reflectance": Setting(next(k for k, m in REFLECTANCES.items()
+                                    if type(reflectance) is m), "reflectance model",
+                               choices=tuple(REFLECTANCES), group="light"),
+        "albedo": Setting(help="normal albedo of lambert, lommel-seeliger or lunar-lambert",
+                          kind=float, group="light",
+                          default_text=shown_value(default_of(LommelSeeliger, "albedo"))),
+        "bright_ejecta": into("light", own["bright_ejecta"]),
+        "hapke_preset": Setting(help="Hapke parameters", choices=tuple(HAPKE_PRESETS),
+                                default_text="s-type", also=("preset",), group="light"),
+        **SENSOR,
+        "seed": dataclasses.replace(own["seed"], group="sensor", parse=parse_seed),
+        "depth_format": into("output", own["depth_format"]),
+        "all_ground_truth": into("output", own["all_ground_truth"]),
+        **{k: into("output", s) for k, s in RUN.items()},
+    }
+
+
+def _camera(v: Values):
     from latlong.sensors import Camera
 
-    w, h = args.size
-    dist = dict(zip(("k1", "k2", "p1", "p2", "k3"), args.distortion or [0.0] * 5,
-                    strict=True))
-    if args.intrinsics is not None:
-        if args.fov_deg is not None:
+    w, h = v.size
+    dist = dict(zip(_DISTORTION, v.distortion or [0.0] * 5, strict=True))
+    if v.intrinsics is not None:
+        if v.fov_deg is not None:
             raise CliError("give --fov-deg or --intrinsics, not both")
-        fx, fy, cx, cy = args.intrinsics
+        fx, fy, cx, cy = v.intrinsics
         return Camera(fx, fy, cx, cy, w, h, **dist)
-    if args.fov_deg is None:
+    if v.fov_deg is None:
         raise CliError("give --fov-deg F or --intrinsics fx,fy,cx,cy (with --size WxH)")
-    return Camera.from_fov(args.fov_deg, w, h, **dist)
+    return Camera.from_fov(v.fov_deg, w, h, **dist)
 
 
-def camera_settings(args):
+def camera_settings(v: Values) -> CameraSettings:
     """The :class:`~latlong.sensors.CameraSettings` the options ask for."""
-    from latlong.sensors import CameraSettings, Sensor, reflectance_model
+    from latlong.sensors import reflectance_model
 
-    model = reflectance_model(args.reflectance, albedo=args.albedo,
-                              preset=args.hapke_preset if args.reflectance == "hapke"
-                              else None)
-    sensor = Sensor(exposure_s=args.exposure_s, flux_e_per_s=args.flux_e_per_s,
-                    full_well_e=args.full_well_e, gain=args.gain, bits=args.bits,
-                    photon_noise=args.photon_noise, read_noise_e=args.read_noise_e,
-                    psf_sigma_px=args.psf_sigma_px)
-    return CameraSettings(_camera(args), model, sensor,
-                          soft_shadow_samples=args.soft_shadow_samples, seed=args.seed,
-                          bright_ejecta=args.bright_ejecta, depth_format=args.depth_format,
-                          all_ground_truth=args.all_ground_truth)
+    model = reflectance_model(v.reflectance, albedo=v.albedo,
+                              preset=v.hapke_preset if v.reflectance == "hapke" else None)
+    sensor = Sensor(**{k: v[k] for k in SENSOR})
+    return CameraSettings(_camera(v), model, sensor,
+                          **{k: v[k] for k in declared_keys(CameraSettings)})
 
 
-def run_camera(args, load) -> int:
-    """The camera command over the surface ``load(args)`` reads from MODEL."""
-    from latlong.sensors import Sun, camera_run
+def run_camera(v: Values, load) -> int:
+    """The camera command over the surface ``load(v)`` reads from MODEL."""
+    from latlong.sensors import camera_run
 
-    with flagged(FLAGS):
-        out = output_folder(args)
-        settings = camera_settings(args)
-        poses = poses_from_args(args)
-        sun = Sun(args.sun_direction, args.sun_angular_radius_deg)
-        geometry, mesh = model_scene(args, load)
-        poses = poses if poses is not None else poses_from_args(args, mesh)
-        refuse_inside(mesh, poses, args, "camera")
-        camera_run(geometry, settings, poses, sun, out, force=args.force,
-                   progress=not args.quiet, mesh=mesh, model_name=str(args.model))
-    if not args.quiet:
+    out = output_folder(v)
+    settings = camera_settings(v)
+    poses = poses_of(v)
+    sun = Sun(v.sun_direction, v.sun_angular_radius_deg)
+    geometry, mesh = model_scene(v, load)
+    poses = poses if poses is not None else poses_of(v, mesh)
+    refuse_inside(mesh, poses, v, "camera")
+    camera_run(geometry, settings, poses, sun, out, force=v.force, progress=not v.quiet,
+               mesh=mesh, model_name=str(v.model))
+    if not v.quiet:
         print(f"wrote {len(poses)} frame(s) and {out / 'frames.json'}")
     return 0
 
 
-def add_camera_options(c, *, model_help: str, units: bool = True, vertical=None) -> None:
-    """The options of a camera command (``latlong camera``, ``dem camera``)."""
-    from latlong.sensors import HAPKE_PRESETS, REFLECTANCES
-
-    add_model_options(c, "frames", model_help, units=units)
-    p = c.add_argument_group("pose (body frame; camera-to-body rotation, OpenCV camera frame)")
-    add_pose_options(p, "camera", vertical=vertical)
-    i = c.add_argument_group("intrinsics (pixel centres at integer + 0.5)")
-    i.add_argument("--size", type=wxh("in pixels", "1024x768"), required=True,
-                   help="image size WxH in pixels (required)")
-    i.add_argument("--fov-deg", type=float, help="horizontal field of view, degrees, "
-                   "centred square pixels (default: none; or --intrinsics)")
-    i.add_argument("--intrinsics", type=numbers(4, "fx,fy,cx,cy"),
-                   help="fx,fy,cx,cy in pixels (default: none)")
-    i.add_argument("--distortion", type=numbers(5, "k1,k2,p1,p2,k3"),
-                   help="Brown-Conrady coefficients k1,k2,p1,p2,k3 as OpenCV (default: none)")
-    s = c.add_argument_group("light and surface")
-    s.add_argument("--sun-direction", type=numbers(3, "X,Y,Z"), required=True,
-                   help="direction towards the sun X,Y,Z, body frame (required)")
-    s.add_argument("--sun-angular-radius-deg", type=float, default=0.0,
-                   help="angular radius of the sun, degrees; 0.2666 at 1 au (default: 0)")
-    s.add_argument("--soft-shadow-samples", type=int, default=0,
-                   help="shadow rays per pixel over the solar disk (default: 0 = hard)")
-    s.add_argument("--reflectance", default="lommel-seeliger",
-                   help=f"{'|'.join(REFLECTANCES)} (default: lommel-seeliger)")
-    s.add_argument("--albedo", type=float, help="normal albedo of lambert, lommel-seeliger "
-                   "or lunar-lambert (default: 0.12)")
-    s.add_argument("--bright-ejecta", type=float, default=0.0,
-                   help="albedo contrast of fresh craters' ejecta (0.5 = 50 %% brighter at the "
-                   "rim, fading as (r/R)^-3 and with degradation; needs a crater catalog) "
-                   "(default: 0 = off)")
-    s.add_argument("--hapke-preset", default="s-type",
-                   help=f"Hapke parameters: {'|'.join(HAPKE_PRESETS)} (default: s-type)")
-    d = c.add_argument_group("sensor")
-    d.add_argument("--exposure-s", type=float, default=0.01,
-                   help="exposure time, seconds (default: 0.01)")
-    d.add_argument("--flux-e-per-s", type=float, default=1.2e7,
-                   help="photo-electrons per second of a pixel seeing I/F = 1 (default: 1.2e7)")
-    d.add_argument("--full-well-e", type=float, default=40000.0,
-                   help="full well, electrons (default: 40000)")
-    d.add_argument("--gain", type=float, default=1.0,
-                   help="gain relative to full well = full scale (default: 1)")
-    d.add_argument("--bits", type=int, default=16,
-                   help="8 or 16 (PNG) or 32 (float32 I/F TIFF) (default: 16)")
-    d.add_argument("--photon-noise", action="store_true",
-                   help="Poisson photon noise (default: off)")
-    d.add_argument("--read-noise-e", type=float, default=0.0,
-                   help="Gaussian read noise, electrons RMS (default: 0)")
-    d.add_argument("--psf-sigma-px", type=float, default=0.0,
-                   help="Gaussian PSF sigma, pixels (default: 0 = none)")
-    d.add_argument("--seed", type=parse_seed, default=0,
-                   help="seed of the noise and of the sun-disk samples (default: 0)")
-    o = c.add_argument_group("output")
-    o.add_argument("--depth-format", choices=("tif", "npy"), default="tif",
-                   help="float32 depth and range files (default: tif)")
-    o.add_argument("--all-ground-truth", action="store_true",
-                   help="also write incidence, emission, phase, position, face and lit "
-                   "fraction per frame (.npy) (default: off)")
-    add_run_options(o)
-
-
-def add_camera_parser(sub) -> None:
+def register(sub) -> None:
     """Register ``latlong camera``."""
-    add_sensor_command(sub, "camera", "render camera frames (image, depth, range, normals) "
-                       "of a body or a mesh, with a frames.json manifest", add_camera_options,
-                       run_camera, load_model, model_help="a body .npz or a mesh file (.ply "
-                       ".obj .stl .vtp .vtk .glb)")
+    sensor_command(sub, "camera", "render camera frames (image, depth, range, normals) of a "
+                   "body or a mesh, with a frames.json manifest",
+                   camera_options("a body .npz or a mesh file (.ply .obj .stl .vtp .vtk "
+                                  ".glb)"), run_camera, load_model, GROUPS)

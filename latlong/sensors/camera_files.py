@@ -29,14 +29,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import (
-    ParameterError,
-    atomic_path,
-    check_choice,
-    check_int,
-    check_range,
-    progress_bar,
-)
+from craters._shared import ParameterError, atomic_path, progress_bar
+from craters._shared.settings import check_declared, setting
 
 from .albedo import ejecta_albedo
 from .camera import Camera
@@ -152,16 +146,22 @@ class CameraSettings:
     """The surface's reflectance model (:mod:`~latlong.sensors.photometry`)."""
     sensor: Sensor = Sensor()
     """Exposure, bit depth, noise and PSF of the detector."""
-    soft_shadow_samples: int = 0
+    soft_shadow_samples: int = setting(0, "shadow rays per pixel over the solar disk (0: hard "
+                                       "shadows)", range=(0, 1024))
     """Shadow rays per pixel over the solar disk, [0, 1024] (0: hard shadows)."""
-    seed: int = 0
+    seed: int = setting(0, "seed of the noise and of the sun-disk samples", range=(0, 2**63 - 1))
     """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
-    bright_ejecta: float = 0.0
+    bright_ejecta: float = setting(0.0, "albedo contrast of fresh craters' ejecta (0.5 = 50 % "
+                                   "brighter at the rim, fading as (r/R)^-3 and with "
+                                   "degradation; needs a crater catalog; 0: off)",
+                                   range=(0.0, 10.0))
     """Albedo contrast of fresh craters' ejecta (:func:`~latlong.sensors.albedo.
     ejecta_albedo`), [0, 10] (0: off)."""
-    depth_format: str = "tif"
+    depth_format: str = setting("tif", "files of the float32 depth and range images and of "
+                                "the label images", choices=DEPTH_FORMATS)
     """Files of the float32 depth and range images and of the label images: tif or npy."""
-    all_ground_truth: bool = False
+    all_ground_truth: bool = setting(False, "also write incidence, emission, phase, position, "
+                                     "face and lit fraction per frame (.npy)")
     """Also write incidence, emission, phase, position, face and lit fraction (.npy)."""
 
     def __post_init__(self):
@@ -170,13 +170,8 @@ class CameraSettings:
             if not isinstance(getattr(self, name), kind):
                 raise TypeError(f"`{name}` must be a {name} model of latlong.sensors; got "
                                 f"{type(getattr(self, name)).__name__}")
-        object.__setattr__(self, "soft_shadow_samples", check_int(
-            "soft_shadow_samples", self.soft_shadow_samples, 0, 1024))
-        object.__setattr__(self, "seed", check_int("seed", self.seed, 0, 2**63 - 1))
-        object.__setattr__(self, "bright_ejecta", check_range(
-            "bright_ejecta", self.bright_ejecta, 0.0, 10.0))
-        check_choice("depth_format", self.depth_format, DEPTH_FORMATS)
         object.__setattr__(self, "all_ground_truth", bool(self.all_ground_truth))
+        check_declared(self)  # every declared range and choice, named by the field
 
     def record(self, sun: Sun) -> dict:
         """The ``settings`` of the manifest (without ``model``)."""

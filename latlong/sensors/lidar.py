@@ -35,18 +35,12 @@ offset.
 from __future__ import annotations
 
 import functools
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
-from craters._shared import (
-    ParameterError,
-    check_choice,
-    check_int,
-    check_positive,
-    check_range,
-    normalize_rng,
-)
+from craters._shared import ParameterError, check_int, check_range, normalize_rng
+from craters._shared.settings import check_declared, setting
 
 from ._lidar_kernels import _returns_kernel
 from .camera import quaternion_to_matrix
@@ -70,29 +64,38 @@ _COS_85 = np.cos(np.radians(85.0))  # steeper surfaces count as 85 degrees for t
 class LidarSettings:
     """What the LIDAR is (module notes)."""
 
-    pattern: str = "flash"
+    pattern: str = setting("flash", "flash (a grid of beams at once), scan (the grid as a "
+                           "raster, one beam after the other) or rosette", choices=LIDAR_PATTERNS)
     """Beam pattern: flash, scan or rosette."""
-    beams: tuple[int, int] = (128, 128)
-    """Beams W x H (the range image's width and height)."""
-    fov_deg: float = 20.0
+    beams: tuple[int, int] = setting((128, 128), "beams WxH: the range image size",
+                                     metavar="WxH", default_text="128x128")
+    """Beams W x H (the range image's width and height), each in [1, 16384]."""
+    fov_deg: float = setting(20.0, "field of view across the W beams (rosette: its diameter); "
+                             "in [1e-06, 170] (rosette: 180)", unit="deg")
     """Field of view, degrees: across the W beams (flash, scan); the rosette's diameter."""
-    divergence_mrad: float = 0.0
+    divergence_mrad: float = setting(0.0, "full beam divergence at 1/e^2 (0 = a thin beam)",
+                                     unit="mrad", range=(0.0, 200.0))
     """Full beam divergence at 1/e^2, milliradians (0 = a thin beam)."""
-    rays_per_beam: int = 1
+    rays_per_beam: int = setting(1, "sub-rays averaged over each footprint (> 1 needs a "
+                                 "divergence)", range=(1, 1024))
     """Sub-rays per beam footprint (> 1 needs a divergence)."""
-    range_noise_m: float = 0.0
+    range_noise_m: float = setting(0.0, "range noise standard deviation", unit="m", range=">=0")
     """Standard deviation of the range noise, metres."""
-    max_range_m: float = 10_000.0
+    max_range_m: float = setting(10_000.0, "longest range that returns", unit="m", range=">0")
     """Longest range that returns, metres."""
-    multiple_returns: bool = False
+    multiple_returns: bool = setting(False, "report distinct surfaces in a footprint as "
+                                     "separate returns")
     """Split a footprint into returns from distinct surfaces (otherwise one return)."""
-    return_separation_m: float = 1.0
+    return_separation_m: float = setting(1.0, "range gap between two returns of one beam",
+                                         unit="m", range=">0")
     """Range gap that separates two returns of one beam, metres."""
-    pulse_rate_hz: float = 100_000.0
+    pulse_rate_hz: float = setting(100_000.0, "beams per second of scan and rosette",
+                                   unit="Hz", range=">0")
     """Beams per second of the scanning patterns (scan, rosette)."""
 
     def __post_init__(self):
-        check_choice("pattern", self.pattern, LIDAR_PATTERNS)
+        # values kept as given (lidar.json records them); the beams as a tuple of ints
+        check_declared(self, keep=tuple(f.name for f in fields(self)))
         beams = tuple(self.beams) if np.ndim(self.beams) == 1 else ()
         if len(beams) != 2:
             raise ParameterError("beams", f"must be two counts W, H; got {self.beams!r}")
@@ -100,19 +103,10 @@ class LidarSettings:
         object.__setattr__(self, "beams", beams)
         hi = 180.0 if self.pattern == "rosette" else 170.0
         check_range("fov_deg", self.fov_deg, 1e-6, hi)
-        check_range("divergence_mrad", self.divergence_mrad, 0.0, 200.0)
-        check_int("rays_per_beam", self.rays_per_beam, 1, 1024)
         if self.rays_per_beam > 1 and self.divergence_mrad == 0:
             raise ParameterError("rays_per_beam", f"> 1 needs a beam divergence "
                                  f"({{}} > 0); got {self.rays_per_beam}",
                                  see=("divergence_mrad",))
-        check_positive("range_noise_m", self.range_noise_m, allow_zero=True)
-        check_positive("max_range_m", self.max_range_m)
-        check_positive("return_separation_m", self.return_separation_m)
-        check_positive("pulse_rate_hz", self.pulse_rate_hz)
-        if not isinstance(self.multiple_returns, bool):
-            raise ParameterError("multiple_returns", f"must be True or False; got "
-                                 f"{self.multiple_returns!r}")
 
     @property
     def n_beams(self) -> int:

@@ -151,7 +151,7 @@ def surface_point(mesh, lat_deg: float, lon_deg: float) -> np.ndarray:
     return start - hits.t_m[0] * d
 
 
-def approach(target_m, *, n_frames: int, start_range_m: float, end_range_m: float,
+def approach(target_m, *, n_frames: int = 10, start_range_m: float, end_range_m: float,
              path_angle_deg: float = 0.0, path_azimuth_deg: float = 0.0,
              duration_s: float | None = None, up=(0.0, 0.0, 1.0), vertical=None) -> Poses:
     """A straight approach or descent towards ``target_m`` (a surface point, body frame,
@@ -165,6 +165,7 @@ def approach(target_m, *, n_frames: int, start_range_m: float, end_range_m: floa
     points towards the body's +z axis (+y where the vertical is +z: x is then east).
     Times run 0 .. ``duration_s`` (default: one second per
     frame). ``up`` (body frame) points up the pictures (another axis if along the view).
+    ``n_frames`` is 10 unless given.
 
     Examples
     --------

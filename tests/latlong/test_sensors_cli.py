@@ -172,3 +172,63 @@ def test_same_bytes_for_any_thread_count(run_cli, body_npz, tmp_path):
         assert proc.returncode == 0, proc.stderr
         digests.append({p.name: p.read_bytes() for p in sorted(out.iterdir())})
     assert digests[0] == digests[1]
+
+
+def _options(parser, name):
+    import argparse
+
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return sub.choices[name], sub.choices[name].get_default("func").options
+
+
+def test_the_sensor_options_are_the_library_declarations():
+    """Each setting's default lives once, in the library: the records' declarations
+    (CameraSettings, LidarSettings), the detector's fields, the pose functions' defaults;
+    ``dem camera`` / ``dem lidar`` differ only by MODEL, ``--units`` and the vertical."""
+    import dataclasses
+    import inspect
+
+    from dem.cli import build_parser as dem_parser
+    from latlong.cli import build_parser
+    from latlong.sensors import CameraSettings, LidarSettings, Sensor
+    from latlong.sensors.poses import approach
+
+    camera, cam = _options(build_parser(), "camera")
+    _, lid = _options(build_parser(), "lidar")
+    for f in dataclasses.fields(LidarSettings):
+        assert lid[f.name].default == f.default, f.name
+    for f in dataclasses.fields(CameraSettings)[3:]:
+        assert cam[f.name] == dataclasses.replace(f.metadata["setting"], key=cam[f.name].key,
+                                                  kind=cam[f.name].kind,
+                                                  group=cam[f.name].group,
+                                                  parse=cam[f.name].parse), f.name
+    for f in dataclasses.fields(Sensor):
+        assert cam[f.name].default == f.default, f.name
+    signature = inspect.signature(approach).parameters
+    for key, param in (("frames", "n_frames"), ("path_angle_deg", "path_angle_deg"),
+                       ("path_azimuth_deg", "path_azimuth_deg"), ("vertical", "vertical")):
+        assert cam[key].default == lid[key].default == signature[param].default, key
+    assert "(0.5 = 50 % brighter" in " ".join(camera.format_help().split())  # % escaped
+    for name, ours in (("camera", cam), ("lidar", lid)):
+        _, site = _options(dem_parser(), name)
+        assert set(ours) - set(site) == {"units"} and set(site) <= set(ours)
+        assert site["vertical"].default == (0.0, 0.0, 1.0)
+        assert site["model"].help != ours["model"].help
+        same = [k for k in site if dataclasses.replace(site[k], parse=None)
+                == dataclasses.replace(ours[k], parse=None)]  # parsers: one closure a table
+        assert set(site) - set(same) == {"model", "vertical"}, name
+
+
+def test_a_library_error_is_shown_under_its_flag(run_cli, body_npz, tmp_path):
+    """Errors about library parameters (Camera's fx, Sensor's bits, approach's n_frames)
+    are named by the option that sets them, through the kit's declarations."""
+    one = ["--position-m", "-3000,200,100", "--quaternion", Q]
+    for extra, needle in ((["--size", "48x32", "--sun-direction", "1,0,0", "--intrinsics",
+                            "-60,60,24,16", *one], "error: --intrinsics must be"),
+                          ([*BASE, "--bits", "12", *one], "error: --bits must be 8, 16 or 32"),
+                          ([*BASE, "--target-m", "1000,0,0", "--range-m", "400,200",
+                            "--frames", "0"], "error: --frames must be an integer"),
+                          ([*BASE, "--units", "mm", *one], "error: --units must be one of m, km")):
+        proc = run_cli("latlong", "camera", str(body_npz), "-o", str(tmp_path / "x"), *extra)
+        assert proc.returncode == 2 and proc.stderr.startswith(needle), proc.stderr
+    assert list(tmp_path.iterdir()) == []
