@@ -17,7 +17,7 @@ __all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "check_ch
            "check_finite", "check_int", "check_positive", "check_range", "normalize_rng",
            "parameter_of"]
 
-RngLike = int | np.random.Generator | None
+RngLike = int | np.integer | np.random.Generator | None
 
 
 class _Named:
