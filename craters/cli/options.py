@@ -325,7 +325,8 @@ def command(sub, name: str, run: Callable[[Values], int | None],
         with values.named_errors():
             return int(run(values) or 0)
 
-    call.options = dict(options)  # type: ignore[attr-defined]  # the table of the flags and config keys, for tests
+    # the table of the flags and config keys, for tests (an attribute of the function)
+    call.options = dict(options)  # type: ignore[attr-defined]
     p.set_defaults(func=call)
     return p
 
