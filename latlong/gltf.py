@@ -36,7 +36,7 @@ import os
 import shutil
 import struct
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
 import numpy as np
 
@@ -54,9 +54,6 @@ from .geometry.normals import vertex_normals
 from .grid import LatLongGrid
 from .patchdata import leaf_metadata, write_leaf_data
 from .strips import patch_tree, triangle_strips
-
-if TYPE_CHECKING:
-    from .body import Body
 
 __all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
 
@@ -198,7 +195,8 @@ class _LevelPlan:
     """One level's patches after the first pass: what the second pass writes where."""
 
     level: int
-    body: Body
+    body: Any
+    """The :class:`latlong.Body` (not imported: latlong.body reaches this module)."""
     leaves: tuple
     """(band_lo, entry pointers, triangle range lo, hi) arrays of the patch tree leaves."""
     at: np.ndarray
