@@ -29,6 +29,7 @@ from __future__ import annotations
 import csv
 import json
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -170,9 +171,13 @@ def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path
     check_choice("columns", columns, CATALOG_COLUMNS)
     path = Path(path)
     boulders = is_boulder_catalog(cat)
+    fields = cat.dtype.names
+    assert fields is not None  # validate_catalog: a structured array
     if boulders:
-        cat = cat[[n for n in cat.dtype.names if n not in _CRATER_ONLY]]
-    names = list(cat.dtype.names)
+        cat = cat[[n for n in fields if n not in _CRATER_ONLY]]
+        fields = cat.dtype.names
+        assert fields is not None
+    names = list(fields)
     rows = [[_format(v) for v in row] for row in cat.tolist()]
     if columns == "robbins":
         if "lat_deg" not in names:
@@ -180,11 +185,11 @@ def write_catalog(cat: np.ndarray, path, *, columns: str = "craterform") -> Path
                                  "lon_deg); this one is planar (x_m, y_m)")
         rest = [n for n in names if n not in ("lat_deg", "lon_deg", "diameter_m")]
         lon = np.mod(cat["lon_deg"], 360.0)
-        head = [[f"CF-{i:07d}", _format(la), _format(lo), _format(d / 1000.0)]
+        lead = [[f"CF-{i:07d}", _format(la), _format(lo), _format(d / 1000.0)]
                 for i, (la, lo, d) in enumerate(zip(cat["lat_deg"].tolist(), lon.tolist(),
                                                     cat["diameter_m"].tolist(), strict=True))]
         keep = [names.index(n) for n in rest]
-        rows = [h + [r[j] for j in keep] for h, r in zip(head, rows, strict=True)]
+        rows = [h + [r[j] for j in keep] for h, r in zip(lead, rows, strict=True)]
         names = [_ROBBINS_ID, *_ROBBINS, *rest]
     if boulders:
         head = (f"{BOULDER_FORMAT}; units: metres (_m), degrees (_deg); diameter_m = "
@@ -239,22 +244,26 @@ def write_geojson(cat: np.ndarray, path, *, to_world=None, crs: str | None = Non
     (default identity); ``crs`` is recorded as a top-level ``crs`` name if given.
     """
     validate_catalog(cat)
-    if "x_m" not in cat.dtype.names:
+    fields = cat.dtype.names
+    assert fields is not None  # validate_catalog: a structured array
+    if "x_m" not in fields:
         raise ValueError("GeoJSON output needs a planar catalog (x_m, y_m)")
     xs, ys = cat["x_m"], cat["y_m"]
     if is_boulder_catalog(cat):  # as its CSV: no crater-only columns
-        cat = cat[[n for n in cat.dtype.names if n not in _CRATER_ONLY]]
+        cat = cat[[n for n in fields if n not in _CRATER_ONLY]]
+        fields = cat.dtype.names
+        assert fields is not None
     if to_world is not None:
         xs, ys = to_world(xs, ys)
     feats = []
     for k, row in enumerate(cat.tolist()):
         props = {n: (float(v) if isinstance(v, float) else v)
-                 for n, v in zip(cat.dtype.names, row, strict=True)}
+                 for n, v in zip(fields, row, strict=True)}
         props = {n: (int(v) if isinstance(v, np.integer) else v) for n, v in props.items()}
         feats.append({"type": "Feature",
                       "geometry": {"type": "Point", "coordinates": [float(xs[k]), float(ys[k])]},
                       "properties": props})
-    doc = {"type": "FeatureCollection", "features": feats}
+    doc: dict[str, Any] = {"type": "FeatureCollection", "features": feats}
     if crs:
         doc["crs"] = {"type": "name", "properties": {"name": crs}}
     path = Path(path)

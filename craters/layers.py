@@ -298,6 +298,8 @@ _OLD_KEYS = {"dmin": "d_min_m", "dmax": "d_max_m", "amin": "age_min_gyr",
 def _layer_from(values: dict, age_max_gyr: float | None):
     """The layer record ``values`` (field -> value) describe; ParameterError on a
     mixture of the two kinds or a missing field."""
+    kind: type[ModelAgeLayer | CraterLayer]
+    required: tuple[str, ...]
     if "npf" in values:
         for key in values:
             if key not in _MODEL_AGE:

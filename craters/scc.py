@@ -141,7 +141,10 @@ def read_scc(path) -> dict:
     path = Path(path)
     check_regular_file(path, "crater count")
     text = path.read_text(encoding="utf-8-sig")
-    values, tables, table, rows = {}, {}, None, []
+    values: dict[str, str] = {}
+    tables: dict[str, tuple[list[str], list[list[str]]]] = {}
+    table: tuple[str, list[str]] | None = None
+    rows: list[list[str]] = []
     for raw in text.splitlines():
         line = raw.split("#", 1)[0].strip()
         if not line:
@@ -172,10 +175,14 @@ def read_scc(path) -> dict:
         j = cols.index(name)
         return np.array([float(r[j]) for r in rows], dtype=np.float64)
 
-    area = float(re.match(r"\s*([\d.]+)", values["Total_area"]).group(1))
+    number = re.match(r"\s*([\d.]+)", values["Total_area"])
+    if number is None:
+        raise ValueError(f"{str(path)!r}: Total_area must start with a number; got "
+                         f"{values['Total_area']!r}")
+    area = float(number.group(1))
     axes = [values.get(f"{n}_axis_radius") for n in "abc"]
-    axes_m = (tuple(float(a.split()[0]) * 1e3 for a in axes)
-              if all(a is not None for a in axes) else None)
+    given = [a for a in axes if a is not None]
+    axes_m = tuple(float(a.split()[0]) * 1e3 for a in given) if len(given) == 3 else None
     fraction = column("fraction")
     diam = column("diam")
     return {"area_m2": area * 1e6, "axes_m": axes_m, "diameter_m": diam * 1e3,

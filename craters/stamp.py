@@ -194,7 +194,9 @@ def stamp_request(catalog, *, columns: tuple[str, ...], onto: str, roughness=Tru
     (``"a grid"``, ``"a body"``, ``"a mesh"``) needs; ``ValueError``/``TypeError``
     naming the parameter otherwise."""
     cat = sort_oldest_first(validate_catalog(catalog))
-    missing = [c for c in columns if c not in cat.dtype.names]
+    fields = cat.dtype.names
+    assert fields is not None  # validate_catalog: a structured array
+    missing = [c for c in columns if c not in fields]
     if missing:
         raise ValueError(f"`catalog` needs {', '.join(columns)} columns to stamp on {onto}; "
                          f"it has no {missing[0]!r}")
@@ -239,6 +241,7 @@ def stamping_profiles(catalog, target: str | Target = "moon", *,
     cat = np.asarray(catalog)
     names = cat.dtype.names
     d = np.ascontiguousarray(cat["diameter_m"], dtype=np.float64)
+    assert names is not None  # cat["diameter_m"] read a field: a structured array
     n = len(d)
     age = cat["age_gyr"] if "age_gyr" in names else np.zeros(n)
     deg = cat["degradation"] if "degradation" in names else np.zeros(n)
@@ -314,6 +317,7 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     rng = normalize_rng(rng)
     n = len(cat)
     names = cat.dtype.names
+    assert names is not None  # stamp_request validated the catalog: a structured array
     prof = stamping_profiles(cat, target, ejecta_edge=ejecta_edge)
     rim_tabs, seeds = req.draws(n, rng)
     cx = np.ascontiguousarray(cat["x_m"] / pixel, dtype=np.float64)

@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 from ._shared import ParameterError, check_choice, check_positive, check_range
 
@@ -119,10 +120,11 @@ _PIKE_COMPLEX_RIM = (0.236, 0.399)
 def _from_moon(name: str, radius_m: float, gravity: float, source: str, **measured) -> Target:
     """A body whose unmeasured laws are the Moon's scaled by 1/g."""
     f = _MOON_G / gravity
-    base = {"transition_m": 1000.0 * _MOON_DT_KM * f, "peak_ring_m": 1000.0 * _MOON_DPR_KM * f,
-            "simple_depth": _PIKE_SIMPLE_DEPTH, "simple_rim": _PIKE_SIMPLE_RIM,
-            "complex_depth": _scaled_law(_PIKE_COMPLEX_DEPTH, f),
-            "complex_rim": _scaled_law(_PIKE_COMPLEX_RIM, f)}
+    base: dict[str, Any] = {
+        "transition_m": 1000.0 * _MOON_DT_KM * f, "peak_ring_m": 1000.0 * _MOON_DPR_KM * f,
+        "simple_depth": _PIKE_SIMPLE_DEPTH, "simple_rim": _PIKE_SIMPLE_RIM,
+        "complex_depth": _scaled_law(_PIKE_COMPLEX_DEPTH, f),
+        "complex_rim": _scaled_law(_PIKE_COMPLEX_RIM, f)}
     scaled = tuple(k for k in base if k not in measured)
     if "transition_m" in measured:  # complex laws follow the measured transition
         ft = measured["transition_m"] / (1000.0 * _MOON_DT_KM)

@@ -74,6 +74,7 @@ class _Parser:
         self.tokens = []
         for m in _TOKEN.finditer(text):
             kind = m.lastgroup
+            assert kind is not None  # every alternative of _TOKEN is a named group
             value = m.group(kind)
             if kind == "str":
                 value = " ".join(value.split())

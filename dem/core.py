@@ -99,7 +99,7 @@ def parse_region(region) -> Window | BoundingBox:
     if isinstance(region, Window | BoundingBox):
         return region
     if isinstance(region, str):
-        parts = [p.strip() for p in region.split(",")]
+        parts: list[str | int | float] = [p.strip() for p in region.split(",")]
         try:
             if len(parts) == 3:
                 parts = [int(p) for p in parts]

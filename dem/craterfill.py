@@ -147,7 +147,8 @@ def harmonic_warp(z: np.ndarray, synth: np.ndarray, region: np.ndarray) -> np.nd
     known = np.isfinite(z)
     diag = np.zeros(n)
     rhs = np.zeros(n)
-    i_off, j_off = [], []
+    i_parts: list[np.ndarray] = []
+    j_parts: list[np.ndarray] = []
     pr, pc = np.nonzero(region)
     for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
         qr, qc = pr + dr, pc + dc
@@ -156,13 +157,13 @@ def harmonic_warp(z: np.ndarray, synth: np.ndarray, region: np.ndarray) -> np.nd
         qr, qc = qr[ok], qc[ok]
         inner = region[qr, qc]
         diag[p_i[inner]] += 1.0
-        i_off.append(p_i[inner])
-        j_off.append(idx[qr[inner], qc[inner]])
+        i_parts.append(p_i[inner])
+        j_parts.append(idx[qr[inner], qc[inner]])
         border = ~inner & known[qr, qc]
         diag[p_i[border]] += 1.0
         np.add.at(rhs, p_i[border], z[qr[border], qc[border]] - synth[qr[border], qc[border]])
-    i_off = np.concatenate(i_off)
-    j_off = np.concatenate(j_off)
+    i_off = np.concatenate(i_parts)
+    j_off = np.concatenate(j_parts)
     rows_i = np.concatenate([np.arange(n), i_off])
     cols_j = np.concatenate([np.arange(n), j_off])
     vals = np.concatenate([diag + _SCREEN * np.maximum(diag, 1.0), -np.ones(i_off.size)])
@@ -236,7 +237,9 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
         return (out, cat[:0]) if return_catalog else out
     r0, r1, c0, c1 = _work_window(fill, gx / p, gy / p, cat["diameter_m"], p, smooth_craters)
     crop = dem.crop(Window(c0, r0, c1 - c0, r1 - r0))
-    local = {name: cat[name] for name in cat.dtype.names}
+    names = cat.dtype.names
+    assert names is not None  # a catalog: a structured array
+    local = {name: cat[name] for name in names}
     local.update(x_m=gx - c0 * p, y_m=gy - r0 * p)
     synth, stamped = _synthetic_copy(crop, p, craters.make_catalog(**local), roughness,
                                      smooth_craters, _IRREGULARITY, gen)
@@ -339,8 +342,10 @@ def _append(cat, row: np.ndarray) -> np.ndarray:
         return row
     out = np.zeros(len(cat) + 1, dtype=cat.dtype)
     out[:-1] = cat
-    for name in cat.dtype.names:
-        if name in row.dtype.names:
+    names, row_names = cat.dtype.names, row.dtype.names
+    assert names is not None and row_names is not None  # catalog rows: structured arrays
+    for name in names:
+        if name in row_names:
             out[name][-1] = row[name][0]
     return out
 

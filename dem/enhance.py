@@ -55,10 +55,10 @@ from craters._shared import ParameterError, human_bytes, physical_memory_bytes, 
 from .boulders import place_boulders
 from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
-from .craterdensity import crater_density
+from .craterdensity import CraterDensity, crater_density
 from .expansion import expand
 from .fractal import expansion_fit
-from .frame import crater_target, grid_pixel_size, local_frame, pixel_affine
+from .frame import LocalFrame, crater_target, grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .planning import (
     STREAM_STAMP,
@@ -143,7 +143,9 @@ def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: StackGeometry, k: int
         return z, cat
     r, c = geometry.offsets[k]
     p0 = geometry.pixel0_m
-    cols = {name: cat[name] for name in cat.dtype.names}
+    names = cat.dtype.names
+    assert names is not None  # a catalog: a structured array
+    cols = {name: cat[name] for name in names}
     cols["x_m"] = cat["x_m"] - c * p0
     cols["y_m"] = cat["y_m"] - r * p0
     grid = craters.make_catalog(**cols)
@@ -161,7 +163,9 @@ def _stamp_layer(z: np.ndarray, cat: np.ndarray, geometry: StackGeometry, k: int
 def _to_local(cat: np.ndarray, a0, p0: float) -> np.ndarray:
     """Catalog positions: layer-0 grid frame -> local frame (pixel affine ``a0``)."""
     u, v = cat["x_m"] / p0, cat["y_m"] / p0
-    cols = {name: cat[name] for name in cat.dtype.names}
+    names = cat.dtype.names
+    assert names is not None  # a catalog: a structured array
+    cols = {name: cat[name] for name in names}
     cols["x_m"] = a0.a * u + a0.b * v + a0.c
     cols["y_m"] = a0.d * u + a0.e * v + a0.f
     return craters.make_catalog(**cols)
@@ -230,7 +234,7 @@ class Run(NamedTuple):
     windows: list
     t0: tuple
     t_base: tuple
-    frame: object
+    frame: LocalFrame
     a0: object
     p0: float
     geometry: StackGeometry
@@ -239,7 +243,7 @@ class Run(NamedTuple):
     accounting: dict
     rock_plans: list
     rock_accounting: dict | None
-    source_density: object
+    source_density: CraterDensity | None
     fd: float
     fd_estimated: float | None
 
@@ -267,7 +271,9 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
                                             body_radius_m=cfg.body_radius_m, body=cfg.body)
     seed = cfg.seed  # checked by the config
     if seed is None:
-        seed = int(np.random.SeedSequence().entropy % 2**63)
+        entropy = np.random.SeedSequence().entropy
+        assert isinstance(entropy, int)  # a fresh SeedSequence's own
+        seed = int(entropy % 2**63)
     win0, windows, t0, t_base = layer_windows(base, cfg.target, cfg.size, cfg.layers)
     layer0 = base.crop(win0)
     unknown = int((~layer0.known).sum())
@@ -305,12 +311,15 @@ def layers_of(run: Run, *, progress: bool = False):
     finer layers (:func:`dem.stack.propagate_up`); only the previous layer is kept."""
     cfg = run.cfg
     rock_shape = craters.BoulderShape()
-    prev = None
+    prev: tuple[Dem, np.ndarray] | None = None
+    meta: Dem | None
+    z: np.ndarray | None
     for k in progress_bar(range(cfg.layers), enabled=progress, desc="enhance"):
         if k == 0:
             meta = run.layer0
         else:
             rr, cc, w = run.windows[k - 1]
+            assert prev is not None  # k > 0: the previous layer's
             parent = prev[0].replace(heights=prev[1])
             prev = meta = z = None  # the caller may drop them too: only the copy is held
             meta = expand(parent, 1, run.fd, cfg.roughness, Window(cc, rr, w, w), rng=run.seed)

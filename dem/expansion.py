@@ -396,11 +396,13 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
     if fractal_dimension is None or roughness is None:
         fit = expansion_fit(dem)
     if fractal_dimension is None:
+        assert fit is not None  # fitted above
         fractal_dimension = min(3.0, max(2.0, fit.fractal_dimension))
         params["fractal_dimension_estimated"] = fit.fractal_dimension
     params["fractal_dimension"] = fractal_dimension
     resolution = dem.resolution_m
     if roughness is None:
+        assert fit is not None  # fitted above
         uniform, fallback = None, fit.roughness * resolution
         params["roughness"] = "local"
         params["roughness_rms"] = fit.roughness

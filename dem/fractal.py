@@ -63,6 +63,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import cast
 
 import numpy as np
 
@@ -142,6 +143,7 @@ class _DimensionRange:
     """The [2, 3] check shared by the fit records (they define ``fractal_dimension``)."""
 
     __slots__ = ()
+    fractal_dimension: float
 
     @property
     def is_surface_dimension(self) -> bool:
@@ -293,7 +295,8 @@ def window_mean(values: np.ndarray, window_px: int) -> np.ndarray:
     out = []
     for a in (np.where(ok, v, 0.0), ok.astype(np.float64)):
         p = np.pad(a, h)
-        rows = sum(p[k:k + a.shape[0], :] for k in range(2 * h + 1))
+        # sum() of a non-empty range: an array, never its start 0
+        rows = cast(np.ndarray, sum(p[k:k + a.shape[0], :] for k in range(2 * h + 1)))
         out.append(sum(rows[:, k:k + a.shape[1]] for k in range(2 * h + 1)))
     total, count = out
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -357,7 +360,7 @@ def fractal_fit_rows(read_rows, shape, pixel_size_m, resolution_m: float, *,
     rows, cols = (int(v) for v in shape)
     strip_rows = check_int("strip_rows", strip_rows, 1)
     lag_px = _lag_range((rows, cols), DEFAULT_MIN_LAG_PX, DEFAULT_MAX_LAG_PX)
-    keys = [("msd", 0)] + [(axis, k) for axis in (1, 0) for k in lag_px
+    keys: list[tuple[int | str, int]] = [("msd", 0)] + [(axis, k) for axis in (1, 0) for k in lag_px
                            if k < (cols if axis == 1 else rows)]
     halo = NORMALISER_WINDOW_PX // 2 + 1  # the normaliser: msd within 4 px, z within 1
 

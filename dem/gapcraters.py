@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Any
 
 import numpy as np
 
@@ -112,7 +113,7 @@ def stamp_gap_craters(z: np.ndarray, sl, hole: np.ndarray, layer, key: int, targ
         d_fit = min(d_fit, layer.d_max_m)
     if d_fit <= d_lo:
         return None, None
-    note = {"gap": [int(g0), int(h0), int(r1 - r0), int(c1 - c0)]}
+    note: dict[str, Any] = {"gap": [int(g0), int(h0), int(r1 - r0), int(c1 - c0)]}
     if layer == "auto":
         density = _density_around(z, sl, around)
         note.update(source="measured around the gap",

@@ -84,6 +84,10 @@ _SMOOTHING = 2
 _OVERCORRECTION = 1.8
 _COARSEST_PX = 16
 _COARSEST_SWEEPS = 10
+#: One multigrid level's operator (north, south, west, east link weights; Dirichlet term)
+#: and its active pixels (:func:`_hierarchy`).
+_Ops = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+_Level = tuple[_Ops, np.ndarray]
 
 
 def fill_gaps(dem: Dem, roughness: float | None = None, *,
@@ -167,7 +171,8 @@ def _fill_holes(z: np.ndarray, dem: Dem, holes: list, roughness, fractal_dimensi
                 layer, key: int, target) -> tuple[list, list]:
     """Fill ``holes`` (:func:`_holes`) of ``z`` (the heights of ``dem``) in place, with
     their gap craters; the craters' catalogs and density notes."""
-    catalogs, notes = [], []
+    catalogs: list = []
+    notes: list = []
     if not holes:
         return catalogs, notes
     amp = (None if roughness is not None
@@ -405,7 +410,7 @@ def _dot(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sum(a * b))
 
 
-def _hierarchy(solve: np.ndarray, fixed: np.ndarray) -> list:
+def _hierarchy(solve: np.ndarray, fixed: np.ndarray) -> list[_Level]:
     """The multigrid levels, finest first: (operator, active pixels) per level, each
     with a ring of inactive pixels around it.
 
@@ -421,7 +426,7 @@ def _hierarchy(solve: np.ndarray, fixed: np.ndarray) -> list:
                         (ww, np.s_[:, 1:], np.s_[:, :-1]), (we, np.s_[:, :-1], np.s_[:, 1:])):
         w[src] = solve[src] & solve[dst]
         d[src] += solve[src] & fixed[dst]
-    levels = [((wn, ws, ww, we, d), solve)]
+    levels: list[_Level] = [((wn, ws, ww, we, d), solve)]
     while int(levels[-1][1].sum()) > _COARSEST_PX and min(levels[-1][1].shape) > 4:
         ops, active = levels[-1]
         rows, cols = active.shape[0] - 2, active.shape[1] - 2
@@ -432,10 +437,10 @@ def _hierarchy(solve: np.ndarray, fixed: np.ndarray) -> list:
             return np.pad(a[1:-1, 1:-1], pad).reshape(h, 2, w, 2)
 
         wn, ws, ww, we, d = (blocks(a) for a in ops)
-        ops_c = tuple(np.pad(a, 1) for a in (
+        cn, cs, cw, ce, cd = (np.pad(a, 1) for a in (
             wn[:, 0].sum(axis=-1), ws[:, 1].sum(axis=-1), ww[:, :, :, 0].sum(axis=1),
             we[:, :, :, 1].sum(axis=1), d.sum(axis=(1, 3))))
-        levels.append((ops_c, np.pad(blocks(active).any(axis=(1, 3)), 1)))
+        levels.append(((cn, cs, cw, ce, cd), np.pad(blocks(active).any(axis=(1, 3)), 1)))
     return levels
 
 
@@ -448,7 +453,7 @@ def _data_term(u: np.ndarray, fixed: np.ndarray, solve: np.ndarray) -> np.ndarra
     return out
 
 
-def _vcycle(levels: list, k: int, e: np.ndarray, f: np.ndarray) -> None:
+def _vcycle(levels: list[_Level], k: int, e: np.ndarray, f: np.ndarray) -> None:
     """One symmetric V-cycle for ``A e = f`` at level ``k`` of ``levels``, in place:
     red-black Gauss-Seidel, the coarse correction (residual summed over the blocks,
     correction added back to their pixels times :data:`_OVERCORRECTION`), black-red."""

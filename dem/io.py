@@ -185,8 +185,8 @@ def _lattice(tags: dict, path: Path) -> tuple[int, tuple[int, int]]:
     """The expansion level and lattice origin the tags record ((0, (0, 0)) if none)."""
     try:
         if LEVEL_TAG in tags:
-            return (int(tags[LEVEL_TAG]),
-                    tuple(int(v) for v in tags.get(ORIGIN_TAG, "0,0").split(",")))
+            row, col = (int(v) for v in tags.get(ORIGIN_TAG, "0,0").split(","))
+            return int(tags[LEVEL_TAG]), (row, col)
     except ValueError:
         logger.warning("%s: ignoring malformed %s/%s tags", path, LEVEL_TAG, ORIGIN_TAG)
     return 0, (0, 0)
@@ -201,7 +201,7 @@ def _naming_file(exc: ValueError | TypeError, path: Path) -> ValueError | TypeEr
     out = kind(f"{str(path)!r}: {exc}")  # ParameterError needs a rule
     tag = parameter_of(exc)
     if tag is not None:
-        out.parameter = tag
+        out.parameter = tag  # type: ignore[union-attr]  # a tag (parameter_of)
     return out
 
 
@@ -209,7 +209,7 @@ def _check_window(window) -> tuple[int, int, int, int]:
     """(row_off, col_off, rows, cols) of a rasterio Window or a 4-tuple of integers."""
     with about("window"):
         if isinstance(window, Window):
-            vals = (window.row_off, window.col_off, window.height, window.width)
+            vals: tuple = (window.row_off, window.col_off, window.height, window.width)
         else:
             try:
                 vals = tuple(window)

@@ -104,7 +104,9 @@ class _Layout:
         hole = self.holes[k]
         if hole is not None:
             r0, c0, w = hole
-            fine = self._index[k + 1][::2, ::2]
+            finer = self._index[k + 1]
+            assert finer is not None  # made before this one (finest first)
+            fine = finer[::2, ::2]
             for sl_c, sl_f in (((r0, slice(c0, c0 + w)), (0, slice(None))),
                                ((r0 + w - 1, slice(c0, c0 + w)), (w - 1, slice(None))),
                                ((slice(r0, r0 + w), c0), (slice(None), 0)),
@@ -124,6 +126,7 @@ class _Layout:
     def faces(self, k: int) -> np.ndarray:
         """(m, 3) vertex indices of layer k's triangles, counter-clockwise seen from +z."""
         idx = self._index[k]
+        assert idx is not None  # __init__ made them all
         rows, cols = idx.shape
         cell = np.ones((rows - 1, cols - 1), dtype=bool)
         hole = self.holes[k]
@@ -149,9 +152,9 @@ class _Layout:
 
     def _seam(self, k: int) -> np.ndarray:
         """Fans from the finer layer's odd border vertices over the ring of coarse cells."""
-        idx = self._index[k]
-        fine = self._index[k + 1]
-        r0, c0, w = self.holes[k]
+        idx, fine, hole = self._index[k], self._index[k + 1], self.holes[k]
+        assert idx is not None and fine is not None and hole is not None  # k has a finer layer
+        r0, c0, w = hole
         s = np.arange(w - 1)
         odd = 2 * s + 1
         last = 2 * (w - 1)
@@ -186,6 +189,7 @@ class _Rocks:
         self.layer = np.concatenate(layers) if layers else np.zeros(0, np.uint8)
         n = 0 if self.cat is None else len(self.cat)
         if n:
+            assert self.cat is not None and self.cat.dtype.names is not None  # n boulders
             self.shape = catalog_shape(self.cat)
             self.level, self.chunk = self.shape.levels[-1], mesh_chunk(self.shape)
             self.ids = (self.cat["index"].astype(np.int32) if "index" in self.cat.dtype.names
@@ -208,6 +212,7 @@ class _Rocks:
 
     def face_chunks(self, base: int):
         faces = boulder_faces(self.level)
+        assert self.cat is not None  # asked only when there are boulders (__bool__)
         n = len(self.cat)
         for s0 in range(0, n, self.chunk):
             k = min(self.chunk, n - s0)

@@ -101,6 +101,7 @@ def read_pds(path: Path, band: int, win=None):
     if image is None:
         raise ValueError(f"{where!r}: the PDS label has no IMAGE object")
     layout = _image_layout(image, band, where)
+    assert parent is not None  # found with the image
     data_path, offset = _image_start(label, parent, label_path, where)
     _check_extent(layout, data_path, offset + (band - 1) * layout.lines * layout.stride)
     r0, c0, n_lines, n_samples = (0, 0, layout.lines, layout.samples) if win is None else win
@@ -184,7 +185,8 @@ def _image_start(label: dict, parent: dict, label_path: Path, where: str):
     # ^IMAGE = "F.IMG" | ("F.IMG", record) | ("F.IMG", n <BYTES>) | record | n <BYTES>
     pointer = parent.get("^IMAGE", label.get("^IMAGE"))
     record_bytes = parent.get("RECORD_BYTES", label.get("RECORD_BYTES"))
-    data_name, start = None, 1
+    data_name: str | None = None
+    start: float = 1
     if isinstance(pointer, list) and pointer:
         data_name = str(pointer[0])
         start = pointer[1] if len(pointer) > 1 else 1

@@ -45,6 +45,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 from rasterio.windows import Window
@@ -232,7 +233,7 @@ def _plan_banded(specs, geometry: StackGeometry, drawn: _Drawn, *, min_px: float
                          f"(limit {MAX_STAMPED:.0e}); raise d_min_m or lower c")
     tag_band, tag_outside, tag_small = drawn.streams
     per_layer: list[list[np.ndarray]] = [[] for _ in range(n)]
-    band_rows = []
+    band_rows: list[dict[str, Any]] = []
     next_index = 0
     for b in range(n):
         entry = {"layer": b, "d_min_m": lo[b], "d_max_m": hi[b] if b else None,

@@ -339,7 +339,9 @@ class Stack:
         lonlat = world_to_lonlat(d.crs, wx, wy)
         if lonlat is not None:
             extra.update(lat_deg=lonlat[1], lon_deg=lonlat[0])
-        cols = {n: cat[n] for n in cat.dtype.names}
+        names = cat.dtype.names
+        assert names is not None  # a catalog: a structured array
+        cols = {n: cat[n] for n in names}
         return make_catalog(**cols, **extra), (x1 - x0) * (y1 - y0)
 
 

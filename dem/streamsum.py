@@ -59,6 +59,7 @@ class PairwiseSum:
             raise ValueError(f"more values pushed ({self._pushed}) than announced ({self.n})")
         self._chunks.append(v)
         self._buffered += v.size
+        assert self._walk is not None  # n > 0, as values came within the announced n
         try:
             self._walk.send(None)
         except StopIteration as done:

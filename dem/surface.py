@@ -66,7 +66,7 @@ class DemSurface:
     def __init__(self, source, *, source_name: str = ""):
         self._stack = as_stack(source)
         self._name = str(source_name)
-        self._mesh = None
+        self._mesh: tuple[np.ndarray, np.ndarray] | None = None
 
     @classmethod
     def read(cls, path, *, progress: bool = False) -> DemSurface:

@@ -113,6 +113,7 @@ def raster_shape(path) -> tuple[int, int]:
     if path.suffix.lower() in PDS_SUFFIXES:
         text, label_path = label_text(path)
         image, _ = find_object(parse_label(text), "IMAGE")
+        assert image is not None  # dem.read checked the label (call that first)
         return (int(label_number(image, "LINES", str(label_path))),
                 int(label_number(image, "LINE_SAMPLES", str(label_path))))
     with warnings.catch_warnings():

@@ -146,7 +146,7 @@ def _outputs_for(scene: Scene, outputs: Outputs, name: str) -> Outputs:
     if outputs.files():
         return outputs.renamed(lambda f: f"{name}_{Path(f).name}")
     kind = output_kind(scene)
-    layers = scene.implicit.layers if kind == "implicit" else scene.craters.layers
+    layers = scene.implicit.layers if scene.implicit is not None else scene.craters.layers
     return Outputs(output=(f"{name}{'.npz' if kind == 'latlong' else '.ply'}",),
                    catalog=f"{name}_craters.csv" if layers else None)
 

@@ -73,6 +73,7 @@ def boulder_population(body: Body, layers, *, rng=None) -> np.ndarray:
         lat, lon, _ = sample_surface_points(body, totals, n, rng)
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
+            assert cat is not None  # n_near > 0 needs craters
             weights = cat["diameter_m"] ** 2
             pick = rng.choice(len(cat), n_near, p=weights / weights.sum())
             r = 0.5 * cat["diameter_m"][pick] * rng.uniform(1.0, 2.0, n_near)

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+from typing import Any, cast
 
 import numba
 import numpy as np
@@ -51,10 +52,11 @@ def _base_heights(scene: Scene, grid: LatLongGrid, rng, progress: bool, out=None
             out[b0:b0 + _BLOCK] = 0.0
         return out, body.radius_m, {}
     if isinstance(base, FaultingParams):  # its stretch is the body's (the scene made it so)
+        assert body.radius_m is not None  # Scene.__post_init__ sets it
         heights = two_phase_faulting(grid, body.radius_m, base, rng=rng, progress=progress)
         return heights, body.radius_m, dataclasses.asdict(base)
     if isinstance(base, FbmParams):
-        params = {"frequency": base.frequency, "octaves": base.octaves,
+        params: dict[str, Any] = {"frequency": base.frequency, "octaves": base.octaves,
                   "persistence": base.persistence, "lacunarity": base.lacunarity,
                   "amplitude_m": base.amplitude_m}
         return (perlin_fbm(grid, *params.values(), rng=rng, out=out, progress=progress),
@@ -162,6 +164,7 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
                              target=target, too_large="skip",
                              slope_reference="gravity" if isinstance(scene.base, ShapeBase)
                              else "body", overwrite_body=overwrite)
+        assert body.craters is not None  # stamp_craters records the catalog it stamped
         body = body.replace(metadata={**body.metadata,
                                       "craters_skipped_too_large": len(cat) - len(body.craters)})
     if boulders.layers:
@@ -173,6 +176,7 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
 def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterError:
     """A base whose heights make radii <= 0 (or not finite): the error of the settings
     that made them (the scene's names), not of the body's radii."""
+    see: tuple[str, ...]
     if isinstance(scene.base, FaultingParams):
         name, see, what = "max_fault_1_m", ("max_fault_2_m",), "and {} are"
     else:  # fBm, or a shape model's fBm detail
@@ -186,6 +190,7 @@ def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterE
 
 def _metadata(scene: Scene, params: dict) -> dict:
     craters, boulders, target = scene.craters, scene.boulders, scene.target()
+    assert scene.base is not None  # a lat/long or mesh build: Scene.__post_init__ set it
     return {
         "generator": GENERATOR,
         "version": package_version(),
@@ -206,7 +211,7 @@ def mesh_spacing_m(scene: Scene) -> float:
     """The refined mesh's mean edge of a ``surface="mesh"`` shape base: its
     ``spacing_m``, else the lat/long grid's spacing at the scene's magnitude,
     (pi / 2) R / M (R the model's volume-equivalent radius)."""
-    base = scene.base
+    base = cast(ShapeBase, scene.base)  # documented precondition: a shape base
     if base.spacing_m is not None:
         return base.spacing_m
     return 0.5 * np.pi * base.radius_m / scene.body.magnitude
@@ -224,9 +229,11 @@ def _build_mesh(scene: Scene, progress: bool):
     )
 
     base, rng = scene.base, np.random.default_rng(scene.seed)
-    params = {"frequency": base.detail_frequency, "octaves": base.detail_octaves,
-              "persistence": base.detail_persistence, "lacunarity": base.detail_lacunarity,
-              "amplitude_m": base.detail_amplitude_m}
+    assert isinstance(base, ShapeBase)  # build() sends only shape bases here
+    params: dict[str, Any] = {
+        "frequency": base.detail_frequency, "octaves": base.detail_octaves,
+        "persistence": base.detail_persistence, "lacunarity": base.detail_lacunarity,
+        "amplitude_m": base.detail_amplitude_m}
     try:
         surf = mesh_surface(base.model, mesh_spacing_m(scene), center=base.center,
                             smooth=base.smooth)
@@ -253,6 +260,7 @@ def _build_implicit(scene: Scene, progress: bool):
     from .implicit import implicit_surface
 
     imp = scene.implicit
+    assert imp is not None  # build() sends only implicit scenes here
     try:
         surf = implicit_surface(imp.shape, imp.layers, gabor=imp.gabor, voxel_m=imp.voxel_m,
                                 target_polygons=imp.polygons, cell_m=imp.cell_m,

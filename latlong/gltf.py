@@ -36,6 +36,7 @@ import os
 import shutil
 import struct
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -194,7 +195,8 @@ class _LevelPlan:
     """One level's patches after the first pass: what the second pass writes where."""
 
     level: int
-    body: object
+    body: Any
+    """The :class:`latlong.Body` (not imported: latlong.body reaches this module)."""
     leaves: tuple
     """(band_lo, entry pointers, triangle range lo, hi) arrays of the patch tree leaves."""
     at: np.ndarray

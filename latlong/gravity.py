@@ -246,5 +246,5 @@ def gravity(body_or_mesh, density_kg_m3: float, period_h: float = math.inf, *,
         effective_m_s2=acc + omega**2 * perp,
         effective_potential_m2_s2=pot + 0.5 * omega**2 * np.einsum("ij,ij->i", perp, perp),
         density_kg_m3=density_kg_m3, period_h=period_h,
-        spin_axis=tuple(float(c) for c in axis), source_facets=int(n_f),
+        spin_axis=(float(axis[0]), float(axis[1]), float(axis[2])), source_facets=int(n_f),
         evaluated_points=int(n_p))

@@ -58,7 +58,7 @@ def check_memory(magnitude: int, max_memory_gb: float | None = None, *,
         on_disk = LatLongGrid.estimate_bytes(magnitude, bpv) + counts > limit
     if on_disk:
         bpv -= RADII_BYTES_PER_VERTEX
-    need = LatLongGrid.estimate_bytes(magnitude, bpv)
+    need: float = LatLongGrid.estimate_bytes(magnitude, bpv)
     if need > limit:
         n = 6 * magnitude * magnitude + 2
         where = " with the radii on disk" if on_disk else ""

@@ -131,10 +131,10 @@ class Outputs:
                                      see=("boulders",))
         seen = set()
         for x in self.files():
-            key = Path(x).resolve()
-            if key in seen:
+            resolved = Path(x).resolve()
+            if resolved in seen:
                 raise ValueError(f"output {x!r} is given twice")
-            seen.add(key)
+            seen.add(resolved)
         named = [("output", o, _SUFFIXES[kind]) for o in self.output]
         named += [(k, getattr(self, k), s) for k, s in _EXTRA_SUFFIXES.items()
                   if getattr(self, k)]
@@ -191,6 +191,7 @@ def write_outputs(made, scene: Scene, outputs: Outputs, *, progress: bool = Fals
         body = None
         if any(o.lower().endswith(".npz") for o in outputs.output):  # before any write
             try:
+                assert scene.implicit is not None  # the implicit backend
                 body = made.to_body(scene.body.magnitude, crossings=scene.implicit.crossings)
             except ValueError as exc:
                 if not (isinstance(exc, ParameterError) and exc.name == "crossings"):
@@ -203,7 +204,11 @@ def write_outputs(made, scene: Scene, outputs: Outputs, *, progress: bool = Fals
                                      f"grid from its origin): {why}; or write only meshes "
                                      "(.ply .obj .stl .vtp .vtk .glb)") from None
         for out in outputs.output:
-            (body.save if out.lower().endswith(".npz") else made.save)(out)
+            if out.lower().endswith(".npz"):
+                assert body is not None  # made above for the .npz outputs
+                body.save(out)
+            else:
+                made.save(out)
             done()
         catalog, area, axes = made.catalog, made.area_m2, None
     else:

@@ -12,6 +12,7 @@ data (``os.pwrite``), so the file is the one the whole-body pass wrote.
 
 from __future__ import annotations
 
+import functools
 import os
 
 import numpy as np
@@ -146,8 +147,8 @@ def write_leaf_data(grid, radii, stretch, leaves: tuple, at: np.ndarray, nbytes:
                 return words.view(np.uint8), g0, local
 
             for data, g0, local in ordered_chunks(make, groups,
-                                                  lambda big=big: np.empty(max(big, 4) // 4,
-                                                                           np.uint32)):
+                                                  functools.partial(np.empty, max(big, 4) // 4,
+                                                                    np.uint32)):
                 for k in range(len(local) - 1):
                     size = int(local[k + 1] - local[k])
                     if size:

@@ -22,6 +22,7 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import numpy as np
 
@@ -50,7 +51,7 @@ from .settings import (
     ShapeBase,
     SphereBase,
 )
-from .shapes import read_shape_model
+from .shapes import ShapeModel, read_shape_model
 
 __all__ = ["SETTINGS", "SETTING_DEFAULTS", "SETTING_PARTS", "Scene"]
 
@@ -74,6 +75,7 @@ _BOULDER_SHAPE = {f"boulder_{f.name}": Setting(f.default, _BOULDER_HELP[f.name])
 
 def _ellipsoid_area(body: BodySettings) -> float:
     """The stretched sphere's area (Knud Thomsen's formula, within 1.1 %)."""
+    assert body.radius_m is not None and body.stretch is not None  # a scene's body
     a, b, c = (body.radius_m * f for f in body.stretch)
     p = 1.6075
     return 4 * math.pi * (((a * b) ** p + (a * c) ** p + (b * c) ** p) / 3) ** (1 / p)
@@ -194,6 +196,7 @@ class Scene:
         b = self.body
         if b.target != "small-body":
             return _craters.get_target(b.target, gravity_m_s2=b.gravity_m_s2)
+        assert b.radius_m is not None and b.stretch is not None  # __post_init__ set them
         radius = b.radius_m * float(np.prod(b.stretch)) ** (1.0 / 3.0)
         return _craters.get_target("small-body", radius_m=radius, density_kg_m3=b.density_kg_m3,
                                    gravity_m_s2=b.gravity_m_s2,
@@ -257,7 +260,7 @@ def _keys(kind) -> tuple[str, ...]:
 
 def _names(kind) -> dict[str, str]:
     """Setting -> field of a record's declared fields."""
-    return {s.key: name for name, s in declared(kind).items()}
+    return {cast(str, s.key): name for name, s in declared(kind).items()}  # keys filled in
 
 
 def _part(factory, values: dict, names: dict | None = None, **fixed):
@@ -273,7 +276,9 @@ def _part(factory, values: dict, names: dict | None = None, **fixed):
         raise exc.renamed(key) from None
     except FileNotFoundError as exc:  # a file setting's: kept, its tag renamed
         tag = getattr(exc, "parameter", None)
-        exc.parameter = next((k for k, f in names.items() if f == tag), tag)
+        # a tag (parameter_of)
+        exc.parameter = next(  # type: ignore[attr-defined]
+            (k for k, f in names.items() if f == tag), tag)
         raise
 
 
@@ -294,7 +299,7 @@ def _latlong_scene(cls, given: dict) -> Scene:
                              "from the real body's bundled shape model)")
     if preset is not None and preset not in PRESETS:
         raise ParameterError("preset", f"must be one of {', '.join(PRESETS)}; got {preset!r}")
-    shape_path = None
+    shape_path: str | ShapeModel | None = None
     if isinstance(base, str) and base.startswith("shape:"):
         shape_path, base = base[len("shape:"):], "shape"
         if preset is not None:
@@ -313,6 +318,7 @@ def _latlong_scene(cls, given: dict) -> Scene:
         preset = DEFAULT_PRESET.get(base)
     p = PRESETS[preset] if preset else None
     base = p.base if p else base
+    assert base is not None  # the preset's, or the given one (default fbm)
     if p is not None and p.model is not None:
         # the bundled model, recorded by its place in the package (not this machine's path)
         units = {**p.settings, **given}.get("shape_units", "km")

@@ -85,7 +85,7 @@ def disk_radii(n_vertices: int, folder=None, *,
 
 def is_on_disk(a: np.ndarray) -> bool:
     """Whether ``a`` is (a view of) an array made by :func:`disk_radii`."""
-    base = a
+    base: object = a
     while isinstance(base, np.ndarray):
         base = base.base
     if isinstance(base, memoryview):

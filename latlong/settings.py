@@ -130,7 +130,7 @@ def _read_shape(record, name: str, what: str) -> None:
     try:
         _set(record, name, as_shape_model(value, units=record.units, what=what, name=name))
     except FileNotFoundError as exc:  # kept (Python), tagged (a command's flag)
-        exc.parameter = name
+        exc.parameter = name  # type: ignore[attr-defined]  # a tag (parameter_of)
         raise
     except ValueError as exc:
         raise ParameterError(name, f"{value}: {exc}") from None
@@ -211,6 +211,7 @@ class ShapeBase:
     @property
     def radius_m(self) -> float:
         """Volume-equivalent radius of the model, metres."""
+        assert isinstance(self.model, ShapeModel)  # __post_init__ read it
         return (3.0 * self.model.volume_m3 / (4.0 * math.pi)) ** (1.0 / 3.0)
 
 

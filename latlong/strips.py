@@ -81,7 +81,7 @@ def triangle_strips(grid: LatLongGrid) -> list[np.ndarray]:
 
 def join_strips(strips: list[np.ndarray]) -> np.ndarray:
     """One strip from several, stitched with degenerate triangles (parity kept)."""
-    parts = []
+    parts: list[np.ndarray] = []
     length = 0
     for s in strips:
         if len(s) == 0:

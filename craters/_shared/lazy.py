@@ -30,6 +30,10 @@ import importlib
 import importlib.util
 import sys
 import types
+from typing import TYPE_CHECKING, cast
+
+if TYPE_CHECKING:
+    from importlib.abc import InspectLoader
 
 __all__ = ["lazy_package", "lazy_names"]
 
@@ -68,7 +72,9 @@ def lazy_package(name: str) -> None:
     and ``__dir__`` (PEP 562)."""
     module = sys.modules[name]
     spec = module.__spec__
-    source = spec.loader.get_source(name) if spec and spec.loader else None
+    # a package's loader reads source files: an InspectLoader (importlib.abc)
+    loader = cast("InspectLoader | None", spec.loader if spec else None)
+    source = loader.get_source(name) if loader else None
     if source is None:
         raise ImportError(f"lazy package {name} needs its source", name=name)
     names = lazy_names(source)

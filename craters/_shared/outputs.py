@@ -89,7 +89,7 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
             return []
         _SWEPT.add(key)
     now = time.time() if now is None else now
-    removed = []
+    removed: list[Path] = []
     try:
         entries = list(os.scandir(folder))
     except OSError:
@@ -134,8 +134,9 @@ class _Group:
 
     def commit(self) -> None:
         for m in self.moved:
-            if m.holder is not None or m.backup is not None:
-                _remove(m.holder or m.backup)
+            gone = m.holder or m.backup
+            if gone is not None:
+                _remove(gone)
         self.moved.clear()
 
     def rollback(self) -> None:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 from .validation import (
     ParameterTypeError,
@@ -142,7 +142,7 @@ def by_key(source) -> dict[str, Setting]:
     settings by key (their ``key`` filled in)."""
     if isinstance(source, dict):
         return {k: dataclasses.replace(s, key=k) for k, s in source.items()}
-    return {s.key: s for s in declared(source).values()}
+    return {cast(str, s.key): s for s in declared(source).values()}  # declared() fills keys
 
 
 def check_declared(obj, *, keep: tuple[str, ...] = ()) -> None:
@@ -150,7 +150,8 @@ def check_declared(obj, *, keep: tuple[str, ...] = ()) -> None:
     type or default allows it) and store the cleaned value (an integer ``3.0`` as ``3``,
     a number as a float) but in the fields of ``keep`` (kept as given)."""
     types = {f.name: str(f.type) for f in dataclasses.fields(obj)}
-    for name, decl in declared(type(obj)).items():
+    # a class is hashable; mypy reads type[Any] as not Hashable
+    for name, decl in declared(type(obj)).items():  # type: ignore[arg-type]
         value = getattr(obj, name)
         if value is None and (decl.default is None or "None" in types[name]):
             continue

@@ -17,7 +17,7 @@ __all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about", "check_ch
            "check_finite", "check_int", "check_positive", "check_range", "normalize_rng",
            "parameter_of"]
 
-RngLike = int | np.random.Generator | None
+RngLike = int | np.integer | np.random.Generator | None
 
 
 class _Named:
@@ -31,7 +31,8 @@ class _Named:
 
     def __init__(self, name: str, rule: str, *, see: tuple[str, ...] = ()):
         self.name, self.rule, self.see = name, rule, tuple(see)
-        super().__init__(self.shown_as(f"`{name}`"))
+        # a mixin: the next class is ValueError or TypeError
+        super().__init__(self.shown_as(f"`{name}`"))  # type: ignore[call-arg]
 
     def shown_as(self, label: str, name_of=None) -> str:
         """The message with ``label`` (a flag, a key) in place of the parameter name and
@@ -79,7 +80,7 @@ def about(parameter: str | None) -> Iterator[None]:
         yield
     except (TypeError, ValueError) as exc:
         if parameter is not None and getattr(exc, "parameter", None) is None:
-            exc.parameter = parameter
+            exc.parameter = parameter  # type: ignore[union-attr]  # a tag on any error
         raise
 
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from typing import cast
 
 import numpy as np
 
@@ -211,7 +212,8 @@ def boulder(*, rng=None, shape: BoulderShape = BoulderShape()) -> BoulderNode:
 def catalog_shape(catalog) -> BoulderShape:
     """The :class:`BoulderShape` recorded in a placed catalog."""
     cat = np.asarray(catalog)
-    if len(cat) == 0 or "shape_flatten" not in cat.dtype.names:
+    names = cast(tuple[str, ...], cat.dtype.names)  # a catalog: a structured array
+    if len(cat) == 0 or "shape_flatten" not in names:
         return BoulderShape()
     vals = {}
     for f in dataclasses.fields(BoulderShape):

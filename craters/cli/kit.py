@@ -94,10 +94,12 @@ def run_cli(func: Callable[[], int | None], *, flags: Mapping[str, str] | None =
     except (CliError, ValueError, TypeError, OSError, MemoryError) as exc:
         if os.environ.get("CRATERFORM_DEBUG"):
             raise
-        if isinstance(exc, ParameterError | ParameterTypeError) and exc.name in (flags or {}):
+        tag = parameter_of(exc)
+        if isinstance(exc, ParameterError | ParameterTypeError) and flags is not None \
+                and exc.name in flags:
             msg = exc.shown_as(flags[exc.name], lambda k: flags.get(k, f"`{k}`"))
-        elif isinstance(exc, OSError) and parameter_of(exc) in (flags or {}):
-            msg = f"{flags[parameter_of(exc)]}: {exc}"  # a missing file of a setting
+        elif isinstance(exc, OSError) and flags is not None and tag is not None and tag in flags:
+            msg = f"{flags[tag]}: {exc}"  # a missing file of a setting
         else:
             msg = str(exc) if str(exc) else exc.__class__.__name__
         sys.stderr.write(f"error: {msg}\n".replace("\n", " ").rstrip() + "\n")

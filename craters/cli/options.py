@@ -87,7 +87,8 @@ def _text_parser(s: Setting) -> Callable[[str], object]:
     """The argparse type of a setting: its ``parse`` (a ValueError's rule becomes the
     message) or the parser of its kind."""
     if s.parse is None:
-        return {int: _integer, float: _number}.get(s.kind, str)
+        parsers: dict[type | None, Callable[[str], object]] = {int: _integer, float: _number}
+        return parsers.get(s.kind, str)
     parse = s.parse
 
     def parse_text(text):
@@ -185,8 +186,9 @@ def add_options(parser, options: Mapping[str, Setting],
     """Add one argparse option a setting (module notes); ``groups``: group name -> title
     of the setting groups that get their own section; nothing given stays None."""
     used = {s.group for s in options.values()}
-    sections = {g: parser.add_argument_group(title) for g, title in (groups or {}).items()
-                if g in used}
+    sections: dict[str | None, argparse._ActionsContainer] = {
+        g: parser.add_argument_group(title) for g, title in (groups or {}).items()
+        if g in used}
     for key, s in options.items():
         where = sections.get(s.group, parser)
         kw: dict = {"help": help_text(s).replace("%", "%%"), "default": None}  # argparse
@@ -210,7 +212,8 @@ def add_options(parser, options: Mapping[str, Setting],
 
 
 # --------------------------------------------------------------------------- config files
-_TOML_KINDS = {str: "a file name", bool: "true or false", list: "a list of strings"}
+_TOML_KINDS: dict[type | None, str] = {str: "a file name", bool: "true or false",
+                                       list: "a list of strings"}
 
 
 def _good_toml(s: Setting, value) -> bool:
@@ -277,8 +280,9 @@ class Values(dict):
         try:
             yield
         except (TypeError, ValueError, OSError) as exc:
-            if isinstance(exc, ParameterError | ParameterTypeError) and self.where(exc.name):
-                raise CliError(exc.shown_as(self.where(exc.name),
+            if isinstance(exc, ParameterError | ParameterTypeError) \
+                    and (where := self.where(exc.name)):
+                raise CliError(exc.shown_as(where,
                                             lambda k: self.where(k) or f"`{k}`")) from None
             where = self.where(parameter_of(exc))
             if where is None:
@@ -321,7 +325,8 @@ def command(sub, name: str, run: Callable[[Values], int | None],
         with values.named_errors():
             return int(run(values) or 0)
 
-    call.options = dict(options)  # the table of the flags and config keys, for tests
+    # the table of the flags and config keys, for tests (an attribute of the function)
+    call.options = dict(options)  # type: ignore[attr-defined]
     p.set_defaults(func=call)
     return p
 

@@ -29,6 +29,7 @@ from craters.cli.kit import CliError, check_not_input
 from craters.cli.options import FORCE, QUIET, REPORT, Setting, Values, command, declared_keys
 
 from ..config import EnhanceConfig
+from ..core import Dem
 from ..io import DEM_SUFFIXES, read
 from ..stack import read_stack
 from ..zarrio import check_zarr_output, is_zarr
@@ -111,7 +112,9 @@ def begin(v: Values, name: str):
 def seed_of(v: Values) -> int:
     """The given seed (checked before any work) or a fresh one; recorded in the output."""
     if v["seed"] is None:
-        return int(np.random.SeedSequence().entropy % (2**63))
+        entropy = np.random.SeedSequence().entropy
+        assert isinstance(entropy, int)  # a fresh SeedSequence's own
+        return int(entropy % (2**63))
     with about("rng"):
         normalize_rng(v["seed"])
     return v["seed"]
@@ -130,7 +133,7 @@ def summary(v: Values, seed: int, shape_in, shape, params: dict) -> None:
     print(f"wrote {v['output']}")
 
 
-def report_inputs(v: Values) -> list[tuple[str, object]]:
+def report_inputs(v: Values) -> list[tuple[str, Dem]]:
     """(label, DEM) of the inputs of ``dem slopes`` / ``dem spectrum``: every layer of a
     stack manifest is one input."""
     out = []

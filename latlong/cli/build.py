@@ -64,6 +64,7 @@ def _summary(made, scene: Scene) -> str:
                 f"on folds), {n_boulders} boulders, seed {scene.seed}")
     lo, hi = _distance_range(made)
     n_craters = 0 if made.craters is None else len(made.craters)
+    assert scene.base is not None  # a lat/long scene
     return (f"body: magnitude {made.magnitude}, {made.n_vertices} vertices, base "
             f"{scene.base.name} ({scene.preset or '-'}), {n_craters} craters, seed "
             f"{scene.seed}, surface {lo:.4g}..{hi:.4g} m from the centre")

@@ -45,7 +45,7 @@ def _spectrum(v: Values) -> int:
             cols += [f"wavelength_m[{label}]", f"power_m2[{label}]"]
         rows = []
         for k in range(n):
-            row = [k]
+            row: list[float] = [k]
             for _, d, p, r in results:
                 wl = 2 * np.pi * r / np.sqrt(d[k] * (d[k] + 1)) if d[k] else float("inf")
                 row += [wl, p[k]]

@@ -12,13 +12,14 @@ catalogs of a mesh that has none.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from craters._shared import ParameterError
 
-from ..meshio.writers import write_mesh
+from ..meshio.writers import MeshSource, write_mesh
 from .normals import face_normals, tangent_frames, vertex_normals
 
 __all__ = ["CENTRES", "PlainMeshSurface", "TriangleMeshSurface", "area_centroid", "centre_point",
@@ -103,6 +104,8 @@ class TriangleMeshSurface:
     (V, 3) float64 metres and ``faces`` (F, 3) int64 (module notes)."""
 
     __slots__ = ()
+    mesh_source: Callable[[], MeshSource]
+    """The class's own: the mesh and what it merges into it (boulders, fields)."""
     vertices: np.ndarray
     faces: np.ndarray
 

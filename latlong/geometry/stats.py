@@ -32,7 +32,7 @@ def area_slope_summary(slopes_deg, areas, *, bin_deg: float = 3.0) -> dict:
     frac = hist / w.sum()
     order = np.argsort(s)
     cw = np.cumsum(w[order]) / w.sum()
-    median = float(s[order][min(np.searchsorted(cw, 0.5), len(s) - 1)])
+    median = float(s[order][min(int(np.searchsorted(cw, 0.5)), len(s) - 1)])
     above = 100.0 * (1.0 - np.concatenate([[0.0], np.cumsum(frac)]))[:len(edges)]
     return {"edges_deg": edges, "area_fraction": frac, "above_percent": above,
             "median_deg": median, "mean_deg": float(np.average(s, weights=w)),

@@ -267,7 +267,8 @@ def _coarse_grid(plan: _Plan, meta: Metaballs, smooth: ShapeModel):
     margin = 0.05 * float((hi - lo).max()) + band
     for _ in range(_GROWTH_STEPS):
         glo, ghi = lo - margin, hi + margin
-        shape = tuple(int(v) for v in (np.ceil((ghi - glo) / h).astype(np.int64) + 1)[::-1])
+        zyx = (np.ceil((ghi - glo) / h).astype(np.int64) + 1)[::-1]
+        shape = (int(zyx[0]), int(zyx[1]), int(zyx[2]))
         need = _estimate_bytes(shape)
         if need > 0.6 * physical_memory_bytes():
             raise ParameterError("voxel_m", f"= {h:.4g} m needs a {shape[2]} x {shape[1]} x "

@@ -17,6 +17,8 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
+from typing import Any
 
 import numpy as np
 
@@ -89,8 +91,9 @@ def _ratio_range(text: str) -> tuple[float, float]:
     return float(lo), float(hi or lo)
 
 
-_SPEC = {"kernel": str, "d_min_m": float, "d_max_m": float, "exponent": float,
-         "probability": float, "weight": float, "depth_ratio": _ratio_range}
+_SPEC: dict[str, Callable[[str], Any]] = {
+    "kernel": str, "d_min_m": float, "d_max_m": float, "exponent": float,
+    "probability": float, "weight": float, "depth_ratio": _ratio_range}
 _OLD_KEYS = {"dmin": "d_min_m", "dmax": "d_max_m", "B": "exponent", "p": "probability",
              "w": "weight", "hd": "depth_ratio"}
 

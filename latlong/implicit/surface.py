@@ -59,9 +59,10 @@ class ImplicitSurface(TriangleMeshSurface):
         sel = slice(None) if rows is None else np.atleast_1d(np.asarray(rows, dtype=np.int64))
         out = np.zeros(len(pts))
         if imp and len(imp["centers"]):
-            arrays = [np.ascontiguousarray(imp[k][sel]) for k in (
-                "centers", "normals", "kinds", "params", "support", "zhalf")]
-            _k._crater_points_kernel(pts, *arrays, out)
+            centers, normals, kinds, params, support, zhalf = (
+                np.ascontiguousarray(imp[k][sel]) for k in (
+                    "centers", "normals", "kinds", "params", "support", "zhalf"))
+            _k._crater_points_kernel(pts, centers, normals, kinds, params, support, zhalf, out)
         return out
 
     @property

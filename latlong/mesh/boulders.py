@@ -67,6 +67,7 @@ def mesh_boulder_population(surface: MeshSurface, layers, *, rng=None) -> np.nda
         p = _points(v, f, *sample_mesh_points(v, f, n, rng))
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
+            assert cat is not None  # n_near > 0 needs craters
             weights = cat["diameter_m"] ** 2
             pick = rng.choice(len(cat), n_near, p=weights / weights.sum())
             r = 0.5 * cat["diameter_m"][pick] * rng.uniform(1.0, 2.0, n_near)

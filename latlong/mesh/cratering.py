@@ -119,7 +119,9 @@ def mesh_crater_population(surface: MeshSurface, layers, *, rng=None) -> np.ndar
     cat = _craters.population(layers, area_m2=surface.area_m2, rng=rng)
     face, uv = sample_mesh_points(surface.vertices, surface.faces, len(cat), rng)
     p = _points(surface.vertices, surface.faces, face, uv)
-    cols = {k: cat[k] for k in cat.dtype.names}
+    names = cat.dtype.names
+    assert names is not None  # a catalog: a structured array
+    cols = {k: cat[k] for k in names}
     cols["lat_deg"], cols["lon_deg"] = lat_lon_deg(p)
     cols.update(centre_x_m=p[:, 0], centre_y_m=p[:, 1], centre_z_m=p[:, 2])
     return _craters.make_catalog(**cols)

@@ -64,7 +64,7 @@ def refinement_plan(edge_m: float, spacing_m: float, smooth: str = "butterfly") 
     most = int(math.floor(math.log2(ratio * 1.15)))  # within 15 % of a level
     top = 0 if smooth in ("none", "linear") else min(MAX_BUTTERFLY_LEVELS, most)
     least = min(top, MIN_BUTTERFLY_LEVELS)
-    best = None
+    best: tuple[float, int, int] | None = None
     for levels in range(top, least - 1, -1):
         n = max(1, round(ratio / 2**levels))
         err = abs(math.log(2**levels * n / ratio))
@@ -72,6 +72,7 @@ def refinement_plan(edge_m: float, spacing_m: float, smooth: str = "butterfly") 
             return levels, n
         if best is None or err < best[0] - 1e-12:
             best = (err, levels, n)
+    assert best is not None  # the loop ran at least once (least <= top)
     return best[1], best[2]
 
 

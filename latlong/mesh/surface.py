@@ -199,7 +199,7 @@ def fbm_detail(vertices, faces, frequency: float, octaves: int, persistence: flo
     p = np.asarray(vertices, dtype=np.float64) / scale_m
     xyz = [(p[:, 0] * rot[a, 0] + p[:, 1] * rot[a, 1] + p[:, 2] * rot[a, 2]) * frequency
            + offset[a] for a in range(3)]
-    return amplitude_m * fbm3(*xyz, octaves=octaves, persistence=persistence,
+    return amplitude_m * fbm3(xyz[0], xyz[1], xyz[2], octaves=octaves, persistence=persistence,
                               lacunarity=lacunarity)
 
 

@@ -178,7 +178,8 @@ def _triangle_ply(path: Path):
     with open(path, "rb") as fh:
         if fh.readline().strip() != b"ply":
             return None
-        elements, fmt = [], None
+        elements: list[tuple[str, int, list[list[str]]]] = []
+        fmt = None
         while True:
             line = fh.readline()
             if not line:
@@ -203,6 +204,7 @@ def _triangle_ply(path: Path):
                 or fprops[0][2] not in _PLY_TYPES:
             return None
         vdt = np.dtype([(p[1], _PLY_TYPES[p[0]]) for p in vprops])
+        assert vdt.names is not None  # made from a list of fields
         fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]]), ("i", _PLY_TYPES[fprops[0][2]], 3)])
         verts = np.fromfile(fh, dtype=vdt, count=nv)
         faces = np.fromfile(fh, dtype=fdt, count=nf)

@@ -96,7 +96,8 @@ class MeshSource:
     def arrays(self) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
         """The whole mesh in memory: vertices (n, 3) float64 metres, faces (m, 3) int64
         and the per-vertex fields ``{name: (n,) values}``."""
-        xyz, values = [], {name: [] for name, _ in self.fields}
+        xyz: list[np.ndarray] = []
+        values: dict[str, list[np.ndarray]] = {name: [] for name, _ in self.fields}
         for chunk, vals in self.vertex_chunks():
             xyz.append(np.asarray(chunk, dtype=np.float64))
             for name, parts in values.items():
@@ -151,6 +152,7 @@ def pack_vertices(xyz, values: dict, dtype: np.dtype, out: np.ndarray | None = N
     """Vertex records of ``dtype`` (:func:`ply_vertex_dtype`) from positions and fields."""
     rec = np.empty(len(xyz), dtype=dtype) if out is None else out[:len(xyz)]
     rec["x"], rec["y"], rec["z"] = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    assert dtype.names is not None  # x, y, z were set: a structured dtype
     for name in dtype.names[3:]:
         rec[name] = values[name]
     return rec
@@ -312,11 +314,11 @@ def write_vtk(src: MeshSource, fh, progress: bool = False) -> None:
     if src.fields:
         fh.write(f"\nPOINT_DATA {src.n_vertices}\n".encode("ascii"))
     for name, t in src.fields:
-        t = _dtype(t)
-        fh.write(f"SCALARS {name} {_VTK_LEGACY_TYPES[t.str[1:]]} 1\nLOOKUP_TABLE default\n"
+        dt = _dtype(t)
+        fh.write(f"SCALARS {name} {_VTK_LEGACY_TYPES[dt.str[1:]]} 1\nLOOKUP_TABLE default\n"
                  .encode("ascii"))
         for _, values in src.vertex_chunks():
-            fh.write(np.asarray(values[name]).astype(t.newbyteorder(">")).tobytes())
+            fh.write(np.asarray(values[name]).astype(dt.newbyteorder(">")).tobytes())
         fh.write(b"\n")
 
 

@@ -146,7 +146,9 @@ def limit_numba_threads(threads: int) -> None:
     with contextlib.suppress(ImportError):
         import numba
 
-        numba.set_num_threads(max(1, min(threads, numba.config.NUMBA_NUM_THREADS)))
+        # numba.config sets its names at import, from the environment
+        limit = numba.config.NUMBA_NUM_THREADS  # type: ignore[attr-defined]
+        numba.set_num_threads(max(1, min(threads, limit)))
 
 
 def choose_backend(backend: str | None = None, scheduler: str | None = None,

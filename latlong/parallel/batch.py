@@ -375,6 +375,7 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
         _write_index(index, columns, [*others, *(rows[n] for n in names
                                                  if n in rows and n not in redo)])
         if todo:
+            assert runner is not None  # open_backend's, as there is work
             _collect(runner, todo, task, folder, columns, rows, retries=retries,
                      progress=progress, on_done=on_done)
     _write_index(index, columns, [*others, *(rows[n] for n in names)])

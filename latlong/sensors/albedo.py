@@ -67,6 +67,7 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     names = cat.dtype.names
     centres = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1) \
         .astype(np.float64)
+    assert names is not None  # fields were read: a structured array
     radii = np.asarray(cat["rim_radius_m"] if "rim_radius_m" in names
                        else 0.5 * cat["diameter_m"], dtype=np.float64)
     deg = np.asarray(cat["degradation"], dtype=np.float64) if "degradation" in names \

@@ -113,9 +113,9 @@ def quaternion_from_matrix(m) -> np.ndarray:
     else:
         s = 2.0 * math.sqrt(1.0 + m[2, 2] - m[0, 0] - m[1, 1])
         q = [(m[1, 0] - m[0, 1]) / s, (m[0, 2] + m[2, 0]) / s, (m[1, 2] + m[2, 1]) / s, 0.25 * s]
-    q = np.array(q)
-    q /= np.linalg.norm(q)
-    return q if q[0] >= 0 else -q
+    quat = np.array(q)
+    quat /= np.linalg.norm(quat)
+    return quat if quat[0] >= 0 else -quat
 
 
 def _vector(name: str, value, n: int) -> np.ndarray:
@@ -165,7 +165,7 @@ class Pose:
         z = z / np.linalg.norm(z)
         up = _vector("up", up, 3)
         y = -(up - (up @ z) * z)
-        if np.linalg.norm(y) < 1e-9 * max(np.linalg.norm(up), 1e-300):
+        if np.linalg.norm(y) < 1e-9 * max(float(np.linalg.norm(up)), 1e-300):
             alt = np.eye(3)[int(np.argmin(np.abs(z)))]
             y = -(alt - (alt @ z) * z)
         y /= np.linalg.norm(y)

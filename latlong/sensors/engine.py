@@ -204,8 +204,8 @@ class RayMesh:
         self._index = np.ascontiguousarray(f, dtype=np.uint32)  # Embree's index buffer
         self._index.flags.writeable = False
         self._centre = centre
-        self._face_normals = None
-        self._vertex_normals = None
+        self._face_normals: np.ndarray | None = None
+        self._vertex_normals: np.ndarray | None = None
         lib, self._intersect1, self._occluded1 = _embree()
         self._lib = lib
         self._device = self._scene = None

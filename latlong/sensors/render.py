@@ -255,7 +255,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
                     sun.direction, pos, ng, ns, cosines, facing)
     lit = _sunlit(mesh, pos, ng, facing, sun, samples, seed)
     albedo = _vertex_albedo(mesh, vertex_albedo, hits)
-    refl = np.empty(n)
+    refl: np.ndarray = np.empty(n)
     _shade_kernel(photometry.code, photometry.vector(), cosines, lit, albedo, refl)
     refl = refl.reshape(h, w)
     depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))

@@ -159,6 +159,15 @@ def test_scc_roundtrip(tmp_path, area_m2):
     assert (back["fraction"] == 1).all()
 
 
+def test_read_scc_unreadable_area(tmp_path):
+    """A Total_area that is not a number is a ValueError naming the file (was an
+    AttributeError from a failed regular-expression match; found by mypy)."""
+    path = tmp_path / "bad.scc"
+    path.write_text("Total_area = unknown <km^2>\ncrater = {diam, fraction, lon, lat\n}\n")
+    with pytest.raises(ValueError, match="Total_area must start with a number; got 'unknown"):
+        craters.read_scc(path)
+
+
 def test_scc_planar_and_real_sample(tmp_path):
     cat = population(CraterLayer(1e-3, -2.0, 10.0, 100.0), x_range_m=(0, 1e3),
                      y_range_m=(0, 1e3), rng=1)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 from pathlib import Path
 
@@ -354,3 +355,19 @@ def test_window_writer_leaves_nothing_on_error(tmp_path):
     with pytest.raises(ValueError, match="pixel_size_m"):
         dem.WindowWriter(tmp_path / "x.tif", (4, 4))
     assert [p.name for p in tmp_path.iterdir()] == ["w.tif"]
+
+
+def test_read_lattice_tags(tiny_geotiff, caplog):
+    """The expansion level and lattice origin come from the tags; an origin that is not a
+    (row, col) pair is ignored with a warning, as a malformed level is (it was passed on
+    as a 3-tuple and refused by Dem; found by mypy)."""
+    with rasterio.open(tiny_geotiff, "r+") as ds:
+        ds.update_tags(CRATERFORM_LEVEL="1", CRATERFORM_ORIGIN="4,5")
+    d = dem.read(tiny_geotiff)
+    assert (d.level, d.origin) == (1, (4, 5))
+    with rasterio.open(tiny_geotiff, "r+") as ds:
+        ds.update_tags(CRATERFORM_ORIGIN="4,5,6")
+    with caplog.at_level(logging.WARNING, logger="dem.io"):
+        d = dem.read(tiny_geotiff)
+    assert (d.level, d.origin) == (0, (0, 0))
+    assert "ignoring malformed CRATERFORM_LEVEL/CRATERFORM_ORIGIN tags" in caplog.text
