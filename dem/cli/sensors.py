@@ -15,7 +15,7 @@ from latlong.cli.sensor_options import sensor_command
 
 __all__ = ["register"]
 
-_SITE = {"units": False, "vertical": (0.0, 0.0, 1.0)}
+_VERTICAL = (0.0, 0.0, 1.0)  # a site's up; sites are in metres (no --units)
 _MODEL = "a layer stack (its folder or manifest.json) or a DEM file"
 
 
@@ -29,8 +29,9 @@ def register(sub) -> None:
     """Add ``camera`` and ``lidar`` to the sub-command parser."""
     sensor_command(sub, "camera", "render camera frames (image, depth, range, normals, "
                    "crater and boulder ids) of a stack or a DEM, with a frames.json manifest",
-                   camera.camera_options(_MODEL, **_SITE), camera.run_camera, _load,
-                   camera.GROUPS)
+                   camera.camera_options(_MODEL, units=False, vertical=_VERTICAL),
+                   camera.run_camera, _load, camera.GROUPS)
     sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a stack or a DEM: "
                    "LAS 1.4 point clouds, range images and lidar.json",
-                   lidar.lidar_options(_MODEL, **_SITE), lidar.run_lidar, _load, lidar.GROUPS)
+                   lidar.lidar_options(_MODEL, units=False, vertical=_VERTICAL),
+                   lidar.run_lidar, _load, lidar.GROUPS)

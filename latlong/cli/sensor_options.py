@@ -68,7 +68,7 @@ def model_options(what: str, model_help: str, *, units: bool = True) -> dict[str
         "output": Setting(help="output folder (created)", flag="-o/--output", required=True,
                           metavar="FOLDER", run=True),
         **({"units": Setting(default_of(load_surface, "units"), "units of a mesh file's "
-                             "coordinates", choices=tuple(sorted(UNITS, key=UNITS.get)),
+                             "coordinates", choices=tuple(sorted(UNITS, key=lambda u: UNITS[u])),
                              run=True)} if units else {}),
         "catalog": Setting(help=f"crater catalog CSV that labels the {what}", run=True,
                            default_text="the model's own, if it has one", also=("craters",)),

@@ -89,10 +89,10 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
                          ("face", frame.face), ("sunlit", frame.sunlit)):
             files[key] = f"{key}_{tag}.npy"
             arrays[key] = arr
-    for key, arr in (("crater_id", frame.crater_id), ("boulder_id", frame.boulder_id)):
-        if arr is not None:
+    for key, ids in (("crater_id", frame.crater_id), ("boulder_id", frame.boulder_id)):
+        if ids is not None:
             files[key] = f"{key}_{tag}.{depth_format}"
-            arrays[key] = arr
+            arrays[key] = ids
     for key, name in files.items():
         _save(folder / name, arrays[key])
     return {"crater_id": None, "boulder_id": None, **files}
@@ -115,7 +115,7 @@ def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
                            frame.pose.quaternion_wxyz, ids=seen,
                            rims=None if rims is None else rims(seen))
         entry["rim_ellipses"] = [{k: (int(e[k]) if k == "crater_id" else float(e[k]))
-                                  for k in ELLIPSE_DTYPE.names} for e in ell]
+                                  for k in ELLIPSE_DTYPE.names or ()} for e in ell]
     return entry
 
 

@@ -153,6 +153,7 @@ def _beam_arrays(settings: LidarSettings) -> tuple[np.ndarray, np.ndarray]:
         dirs = np.stack([np.sin(off) * np.cos(az), np.sin(off) * np.sin(az), np.cos(off)], 1)
         return dirs, np.arange(n) / settings.pulse_rate_hz
     k = settings.intrinsics()
+    assert k is not None  # the grid patterns have a pinhole (the rosette returned above)
     i, j = np.meshgrid(np.arange(w) + 0.5, np.arange(h) + 0.5)
     dirs = np.stack([(i - k["cx"]) / k["fx"], (j - k["cy"]) / k["fy"], np.ones_like(i)],
                     -1).reshape(-1, 3)
@@ -320,7 +321,7 @@ def _trace_beams(mesh: RayMesh, settings: LidarSettings, origin, rot, axes_s, ax
     counts = np.zeros(nb, dtype=np.int64)
     rng_out, lam_out = np.zeros((nb, nmax)), np.zeros((nb, nmax))
     best_out = np.zeros((nb, nmax), dtype=np.int64)
-    best = (np.zeros((nb, nmax)), np.full((nb, nmax), -1, dtype=np.int64),
+    best: tuple = (np.zeros((nb, nmax)), np.full((nb, nmax), -1, dtype=np.int64),
             np.zeros((nb, nmax, 3))) if labelled else (None, None, None)
     step = max(1, _SUBRAYS_PER_CHUNK // nr)
     for s in range(0, nb, step):
@@ -345,7 +346,9 @@ def _return_labels(traced: _Traced, origin, beam, ks, ground_truth):
     """Crater and boulder ids of the returns (at each return's strongest sub-ray hit)."""
     labels_c = np.full(len(beam), -1)
     labels_b = np.full(len(beam), -1)
-    if ground_truth is not None:
+    if ground_truth is not None:  # then the frame was traced labelled: best_* are set
+        assert traced.best_t is not None and traced.best_dir is not None \
+            and traced.best_face is not None
         if ground_truth.craters is not None:
             pts = origin + traced.best_t[beam, ks, None] * traced.best_dir[beam, ks]
             labels_c = crater_labels(pts, ground_truth.craters)

@@ -131,8 +131,8 @@ def read_poses_toml(path) -> Poses:
             raise ValueError(f"poses {str(path)!r} frame {i}: needs exactly {sorted(keys)}; "
                              f"got {sorted(f)}")
     try:
-        return Poses([f["time_s"] for f in frames], [f["position_m"] for f in frames],
-                     [f["quaternion_wxyz"] for f in frames])
+        return Poses(*(np.array([f[k] for f in frames], dtype=np.float64)
+                       for k in ("time_s", "position_m", "quaternion_wxyz")))
     except (TypeError, ValueError) as exc:
         raise ValueError(f"poses {str(path)!r}: {exc}") from None
 
