@@ -26,6 +26,7 @@ from craters.boulders import (
     draw_boulder_layer,
     iter_boulder_meshes,
     mesh_chunk,
+    near_crater_draws,
     orientations,
     parse_boulder_spec,
     placed_columns,
@@ -74,12 +75,9 @@ def boulder_population(body: Body, layers, *, rng=None) -> np.ndarray:
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
             assert cat is not None  # n_near > 0 needs craters
-            weights = cat["diameter_m"] ** 2
-            pick = rng.choice(len(cat), n_near, p=weights / weights.sum())
-            r = 0.5 * cat["diameter_m"][pick] * rng.uniform(1.0, 2.0, n_near)
+            pick, r, az = near_crater_draws(cat["diameter_m"], n_near, rng)
             rloc = np.asarray(body.radius_m)
-            la2, lo2 = _move(cat["lat_deg"][pick], cat["lon_deg"][pick], r / rloc,
-                             rng.uniform(0, 2 * np.pi, n_near))
+            la2, lo2 = _move(cat["lat_deg"][pick], cat["lon_deg"][pick], r / rloc, az)
             lat[:n_near], lon[:n_near] = la2, lo2
         parts.append(_craters.make_catalog(lat_deg=lat, lon_deg=lon, **cols))
     return np.concatenate(parts)

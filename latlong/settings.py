@@ -10,6 +10,7 @@ import dataclasses
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import craters as _craters
 from craters._shared import ParameterError, ParameterTypeError, physical_memory_bytes
@@ -211,8 +212,8 @@ class ShapeBase:
     @property
     def radius_m(self) -> float:
         """Volume-equivalent radius of the model, metres."""
-        assert isinstance(self.model, ShapeModel)  # __post_init__ read it
-        return (3.0 * self.model.volume_m3 / (4.0 * math.pi)) ** (1.0 / 3.0)
+        model = cast(ShapeModel, self.model)  # __post_init__ read the file
+        return (3.0 * model.volume_m3 / (4.0 * math.pi)) ** (1.0 / 3.0)
 
 
 def _center(value):

@@ -25,6 +25,7 @@ from .placement import (
     MIN_BURIAL,
     BoulderLayer,
     draw_boulder_layer,
+    near_crater_draws,
     orientations,
     parse_boulder_spec,
     placed_columns,
@@ -35,5 +36,6 @@ from .placement import (
 __all__ = ["MIN_BURIAL", "BoulderLayer", "BoulderNode", "BoulderShape", "boulder",
            "boulder_faces", "boulder_meshes", "boulder_world_meshes",
            "catalog_shape", "draw_boulder_layer", "iter_boulder_meshes", "mesh_chunk",
+           "near_crater_draws",
            "orientations", "parse_boulder_spec", "placed_columns", "quaternions",
            "rest_on_ground"]

@@ -16,7 +16,7 @@ from .._shared import check_finite, check_positive, check_range, parse_spec
 from ..population import sample_power_law_diameters
 from .meshes import BoulderShape
 
-__all__ = ["MIN_BURIAL", "BoulderLayer", "draw_boulder_layer", "orientations",
+__all__ = ["MIN_BURIAL", "BoulderLayer", "draw_boulder_layer", "near_crater_draws", "orientations",
            "parse_boulder_spec", "placed_columns", "quaternions", "rest_on_ground"]
 
 
@@ -93,6 +93,19 @@ def draw_boulder_layer(layer: BoulderLayer, area_m2: float, index: int, rng) -> 
 
 #: Lowest vertices (along the normal) tested first for a boulder's deepest point.
 _CANDIDATES = 64
+
+
+def near_crater_draws(diameter_m, n_near: int, rng) -> tuple[np.ndarray, np.ndarray,
+                                                             np.ndarray]:
+    """Where ``n_near`` boulders thrown out by craters of ``diameter_m`` lie: for each a
+    crater row picked with weight D^2, a distance from its centre in [1, 2] crater radii
+    (metres) and an azimuth in [0, 2 pi) (radians), drawn from the Generator ``rng`` in
+    that order (the same draws on every kind of body)."""
+    diameter_m = np.asarray(diameter_m)
+    weights = diameter_m ** 2
+    pick = rng.choice(len(diameter_m), n_near, p=weights / weights.sum())
+    r = 0.5 * diameter_m[pick] * rng.uniform(1.0, 2.0, n_near)
+    return pick, r, rng.uniform(0.0, 2.0 * np.pi, n_near)
 
 
 def orientations(normals, azimuth_rad) -> np.ndarray:

@@ -23,6 +23,7 @@ from craters.boulders import (
     boulder_meshes,
     draw_boulder_layer,
     mesh_chunk,
+    near_crater_draws,
     orientations,
     placed_columns,
     rest_on_ground,
@@ -68,10 +69,7 @@ def mesh_boulder_population(surface: MeshSurface, layers, *, rng=None) -> np.nda
         n_near = int(round(la.near * n)) if cat is not None and len(cat) else 0
         if n_near:
             assert cat is not None  # n_near > 0 needs craters
-            weights = cat["diameter_m"] ** 2
-            pick = rng.choice(len(cat), n_near, p=weights / weights.sum())
-            r = 0.5 * cat["diameter_m"][pick] * rng.uniform(1.0, 2.0, n_near)
-            az = rng.uniform(0.0, 2.0 * np.pi, n_near)
+            pick, r, az = near_crater_draws(cat["diameter_m"], n_near, rng)
             up = np.stack([cat["normal_x"], cat["normal_y"], cat["normal_z"]], 1)[pick]
             ref = np.where(np.abs(up[:, 2:]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
             east = np.cross(ref, up)
