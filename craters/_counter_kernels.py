@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numba import njit, prange
 
@@ -49,3 +51,97 @@ def _philox_kernel(counters, keys, out):
         out[i, 1] = c1
         out[i, 2] = c2
         out[i, 3] = c3
+
+
+# --------------------------------------------------------------------------- portable math
+# exp and log in +, -, *, / only (the algorithms of fdlibm's e_exp.c and e_log.c, Sun
+# Microsystems 1993), so their bytes do not depend on the libm or the CPU (numba does not
+# contract a * b + c into a fused multiply-add without fastmath).
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
+_INV_LN2 = 1.44269504088896338700e+00
+_P1 = 1.66666666666666019037e-01
+_P2 = -2.77777777770155933842e-03
+_P3 = 6.61375632143793436117e-05
+_P4 = -1.65339022054652515390e-06
+_P5 = 4.13813679705723846039e-08
+_EXP_MAX = 7.09782712893383973096e+02
+_EXP_MIN = -7.45133219101941108420e+02
+_LG1 = 6.666666666666735130e-01
+_LG2 = 3.999999999940941908e-01
+_LG3 = 2.857142874366239149e-01
+_LG4 = 2.222219843214978396e-01
+_LG5 = 1.818357216161805012e-01
+_LG6 = 1.531383769920937332e-01
+_LG7 = 1.479819860511658591e-01
+_SQRT_HALF = 0.7071067811865476
+
+
+@njit(cache=True)
+def _exp(x):
+    """e**x, < 1 ulp, the same bytes everywhere (fdlibm's argument reduction and
+    polynomial)."""
+    if x != x:
+        return x
+    if x > _EXP_MAX:
+        return math.inf
+    if x < _EXP_MIN:
+        return 0.0
+    ax = abs(x)
+    if ax < 3.725290298461914e-09:  # 2**-28
+        return 1.0 + x
+    k = 0
+    hi = x
+    lo = 0.0
+    if ax > 0.34657359027997264:  # 0.5 ln 2
+        if ax < 1.0397207708399179:  # 1.5 ln 2
+            k = 1 if x > 0.0 else -1
+        else:
+            k = int(_INV_LN2 * x + (0.5 if x > 0.0 else -0.5))
+        hi = x - k * _LN2_HI
+        lo = k * _LN2_LO
+        x = hi - lo
+    t = x * x
+    c = x - t * (_P1 + t * (_P2 + t * (_P3 + t * (_P4 + t * _P5))))
+    if k == 0:
+        return 1.0 - ((x * c) / (c - 2.0) - x)
+    y = 1.0 - ((lo - (x * c) / (2.0 - c)) - hi)
+    return math.ldexp(y, k)
+
+
+@njit(cache=True)
+def _log(x):
+    """Natural logarithm, < 1 ulp, the same bytes everywhere (fdlibm's reduction to
+    [sqrt(2)/2, sqrt(2)) and polynomial); -inf at 0, nan below."""
+    if x != x or x < 0.0:
+        return math.nan
+    if x == 0.0:
+        return -math.inf
+    if x == math.inf:
+        return x
+    m, e = math.frexp(x)
+    if m < _SQRT_HALF:
+        m = 2.0 * m
+        e -= 1
+    f = m - 1.0
+    k = float(e)
+    s = f / (2.0 + f)
+    z = s * s
+    w = z * z
+    t1 = w * (_LG2 + w * (_LG4 + w * _LG6))
+    t2 = z * (_LG1 + w * (_LG3 + w * (_LG5 + w * _LG7)))
+    r = t2 + t1
+    hfsq = 0.5 * f * f
+    return k * _LN2_HI - ((hfsq - (s * (hfsq + r) + k * _LN2_LO)) - f)
+
+
+@njit(cache=True)
+def _exp_kernel(x, out):
+    for i in range(x.shape[0]):
+        out[i] = _exp(x[i])
+
+
+@njit(cache=True)
+def _log_kernel(x, out):
+    for i in range(x.shape[0]):
+        out[i] = _log(x[i])

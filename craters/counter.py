@@ -10,7 +10,10 @@ reference: ``Philox(key=k, counter=c).random_raw(4)`` are the words of counter `
 (the four counter words a 256-bit number, word 0 the lowest).
 
 Only integer arithmetic makes the words, so they are the same bytes on every x86-64
-CPU; the transforms to numbers (:func:`uniform_from_words`) use exact operations only.
+CPU; the transforms to numbers use exact operations (:func:`uniform_from_words`) or
+:func:`portable_exp` and :func:`portable_log`, which use +, -, *, / only (fdlibm's
+algorithms), not the platform's libm, whose last bit may depend on the library version
+and the CPU's instruction set.
 
 Examples
 --------
@@ -25,9 +28,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._counter_kernels import _philox_kernel
+from ._counter_kernels import _exp_kernel, _log_kernel, _philox_kernel
 
-__all__ = ["philox4x64", "uniform_from_words"]
+__all__ = ["philox4x64", "portable_exp", "portable_log", "uniform_from_words"]
 
 _U53 = 2.0 ** -53
 
@@ -78,3 +81,35 @@ def uniform_from_words(words) -> np.ndarray:
     result is a multiple of 2**-53, the same bytes everywhere)."""
     w = np.asarray(words, dtype=np.uint64)
     return (w >> np.uint64(11)).astype(np.float64) * _U53
+
+
+def _elementwise(kernel, x) -> np.ndarray:
+    arr = np.asarray(x, dtype=np.float64)
+    flat = np.ascontiguousarray(arr.ravel())
+    out = np.empty_like(flat)
+    kernel(flat, out)
+    return out.reshape(arr.shape)
+
+
+def portable_exp(x) -> np.ndarray:
+    """e**x elementwise, within 1 ulp of the true value and the same bytes on every
+    machine (fdlibm's ``e_exp.c`` algorithm in +, -, *, /).
+
+    Examples
+    --------
+    >>> float(portable_exp(0.0)), float(portable_exp(1.0))
+    (1.0, 2.718281828459045)
+    """
+    return _elementwise(_exp_kernel, x)
+
+
+def portable_log(x) -> np.ndarray:
+    """Natural logarithm elementwise, within 1 ulp and the same bytes on every machine
+    (fdlibm's ``e_log.c`` algorithm); -inf at 0, nan below 0.
+
+    Examples
+    --------
+    >>> float(portable_log(1.0)), float(portable_log(np.e))
+    (0.0, 1.0)
+    """
+    return _elementwise(_log_kernel, x)
