@@ -145,3 +145,38 @@ def _exp_kernel(x, out):
 def _log_kernel(x, out):
     for i in range(x.shape[0]):
         out[i] = _log(x[i])
+
+
+# --------------------------------------------------------------------------- distributions
+@njit(cache=True)
+def _poisson(u, mean):
+    """The Poisson(``mean``) count whose CDF first exceeds ``u`` (inversion; exact
+    operations but for :func:`_exp`; a CDF that stops growing ends the search)."""
+    p = _exp(-mean)
+    cdf = p
+    k = 0
+    while u >= cdf and p > 0.0:
+        k += 1
+        p = p * mean / k
+        cdf += p
+    return k
+
+
+@njit(cache=True)
+def _poisson_kernel(u, mean, out):
+    for i in range(u.shape[0]):
+        out[i] = _poisson(u[i], mean[i])
+
+
+@njit(cache=True)
+def _power_law(u, d_min, d_max, slope):
+    """The diameter whose cumulative share N(>D) ~ D**slope of [d_min, d_max) is ``u``."""
+    a = _exp(slope * _log(d_min))
+    b = _exp(slope * _log(d_max))
+    return _exp(_log(a - u * (a - b)) / slope)
+
+
+@njit(cache=True)
+def _power_law_kernel(u, d_min, d_max, slope, out):
+    for i in range(u.shape[0]):
+        out[i] = _power_law(u[i], d_min[i], d_max[i], slope[i])

@@ -28,11 +28,21 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._counter_kernels import _exp_kernel, _log_kernel, _philox_kernel
+from ._counter_kernels import (
+    _exp_kernel,
+    _log_kernel,
+    _philox_kernel,
+    _poisson_kernel,
+    _power_law_kernel,
+)
 
-__all__ = ["philox4x64", "portable_exp", "portable_log", "uniform_from_words"]
+__all__ = ["MAX_POISSON_MEAN", "philox4x64", "poisson_from_uniform", "portable_exp",
+           "portable_log", "power_law_from_uniform", "uniform_from_words"]
 
 _U53 = 2.0 ** -53
+#: Largest Poisson mean drawn by inversion (its cost grows with the mean; a cell hierarchy
+#: keeps the mean count of a cell and size bin small).
+MAX_POISSON_MEAN = 500.0
 
 
 def _rows(values, width: int, name: str) -> np.ndarray:
@@ -113,3 +123,53 @@ def portable_log(x) -> np.ndarray:
     (0.0, 1.0)
     """
     return _elementwise(_log_kernel, x)
+
+
+def _uniforms(u) -> np.ndarray:
+    arr = np.asarray(u, dtype=np.float64)
+    if arr.size and not ((arr >= 0.0) & (arr < 1.0)).all():
+        raise ValueError("`u` must hold numbers in [0, 1) (uniform_from_words)")
+    return arr
+
+
+def poisson_from_uniform(u, mean) -> np.ndarray:
+    """Poisson counts of ``mean`` (broadcast with ``u``) by inversion of uniforms ``u`` in
+    [0, 1): the same count for the same (u, mean) everywhere (:func:`portable_exp`).
+
+    Examples
+    --------
+    >>> poisson_from_uniform([0.0, 0.5, 0.99], 3.0).tolist()
+    [0, 3, 8]
+    """
+    u = _uniforms(u)
+    mean = np.asarray(mean, dtype=np.float64)
+    if mean.size and not ((mean >= 0.0) & (mean <= MAX_POISSON_MEAN)).all():
+        raise ValueError(f"`mean` must be in [0, {MAX_POISSON_MEAN:g}]; got "
+                         f"{mean.min():g} .. {mean.max():g}")
+    uu, mm = np.broadcast_arrays(u, mean)
+    out = np.empty(uu.size, dtype=np.int64)
+    _poisson_kernel(np.ascontiguousarray(uu.ravel()), np.ascontiguousarray(mm.ravel()), out)
+    return out.reshape(uu.shape)
+
+
+def power_law_from_uniform(u, d_min, d_max, slope) -> np.ndarray:
+    """Sizes in [``d_min``, ``d_max``) of a cumulative power law N(>D) ~ D**``slope``
+    (``slope`` < 0; a crater size-frequency distribution) from uniforms ``u`` in [0, 1)
+    by inversion; all broadcast; the same bytes everywhere (:func:`portable_exp`).
+
+    Examples
+    --------
+    >>> power_law_from_uniform([0.0, 0.75], 1.0, 4.0, -2.0).round(12).tolist()
+    [1.0, 1.835325870964]
+    """
+    u = _uniforms(u)
+    uu, lo, hi, s = np.broadcast_arrays(u, np.asarray(d_min, np.float64),
+                                        np.asarray(d_max, np.float64),
+                                        np.asarray(slope, np.float64))
+    if uu.size and not ((lo > 0) & (hi > lo) & np.isfinite(hi)).all():
+        raise ValueError("`d_min` and `d_max` must satisfy 0 < d_min < d_max < inf")
+    if uu.size and not ((s < 0) & np.isfinite(s)).all():
+        raise ValueError("`slope` must be finite and < 0 (a cumulative size-frequency law)")
+    out = np.empty(uu.size, dtype=np.float64)
+    _power_law_kernel(*(np.ascontiguousarray(a.ravel()) for a in (uu, lo, hi, s)), out)
+    return out.reshape(uu.shape)

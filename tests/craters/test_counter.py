@@ -174,3 +174,90 @@ def test_the_portable_kernels_match_their_python_reference_bit_for_bit():
     assert portable_exp(x).tobytes() == np.array([_exp_ref(v) for v in x]).tobytes()
     y = np.exp(rng.uniform(-700, 700, 6000))
     assert portable_log(y).tobytes() == np.array([_log_ref(v) for v in y]).tobytes()
+
+
+# ---------------------------------------------------------------- distributions from words
+def _words_uniforms(n, key):
+    from craters.counter import uniform_from_words
+
+    counters = np.zeros((n, 4), dtype=np.uint64)
+    counters[:, 0] = np.arange(n, dtype=np.uint64)
+    return uniform_from_words(philox4x64(counters, key)[:, 0])
+
+
+@pytest.mark.parametrize("mean", [0.0, 0.3, 3.0, 40.0, 400.0])
+def test_poisson_counts_have_the_poisson_distribution(mean):
+    from scipy import stats
+
+    from craters.counter import poisson_from_uniform
+
+    k = poisson_from_uniform(_words_uniforms(40000, (9, int(mean * 10))), mean)
+    assert abs(k.mean() - mean) <= 4.0 * math.sqrt(max(mean, 1e-9) / len(k)) + 1e-12
+    if mean > 0:
+        # the CDF at a few quantiles (inversion: P(k <= q) is exact up to sampling noise)
+        for q in np.unique(stats.poisson.ppf([0.1, 0.5, 0.9], mean)):
+            share = (k <= q).mean()
+            assert abs(share - stats.poisson.cdf(q, mean)) < 0.01
+
+
+def test_poisson_inversion_matches_scipys_quantiles():
+    from scipy import stats
+
+    from craters.counter import poisson_from_uniform
+
+    u = np.linspace(0.0, 0.999, 400)
+    for mean in (0.5, 7.0, 120.0):
+        got = poisson_from_uniform(u, mean)
+        want = stats.poisson.ppf(u, mean)
+        # ties at a CDF step may fall either side by one rounding
+        assert np.abs(got - want).max() <= 1 and (got == want).mean() > 0.97
+
+
+def test_power_law_sizes_follow_the_cumulative_law():
+    from scipy import stats
+
+    from craters.counter import power_law_from_uniform
+
+    d = power_law_from_uniform(_words_uniforms(30000, (3, 3)), 10.0, 1000.0, -1.8)
+    assert d.min() >= 10.0 and d.max() < 1000.0
+    a, b = 10.0 ** -1.8, 1000.0 ** -1.8
+    cdf = lambda x: (a - np.asarray(x) ** -1.8) / (a - b)  # noqa: E731
+    assert stats.kstest(d, cdf).statistic < 0.01
+
+
+@pytest.mark.parametrize(("call", "message"), [
+    (lambda f: f.poisson_from_uniform(1.0, 2.0), "in \\[0, 1\\)"),
+    (lambda f: f.poisson_from_uniform(0.5, 501.0), "mean"),
+    (lambda f: f.poisson_from_uniform(0.5, -1.0), "mean"),
+    (lambda f: f.power_law_from_uniform(0.5, 2.0, 1.0, -2.0), "d_min < d_max"),
+    (lambda f: f.power_law_from_uniform(0.5, 1.0, 2.0, 0.5), "slope"),
+])
+def test_distribution_inputs_are_checked(call, message):
+    import craters.counter as f
+
+    with pytest.raises(ValueError, match=message):
+        call(f)
+
+
+def test_the_distribution_kernels_match_their_python_reference_bit_for_bit():
+    from craters.counter import poisson_from_uniform, power_law_from_uniform
+
+    def poisson_ref(u, mean):
+        p = _exp_ref(-mean)
+        cdf, k = p, 0
+        while u >= cdf and p > 0.0:
+            k += 1
+            p = p * mean / k
+            cdf += p
+        return k
+
+    def power_ref(u, lo, hi, s):
+        a, b = _exp_ref(s * _log_ref(lo)), _exp_ref(s * _log_ref(hi))
+        return _exp_ref(_log_ref(a - u * (a - b)) / s)
+
+    u = _words_uniforms(2000, (11, 12))
+    means = np.linspace(0.0, 60.0, 2000)
+    assert poisson_from_uniform(u, means).tolist() == [poisson_ref(a, m) for a, m in
+                                                       zip(u, means, strict=True)]
+    got = power_law_from_uniform(u, 3.0, 50.0, -2.3)
+    assert got.tobytes() == np.array([power_ref(a, 3.0, 50.0, -2.3) for a in u]).tobytes()
