@@ -7,7 +7,9 @@ with it, in whatever order, on whatever core or machine (DESIGN: locality). crat
 uses Philox4x64-10 (Salmon, Moraes, Dror & Shaw 2011, ``craters.reference("salmon2011")``),
 the generator behind numpy's :class:`numpy.random.Philox`, which the tests use as the
 reference: ``Philox(key=k, counter=c).random_raw(4)`` are the words of counter ``c + 1``
-(the four counter words a 256-bit number, word 0 the lowest).
+(the four counter words a 256-bit number, word 0 the lowest). The splitmix64 hash of the
+existing noise kernels (``craters._rng_kernels``) stays where it is; whole catalogues are
+drawn from Philox, a keyed bijection that passes BigCrush for every key.
 
 Only integer arithmetic makes the words, so they are the same bytes on every x86-64
 CPU; the transforms to numbers use exact operations (:func:`uniform_from_words`) or
