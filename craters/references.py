@@ -34,6 +34,7 @@ The entries, by topic (keys of :data:`REFERENCES`):
   ``perlin2002`` ``steele2014``.
 * Implicit surfaces and meshes: ``wyvill1986`` ``weller2010`` ``zorin1996``
   ``baerentzen2005`` ``lagae2009`` ``galerne2012`` ``ericson2005`` ``max1999``.
+* Randomness of terrain on demand: ``salmon2011`` (counter-based Philox).
 * Sensors: ``moller1997`` ``wald2014`` ``shepperd1978`` ``brown1966`` ``conrady1919``
   ``hofle2007``; photometry ``lommel1887`` ``seeliger1888`` ``mcewen1991`` ``mcewen1996``
   ``hapke1984`` ``hapke1986`` ``hapke2002`` ``hapke2008`` ``hapke2012``
@@ -370,6 +371,11 @@ REFERENCES = _entries(
     _R("max1999", ("Max, N.",), 1999,
        "Weights for computing vertex normals from facet normals",
        "Journal of Graphics Tools 4(2), 1-6", "10.1080/10867651.1999.10487501"),
+    # ---------------------------------------------------------------- randomness
+    _R("salmon2011", ("Salmon, J. K.", "Moraes, M. A.", "Dror, R. O.", "Shaw, D. E."), 2011,
+       "Parallel random numbers: as easy as 1, 2, 3",
+       "Proceedings of SC'11, the International Conference for High Performance Computing, "
+       "Networking, Storage and Analysis (DOI not confirmed)"),
     # ---------------------------------------------------------------- sensors
     _R("moller1997", ("Möller, T.", "Trumbore, B."), 1997,
        "Fast, minimum storage ray-triangle intersection", "Journal of Graphics Tools 2(1), "

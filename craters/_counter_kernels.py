@@ -1,0 +1,182 @@
+"""Numba kernel of :mod:`craters.counter`: Philox4x64-10 (Salmon et al. 2011)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+_M0 = np.uint64(0xD2E7470EE14C6C93)
+_M1 = np.uint64(0xCA5A826395121157)
+_W0 = np.uint64(0x9E3779B97F4A7C15)
+_W1 = np.uint64(0xBB67AE8584CAA73B)
+_LOW32 = np.uint64(0xFFFFFFFF)
+_S32 = np.uint64(32)
+
+
+@njit(cache=True, inline="always")
+def _mulhilo(a, b):
+    """(high, low) 64-bit halves of the 128-bit product of two uint64."""
+    a_lo = a & _LOW32
+    a_hi = a >> _S32
+    b_lo = b & _LOW32
+    b_hi = b >> _S32
+    p0 = a_lo * b_lo
+    p1 = a_lo * b_hi
+    p2 = a_hi * b_lo
+    p3 = a_hi * b_hi
+    carry = ((p0 >> _S32) + (p1 & _LOW32) + (p2 & _LOW32)) >> _S32
+    return p3 + (p1 >> _S32) + (p2 >> _S32) + carry, a * b
+
+
+@njit(cache=True, parallel=True)
+def _philox_kernel(counters, keys, out):
+    """out[i] = Philox4x64-10(counters[i], keys[i]); rows independent."""
+    for i in prange(counters.shape[0]):
+        c0 = counters[i, 0]
+        c1 = counters[i, 1]
+        c2 = counters[i, 2]
+        c3 = counters[i, 3]
+        k0 = keys[i, 0]
+        k1 = keys[i, 1]
+        for r in range(10):
+            if r > 0:
+                k0 = k0 + _W0
+                k1 = k1 + _W1
+            hi0, lo0 = _mulhilo(_M0, c0)
+            hi1, lo1 = _mulhilo(_M1, c2)
+            c0, c1, c2, c3 = hi1 ^ c1 ^ k0, lo1, hi0 ^ c3 ^ k1, lo0
+        out[i, 0] = c0
+        out[i, 1] = c1
+        out[i, 2] = c2
+        out[i, 3] = c3
+
+
+# --------------------------------------------------------------------------- portable math
+# exp and log in +, -, *, / only (the algorithms of fdlibm's e_exp.c and e_log.c, Sun
+# Microsystems 1993), so their bytes do not depend on the libm or the CPU (numba does not
+# contract a * b + c into a fused multiply-add without fastmath).
+_LN2_HI = 6.93147180369123816490e-01
+_LN2_LO = 1.90821492927058770002e-10
+_INV_LN2 = 1.44269504088896338700e+00
+_P1 = 1.66666666666666019037e-01
+_P2 = -2.77777777770155933842e-03
+_P3 = 6.61375632143793436117e-05
+_P4 = -1.65339022054652515390e-06
+_P5 = 4.13813679705723846039e-08
+_EXP_MAX = 7.09782712893383973096e+02
+_EXP_MIN = -7.45133219101941108420e+02
+_LG1 = 6.666666666666735130e-01
+_LG2 = 3.999999999940941908e-01
+_LG3 = 2.857142874366239149e-01
+_LG4 = 2.222219843214978396e-01
+_LG5 = 1.818357216161805012e-01
+_LG6 = 1.531383769920937332e-01
+_LG7 = 1.479819860511658591e-01
+_SQRT_HALF = 0.7071067811865476
+
+
+@njit(cache=True)
+def _exp(x):
+    """e**x, < 1 ulp, the same bytes everywhere (fdlibm's argument reduction and
+    polynomial)."""
+    if x != x:
+        return x
+    if x > _EXP_MAX:
+        return math.inf
+    if x < _EXP_MIN:
+        return 0.0
+    ax = abs(x)
+    if ax < 3.725290298461914e-09:  # 2**-28
+        return 1.0 + x
+    k = 0
+    hi = x
+    lo = 0.0
+    if ax > 0.34657359027997264:  # 0.5 ln 2
+        if ax < 1.0397207708399179:  # 1.5 ln 2
+            k = 1 if x > 0.0 else -1
+        else:
+            k = int(_INV_LN2 * x + (0.5 if x > 0.0 else -0.5))
+        hi = x - k * _LN2_HI
+        lo = k * _LN2_LO
+        x = hi - lo
+    t = x * x
+    c = x - t * (_P1 + t * (_P2 + t * (_P3 + t * (_P4 + t * _P5))))
+    if k == 0:
+        return 1.0 - ((x * c) / (c - 2.0) - x)
+    y = 1.0 - ((lo - (x * c) / (2.0 - c)) - hi)
+    return math.ldexp(y, k)
+
+
+@njit(cache=True)
+def _log(x):
+    """Natural logarithm, < 1 ulp, the same bytes everywhere (fdlibm's reduction to
+    [sqrt(2)/2, sqrt(2)) and polynomial); -inf at 0, nan below."""
+    if x != x or x < 0.0:
+        return math.nan
+    if x == 0.0:
+        return -math.inf
+    if x == math.inf:
+        return x
+    m, e = math.frexp(x)
+    if m < _SQRT_HALF:
+        m = 2.0 * m
+        e -= 1
+    f = m - 1.0
+    k = float(e)
+    s = f / (2.0 + f)
+    z = s * s
+    w = z * z
+    t1 = w * (_LG2 + w * (_LG4 + w * _LG6))
+    t2 = z * (_LG1 + w * (_LG3 + w * (_LG5 + w * _LG7)))
+    r = t2 + t1
+    hfsq = 0.5 * f * f
+    return k * _LN2_HI - ((hfsq - (s * (hfsq + r) + k * _LN2_LO)) - f)
+
+
+@njit(cache=True)
+def _exp_kernel(x, out):
+    for i in range(x.shape[0]):
+        out[i] = _exp(x[i])
+
+
+@njit(cache=True)
+def _log_kernel(x, out):
+    for i in range(x.shape[0]):
+        out[i] = _log(x[i])
+
+
+# --------------------------------------------------------------------------- distributions
+@njit(cache=True)
+def _poisson(u, mean):
+    """The Poisson(``mean``) count whose CDF first exceeds ``u`` (inversion; exact
+    operations but for :func:`_exp`; a CDF that stops growing ends the search)."""
+    p = _exp(-mean)
+    cdf = p
+    k = 0
+    while u >= cdf and p > 0.0:
+        k += 1
+        p = p * mean / k
+        cdf += p
+    return k
+
+
+@njit(cache=True)
+def _poisson_kernel(u, mean, out):
+    for i in range(u.shape[0]):
+        out[i] = _poisson(u[i], mean[i])
+
+
+@njit(cache=True)
+def _power_law(u, d_min, d_max, slope):
+    """The diameter whose cumulative share N(>D) ~ D**slope of [d_min, d_max) is ``u``."""
+    a = _exp(slope * _log(d_min))
+    b = _exp(slope * _log(d_max))
+    return _exp(_log(a - u * (a - b)) / slope)
+
+
+@njit(cache=True)
+def _power_law_kernel(u, d_min, d_max, slope, out):
+    for i in range(u.shape[0]):
+        out[i] = _power_law(u[i], d_min[i], d_max[i], slope[i])
