@@ -55,8 +55,8 @@ def _philox_kernel(counters, keys, out):
 
 # --------------------------------------------------------------------------- portable math
 # exp and log in +, -, *, / only (the algorithms of e_exp.c and e_log.c of fdlibm, Sun
-# Microsystems' freely distributable libm), so their bytes do not depend on the libm or the CPU (numba does not
-# contract a * b + c into a fused multiply-add without fastmath).
+# Microsystems' freely distributable libm), so their bytes do not depend on the libm or
+# the CPU (numba does not contract a * b + c into a fused multiply-add without fastmath).
 _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
 _INV_LN2 = 1.44269504088896338700e+00
