@@ -54,9 +54,9 @@ def _philox_kernel(counters, keys, out):
 
 
 # --------------------------------------------------------------------------- portable math
-# exp and log in +, -, *, / only (the algorithms of fdlibm's e_exp.c and e_log.c, Sun
-# Microsystems 1993), so their bytes do not depend on the libm or the CPU (numba does not
-# contract a * b + c into a fused multiply-add without fastmath).
+# exp and log in +, -, *, / only (the algorithms of e_exp.c and e_log.c of fdlibm, Sun
+# Microsystems' freely distributable libm), so their bytes do not depend on the libm or
+# the CPU (numba does not contract a * b + c into a fused multiply-add without fastmath).
 _LN2_HI = 6.93147180369123816490e-01
 _LN2_LO = 1.90821492927058770002e-10
 _INV_LN2 = 1.44269504088896338700e+00
@@ -180,3 +180,105 @@ def _power_law(u, d_min, d_max, slope):
 def _power_law_kernel(u, d_min, d_max, slope, out):
     for i in range(u.shape[0]):
         out[i] = _power_law(u[i], d_min[i], d_max[i], slope[i])
+
+
+# fdlibm s_atan.c: atan in +, -, *, / (the same bytes everywhere)
+_ATAN_HI = (4.63647609000806093515e-01, 7.85398163397448278999e-01,
+            9.82793723247329054082e-01, 1.57079632679489655800e+00)
+_ATAN_LO = (2.26987774529616870924e-17, 3.06161699786838301793e-17,
+            1.39033110312309984516e-17, 6.12323399573676603587e-17)
+_AT = (3.33333333333329318027e-01, -1.99999999998764832476e-01,
+       1.42857142725034663711e-01, -1.11111104054623557880e-01,
+       9.09088713343650656196e-02, -7.69187620504482999495e-02,
+       6.66107313738753120669e-02, -5.83357013379057348645e-02,
+       4.97687799461593236017e-02, -3.65315727442169155270e-02,
+       1.62858201153657823623e-02)
+
+
+@njit(cache=True)
+def _atan(x):
+    """atan(x), < 1 ulp, the same bytes everywhere (fdlibm's ``s_atan.c``)."""
+    if x != x:
+        return x
+    neg = x < 0.0
+    ax = -x if neg else x
+    if ax >= 3.602879701896397e16:  # 2**55: atan = +-pi/2
+        r = _ATAN_HI[3] + _ATAN_LO[3]
+        return -r if neg else r
+    idx = -1
+    if ax < 0.4375:
+        if ax < 3.725290298461914e-09:  # 2**-28
+            return x
+    elif ax < 1.1875:
+        if ax < 0.6875:  # 7/16 <= |x| < 11/16
+            idx = 0
+            ax = (2.0 * ax - 1.0) / (2.0 + ax)
+        else:  # 11/16 <= |x| < 19/16
+            idx = 1
+            ax = (ax - 1.0) / (ax + 1.0)
+    elif ax < 2.4375:  # 19/16 <= |x| < 39/16
+        idx = 2
+        ax = (ax - 1.5) / (1.0 + 1.5 * ax)
+    else:  # 39/16 <= |x| < 2**55
+        idx = 3
+        ax = -1.0 / ax
+    z = ax * ax
+    w = z * z
+    s1 = z * (_AT[0] + w * (_AT[2] + w * (_AT[4] + w * (_AT[6] + w * (_AT[8] + w * _AT[10])))))
+    s2 = w * (_AT[1] + w * (_AT[3] + w * (_AT[5] + w * (_AT[7] + w * _AT[9]))))
+    if idx < 0:
+        r = ax - ax * (s1 + s2)
+    else:
+        r = _ATAN_HI[idx] - ((ax * (s1 + s2) - _ATAN_LO[idx]) - ax)
+    return -r if neg else r
+
+
+@njit(cache=True)
+def _atan_kernel(x, out):
+    for i in range(x.shape[0]):
+        out[i] = _atan(x[i])
+
+
+# --------------------------------------------------------------------------- cells
+@njit(cache=True)
+def _cell_of_kernel(points, level, out):
+    """(face, i, j) of each point's gnomonic cube cell at ``level`` (craters.cells)."""
+    n = 1 << level
+    for k in range(points.shape[0]):
+        x = points[k, 0]
+        y = points[k, 1]
+        z = points[k, 2]
+        ax = abs(x)
+        ay = abs(y)
+        az = abs(z)
+        if ax >= ay and ax >= az:
+            a, m, p, q = 0, x, y, z
+        elif ay >= az:
+            a, m, p, q = 1, y, z, x
+        else:
+            a, m, p, q = 2, z, x, y
+        am = abs(m)
+        u = p / am
+        v = q / am
+        i = int(np.floor((u + 1.0) * 0.5 * n))
+        j = int(np.floor((v + 1.0) * 0.5 * n))
+        out[k, 0] = 2 * a + (0 if m > 0.0 else 1)
+        out[k, 1] = min(max(i, 0), n - 1)
+        out[k, 2] = min(max(j, 0), n - 1)
+
+
+@njit(cache=True)
+def _corner_angle(u, v):
+    return _atan(u * v / np.sqrt(1.0 + u * u + v * v))
+
+
+@njit(cache=True)
+def _cell_solid_angle_kernel(level, i, j, out):
+    scale = 2.0 / (1 << level)
+    for k in range(i.shape[0]):
+        u0 = -1.0 + i[k] * scale
+        u1 = -1.0 + (i[k] + 1) * scale
+        v0 = -1.0 + j[k] * scale
+        v1 = -1.0 + (j[k] + 1) * scale
+        out[k] = (_corner_angle(u1, v1) - _corner_angle(u0, v1)) \
+            - (_corner_angle(u1, v0) - _corner_angle(u0, v0))

@@ -173,5 +173,6 @@ def power_law_from_uniform(u, d_min, d_max, slope) -> np.ndarray:
     if uu.size and not ((s < 0) & np.isfinite(s)).all():
         raise ValueError("`slope` must be finite and < 0 (a cumulative size-frequency law)")
     out = np.empty(uu.size, dtype=np.float64)
-    _power_law_kernel(*(np.ascontiguousarray(a.ravel()) for a in (uu, lo, hi, s)), out)
+    flat = [np.ascontiguousarray(a.ravel()) for a in (uu, lo, hi, s)]
+    _power_law_kernel(flat[0], flat[1], flat[2], flat[3], out)
     return out.reshape(uu.shape)
