@@ -73,9 +73,9 @@ def cell_parts(ids) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(level, face, i, j) int64 arrays of cell ids."""
     c = np.asarray(ids, dtype=np.uint64)
     mask = np.uint64((1 << 27) - 1)
-    return tuple((x.astype(np.int64)) for x in (
-        c >> np.uint64(57), (c >> np.uint64(54)) & np.uint64(7), (c >> np.uint64(27)) & mask,
-        c & mask))  # type: ignore[return-value]  # a 4-tuple by construction
+    return ((c >> np.uint64(57)).astype(np.int64),
+            ((c >> np.uint64(54)) & np.uint64(7)).astype(np.int64),
+            ((c >> np.uint64(27)) & mask).astype(np.int64), (c & mask).astype(np.int64))
 
 
 def cell_solid_angle(level: int, face, i, j) -> np.ndarray:
@@ -100,9 +100,6 @@ def cell_points(level: int, face, i, j, fu, fv) -> np.ndarray:
     v = -1.0 + (jj + np.asarray(b, np.float64)) * scale
     axis = f.astype(np.int64) // 2
     sign = np.where(f.astype(np.int64) % 2 == 0, 1.0, -1.0)
-    out = np.empty(u.shape + (3,))
-    rows = np.arange(u.size).reshape(u.shape)
-    out.reshape(-1, 3)[rows.ravel(), axis.ravel()] = sign.ravel()
-    out.reshape(-1, 3)[rows.ravel(), ((axis + 1) % 3).ravel()] = u.ravel()
-    out.reshape(-1, 3)[rows.ravel(), ((axis + 2) % 3).ravel()] = v.ravel()
+    local = np.stack([sign, u, v], axis=-1)  # along the face's axis, a + 1, a + 2
+    out = np.take_along_axis(local, (np.arange(3) - axis[..., None]) % 3, axis=-1)
     return out / np.sqrt((out * out).sum(axis=-1, keepdims=True))
