@@ -261,7 +261,8 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         implicit_surface,
         sphere_packing,
     )
-    from .loader import MeshData, load_surface
+    from .loader import load_surface
+    from .meshio.readers import MeshData
     from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
     from .presets import PRESETS
     from .preview import PreviewSettings, render_preview

@@ -19,9 +19,9 @@ from craters._shared import ParameterError, check_choice
 from craters._shared.files import check_regular_file
 
 from .body import load
-from .meshio.readers import MESH_READ_SUFFIXES, UNITS, MeshData, read_mesh
+from .meshio.readers import MESH_READ_SUFFIXES, UNITS, read_mesh
 
-__all__ = ["MeshData", "load_surface"]
+__all__ = ["load_surface"]
 
 
 def load_surface(path, *, units: str = "m"):
