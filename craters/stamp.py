@@ -47,7 +47,7 @@ from .targets import Target, get_target
 logger = logging.getLogger(__name__)
 
 __all__ = ["Crater", "Roughness", "StampRequest", "StampingProfiles", "resolve_roughness",
-           "rim_perturbations", "stamp", "stamp_many", "stamp_request", "stamped_after",
+           "rim_perturbations", "rim_perturbations_from_phases", "stamp", "stamp_many", "stamp_request", "stamped_after",
            "stamping_profiles"]
 
 _HARMONICS = np.arange(2, 17)
@@ -112,8 +112,16 @@ def rim_perturbations(n: int, irregularity, *, rng=None) -> np.ndarray:
     its largest magnitude is ``irregularity`` (scalar or per row).
     """
     rng = normalize_rng(rng)
+    return rim_perturbations_from_phases(
+        rng.uniform(0.0, 2 * np.pi, size=(n, _HARMONICS.size)), irregularity)
+
+
+def rim_perturbations_from_phases(phases, irregularity) -> np.ndarray:
+    """:func:`rim_perturbations` of given phases (n, 15) in [0, 2 pi) of the harmonics
+    2..16 (row c depends only on ``phases[c]``: for craters drawn from counter words)."""
+    phases = np.ascontiguousarray(phases, dtype=np.float64)
+    n = phases.shape[0]
     irr = np.broadcast_to(np.asarray(irregularity, dtype=np.float64), (n,))
-    phases = rng.uniform(0.0, 2 * np.pi, size=(n, _HARMONICS.size))
     amps = _HARMONICS.astype(float) ** -1.5
     # sum_k a_k cos(k theta + phi_k) at theta = -pi + 2 pi j / 64, by an inverse real FFT:
     # the shift by -pi is the factor (-1)^k

@@ -1,0 +1,198 @@
+"""Crater catalogues drawn cell by cell: the craters of any region, the same as the whole
+body's there (terrain on demand).
+
+A power-law layer (:class:`craters.CraterLayer`) is split into size bins
+``[2**b, 2**(b + 1))`` metres (clipped to the layer's range). Bin ``b`` is drawn per
+cell of one level of the cube-sphere hierarchy (:mod:`craters.cells`): a Poisson count
+of mean ``area x (N(lo) - N(hi))``, then per crater its diameter (inverse power law),
+age (uniform in the layer's range), position (uniform in the cell's solid angle),
+rim-shape phases and roughness seed. Every number comes from the Philox words of the
+counter ``(cell id, layer << 32 | bin + 2**31, crater index, purpose)`` under the key
+``(seed, 0x6372617465727300)`` through exact or portable transforms
+(:mod:`craters.counter`), so a crater depends on nothing but its own counter: any set of
+cells asked in any order, on any core, gives each cell the same craters.
+
+The caller chooses the cells (those that can reach its region) and the level of each
+bin (:func:`bin_level`: a function of the bin and the body, never of the region asked),
+and gives each cell's area on its surface.
+
+Examples
+--------
+>>> from craters import CraterLayer
+>>> la = CraterLayer(0.5, -2.0, 1.0, 8.0)
+>>> bins(la).tolist()
+[0, 1, 2]
+>>> a = draw_cells(la, 0, seed=1, b=1, level=20, cell_ids=[(20 << 57) | 5], area_m2=[400.0])
+>>> bool(((a["diameter_m"] >= 2) & (a["diameter_m"] < 4)).all())
+True
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .cells import cell_parts, cell_points
+from .counter import philox4x64, poisson_from_uniform, portable_exp, portable_log, \
+    power_law_from_uniform, uniform_from_words
+from .layers import CraterLayer
+
+__all__ = ["CRATER_KEY", "bin_bounds", "bin_level", "bins", "draw_cells", "min_cell_angle"]
+
+#: The second key word of crater draws ("craters\0").
+CRATER_KEY = 0x6372617465727300
+_BIN_OFFSET = 1 << 31
+_COUNT, _MAIN, _RIM, _POSITION = 0, 1, 2, 16  # counter purposes
+_RIM_COUNTERS = 4  # 16 words for the 15 rim phases
+_MAX_CANDIDATES = 64  # position candidates per crater (acceptance >= 0.19 a candidate)
+_TWO_PI = 2.0 * np.pi
+
+
+def _bin_of(d: float) -> int:
+    """``b`` with ``2**b <= d < 2**(b + 1)``, exactly (``frexp``)."""
+    _, e = np.frexp(d)
+    return int(e) - 1
+
+
+def bins(layer: CraterLayer) -> np.ndarray:
+    """The size bins ``b`` (int64) of a layer: ``[2**b, 2**(b + 1))`` meets
+    ``[d_min_m, d_max_m)``."""
+    if not isinstance(layer, CraterLayer):
+        raise TypeError("terrain on demand draws power-law layers (craters.CraterLayer); got "
+                        f"{type(layer).__name__}")
+    lo = _bin_of(layer.d_min_m)
+    hi = _bin_of(layer.d_max_m)
+    if np.ldexp(1.0, hi) == layer.d_max_m:
+        hi -= 1  # d_max is a bin edge: the bin above it is empty
+    return np.arange(lo, hi + 1, dtype=np.int64)
+
+
+def bin_bounds(layer: CraterLayer, b: int) -> tuple[float, float]:
+    """``(lo, hi)`` metres: bin ``b`` clipped to the layer's range."""
+    return max(float(np.ldexp(1.0, int(b))), layer.d_min_m), \
+        min(float(np.ldexp(1.0, int(b) + 1)), layer.d_max_m)
+
+
+def min_cell_angle(level: int) -> float:
+    """A lower bound of the angular width (radians) of every cell of ``level``: the
+    gnomonic scale ``sqrt(1 + v^2) / (1 + u^2 + v^2)`` is smallest (sqrt(2) / 3 > 0.47)
+    at a face's corners."""
+    return 0.47 * 2.0 ** (1 - int(level))
+
+
+def bin_level(halo_rad: float, max_level: int = 27) -> int:
+    """The deepest level whose cells are all at least ``halo_rad`` wide (0 if none), so
+    that the craters within ``halo_rad`` of a point lie in its cell or the 8 around it."""
+    if not halo_rad > 0:
+        raise ValueError(f"`halo_rad` must be > 0; got {halo_rad!r}")
+    level = 0
+    while level < max_level and min_cell_angle(level + 1) >= halo_rad:
+        level += 1
+    return level
+
+
+def _pow(x: np.ndarray, k: float) -> np.ndarray:
+    """x ** k, the same bytes everywhere (portable exp and log)."""
+    return portable_exp(k * portable_log(x))
+
+
+def _words(cells: np.ndarray, tag: int, index: np.ndarray, purpose: int, seed: int):
+    counters = np.empty((len(cells), 4), dtype=np.uint64)
+    counters[:, 0] = cells
+    counters[:, 1] = np.uint64(tag)
+    counters[:, 2] = index.astype(np.uint64)
+    counters[:, 3] = np.uint64(purpose)
+    return philox4x64(counters, [seed, CRATER_KEY])
+
+
+def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level: int,
+               cell_ids, area_m2) -> dict:
+    """The craters of size bin ``b`` of ``layer`` in the given cells (ids of ``level``).
+
+    Parameters
+    ----------
+    layer, layer_index : CraterLayer, int
+        The layer and its place in the scene (part of every counter).
+    seed : int
+        The scene's seed, in [0, 2**64).
+    area_m2 : (n,) floats
+        Each cell's area on the body's surface (m^2): the Poisson mean of its count is
+        ``area x (N(lo) - N(hi))``.
+
+    Returns
+    -------
+    dict of arrays, one entry per crater, cell by cell in the order given and by index
+    within a cell: ``unit`` (n, 3) direction of the centre, ``diameter_m``, ``age_gyr``,
+    ``rim_phases`` (n, 15), ``seed`` (uint64 roughness seed), ``id`` (uint64), ``cell``
+    (uint64), ``index``.
+    """
+    seed = int(seed)
+    if not 0 <= seed < 2**64:
+        raise ValueError(f"`seed` must be in [0, 2**64); got {seed}")
+    cells = np.ascontiguousarray(np.asarray(cell_ids, dtype=np.uint64).ravel())
+    area = np.asarray(area_m2, dtype=np.float64).ravel()
+    if area.shape != cells.shape:
+        raise ValueError(f"`area_m2` must have one value per cell ({len(cells)}); got "
+                         f"{area.shape}")
+    lo, hi = bin_bounds(layer, b)
+    tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
+    density = layer.c * float(_pow(np.array([lo]), layer.k)[0] - _pow(np.array([hi]), layer.k)[0])
+    zero = np.zeros(len(cells), dtype=np.int64)
+    u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed)[:, 0])
+    counts = poisson_from_uniform(u, area * density)
+    cell = np.repeat(cells, counts)
+    index = np.concatenate([np.arange(n, dtype=np.int64) for n in counts]) if len(cells) \
+        else zero
+    n = len(cell)
+    main = _words(cell, tag, index, _MAIN, seed)
+    um = uniform_from_words(main)
+    diameter = power_law_from_uniform(um[:, 0], lo, hi, layer.k) if n else np.zeros(0)
+    age = layer.age_min_gyr + um[:, 1] * (layer.age_max_gyr - layer.age_min_gyr)
+    rim = np.concatenate([uniform_from_words(_words(cell, tag, index, _RIM + r, seed))
+                          for r in range(_RIM_COUNTERS)], axis=1)[:, :15] * _TWO_PI
+    unit = _positions(cell, tag, index, seed)
+    return {"unit": unit, "diameter_m": diameter, "age_gyr": age, "rim_phases": rim,
+            "seed": main[:, 2] >> np.uint64(1), "id": main[:, 3], "cell": cell,
+            "index": index}
+
+
+def _positions(cell: np.ndarray, tag: int, index: np.ndarray, seed: int) -> np.ndarray:
+    """Uniform directions in each crater's cell: candidates uniform in the cell's
+    tangent-plane square, accepted with probability J / J_max (J = (1 + u^2 + v^2)^-1.5,
+    the gnomonic area element); the last candidate if none of 64 is (never seen: at
+    least 0.19 of the candidates pass, in a level-0 cell)."""
+    n = len(cell)
+    level, face, i, j = cell_parts(cell)
+    scale = 2.0 / np.left_shift(1, level).astype(np.float64)
+    u0 = -1.0 + i * scale
+    v0 = -1.0 + j * scale
+    near_u = np.minimum(np.abs(u0), np.abs(u0 + scale)) * ((u0 > 0) | (u0 + scale < 0))
+    near_v = np.minimum(np.abs(v0), np.abs(v0 + scale)) * ((v0 > 0) | (v0 + scale < 0))
+    s_max = 1.0 + near_u * near_u + near_v * near_v  # J_max = s_max ** -1.5
+    fu = np.zeros(n)
+    fv = np.zeros(n)
+    todo = np.arange(n)
+    for k in range(_MAX_CANDIDATES):
+        if not len(todo):
+            break
+        w = uniform_from_words(_words(cell[todo], tag, index[todo], _POSITION + k, seed))
+        uu = u0[todo] + w[:, 0] * scale[todo]
+        vv = v0[todo] + w[:, 1] * scale[todo]
+        s = 1.0 + uu * uu + vv * vv
+        # accept when w2 < J / J_max = (s_max / s) ** 1.5
+        ratio = s_max[todo] / s
+        ok = w[:, 2] < ratio * np.sqrt(ratio)
+        if k == _MAX_CANDIDATES - 1:
+            ok[:] = True
+        fu[todo[ok]] = w[ok, 0]
+        fv[todo[ok]] = w[ok, 1]
+        todo = todo[~ok]
+    return _cell_point(level, face, i, j, fu, fv) if n else np.zeros((0, 3))
+
+
+def _cell_point(level, face, i, j, fu, fv) -> np.ndarray:
+    """:func:`craters.cells.cell_points` for per-point levels."""
+    out = np.empty((len(level), 3))
+    for lv in np.unique(level):
+        sel = level == lv
+        out[sel] = cell_points(int(lv), face[sel], i[sel], j[sel], fu[sel], fv[sel])
+    return out

@@ -1,0 +1,429 @@
+"""Numba kernels of the local crater field (:mod:`latlong.ondemand.field`).
+
+Every value at a point is computed by one thread from that point's own data in a fixed
+order, so no result depends on which other points are asked with it or on the thread
+count. References in numpy: ``tests/latlong/test_ondemand.py``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from craters.kernels import fbm2, roughness_amp, table, table_value
+
+# crater record columns (float64 array "fc", one row per crater)
+C0, C1, C2 = 0, 1, 2          # centre direction (unit)
+E0, E1, E2 = 3, 4, 5          # east at the centre
+N0, N1, N2 = 6, 7, 8          # north at the centre
+RHO = 9                       # reference radius (the base's, m)
+RAD = 10                      # crater radius (m)
+COS_FAR = 11                  # cos of the widest ejecta edge's angle
+P0, GX, GY, QA, QB, QC = 12, 13, 14, 15, 16, 17   # base quadric (radial heights over RHO)
+SCALE = 18                    # slope-erosion factor of the relief
+DEPTH = 19                    # rim crest to floor of the table (m)
+ACTIVE = 20                   # 1 when stamped (0: erased by slope erosion, or no params yet)
+FAR = 21                      # the widest ejecta edge's angle (radians)
+N_COLS = 22
+
+
+@njit(cache=True, inline="always")
+def _local(fc, k, p0, p1, p2):
+    """(cos angle, distance in metres, x, y in the crater's frame, azimuth) of direction
+    p from crater k's centre (azimuthal equidistant at the crater's reference radius)."""
+    c = fc[k, C0] * p0 + fc[k, C1] * p1 + fc[k, C2] * p2
+    xe = fc[k, E0] * p0 + fc[k, E1] * p1 + fc[k, E2] * p2
+    xn = fc[k, N0] * p0 + fc[k, N1] * p1 + fc[k, N2] * p2
+    s = np.sqrt(xe * xe + xn * xn)
+    dist = np.arctan2(s, c) * fc[k, RHO]
+    if s > 0.0:
+        x = dist * xe / s
+        y = dist * xn / s
+        az = np.arctan2(xn, xe)
+    else:
+        x = 0.0
+        y = 0.0
+        az = 0.0
+    return c, dist, x, y, az
+
+
+@njit(cache=True, inline="always")
+def _quadric(fc, k, x, y):
+    return (fc[k, P0] + fc[k, GX] * x + fc[k, GY] * y + fc[k, QA] * x * x
+            + fc[k, QB] * x * y + fc[k, QC] * y * y)
+
+
+@njit(cache=True, inline="always")
+def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
+    """Crater k at direction p as an affine map of the height before it, h -> a h + b:
+    (touched?, a, b). Inside the rim a = 0 (the crater replaces what was there: its base
+    quadric plus its profile); outside, the profile adds to the old terrain, which is
+    blended into the base quadric towards the rim (weight a = 1 - ((xb - x)/(xb - 1))^2
+    from the rim to ``xb`` radii, 1 beyond), so the rim is continuous whatever the older
+    terrain is."""
+    cosang, dist, x, y, az = _local(fc, k, p0, p1, p2)
+    if cosang < fc[k, COS_FAR]:
+        return False, 1.0, 0.0
+    radius = fc[k, RAD]
+    xr = dist / (radius * (1.0 + table(rims[k], az)))
+    if not xr < xe:
+        return False, 1.0, 0.0
+    scale = fc[k, SCALE]
+    prof = scale * table_value(tabs[k], xr, xe)
+    if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
+        amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
+        prof += amp * fbm2(seeds[k], x, y, radius, octaves, gain)
+    q = fc[k, RHO] + _quadric(fc, k, x, y)
+    if xr <= 1.0:
+        return True, 0.0, q + prof
+    if xr < xb:
+        t = (xb - xr) / (xb - 1.0)
+        w = 1.0 - t * t
+        return True, w, (1.0 - w) * q + prof
+    return True, 1.0, prof
+
+
+@njit(cache=True, inline="always")
+def _compose(order, lo, hi, fc, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2,
+             base, older_than, age_key, d_above, diam):
+    """Height at p from craters ``order[lo:hi]`` (youngest first) over ``base``: the
+    composition of their affine maps, stopping at the first rim that holds p. With
+    ``older_than`` >= 0 only craters older than that age key and larger than ``d_above``
+    count (a crater's base: the terrain of the older, larger craters)."""
+    a = 1.0
+    b = 0.0
+    for t in range(lo, hi):
+        k = order[t]
+        if fc[k, ACTIVE] == 0.0:
+            continue
+        if older_than >= 0 and (age_key[k] <= older_than or not diam[k] > d_above):
+            continue
+        hit, ak, bk = _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2)
+        if not hit:
+            continue
+        b += a * bk
+        a *= ak
+        if a == 0.0:
+            return b
+    return b + a * base
+
+
+@njit(cache=True)
+def _params_kernel(todo, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
+                   rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
+    """Base quadric and slope-erosion factor of each crater in ``todo`` (largest first):
+    the terrain of its older, larger craters (``dep_list[dep_start[k]:dep_start[k+1]]``,
+    youngest first) at its stencil points, fitted by the fixed least-squares operator
+    ``fit`` (6, n_stencil) in the crater's normalised coordinates."""
+    n_st = stencil.shape[1]
+    h = np.empty(n_st)
+    for t in range(todo.shape[0]):
+        k = todo[t]
+        for s in range(n_st):
+            h[s] = _compose(dep_list, dep_start[k], dep_start[k + 1], fc, tabs, rims, seeds,
+                            rough, gain, octaves, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
+                            stencil[k, s, 2], st_base[k, s], age_key[k], age_key, diam[k],
+                            diam) - fc[k, RHO]
+        coef = np.zeros(6)
+        for r in range(6):
+            acc = 0.0
+            for s in range(n_st):
+                acc += fit[r, s] * h[s]
+            coef[r] = acc
+        radius = fc[k, RAD]
+        fc[k, P0] = coef[0]
+        fc[k, GX] = coef[1] / radius
+        fc[k, GY] = coef[2] / radius
+        fc[k, QA] = coef[3] / (radius * radius)
+        fc[k, QB] = coef[4] / (radius * radius)
+        fc[k, QC] = coef[5] / (radius * radius)
+        # slope: the base plane's normal against "up"
+        gx = fc[k, GX]
+        gy = fc[k, GY]
+        l0 = fc[k, C0] - gx * fc[k, E0] - gy * fc[k, N0]
+        l1 = fc[k, C1] - gx * fc[k, E1] - gy * fc[k, N1]
+        l2 = fc[k, C2] - gx * fc[k, E2] - gy * fc[k, N2]
+        r0 = up[k, 0]
+        r1 = up[k, 1]
+        r2 = up[k, 2]
+        cr0 = l1 * r2 - l2 * r1
+        cr1 = l2 * r0 - l0 * r2
+        cr2 = l0 * r1 - l1 * r0
+        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                      l0 * r0 + l1 * r1 + l2 * r2))
+        scale = 1.0
+        if slope_erosion:
+            if slope >= full:
+                scale = 0.0
+            elif slope > onset:
+                scale = (full - slope) / (full - onset)
+        fc[k, SCALE] = scale
+        fc[k, ACTIVE] = 1.0 if scale > 0.0 else 0.0
+
+
+@njit(cache=True, parallel=True)
+def _points_kernel(points, block_of, blk_start, blk_list, base, fc, tabs, rims, seeds, rough,
+                   gain, octaves, xe, xb, age_key, diam, out):
+    """Radius at each point: the composition over its block's craters (youngest first)."""
+    for i in prange(points.shape[0]):
+        blk = block_of[i]
+        out[i] = _compose(blk_list, blk_start[blk], blk_start[blk + 1], fc, tabs, rims, seeds,
+                          rough, gain, octaves, xe, xb, points[i, 0], points[i, 1],
+                          points[i, 2], base[i], -1, age_key, 0.0, diam)
+
+
+# ----------------------------------------------------------------------------- cells
+@njit(cache=True, inline="always")
+def _face_uv(x, y, z):
+    """(face, u, v) of a direction on the gnomonic cube (craters.cells)."""
+    ax = abs(x)
+    ay = abs(y)
+    az = abs(z)
+    if ax >= ay and ax >= az:
+        a, m, p, q = 0, x, y, z
+    elif ay >= az:
+        a, m, p, q = 1, y, z, x
+    else:
+        a, m, p, q = 2, z, x, y
+    am = abs(m)
+    return 2 * a + (0 if m > 0.0 else 1), p / am, q / am
+
+
+@njit(cache=True, inline="always")
+def _cell_id(level, face, u, v):
+    n = 1 << level
+    i = min(max(int(np.floor((u + 1.0) * 0.5 * n)), 0), n - 1)
+    j = min(max(int(np.floor((v + 1.0) * 0.5 * n)), 0), n - 1)
+    return (np.uint64(level) << np.uint64(57)) | (np.uint64(face) << np.uint64(54)) \
+        | (np.uint64(i) << np.uint64(27)) | np.uint64(j)
+
+
+@njit(cache=True)
+def _cells_kernel(points, level, out):
+    """Cell id of each direction at ``level``."""
+    for k in range(points.shape[0]):
+        f, u, v = _face_uv(points[k, 0], points[k, 1], points[k, 2])
+        out[k] = _cell_id(level, f, u, v)
+
+
+@njit(cache=True, inline="always")
+def _face_point(face, u, v):
+    a = face // 2
+    s = 1.0 if face % 2 == 0 else -1.0
+    w = np.empty(3)
+    w[a] = s
+    w[(a + 1) % 3] = u
+    w[(a + 2) % 3] = v
+    return w
+
+
+@njit(cache=True)
+def _neighbourhood_kernel(ids, out):
+    """The 9 cells around each cell (itself and the 8 next to it, across face edges; at a
+    cube corner one of them repeats): ``out`` (n, 9) uint64."""
+    mask = np.uint64((1 << 27) - 1)
+    for k in range(ids.shape[0]):
+        c = ids[k]
+        level = int(c >> np.uint64(57))
+        face = int((c >> np.uint64(54)) & np.uint64(7))
+        i = int((c >> np.uint64(27)) & mask)
+        j = int(c & mask)
+        scale = 2.0 / (1 << level)
+        t = 0
+        for di in (-1, 0, 1):
+            for dj in (-1, 0, 1):
+                u = -1.0 + (i + 0.5 + di) * scale
+                v = -1.0 + (j + 0.5 + dj) * scale
+                w = _face_point(face, u, v)
+                f2, u2, v2 = _face_uv(w[0], w[1], w[2])
+                out[k, t] = _cell_id(level, f2, u2, v2)
+                t += 1
+
+
+@njit(cache=True)
+def _dep_kernel(owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam, out_owner,
+                out_dep):
+    """Pairs (owner, candidate) where a candidate crater of the bin (``cand_sorted``,
+    grouped by cell ``cand_cells`` with ranges ``cand_start``) is larger than the owner
+    and its ejecta reach the owner's rim disc (centres within the candidate's widest
+    ejecta edge plus the owner's radius). Returns the number of pairs (writes as many
+    as fit)."""
+    n = 0
+    for s in range(owners.shape[0]):
+        o = owners[s]
+        for t in range(9):
+            cell = own_cell9[s, t]
+            dup = False
+            for t2 in range(t):
+                if own_cell9[s, t2] == cell:
+                    dup = True
+            if dup:
+                continue
+            pos = np.searchsorted(cand_cells, cell)
+            if pos >= cand_cells.shape[0] or cand_cells[pos] != cell:
+                continue
+            for q in range(cand_start[pos], cand_start[pos + 1]):
+                k = cand_sorted[q]
+                if not diam[k] > diam[o]:
+                    continue
+                c = fc[k, C0] * fc[o, C0] + fc[k, C1] * fc[o, C1] + fc[k, C2] * fc[o, C2]
+                lim = fc[k, FAR] + fc[o, RAD] / fc[o, RHO] * (1.0 + 1e-9)
+                if lim >= np.pi or c >= np.cos(lim):
+                    if n < out_owner.shape[0]:
+                        out_owner[n] = o
+                        out_dep[n] = k
+                    n += 1
+    return n
+
+
+@njit(cache=True)
+def _cap_blocks_kernel(fc, craters, level, occ, cos_margin, out_blk, out_crater):
+    """Pairs (block, crater): the occupied blocks (sorted cell ids ``occ`` at ``level``)
+    that crater caps may reach. A cap narrower than 0.3 rad is projected on each face it
+    can touch and the blocks of its bounding box are looked up; a wider one is tested
+    against every occupied block (its centre within the cap widened by ``cos_margin``,
+    the blocks' angular radius). Returns the number of pairs (writes as many as fit)."""
+    n = 0
+    nside = 1 << level
+    n_samples = 64
+    bp = np.empty((n_samples + 1, 3))
+    for t in range(craters.shape[0]):
+        k = craters[t]
+        cosf = fc[k, COS_FAR]
+        ang = np.arccos(min(1.0, max(-1.0, cosf)))
+        c = np.array([fc[k, C0], fc[k, C1], fc[k, C2]])
+        if ang >= 0.3:
+            # angle(c, block) <= ang + margin
+            cos_tot = np.cos(min(np.pi, ang + np.arccos(cos_margin)))
+            for b in range(occ.shape[0]):
+                cell = occ[b]
+                lv = int(cell >> np.uint64(57))
+                face = int((cell >> np.uint64(54)) & np.uint64(7))
+                i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
+                j = int(cell & np.uint64((1 << 27) - 1))
+                sc = 2.0 / (1 << lv)
+                w = _face_point(face, -1.0 + (i + 0.5) * sc, -1.0 + (j + 0.5) * sc)
+                nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+                if (w[0] * c[0] + w[1] * c[1] + w[2] * c[2]) / nw >= cos_tot:
+                    if n < out_blk.shape[0]:
+                        out_blk[n] = b
+                        out_crater[n] = k
+                    n += 1
+            continue
+        sa = np.sin(ang)
+        for s in range(n_samples):
+            phi = 2.0 * np.pi * s / n_samples
+            for d in range(3):
+                bp[s, d] = cosf * c[d] + sa * (np.cos(phi) * fc[k, E0 + d]
+                                               + np.sin(phi) * fc[k, N0 + d])
+        for d in range(3):
+            bp[n_samples, d] = c[d]
+        for face in range(6):
+            a = face // 2
+            sgn = 1.0 if face % 2 == 0 else -1.0
+            ok = True
+            umin = 1e300
+            umax = -1e300
+            vmin = 1e300
+            vmax = -1e300
+            for s in range(n_samples + 1):
+                m = sgn * bp[s, a]
+                if m <= 0.0:
+                    ok = False
+                    break
+                u = bp[s, (a + 1) % 3] / m
+                v = bp[s, (a + 2) % 3] / m
+                umin = min(umin, u)
+                umax = max(umax, u)
+                vmin = min(vmin, v)
+                vmax = max(vmax, v)
+            if not ok:
+                continue
+            big = max(max(abs(umin), abs(umax)), max(abs(vmin), abs(vmax)))
+            pad = 0.02 * ang * (1.0 + 2.0 * big * big) + 1e-12
+            umin -= pad
+            umax += pad
+            vmin -= pad
+            vmax += pad
+            if umin > 1.0 or umax < -1.0 or vmin > 1.0 or vmax < -1.0:
+                continue
+            i0 = max(int(np.floor((max(umin, -1.0) + 1.0) * 0.5 * nside)), 0)
+            i1 = min(int(np.floor((min(umax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
+            j0 = max(int(np.floor((max(vmin, -1.0) + 1.0) * 0.5 * nside)), 0)
+            j1 = min(int(np.floor((min(vmax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
+            if (i1 - i0 + 1) * (j1 - j0 + 1) > occ.shape[0]:
+                # fewer occupied blocks than cells in the box: test those
+                for pos in range(occ.shape[0]):
+                    cell = occ[pos]
+                    if int((cell >> np.uint64(54)) & np.uint64(7)) != face:
+                        continue
+                    i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
+                    j = int(cell & np.uint64((1 << 27) - 1))
+                    if i0 <= i <= i1 and j0 <= j <= j1:
+                        if n < out_blk.shape[0]:
+                            out_blk[n] = pos
+                            out_crater[n] = k
+                        n += 1
+                continue
+            for i in range(i0, i1 + 1):
+                for j in range(j0, j1 + 1):
+                    cell = (np.uint64(level) << np.uint64(57)) \
+                        | (np.uint64(face) << np.uint64(54)) \
+                        | (np.uint64(i) << np.uint64(27)) | np.uint64(j)
+                    pos = np.searchsorted(occ, cell)
+                    if pos < occ.shape[0] and occ[pos] == cell:
+                        if n < out_blk.shape[0]:
+                            out_blk[n] = pos
+                            out_crater[n] = k
+                        n += 1
+    return n
+
+
+@njit(cache=True)
+def _fit_operator(st_xy):
+    """The least-squares operator (6, n) of the quadric 1, x, y, x^2, xy, y^2 at the
+    stencil's normalised coordinates (normal equations, Cholesky, fixed order)."""
+    n = st_xy.shape[0]
+    a = np.empty((n, 6))
+    for s in range(n):
+        x = st_xy[s, 0]
+        y = st_xy[s, 1]
+        a[s, 0] = 1.0
+        a[s, 1] = x
+        a[s, 2] = y
+        a[s, 3] = x * x
+        a[s, 4] = x * y
+        a[s, 5] = y * y
+    ata = np.zeros((6, 6))
+    for r in range(6):
+        for c in range(6):
+            acc = 0.0
+            for s in range(n):
+                acc += a[s, r] * a[s, c]
+            ata[r, c] = acc
+    # Cholesky
+    lo = np.zeros((6, 6))
+    for r in range(6):
+        for c in range(r + 1):
+            acc = ata[r, c]
+            for t in range(c):
+                acc -= lo[r, t] * lo[c, t]
+            if r == c:
+                lo[r, c] = np.sqrt(acc)
+            else:
+                lo[r, c] = acc / lo[c, c]
+    out = np.empty((6, n))
+    y = np.empty(6)
+    for s in range(n):
+        # solve (L L^T) x = a[s]
+        for r in range(6):
+            acc = a[s, r]
+            for t in range(r):
+                acc -= lo[r, t] * y[t]
+            y[r] = acc / lo[r, r]
+        for r in range(5, -1, -1):
+            acc = y[r]
+            for t in range(r + 1, 6):
+                acc -= lo[t, r] * out[t, s]
+            out[r, s] = acc / lo[r, r]
+    return out

@@ -1,0 +1,183 @@
+"""The base shape of a scene as a function of direction (terrain on demand).
+
+:class:`BaseField` gives the radius of the scene's base (before craters) in any direction,
+the same value whatever other directions are asked with it:
+
+* sphere: the radius;
+* fBm: the radius plus Perlin fBm evaluated at the point itself (the scene's octaves,
+  never the requested resolution); its rotation and offset come from counter words of
+  the seed, not from a generator stream;
+* faulting and shape models: a fixed base grid (the scene's magnitude, at most
+  :data:`MAX_BASE_MAGNITUDE`) interpolated linearly (:meth:`LatLongGrid.interpolate`):
+  faults are global and a shape model holds nothing finer than its facets, so both are
+  made once per scene and read pointwise; a shape's fBm detail is pointwise.
+
+It also gives what crater statistics need from the base: the surface area over a solid
+angle and the "up" slopes are measured against (radial, or against the self-gravity of a
+shape model, from a coarse grid of :func:`latlong.mesh.down_directions`).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+
+import numpy as np
+
+from craters.counter import philox4x64, uniform_from_words
+
+from ..faulting import FaultingParams, two_phase_faulting
+from ..grid import LatLongGrid
+from ..mesh.cratering import down_directions
+from ..perlin import FbmParams, _run_fbm3
+from ..scene import Scene
+from ..settings import ShapeBase, SphereBase
+from ..shapes import from_shape_model
+
+__all__ = ["MAX_BASE_MAGNITUDE", "BaseField", "base_field"]
+
+#: Largest magnitude of the base grid of faulting and shape-model bases.
+MAX_BASE_MAGNITUDE = 1024
+_GRAVITY_MAGNITUDE = 48  # the grid of "up" directions on a shape model
+_BASE_KEY = 0x6261736500000000  # "base"
+
+
+def _rotation_offset(seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """A uniformly random rotation (Shoemake's quaternion from three uniforms) and an
+    offset in [0, 256)^3 from the counter words of ``seed``."""
+    w = uniform_from_words(philox4x64([0, 0, 0, 1], [seed, _BASE_KEY]))[0]
+    o = uniform_from_words(philox4x64([0, 0, 0, 2], [seed, _BASE_KEY]))[0]
+    u1, u2, u3 = (float(x) for x in w[:3])
+    a, b = math.sqrt(1.0 - u1), math.sqrt(u1)
+    qw, qx, qy, qz = (a * math.sin(2 * math.pi * u2), a * math.cos(2 * math.pi * u2),
+                      b * math.sin(2 * math.pi * u3), b * math.cos(2 * math.pi * u3))
+    rot = np.array([
+        [1 - 2 * (qy * qy + qz * qz), 2 * (qx * qy - qz * qw), 2 * (qx * qz + qy * qw)],
+        [2 * (qx * qy + qz * qw), 1 - 2 * (qx * qx + qz * qz), 2 * (qy * qz - qx * qw)],
+        [2 * (qx * qz - qy * qw), 2 * (qy * qz + qx * qw), 1 - 2 * (qx * qx + qy * qy)]])
+    return rot, 256.0 * o[:3]
+
+
+class BaseField:
+    """The radius of a scene's base shape in any direction (module notes)."""
+
+    def __init__(self, scene: Scene):
+        if not isinstance(scene, Scene):
+            raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+        self.scene = scene
+        self.seed = int(scene.seed)
+        base = scene.base
+        self._fbm: tuple | None = None
+        self._grid: LatLongGrid | None = None
+        self._radii: np.ndarray | None = None
+        self.gravity = isinstance(base, ShapeBase)
+        rng = np.random.default_rng([self.seed, 1])
+        if base is None or isinstance(base, SphereBase):
+            self.radius_m = float(scene.body.radius_m)
+        elif isinstance(base, FbmParams):
+            self.radius_m = float(scene.body.radius_m)
+            self._fbm = (base.frequency, base.octaves, base.persistence, base.lacunarity,
+                         base.amplitude_m)
+        elif isinstance(base, FaultingParams):
+            self.radius_m = float(scene.body.radius_m)
+            self._grid = LatLongGrid(min(scene.body.magnitude, MAX_BASE_MAGNITUDE))
+            self._radii = self.radius_m + two_phase_faulting(self._grid, self.radius_m, base,
+                                                             rng=rng)
+        else:
+            assert isinstance(base, ShapeBase)
+            self._grid = LatLongGrid(min(scene.body.magnitude, MAX_BASE_MAGNITUDE))
+            shaped = from_shape_model(base.model, self._grid.magnitude, center=base.center,
+                                      crossings=base.crossings, smooth=base.smooth)
+            self._radii = np.ascontiguousarray(shaped.radii_m)
+            self.radius_m = float(shaped.radius_m)
+            if base.detail_amplitude_m:
+                self._fbm = (base.detail_frequency, base.detail_octaves,
+                             base.detail_persistence, base.detail_lacunarity,
+                             base.detail_amplitude_m)
+        if self._fbm is not None:
+            self._rot, self._offset = _rotation_offset(self.seed)
+        # the smallest radius bounds every angle a distance on the surface can span
+        self.min_radius_m = self.radius_m if self._radii is None else float(self._radii.min())
+        if self._fbm is not None:
+            self.min_radius_m -= abs(float(self._fbm[4]))
+
+    def radius(self, unit) -> np.ndarray:
+        """Base radius (m) in each direction ``unit`` (n, 3) (unit vectors)."""
+        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        if self._radii is not None:
+            assert self._grid is not None
+            colat = np.arctan2(np.hypot(u[:, 0], u[:, 1]), u[:, 2])
+            lon = np.mod(np.arctan2(u[:, 1], u[:, 0]), 2.0 * np.pi)
+            r = self._grid.interpolate(self._radii, colat, lon)
+        else:
+            r = np.full(len(u), self.radius_m)
+        if self._fbm is not None:
+            freq, octaves, persistence, lacunarity, amplitude = self._fbm
+            # explicit sums, not BLAS: the rounding never depends on the batch
+            xs, ys, zs = (((u[:, 0] * self._rot[a, 0] + u[:, 1] * self._rot[a, 1]
+                            + u[:, 2] * self._rot[a, 2]) * freq + self._offset[a])
+                          .astype(np.float32) for a in range(3))
+            out = np.empty(len(u))
+            _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, 0, out)
+            r = r + amplitude * out
+        return r
+
+    def area_factor(self, unit, step_rad: float) -> np.ndarray:
+        """Surface area per steradian (m^2/sr) of the base in each direction: ``r^2 /
+        cos(tilt)``, the tilt from central differences ``step_rad`` apart."""
+        u = np.asarray(unit, dtype=np.float64).reshape(-1, 3)
+        e, n = tangent_frame(u)
+        r = self.radius(u)
+        s = float(step_rad)
+        grads = []
+        for t in (e, n):
+            rp = self.radius(_normalized(u + s * t))
+            rm = self.radius(_normalized(u - s * t))
+            grads.append((rp - rm) / (2.0 * s * r))  # d ln r / d angle = tan(tilt) part
+        tan2 = grads[0] ** 2 + grads[1] ** 2
+        return r * r * np.sqrt(1.0 + tan2)
+
+    @functools.cached_property
+    def _up_grid(self):
+        grid = LatLongGrid(_GRAVITY_MAGNITUDE)
+        radii = self.radius(grid.unit_vectors())
+        verts = grid.unit_vectors() * radii[:, None]
+        up = -down_directions(verts, grid.triangles(), verts, block=64)
+        return grid, [np.ascontiguousarray(up[:, k]) for k in range(3)]
+
+    def up(self, unit) -> np.ndarray:
+        """The direction slopes are measured against at each direction: radial, or for a
+        shape model against its constant-density self-gravity (interpolated from a
+        magnitude-48 grid)."""
+        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        if not self.gravity:
+            return u.copy()
+        grid, comps = self._up_grid
+        colat = np.arctan2(np.hypot(u[:, 0], u[:, 1]), u[:, 2])
+        lon = np.mod(np.arctan2(u[:, 1], u[:, 0]), 2.0 * np.pi)
+        g = np.stack([grid.interpolate(c, colat, lon) for c in comps], axis=1)
+        return g / np.linalg.norm(g, axis=1, keepdims=True)
+
+
+def _normalized(v: np.ndarray) -> np.ndarray:
+    return v / np.sqrt((v * v).sum(axis=1, keepdims=True))
+
+
+def tangent_frame(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """East and north unit vectors at directions ``u`` (x as east at the poles), by the
+    stamping kernel's formulas (east = z x u, north = u x east)."""
+    e = np.stack([-u[:, 1], u[:, 0], np.zeros(len(u))], axis=1)
+    en = np.sqrt(e[:, 0] ** 2 + e[:, 1] ** 2)
+    pole = en < 1e-12
+    e[pole] = (1.0, 0.0, 0.0)
+    en[pole] = 1.0
+    e /= en[:, None]
+    n = np.stack([u[:, 1] * e[:, 2] - u[:, 2] * e[:, 1], u[:, 2] * e[:, 0] - u[:, 0] * e[:, 2],
+                  u[:, 0] * e[:, 1] - u[:, 1] * e[:, 0]], axis=1)
+    return e, n
+
+
+@functools.lru_cache(maxsize=4)
+def base_field(scene: Scene) -> BaseField:
+    """The scene's :class:`BaseField`, made once per scene (scenes are frozen)."""
+    return BaseField(scene)

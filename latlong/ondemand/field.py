@@ -1,0 +1,411 @@
+"""The local crater field: heights at any points, from the craters near them only.
+
+Sequential stamping (:func:`latlong.stamp_craters`) fits each crater's base to whatever
+every older crater left, so a value can depend on craters anywhere. Here (DESIGN notes
+in the README, "Terrain on demand"):
+
+1. **Catalogue.** Each power-law layer's size bin ``[2**b, 2**(b+1))`` is drawn per cell
+   of one level of the cube-sphere hierarchy (:mod:`craters.local`), the level a function
+   of the bin and the body (cells at least one ejecta reach wide), never of the request.
+   Craters smaller than the requested minimum diameter are left out; that only filters.
+2. **A crater's base** is a quadric fitted (fixed 61-point stencil over its rim disc, a
+   fixed least-squares operator) to the terrain made by the base shape and the *older,
+   larger* craters at the stencil points. Smaller craters barely move a plane fitted over
+   a larger crater's floor, and leaving them out makes every crater's parameters
+   independent of the requested resolution. The slope of that base against "up" (radial,
+   or a shape model's self-gravity) sets the slope erosion (Martin's lunar paper III),
+   as in the sequential stamp.
+3. **Composition.** Each crater acts on the height before it as an affine map: inside its
+   (irregular) rim it replaces the terrain by its base quadric plus its profile (so older
+   craters there are erased); outside, its profile (ejecta, roughness) adds to the old
+   terrain, which is blended into the base quadric between the rim and 1.5 radii (the
+   rim stays continuous whatever lies under it). The height at a point is the
+   composition over the craters that reach it, youngest first in the fixed (age, id)
+   order, stopping at the first rim that holds the point; then the base shape.
+
+Which craters are needed for a set of points is found bin by bin, smallest first: those
+in the cells around the points, and then every larger crater that reaches a stencil
+point of a needed crater, until nothing changes. The values do not depend on that set
+(a superset gives the same bytes), nor on the point batch, nor on the thread count.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import logging
+
+import numpy as np
+import numpy.lib.recfunctions as rfn
+
+from craters import CraterLayer
+from craters._shared import ParameterError, check_positive
+from craters.catalog import make_catalog
+from craters.local import bin_bounds, bin_level, bins, draw_cells, min_cell_angle
+from craters.morphology import EJECTA_EDGE
+from craters.stamp import (
+    rim_perturbations_from_phases,
+    resolve_roughness,
+    stamping_profiles,
+)
+from craters.cells import cell_parts, cell_solid_angle, cell_points
+
+from ..scene import Scene
+from . import _field_kernels as K
+from .base import BaseField, tangent_frame
+
+__all__ = ["BLEND_EDGE", "IRREGULARITY", "ROUGHNESS_OCTAVES", "CraterField", "crater_field",
+           "heights_at_units"]
+
+logger = logging.getLogger(__name__)
+
+#: Radii (x = r / R) out to which the older terrain is blended into a crater's base.
+BLEND_EDGE = 1.5
+#: Largest rim-radius perturbation (the sequential stamp's default).
+IRREGULARITY = 0.02
+#: Octaves of a crater's roughness overlay (radius down to radius / 8): fixed per
+#: crater, so the overlay never depends on the requested resolution.
+ROUGHNESS_OCTAVES = 4
+_RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
+_BIN_MARGIN = 1.05
+
+
+def _stencil_xy() -> np.ndarray:
+    pts = []
+    for ring, (r, n) in enumerate(_RINGS):
+        for s in range(n):
+            phi = 2.0 * np.pi * (s + 0.5 * (ring % 2)) / n
+            pts.append((r * np.cos(phi), r * np.sin(phi)))
+    return np.array(pts)
+
+
+STENCIL_XY = _stencil_xy()
+FIT = K._fit_operator(STENCIL_XY)
+
+
+@dataclasses.dataclass
+class _Craters:
+    """Craters as columns (the kernel's record ``fc`` plus the catalogue's)."""
+
+    fc: np.ndarray
+    diameter_m: np.ndarray
+    age_gyr: np.ndarray
+    id: np.ndarray
+    cell: np.ndarray
+    rim_phases: np.ndarray
+    seed: np.ndarray
+    layer: np.ndarray
+
+    @staticmethod
+    def concat(parts: list) -> _Craters:
+        return _Craters(*(np.concatenate([getattr(p, f.name) for p in parts])
+                          for f in dataclasses.fields(_Craters)))
+
+    def take(self, idx) -> _Craters:
+        return _Craters(*(getattr(self, f.name)[idx] for f in dataclasses.fields(_Craters)))
+
+    def __len__(self) -> int:
+        return len(self.diameter_m)
+
+
+class CraterField:
+    """The crater layers of a scene as a local field (module notes)."""
+
+    def __init__(self, scene: Scene, base: BaseField | None = None):
+        self.scene = scene
+        self.base = base if base is not None else BaseField(scene)
+        layers = scene.craters.layers
+        for la in layers:
+            if not isinstance(la, CraterLayer):
+                raise ParameterError("craters", "terrain on demand draws power-law crater layers "
+                                     f"(c=..,k=..); got a {type(la).__name__}")
+        self.layers = tuple(layers)
+        self.target = scene.target()
+        rough, irregular = resolve_roughness(scene.craters.roughness)
+        self.rough = np.array([rough.bowl, rough.wall, rough.ejecta])
+        self.gain = 2.0 ** (rough.fractal_dimension - 3.0)
+        self.irregularity = IRREGULARITY if irregular else 0.0
+        self.xe = float(EJECTA_EDGE)
+        # the level of each size bin: cells at least one ejecta reach wide
+        self.levels: dict[int, int] = {}
+        for la in self.layers:
+            for b in bins(la):
+                # a crater's ejecta reach plus the radius of a smaller crater it shapes
+                reach = (self.xe * (1.0 + self.irregularity) + 1.0) * 0.5 * bin_bounds(la, b)[1]
+                self.levels[int(b)] = min(self.levels.get(int(b), 99),
+                                          bin_level(_BIN_MARGIN * reach / self.base.min_radius_m))
+
+    # ------------------------------------------------------------------ catalogue
+    def _draw(self, b: int, cells: np.ndarray, d_min: float) -> _Craters:
+        """Craters of bin ``b`` (all layers) in ``cells``, at least ``d_min`` across."""
+        level = self.levels[b]
+        lv, face, i, j = cell_parts(cells)
+        centres = cell_points(level, face, i, j, 0.5, 0.5)
+        step = 0.25 * min_cell_angle(level)
+        area = cell_solid_angle(level, face, i, j) * self.base.area_factor(centres, step)
+        parts = []
+        for idx, la in enumerate(self.layers):
+            if b not in set(bins(la).tolist()) or bin_bounds(la, b)[1] <= d_min:
+                continue
+            got = draw_cells(la, idx, seed=self.base.seed, b=b, level=level, cell_ids=cells,
+                             area_m2=area)
+            keep = got["diameter_m"] >= d_min
+            parts.append(self._records({k: v[keep] for k, v in got.items()}, idx))
+        if not parts:
+            return self._records(None, 0)
+        return _Craters.concat(parts)
+
+    def _records(self, got: dict | None, layer: int) -> _Craters:
+        if got is None:
+            z = np.zeros(0)
+            return _Craters(np.zeros((0, K.N_COLS)), z, z, z.astype(np.uint64),
+                            z.astype(np.uint64), np.zeros((0, 15)), z.astype(np.uint64),
+                            z.astype(np.int64))
+        u = got["unit"]
+        n = len(u)
+        fc = np.zeros((n, K.N_COLS))
+        fc[:, K.C0:K.C2 + 1] = u
+        e, nn = tangent_frame(u)
+        fc[:, K.E0:K.E2 + 1] = e
+        fc[:, K.N0:K.N2 + 1] = nn
+        fc[:, K.RHO] = self.base.radius(u)
+        radius = 0.5 * got["diameter_m"]
+        fc[:, K.RAD] = radius
+        far = self.xe * radius * (1.0 + self.irregularity) * (1.0 + 1e-9) / fc[:, K.RHO]
+        fc[:, K.COS_FAR] = np.cos(np.minimum(far, np.pi))
+        fc[:, K.FAR] = np.minimum(far, np.pi)
+        return _Craters(fc, got["diameter_m"], got["age_gyr"], got["id"], got["cell"],
+                        got["rim_phases"], got["seed"], np.full(n, layer, dtype=np.int64))
+
+    def needed(self, units: np.ndarray, d_min: float):
+        """The craters the heights at ``units`` need (module notes), and (owner, dep)
+        index pairs: crater ``dep`` is larger than ``owner`` and its ejecta may reach
+        the owner's rim disc (a superset of what the owner's base fit reads)."""
+        parts: list[_Craters] = []
+        owners_all: list[np.ndarray] = []
+        deps_all: list[np.ndarray] = []
+        n_have = 0
+        fc_have = np.zeros((0, K.N_COLS))
+        d_have = np.zeros(0)
+        for b in sorted(self.levels):
+            if self._bin_top(b) <= d_min:
+                continue
+            level = self.levels[b]
+            # the query rule: every crater of the cells around the points' cells
+            cand_cells = np.unique(_neighbours(np.unique(_cells(units, level))))
+            q_cells = cand_cells
+            # the cells around the centres of the needed smaller craters
+            own_cells9 = _neighbours(_cells(fc_have[:, K.C0:K.C2 + 1], level), keep_shape=True)
+            cand_cells = np.union1d(cand_cells, own_cells9.ravel())
+            cand = self._draw(b, cand_cells, d_min)
+            needed_mask = np.isin(cand.cell, q_cells)
+            owners = np.arange(n_have, dtype=np.int64)
+            cells9 = own_cells9
+            # the query-rule craters are owners within this bin too
+            first = np.flatnonzero(needed_mask)
+            while True:
+                fc_all = np.concatenate([fc_have, cand.fc])
+                d_all = np.concatenate([d_have, cand.diameter_m])
+                owners = np.concatenate([owners, first + n_have])
+                cells9 = np.concatenate([cells9, _neighbours(
+                    _cells(cand.fc[first, K.C0:K.C2 + 1], level), keep_shape=True)])
+                extra = np.setdiff1d(np.unique(cells9), cand_cells)
+                if len(extra):  # cells around same-bin owners not drawn yet
+                    more = self._draw(b, extra, d_min)
+                    cand = _Craters.concat([cand, more])
+                    needed_mask = np.concatenate([needed_mask, np.zeros(len(more), bool)])
+                    cand_cells = np.union1d(cand_cells, extra)
+                    fc_all = np.concatenate([fc_have, cand.fc])
+                    d_all = np.concatenate([d_have, cand.diameter_m])
+                o, d = _dep_pairs(owners, cells9, cand, n_have, fc_all, d_all)
+                owners_all.append(o)
+                deps_all.append(d)
+                hit = np.zeros(len(cand), bool)
+                hit[d - n_have] = True
+                first = np.flatnonzero(hit & ~needed_mask)
+                needed_mask |= hit
+                if not len(first):
+                    break
+                owners = np.zeros(0, dtype=np.int64)
+                cells9 = np.zeros((0, 9), dtype=np.uint64)
+            keep = np.flatnonzero(needed_mask)
+            remap = np.full(len(cand), -1, dtype=np.int64)
+            remap[keep] = np.arange(len(keep)) + n_have
+
+            def fix(x, n_have=n_have, remap=remap):
+                y = x.copy()
+                hi = x >= n_have
+                y[hi] = remap[x[hi] - n_have]
+                return y
+
+            owners_all = [fix(x) for x in owners_all]
+            deps_all = [fix(x) for x in deps_all]
+            kept = cand.take(keep)
+            parts.append(kept)
+            fc_have = np.concatenate([fc_have, kept.fc])
+            d_have = np.concatenate([d_have, kept.diameter_m])
+            n_have += len(keep)
+        craters = _Craters.concat(parts) if parts else self._records(None, 0)
+        if owners_all:
+            owner = np.concatenate(owners_all)
+            dep = np.concatenate(deps_all)
+            ok = (owner >= 0) & (dep >= 0)
+            return craters, owner[ok], dep[ok]
+        return craters, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+
+    def _bin_top(self, b: int) -> float:
+        return max(bin_bounds(la, b)[1] for la in self.layers if b in set(bins(la).tolist()))
+
+    def catalog(self, units: np.ndarray, d_min: float) -> np.ndarray:
+        """The crater catalog (oldest first; ``craters.make_catalog`` columns plus ``id``,
+        ``layer``) of the craters that the heights at ``units`` with craters >= ``d_min``
+        are made of: for every vertex of a body, the whole body's craters >= ``d_min``."""
+        cr, _, _ = self.needed(np.ascontiguousarray(units, dtype=np.float64), d_min)
+        u = cr.fc[:, K.C0:K.C2 + 1]
+        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
+        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+        kinds = np.array([la.kind for la in self.layers] or ["crater"])
+        cat = make_catalog(lat_deg=lat, lon_deg=lon, diameter_m=cr.diameter_m,
+                           age_gyr=cr.age_gyr, degradation=np.full(len(cr), np.nan),
+                           kind=kinds[cr.layer], layer=cr.layer)
+        # oldest first: the composition's (age, id) order reversed
+        order = np.lexsort((cr.id, cr.age_gyr))[::-1]
+        cat = rfn.append_fields(cat, "id", cr.id, usemask=False)
+        return cat[order]
+
+    # ------------------------------------------------------------------ heights
+    def radii(self, units: np.ndarray, d_min: float) -> np.ndarray:
+        """Radius (m) in each direction ``units`` (n, 3) with craters >= ``d_min``."""
+        units = np.ascontiguousarray(units, dtype=np.float64)
+        base = self.base.radius(units)
+        cr, owner, dep = self.needed(units, d_min)
+        n = len(cr)
+        if n == 0:
+            return base
+        fc = cr.fc
+        rank = np.empty(n, dtype=np.int64)
+        rank[np.lexsort((cr.id, cr.age_gyr))] = np.arange(n)  # 0: the youngest
+        cat = make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n), diameter_m=cr.diameter_m,
+                           age_gyr=cr.age_gyr, degradation=np.full(n, np.nan))
+        prof = stamping_profiles(cat, self.target, ejecta_edge=self.xe)
+        tabs = np.ascontiguousarray(prof.tables)
+        rims = np.ascontiguousarray(rim_perturbations_from_phases(cr.rim_phases,
+                                                                  self.irregularity))
+        fc[:, K.DEPTH] = prof.depth_m
+        seeds = np.ascontiguousarray(cr.seed)
+        up = np.ascontiguousarray(self.base.up(fc[:, K.C0:K.C2 + 1]))
+        # dependencies per owner, youngest first
+        key = np.unique(owner * n + dep)
+        owner, dep = key // n, key % n
+        srt = np.lexsort((rank[dep], owner))
+        dep_list = np.ascontiguousarray(dep[srt])
+        dep_start = np.searchsorted(owner[srt], np.arange(n + 1)).astype(np.int64)
+        stencil = _stencil_points(fc)
+        st_base = self.base.radius(stencil.reshape(-1, 3)).reshape(n, -1)
+        todo = np.lexsort((cr.id, -cr.diameter_m)).astype(np.int64)
+        diam = np.ascontiguousarray(cr.diameter_m)
+        rough = self.rough
+        sc = self.scene.craters
+        del sc
+        K._params_kernel(todo, dep_start, dep_list, stencil, st_base, FIT, fc, tabs, rims,
+                         seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
+                         rank, diam, up, 20.0, 45.0, True)
+        # blocks of points, and the craters that may reach each block
+        level = _block_level(len(units), units)
+        pcells = _cells(units, level)
+        occ, block_of = np.unique(pcells, return_inverse=True)
+        margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
+        order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
+        active = order[fc[order, K.ACTIVE] > 0]
+        cap = max(1024, 16 * len(active))
+        while True:
+            ob = np.empty(cap, dtype=np.int64)
+            oc = np.empty(cap, dtype=np.int64)
+            cnt = K._cap_blocks_kernel(fc, active, level, occ, margin, ob, oc)
+            if cnt <= cap:
+                break
+            cap = cnt
+        ob, oc = ob[:cnt], oc[:cnt]
+        srt = np.lexsort((rank[oc], ob))
+        blk_list = np.ascontiguousarray(oc[srt])
+        blk_start = np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64)
+        out = np.empty(len(units))
+        K._points_kernel(units, block_of.astype(np.int64).ravel(), blk_start, blk_list, base,
+                         fc, tabs, rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe,
+                         BLEND_EDGE, rank, diam, out)
+        self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key)}
+        return out
+
+
+def _dep_pairs(owners, cells9, cand: _Craters, n_have: int, fc_all, d_all):
+    """(owner, dep) pairs of ``owners`` (indices into ``fc_all``) and the candidates of
+    the bin (indices ``n_have + i``) (:func:`_field_kernels._dep_kernel`)."""
+    if not len(owners) or not len(cand):
+        return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+    order = np.argsort(cand.cell, kind="stable")
+    ucells, starts = np.unique(cand.cell[order], return_index=True)
+    starts = np.append(starts, len(order)).astype(np.int64)
+    cand_idx = (order + n_have).astype(np.int64)
+    cap = max(1024, 8 * len(owners))
+    while True:
+        o = np.empty(cap, dtype=np.int64)
+        d = np.empty(cap, dtype=np.int64)
+        cnt = K._dep_kernel(owners.astype(np.int64), np.ascontiguousarray(cells9), ucells,
+                            starts, cand_idx, fc_all, d_all, o, d)
+        if cnt <= cap:
+            return o[:cnt], d[:cnt]
+        cap = cnt
+
+
+def _cells(units: np.ndarray, level: int) -> np.ndarray:
+    out = np.empty(len(units), dtype=np.uint64)
+    if len(units):
+        K._cells_kernel(np.ascontiguousarray(units, dtype=np.float64), level, out)
+    return out
+
+
+def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
+    out = np.empty((len(cells), 9), dtype=np.uint64)
+    if len(cells):
+        K._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
+    return out if keep_shape else out.ravel()
+
+
+def _stencil_points(fc: np.ndarray) -> np.ndarray:
+    """(n, 61, 3) directions of each crater's stencil: angle r R / rho from its centre."""
+    t = STENCIL_XY[None, :, :] * (fc[:, K.RAD] / fc[:, K.RHO])[:, None, None]
+    ang = np.sqrt(t[..., 0] ** 2 + t[..., 1] ** 2)
+    safe = np.where(ang > 0, ang, 1.0)
+    ce, cn = t[..., 0] / safe, t[..., 1] / safe
+    s, c = np.sin(ang), np.cos(ang)
+    out = np.empty(t.shape[:2] + (3,))
+    for d in range(3):
+        out[..., d] = c * fc[:, None, K.C0 + d] + s * (ce * fc[:, None, K.E0 + d]
+                                                       + cn * fc[:, None, K.N0 + d])
+    return out
+
+
+def _block_level(n: int, units: np.ndarray) -> int:
+    """A level of blocks holding some tens of points each (any level gives the same
+    values: blocks only narrow the craters each point tests)."""
+    if n < 2:
+        return 20
+    m = units.mean(axis=0)
+    norm = float(np.linalg.norm(m))
+    span = np.pi if norm < 0.5 else float(np.arccos(np.clip((units @ (m / norm)).min(), -1, 1)))
+    width = max(2.0 * span / np.sqrt(n / 32.0), 1e-9)
+    return bin_level(width, 24)
+
+
+@functools.lru_cache(maxsize=4)
+def crater_field(scene: Scene) -> CraterField:
+    """The scene's :class:`CraterField`, made once per scene."""
+    return CraterField(scene)
+
+
+def heights_at_units(scene: Scene, units, *, resolution_m: float) -> np.ndarray:
+    """Radii (m) of the scene's surface in directions ``units`` (n, 3) at
+    ``resolution_m``: craters at least 3 resolutions across."""
+    resolution_m = check_positive("resolution_m", resolution_m)
+    return crater_field(scene).radii(np.asarray(units, dtype=np.float64).reshape(-1, 3),
+                                     3.0 * resolution_m)
