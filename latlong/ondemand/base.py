@@ -29,7 +29,7 @@ from craters.counter import philox4x64, uniform_from_words
 from ..faulting import FaultingParams, two_phase_faulting
 from ..grid import LatLongGrid
 from ..mesh.cratering import down_directions
-from ..perlin import FbmParams, _run_fbm3
+from ..perlin import FbmParams, fbm3
 from ..scene import Scene
 from ..settings import ShapeBase, SphereBase
 from ..shapes import from_shape_model
@@ -114,12 +114,10 @@ class BaseField:
         if self._fbm is not None:
             freq, octaves, persistence, lacunarity, amplitude = self._fbm
             # explicit sums, not BLAS: the rounding never depends on the batch
-            xs, ys, zs = (((u[:, 0] * self._rot[a, 0] + u[:, 1] * self._rot[a, 1]
-                            + u[:, 2] * self._rot[a, 2]) * freq + self._offset[a])
-                          .astype(np.float32) for a in range(3))
-            out = np.empty(len(u))
-            _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, 0, out)
-            r = r + amplitude * out
+            xs, ys, zs = ((u[:, 0] * self._rot[a, 0] + u[:, 1] * self._rot[a, 1]
+                           + u[:, 2] * self._rot[a, 2]) * freq + self._offset[a]
+                          for a in range(3))
+            r = r + amplitude * fbm3(xs, ys, zs, octaves, persistence, lacunarity)
         return r
 
     def area_factor(self, unit, step_rad: float) -> np.ndarray:
