@@ -32,8 +32,14 @@ from __future__ import annotations
 import numpy as np
 
 from .cells import cell_parts, cell_points
-from .counter import philox4x64, poisson_from_uniform, portable_exp, portable_log, \
-    power_law_from_uniform, uniform_from_words
+from .counter import (
+    philox4x64,
+    poisson_from_uniform,
+    portable_exp,
+    portable_log,
+    power_law_from_uniform,
+    uniform_from_words,
+)
 from .layers import CraterLayer
 
 __all__ = ["CRATER_KEY", "bin_bounds", "bin_level", "bins", "draw_cells", "min_cell_angle"]

@@ -47,8 +47,8 @@ from .targets import Target, get_target
 logger = logging.getLogger(__name__)
 
 __all__ = ["Crater", "Roughness", "StampRequest", "StampingProfiles", "resolve_roughness",
-           "rim_perturbations", "rim_perturbations_from_phases", "stamp", "stamp_many", "stamp_request", "stamped_after",
-           "stamping_profiles"]
+           "rim_perturbations", "rim_perturbations_from_phases", "stamp", "stamp_many",
+           "stamp_request", "stamped_after", "stamping_profiles"]
 
 _HARMONICS = np.arange(2, 17)
 _BATCH = 512  # craters per kernel call when a progress bar is shown

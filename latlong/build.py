@@ -115,6 +115,8 @@ def build(scene: Scene, *, progress: bool = False, scratch_dir=None):
         return _build_implicit(scene, progress)
     if isinstance(scene.base, ShapeBase) and scene.base.surface == "mesh":
         return _build_mesh(scene, progress)
+    if scene.on_demand:
+        return _build_on_demand(scene)
     on_disk = scene.radii_on_disk()
     radii = disk_radii(LatLongGrid(scene.body.magnitude).n_vertices, scratch_dir) \
         if on_disk else None
@@ -171,6 +173,23 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
         found = boulder_population(body, boulders.layers, rng=rng)
         body = body.replace(boulders=place_boulders(body, found, shape=boulders.shape))
     return body
+
+
+def _build_on_demand(scene: Scene) -> Body:
+    """The lat/long body as terrain on demand (:mod:`latlong.ondemand`): every vertex of
+    the grid at the grid's ring spacing (craters at least 3 spacings across), each value
+    the same as :func:`latlong.heights_at` gives it alone."""
+    from .ondemand import crater_field  # the on-demand engine loads only when asked
+
+    grid = LatLongGrid(scene.body.magnitude)
+    field = crater_field(scene)
+    radius = field.base.radius_m
+    d_min = 3.0 * grid.spacing(radius)
+    units = grid.unit_vectors()
+    radii = field.radii(units, d_min)
+    cat = field.catalog(units, d_min)
+    metadata = {**_metadata(scene, {}), "on_demand": True, "min_crater_diameter_m": d_min}
+    return Body(grid, radii, radius_m=radius, metadata=metadata, craters=cat, copy=False)
 
 
 def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterError:

@@ -113,6 +113,11 @@ class Scene:
     preset: str | None = setting(None, "named scene (see `latlong presets`): sets the base "
                                  "and its parameters, the body and crater layers")
     """The preset the scene came from (recorded in the body's metadata)."""
+    on_demand: bool = setting(False, "terrain on demand (latlong.ondemand): craters drawn "
+                              "cell by cell, every height a function of its position, "
+                              "memory bounded by the region asked, not the whole body")
+    """Terrain on demand (:mod:`latlong.ondemand`): no whole-body memory estimate (what
+    is made is bounded by the region asked); needs an unstretched lat/long body."""
 
     def __post_init__(self):
         check_declared(self)
@@ -167,6 +172,13 @@ class Scene:
             self.boulders.check_fits(smallest)
         except ParameterError as exc:
             raise exc.renamed("boulders") from None
+        if self.on_demand:
+            if tuple(body.stretch) != NO_STRETCH:
+                raise ParameterError("stretch", "must be 1,1,1 for terrain on demand (an "
+                                     "unstretched body)")
+            if isinstance(base, ShapeBase) and base.surface != "latlong":
+                raise ParameterError("surface", "must be latlong for terrain on demand")
+            return
         if isinstance(base, ShapeBase):
             area = base.model.area_m2
         else:
@@ -238,7 +250,7 @@ class Scene:
 #: setting is listed in by ``latlong build --help``.
 SETTING_PARTS = (
     ("body", {"preset": declared(Scene)["preset"], "base": _CHOICES["base"],
-              "seed": declared(Scene)["seed"]}),
+              "seed": declared(Scene)["seed"], "on_demand": declared(Scene)["on_demand"]}),
     ("implicit", {"backend": _CHOICES["backend"]}), ("body", BodySettings),
     ("faulting", FaultingParams), ("fbm", FbmParams), ("shape", ShapeBase),
     ("craters", CraterSettings), ("boulders", BoulderSettings), ("boulders", _BOULDER_SHAPE),
@@ -346,7 +358,8 @@ def _latlong_scene(cls, given: dict) -> Scene:
                   {k: k[len("boulder_"):] for k in _BOULDER_SHAPE})
     return cls(body=body, base=part, craters=_part(CraterSettings, merged),
                boulders=_part(BoulderSettings, merged, shape=shape),
-               preview=_part(PreviewSettings, given), seed=given.get("seed"), preset=preset)
+               preview=_part(PreviewSettings, given), seed=given.get("seed"), preset=preset,
+               on_demand=given.get("on_demand", False))
 
 
 def _implicit_scene(cls, given: dict) -> Scene:

@@ -1,7 +1,8 @@
 """The ``latlong`` command line (a private subpackage: the library never imports it), one
 module a command: ``build`` (:mod:`.build`, whose options are the settings of
 :class:`latlong.Scene` and also the TOML keys of a scene file), ``batch``, ``info``,
-``presets``, ``render``, ``export``, ``slopes``, ``spectrum``, ``camera`` and ``lidar``.
+``presets``, ``render``, ``export``, ``slopes``, ``spectrum``, ``camera``, ``lidar`` and
+``tile`` and ``descent`` (terrain on demand: a window, frames from orbit to touchdown).
 Every option comes from a declared setting (:mod:`craters.cli.options`). Bad input: one
 line ``error: ...`` naming the flag, exit code 2.
 """
@@ -14,7 +15,20 @@ import sys
 from craters.cli.kit import run_cli
 from craters.cli.options import flag_of, main_parser
 
-from . import batch, build, camera, export, info, lidar, presets, render, slopes, spectrum
+from . import (
+    batch,
+    build,
+    camera,
+    descent,
+    export,
+    info,
+    lidar,
+    presets,
+    render,
+    slopes,
+    spectrum,
+    tile,
+)
 
 __all__ = ["build_parser", "main"]
 
@@ -22,7 +36,7 @@ __all__ = ["build_parser", "main"]
 def build_parser() -> argparse.ArgumentParser:
     parser, sub = main_parser("latlong", "Asteroid bodies on the lat/long mesh.")
     for command in (build, batch, info, presets, render, export, slopes, spectrum, camera,
-                    lidar):
+                    lidar, tile, descent):
         command.register(sub)
     return parser
 

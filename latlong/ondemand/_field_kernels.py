@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import fbm2, roughness_amp, table, table_value
+from craters.kernels import fbm2, roughness_amp, slope_factor, table, table_value
 
 # crater record columns (float64 array "fc", one row per crater)
 C0, C1, C2 = 0, 1, 2          # centre direction (unit)
@@ -109,56 +109,77 @@ def _compose(order, lo, hi, fc, tabs, rims, seeds, rough, gain, octaves, xe, xb,
 
 
 @njit(cache=True)
-def _params_kernel(todo, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
-                   rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
-    """Base quadric and slope-erosion factor of each crater in ``todo`` (largest first):
-    the terrain of its older, larger craters (``dep_list[dep_start[k]:dep_start[k+1]]``,
-    youngest first) at its stencil points, fitted by the fixed least-squares operator
-    ``fit`` (6, n_stencil) in the crater's normalised coordinates."""
-    n_st = stencil.shape[1]
-    h = np.empty(n_st)
+def _generations_kernel(todo, dep_start, dep_list, gen):
+    """Generation of each crater: 0 without dependencies, else one more than its
+    dependencies' largest (``todo`` lists dependencies before their owners)."""
     for t in range(todo.shape[0]):
         k = todo[t]
+        g = 0
+        for q in range(dep_start[k], dep_start[k + 1]):
+            g = max(g, gen[dep_list[q]] + 1)
+        gen[k] = g
+
+
+@njit(cache=True, parallel=True)
+def _params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims,
+                   seeds, rough, gain, octaves, xe, xb, age_key, diam, up, onset, full,
+                   slope_erosion):
+    """Base quadric and slope-erosion factor of each crater (:func:`_crater_params`),
+    generation by generation (``todo[gen_start[g]:gen_start[g + 1]]``), the craters of a
+    generation in parallel: each reads only craters of earlier generations."""
+    for g in range(gen_start.shape[0] - 1):
+        for t in prange(gen_start[g], gen_start[g + 1]):
+            _crater_params(todo[t], dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims,
+                           seeds, rough, gain, octaves, xe, xb, age_key, diam, up, onset, full,
+                           slope_erosion)
+
+
+@njit(cache=True)
+def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
+                   rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
+    """Base quadric and slope-erosion factor of crater k: the terrain of its older, larger
+    craters (``dep_list[dep_start[k]:dep_start[k+1]]``, youngest first) at its stencil
+    points, fitted by the fixed least-squares operator ``fit`` (6, n_stencil) in the
+    crater's normalised coordinates."""
+    n_st = stencil.shape[1]
+    h = np.empty(n_st)
+    for s in range(n_st):
+        h[s] = _compose(dep_list, dep_start[k], dep_start[k + 1], fc, tabs, rims, seeds,
+                        rough, gain, octaves, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
+                        stencil[k, s, 2], st_base[k, s], age_key[k], age_key, diam[k],
+                        diam) - fc[k, RHO]
+    coef = np.zeros(6)
+    for r in range(6):
+        acc = 0.0
         for s in range(n_st):
-            h[s] = _compose(dep_list, dep_start[k], dep_start[k + 1], fc, tabs, rims, seeds,
-                            rough, gain, octaves, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
-                            stencil[k, s, 2], st_base[k, s], age_key[k], age_key, diam[k],
-                            diam) - fc[k, RHO]
-        coef = np.zeros(6)
-        for r in range(6):
-            acc = 0.0
-            for s in range(n_st):
-                acc += fit[r, s] * h[s]
-            coef[r] = acc
-        radius = fc[k, RAD]
-        fc[k, P0] = coef[0]
-        fc[k, GX] = coef[1] / radius
-        fc[k, GY] = coef[2] / radius
-        fc[k, QA] = coef[3] / (radius * radius)
-        fc[k, QB] = coef[4] / (radius * radius)
-        fc[k, QC] = coef[5] / (radius * radius)
-        # slope: the base plane's normal against "up"
-        gx = fc[k, GX]
-        gy = fc[k, GY]
-        l0 = fc[k, C0] - gx * fc[k, E0] - gy * fc[k, N0]
-        l1 = fc[k, C1] - gx * fc[k, E1] - gy * fc[k, N1]
-        l2 = fc[k, C2] - gx * fc[k, E2] - gy * fc[k, N2]
-        r0 = up[k, 0]
-        r1 = up[k, 1]
-        r2 = up[k, 2]
-        cr0 = l1 * r2 - l2 * r1
-        cr1 = l2 * r0 - l0 * r2
-        cr2 = l0 * r1 - l1 * r0
-        slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
-                                      l0 * r0 + l1 * r1 + l2 * r2))
-        scale = 1.0
-        if slope_erosion:
-            if slope >= full:
-                scale = 0.0
-            elif slope > onset:
-                scale = (full - slope) / (full - onset)
-        fc[k, SCALE] = scale
-        fc[k, ACTIVE] = 1.0 if scale > 0.0 else 0.0
+            acc += fit[r, s] * h[s]
+        coef[r] = acc
+    radius = fc[k, RAD]
+    fc[k, P0] = coef[0]
+    fc[k, GX] = coef[1] / radius
+    fc[k, GY] = coef[2] / radius
+    fc[k, QA] = coef[3] / (radius * radius)
+    fc[k, QB] = coef[4] / (radius * radius)
+    fc[k, QC] = coef[5] / (radius * radius)
+    # slope: the base plane's normal against "up"
+    gx = fc[k, GX]
+    gy = fc[k, GY]
+    l0 = fc[k, C0] - gx * fc[k, E0] - gy * fc[k, N0]
+    l1 = fc[k, C1] - gx * fc[k, E1] - gy * fc[k, N1]
+    l2 = fc[k, C2] - gx * fc[k, E2] - gy * fc[k, N2]
+    r0 = up[k, 0]
+    r1 = up[k, 1]
+    r2 = up[k, 2]
+    cr0 = l1 * r2 - l2 * r1
+    cr1 = l2 * r0 - l0 * r2
+    cr2 = l0 * r1 - l1 * r0
+    slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
+                                  l0 * r0 + l1 * r1 + l2 * r2))
+    scale = slope_factor(slope, onset, full) if slope_erosion else 1.0
+    if slope_erosion and slope >= full:
+        scale = 0.0  # steeper than the angle of repose: erased, not stamped
+    fc[k, SCALE] = scale
+    fc[k, ACTIVE] = 1.0 if scale > 0.0 else 0.0
 
 
 @njit(cache=True, parallel=True)

@@ -65,21 +65,27 @@ class BaseField:
         if not isinstance(scene, Scene):
             raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
         self.scene = scene
+        assert scene.seed is not None  # Scene.__post_init__ draws one when none is given
         self.seed = int(scene.seed)
         base = scene.base
-        self._fbm: tuple | None = None
+        self._fbm: tuple[float, int, float, float, float] | None = None
         self._grid: LatLongGrid | None = None
         self._radii: np.ndarray | None = None
         self.gravity = isinstance(base, ShapeBase)
         rng = np.random.default_rng([self.seed, 1])
+        reference = scene.body.radius_m
         if base is None or isinstance(base, SphereBase):
-            self.radius_m = float(scene.body.radius_m)
+            assert reference is not None  # Scene.__post_init__ sets it for these bases
+            self.radius_m = float(reference)
         elif isinstance(base, FbmParams):
-            self.radius_m = float(scene.body.radius_m)
+            assert reference is not None
+            self.radius_m = float(reference)
+            assert base.amplitude_m is not None  # Scene sets it from the fraction
             self._fbm = (base.frequency, base.octaves, base.persistence, base.lacunarity,
                          base.amplitude_m)
         elif isinstance(base, FaultingParams):
-            self.radius_m = float(scene.body.radius_m)
+            assert reference is not None
+            self.radius_m = float(reference)
             self._grid = LatLongGrid(min(scene.body.magnitude, MAX_BASE_MAGNITUDE))
             self._radii = self.radius_m + two_phase_faulting(self._grid, self.radius_m, base,
                                                              rng=rng)
@@ -91,6 +97,7 @@ class BaseField:
             self._radii = np.ascontiguousarray(shaped.radii_m)
             self.radius_m = float(shaped.radius_m)
             if base.detail_amplitude_m:
+                assert base.detail_frequency is not None  # ShapeBase sets it
                 self._fbm = (base.detail_frequency, base.detail_octaves,
                              base.detail_persistence, base.detail_lacunarity,
                              base.detail_amplitude_m)
@@ -175,7 +182,15 @@ def tangent_frame(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e, n
 
 
-@functools.lru_cache(maxsize=4)
+_CACHE_BASE_FIELD: list = []
+
+
 def base_field(scene: Scene) -> BaseField:
     """The scene's :class:`BaseField`, made once per scene (scenes are frozen)."""
-    return BaseField(scene)
+    for held, value in _CACHE_BASE_FIELD:
+        if held is scene:  # scenes are frozen; some hold arrays, so not hashable
+            return value
+    value = BaseField(scene)
+    _CACHE_BASE_FIELD.insert(0, (scene, value))
+    del _CACHE_BASE_FIELD[4:]
+    return value

@@ -32,7 +32,6 @@ point of a needed crater, until nothing changes. The values do not depend on tha
 from __future__ import annotations
 
 import dataclasses
-import functools
 import logging
 
 import numpy as np
@@ -41,18 +40,18 @@ import numpy.lib.recfunctions as rfn
 from craters import CraterLayer
 from craters._shared import ParameterError, check_positive
 from craters.catalog import make_catalog
+from craters.cells import cell_parts, cell_points, cell_solid_angle
 from craters.local import bin_bounds, bin_level, bins, draw_cells, min_cell_angle
 from craters.morphology import EJECTA_EDGE
 from craters.stamp import (
-    rim_perturbations_from_phases,
     resolve_roughness,
+    rim_perturbations_from_phases,
     stamping_profiles,
 )
-from craters.cells import cell_parts, cell_solid_angle, cell_points
 
 from ..scene import Scene
 from . import _field_kernels as K
-from .base import BaseField, tangent_frame
+from .base import BaseField, base_field, tangent_frame
 
 __all__ = ["BLEND_EDGE", "IRREGULARITY", "ROUGHNESS_OCTAVES", "CraterField", "crater_field",
            "heights_at_units"]
@@ -113,13 +112,14 @@ class CraterField:
 
     def __init__(self, scene: Scene, base: BaseField | None = None):
         self.scene = scene
-        self.base = base if base is not None else BaseField(scene)
+        self.base = base if base is not None else base_field(scene)
         layers = scene.craters.layers
         for la in layers:
             if not isinstance(la, CraterLayer):
                 raise ParameterError("craters", "terrain on demand draws power-law crater layers "
                                      f"(c=..,k=..); got a {type(la).__name__}")
-        self.layers = tuple(layers)
+        self.layers: tuple[CraterLayer, ...] = tuple(
+            la for la in layers if isinstance(la, CraterLayer))
         self.target = scene.target()
         rough, irregular = resolve_roughness(scene.craters.roughness)
         self.rough = np.array([rough.bowl, rough.wall, rough.ejecta])
@@ -307,7 +307,12 @@ class CraterField:
         rough = self.rough
         sc = self.scene.craters
         del sc
-        K._params_kernel(todo, dep_start, dep_list, stencil, st_base, FIT, fc, tabs, rims,
+        gen = np.zeros(n, dtype=np.int64)
+        K._generations_kernel(todo, dep_start, dep_list, gen)
+        todo = todo[np.argsort(gen[todo], kind="stable")]
+        gen_start = np.searchsorted(gen[todo], np.arange(gen.max() + 2)).astype(np.int64)
+        K._params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, FIT, fc, tabs,
+                         rims,
                          seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
                          rank, diam, up, 20.0, 45.0, True)
         # blocks of points, and the craters that may reach each block
@@ -397,10 +402,18 @@ def _block_level(n: int, units: np.ndarray) -> int:
     return bin_level(width, 24)
 
 
-@functools.lru_cache(maxsize=4)
+_CACHE_CRATER_FIELD: list = []
+
+
 def crater_field(scene: Scene) -> CraterField:
     """The scene's :class:`CraterField`, made once per scene."""
-    return CraterField(scene)
+    for held, value in _CACHE_CRATER_FIELD:
+        if held is scene:  # scenes are frozen; some hold arrays, so not hashable
+            return value
+    value = CraterField(scene)
+    _CACHE_CRATER_FIELD.insert(0, (scene, value))
+    del _CACHE_CRATER_FIELD[4:]
+    return value
 
 
 def heights_at_units(scene: Scene, units, *, resolution_m: float) -> np.ndarray:

@@ -1,9 +1,9 @@
 """Windows of terrain on demand: a square of the surface around a point, sampled on a
 regular grid of the gnomonic projection tangent at its centre (PROJ ``+proj=gnom`` on
-the scene's reference sphere), at any pixel size.
+the sphere of the base shape's radius at the centre), at any pixel size.
 
 A pixel's value is the surface's radius in the direction of its projected point minus
-the reference radius (metres). The gnomonic projection maps great circles to straight
+that sphere's radius (metres). The gnomonic projection maps great circles to straight
 lines and is exact at the centre; across a window of a few degrees its scale grows by
 ``1 / cos^2(angle)`` (0.3 % at 3 degrees from the centre).
 """
@@ -17,9 +17,9 @@ import numpy as np
 from craters._shared import ParameterError, check_positive, check_range
 
 from ..scene import Scene
+from . import units_of
 from .base import tangent_frame
 from .field import crater_field
-from . import units_of
 
 __all__ = ["Tile", "hillshade", "tile"]
 
@@ -37,7 +37,11 @@ class Tile:
     lon_deg: float
     pixel_m: float
     radius_m: float
-    """The reference sphere's radius (the projection's R)."""
+    """The projection sphere's radius: the base shape's radius at the centre (m)."""
+    min_crater_m: float = 0.0
+    """The smallest crater diameter drawn (m)."""
+    n_craters: int = 0
+    """Craters that make the window (with those around it that shape their bases)."""
 
     @property
     def crs_proj4(self) -> str:
@@ -83,14 +87,31 @@ def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m
         raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
                              f"got {size_m:g} m ({size_px} pixels)")
     field = crater_field(scene)
-    radius = field.base.radius_m
+    # the projection's sphere: the base's radius at the centre, so pixels are metres on
+    # the ground there (an elongated body's ends are far from its mean radius)
+    radius = float(field.base.radius(units_of([lat_deg], [lon_deg]))[0])
     if size_m / radius > 0.5:
         raise ParameterError("size_m", f"must be at most half the reference radius "
                              f"({0.5 * radius:g} m) for a gnomonic window; got {size_m:g}")
     units = tile_units(lat_deg, lon_deg, size_px, pixel_m, radius).reshape(-1, 3)
-    r = field.radii(units, min_crater_px * pixel_m)
+    d_min = min_crater_px * pixel_m
+    r = field.radii(units, d_min)
     return Tile((r - radius).reshape(size_px, size_px), float(lat_deg), float(lon_deg),
-                pixel_m, radius)
+                pixel_m, radius, d_min, len(field.last["craters"]))
+
+
+def tile_mesh(t: Tile) -> tuple[np.ndarray, np.ndarray]:
+    """(vertices (n, 3) in the body's frame, metres; triangles (m, 3)) of a tile: each
+    pixel centre at its radius, two triangles a pixel square, outward (counter-clockwise
+    seen from above)."""
+    ny, nx = t.heights_m.shape
+    units = tile_units(t.lat_deg, t.lon_deg, nx, t.pixel_m, t.radius_m).reshape(-1, 3)
+    verts = units * (t.radius_m + t.heights_m.reshape(-1, 1))
+    idx = np.arange(ny * nx).reshape(ny, nx)
+    a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()   # north row: west, east
+    c, d = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()     # south row
+    faces = np.concatenate([np.stack([a, c, b], 1), np.stack([b, c, d], 1)])
+    return verts, faces
 
 
 def hillshade(heights_m: np.ndarray, pixel_m: float, *, azimuth_deg: float = 270.0,

@@ -1,0 +1,121 @@
+"""``latlong tile``: a window of terrain on demand (:mod:`latlong.ondemand`) around any
+point at any pixel size, from the same scene options as ``latlong build``: a Cloud
+Optimized GeoTIFF of heights in the local gnomonic projection, the window as a mesh in
+the body's frame, and a shaded picture.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from craters._shared import atomic_path, check_output_path, human_bytes
+from craters.cli.kit import CliError
+from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
+
+from ..meshio.writers import MESH_SUFFIXES
+from ..scene import SETTING_PARTS, SETTINGS, Scene
+from .build import GROUPS
+
+__all__ = ["OPTIONS", "register"]
+
+TILE = {
+    "lat_deg": Setting(help="latitude of the window's centre", unit="deg", range=(-90.0, 90.0),
+                       kind=float, required=True, run=True),
+    "lon_deg": Setting(help="longitude of the window's centre", unit="deg", range="finite",
+                       kind=float, required=True, run=True),
+    "size_m": Setting(help="side of the square window", unit="m", range=">0", kind=float,
+                      required=True, run=True),
+    "pixel_m": Setting(help="pixel size", unit="m", range=">0", kind=float, required=True,
+                       run=True),
+    "min_crater_px": Setting(3.0, "smallest crater drawn, in pixels across", range=(1.0, 1000.0),
+                             run=True),
+    "output": Setting(help="heights as a Cloud Optimized GeoTIFF (.tif, float32 metres above "
+                      "the sphere of the base's radius at the centre)", flag="-o/--output",
+                      run=True),
+    "mesh": Setting(help=f"the window as a mesh in the body's frame ({' '.join(MESH_SUFFIXES)})",
+                    run=True),
+    "picture": Setting(help="shaded picture of the window (.png, plane removed, sun from the "
+                       "west at 20 degrees)", run=True),
+}
+#: Every option of ``latlong tile``: the scene's settings, the window, the outputs.
+OPTIONS = {k: s for k, s in declared_keys(
+    *(part for part in SETTING_PARTS if part[0] not in ("implicit", "render")),
+    ("tile", TILE), ("output", {"quiet": QUIET, "force": FORCE})).items()
+    if k not in ("on_demand", "max_memory_gb", "radii_on_disk", "surface", "spacing_m")}
+_GROUPS = {"tile": "window and outputs", **GROUPS}
+
+
+def _check(v: Values) -> list[tuple[str, Path]]:
+    outs = []
+    for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
+                          ("picture", (".png",))):
+        if v[key]:
+            outs.append((key, check_output_path(v[key], force=v["force"], suffixes=suffixes)))
+    if not outs:
+        raise CliError("nothing to write: give -o/--output, --mesh or --picture")
+    return outs
+
+
+def write_cog(tile, path) -> Path:
+    """The tile's heights as a float32 Cloud Optimized GeoTIFF (atomic)."""
+    import rasterio
+    from rasterio.crs import CRS
+    from rasterio.transform import Affine
+
+    h = tile.heights_m.astype(np.float32)
+    x0, dx, _, y0, _, dy = tile.transform
+    profile = {"driver": "COG", "width": h.shape[1], "height": h.shape[0], "count": 1,
+               "dtype": "float32", "crs": CRS.from_proj4(tile.crs_proj4),
+               "transform": Affine(dx, 0.0, x0, 0.0, dy, y0), "compress": "deflate",
+               "predictor": 3, "nodata": None}
+    with atomic_path(path) as tmp:
+        with rasterio.open(tmp, "w", **profile) as dst:
+            dst.write(h, 1)
+            dst.update_tags(units="m", reference_radius_m=repr(tile.radius_m),
+                            generator="craterform latlong tile")
+    return Path(path)
+
+
+def _tile(v: Values) -> int:
+    from ..meshio.writers import array_source, write_mesh  # noqa: I001
+    from ..ondemand.tile import hillshade, tile, tile_mesh
+
+    scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
+                                 "on_demand": True})
+    outs = dict(_check(v))
+    made = tile(scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"], pixel_m=v["pixel_m"],
+                min_crater_px=v["min_crater_px"])
+    if "output" in outs:
+        write_cog(made, outs["output"])
+    if "mesh" in outs:
+        verts, faces = tile_mesh(made)
+        write_mesh(array_source(verts, faces, "craterform latlong tile",
+                                height_m=made.heights_m.ravel()), outs["mesh"])
+    if "picture" in outs:
+        from PIL import Image
+
+        h = made.heights_m
+        yy, xx = np.mgrid[:h.shape[0], :h.shape[1]]
+        a = np.stack([np.ones(h.size), xx.ravel(), yy.ravel()], axis=1)
+        plane = a @ np.linalg.lstsq(a, h.ravel(), rcond=None)[0]
+        shade = hillshade(h - plane.reshape(h.shape), made.pixel_m)
+        with atomic_path(outs["picture"]) as tmp:
+            Image.fromarray((255.0 * shade).astype(np.uint8)).save(tmp, format="PNG")
+    if not v["quiet"]:
+        ny, nx = made.heights_m.shape
+        print(f"tile: {nx} x {ny} pixels of {made.pixel_m:g} m at ({made.lat_deg:g}, "
+              f"{made.lon_deg:g}) deg, heights {made.heights_m.min():.4g}..."
+              f"{made.heights_m.max():.4g} m, {made.n_craters} craters >= "
+              f"{made.min_crater_m:.3g} m, seed {scene.seed}", file=sys.stderr)
+        for path in outs.values():
+            print(f"wrote {path} ({human_bytes(Path(path).stat().st_size)})")
+    return 0
+
+
+def register(sub) -> None:
+    """Register ``latlong tile``."""
+    command(sub, "tile", _tile, OPTIONS, groups=_GROUPS, config=True, prog="latlong",
+            help="a window of terrain on demand at any pixel size (GeoTIFF, mesh, picture)")

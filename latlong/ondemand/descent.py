@@ -1,0 +1,114 @@
+"""Descents: camera frames from orbit to touchdown over terrain made on demand for each
+frame at the resolution that frame needs.
+
+A frame at altitude ``h`` above the site looks straight down (the optical axis along the
+base's radial direction at the site, north towards the top of the picture). Its ground
+footprint is ``2 h tan(fov / 2)`` wide; the terrain under it is generated with pixels of
+the frame's ground pixel size and craters at least 3 of them across (:mod:`.tile`): a
+window 1.6 footprints wide in the gnomonic projection at the site, or, when that would
+be more than half the site's radius, every vertex of a lat/long grid whose spacing is the
+ground pixel (the body as a whole). A crater seen at 10 km is the same crater at 100 m
+(:mod:`.field`: the terrain is a function of position), now with its smaller craters.
+Shadows are cast by what the window holds.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterator
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from craters._shared import ParameterError, check_int, check_range
+
+from ..grid import LatLongGrid
+from ..scene import Scene
+from . import units_of
+from .base import tangent_frame
+from .field import crater_field
+from .tile import tile, tile_mesh
+
+if TYPE_CHECKING:
+    from ..sensors.render import Frame
+
+__all__ = ["DescentFrame", "descent", "descent_altitudes"]
+
+_MARGIN = 1.6
+_MAX_MAGNITUDE = 1500
+
+
+@dataclasses.dataclass(frozen=True)
+class DescentFrame:
+    """One frame of a descent."""
+
+    altitude_m: float
+    """Height of the camera above the terrain at the site (as the frame's terrain has it)."""
+    ground_pixel_m: float
+    """The footprint of a pixel at the site (the terrain's pixel)."""
+    frame: Frame
+    """The rendered :class:`latlong.sensors.render.Frame`."""
+    n_craters: int
+    """Craters that made the frame's terrain."""
+    terrain: str
+    """``window`` or ``body``."""
+
+
+def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
+    """``frames`` altitudes from ``start_m`` down to ``stop_m``, evenly spaced in log."""
+    start_m = check_range("start_m", start_m, 0.01, 1e9)
+    stop_m = check_range("stop_m", stop_m, 0.001, start_m)
+    frames = check_int("frames", frames, 1, 100_000)
+    return np.geomspace(start_m, stop_m, frames)
+
+
+def _terrain(scene: Scene, lat_deg, lon_deg, size_m, pixel_m, site_radius):
+    """(vertices, faces, craters, kind) of a frame's terrain."""
+    if size_m <= 0.5 * site_radius:
+        t = tile(scene, lat_deg, lon_deg, size_m=size_m, pixel_m=pixel_m)
+        verts, faces = tile_mesh(t)
+        return verts, faces, t.n_craters, "window"
+    field = crater_field(scene)
+    m = int(min(_MAX_MAGNITUDE, max(16, math.ceil(math.pi * field.base.radius_m / (2 * pixel_m)))))
+    grid = LatLongGrid(m)
+    units = grid.unit_vectors()
+    d_min = 3.0 * grid.spacing(field.base.radius_m)
+    radii = field.radii(units, d_min)
+    return units * radii[:, None], grid.triangles(), len(field.last["craters"]), "body"
+
+
+def descent(scene: Scene, lat_deg: float, lon_deg: float, altitudes_m, *, fov_deg: float = 30.0,
+            width_px: int = 512, sun_azimuth_deg: float = 90.0,
+            sun_elevation_deg: float = 25.0, reflectance=None) -> Iterator[DescentFrame]:
+    """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes),
+    square pictures ``width_px`` wide, the sun at ``sun_azimuth_deg`` (clockwise from
+    north) and ``sun_elevation_deg`` above the site's horizon."""
+    from ..sensors import Camera, Pose, render  # the sensors load only for descents
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+    check_range("fov_deg", fov_deg, 1.0, 120.0)
+    width_px = check_int("width_px", width_px, 16, 8192)
+    alts = np.asarray(altitudes_m, dtype=np.float64).ravel()
+    if not len(alts) or not (np.isfinite(alts).all() and (alts > 0).all()):
+        raise ParameterError("altitudes_m", "must be positive numbers")
+    field = crater_field(scene)
+    u0 = units_of([lat_deg], [lon_deg])
+    east, north = (a[0] for a in tangent_frame(u0))
+    up = u0[0]
+    site_radius = float(field.base.radius(u0)[0])
+    az, el = math.radians(sun_azimuth_deg), math.radians(sun_elevation_deg)
+    sun = (math.cos(el) * (math.sin(az) * east + math.cos(az) * north) + math.sin(el) * up)
+    camera = Camera.from_fov(fov_deg, width_px, width_px)
+    tan_half = math.tan(math.radians(fov_deg) / 2.0)
+    for h in alts:
+        footprint = 2.0 * h * tan_half
+        pixel = footprint / width_px
+        verts, faces, n_craters, kind = _terrain(scene, lat_deg, lon_deg, _MARGIN * footprint,
+                                                 pixel, site_radius)
+        # the altitude is above the terrain at the site as this frame's terrain has it
+        ground = up * float(field.radii(u0, 3.0 * pixel)[0])
+        pose = Pose.look_at(ground + h * up, ground, up=north)
+        frame = render((verts, faces), camera, pose, sun, reflectance=reflectance)
+        yield DescentFrame(float(h), pixel, frame, n_craters, kind)

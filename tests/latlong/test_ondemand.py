@@ -1,0 +1,219 @@
+"""Terrain on demand (latlong.ondemand, craters.local): locality, refinement, the kernels
+against numpy references, the cell-by-cell catalogue."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from craters import CraterLayer
+from craters.cells import cell_ids, cell_of, cell_solid_angle
+from craters.kernels import fbm2, roughness_amp, table, table_value
+from craters.local import bins, draw_cells
+from latlong import LatLongGrid, Scene, build
+from latlong.ondemand import _field_kernels as K
+from latlong.ondemand import heights_at, units_of
+from latlong.ondemand.field import BLEND_EDGE, FIT, ROUGHNESS_OCTAVES, STENCIL_XY, crater_field
+from latlong.ondemand.tile import tile, tile_mesh
+
+
+@pytest.fixture(scope="module")
+def scene():
+    # a 100 m fBm body with 4-15 m craters (few enough for quick single-point queries)
+    return Scene.from_settings({"preset": "fbm-cratered", "seed": 5, "on_demand": True,
+                                "craters": ["c=0.5,k=-2,d_min_m=4,d_max_m=15"]})
+
+
+# ----------------------------------------------------------------------------- catalogue
+def _cells(level, n=60, face=2):
+    i, j = np.meshgrid(np.arange(n) + 7, np.arange(n) + 11)
+    return cell_ids(level, np.full(i.size, face), i.ravel(), j.ravel()), \
+        cell_solid_angle(level, face, i.ravel(), j.ravel())
+
+
+def test_cells_draw_the_expected_counts_in_their_cells_and_bins():
+    la = CraterLayer(0.5, -2.0, 1.0, 8.0)
+    ids, omega = _cells(12)
+    area = omega * 20000.0**2  # ~32 000 craters
+    got = draw_cells(la, 0, seed=3, b=1, level=12, cell_ids=ids, area_m2=area)
+    expected = area.sum() * la.expected_count(1.0, 2.0, 4.0)
+    assert abs(len(got["diameter_m"]) - expected) < 4 * np.sqrt(expected)
+    d = got["diameter_m"]
+    assert ((d >= 2.0) & (d < 4.0)).all()
+    # a power law of slope -2 in [2, 4): median 2 * sqrt(8 / 5) = 2.53
+    assert abs(np.median(d) - 2.0 * np.sqrt(8.0 / 5.0)) < 0.02  # 4 standard errors
+    f, i, j = cell_of(got["unit"], 12)
+    assert np.array_equal(cell_ids(12, f, i, j), got["cell"])
+    assert np.allclose(np.linalg.norm(got["unit"], axis=1), 1.0)
+    assert ((got["age_gyr"] >= 0.0) & (got["age_gyr"] < 3.5)).all()
+
+
+def test_a_cell_draws_the_same_craters_whatever_else_is_drawn():
+    la = CraterLayer(0.5, -2.0, 1.0, 8.0)
+    ids, omega = _cells(10, n=30)
+    area = omega * 5000.0**2
+    every = draw_cells(la, 2, seed=11, b=0, level=10, cell_ids=ids, area_m2=area)
+    pick = np.array([5, 400, 899])
+    some = draw_cells(la, 2, seed=11, b=0, level=10, cell_ids=ids[pick[::-1]],
+                      area_m2=area[pick[::-1]])
+    for c in ids[pick]:
+        a, b = every["cell"] == c, some["cell"] == c
+        for key in ("unit", "diameter_m", "age_gyr", "rim_phases", "seed", "id"):
+            assert every[key][a].tobytes() == some[key][b].tobytes()
+    other = draw_cells(la, 2, seed=12, b=0, level=10, cell_ids=ids, area_m2=area)
+    assert not np.array_equal(other["id"][:10], every["id"][:10])
+
+
+def test_bins_cover_the_layer_without_an_empty_top_bin():
+    assert bins(CraterLayer(0.5, -2.0, 1.0, 8.0)).tolist() == [0, 1, 2]
+    assert bins(CraterLayer(0.5, -2.0, 0.3, 9.0)).tolist() == [-2, -1, 0, 1, 2, 3]
+
+
+# ----------------------------------------------------------------------------- kernels
+def test_the_fit_operator_reproduces_a_quadric_exactly():
+    x, y = STENCIL_XY[:, 0], STENCIL_XY[:, 1]
+    coef = np.array([0.3, -1.2, 0.7, 2.0, -0.5, 1.5])
+    h = coef[0] + coef[1] * x + coef[2] * y + coef[3] * x * x + coef[4] * x * y + coef[5] * y * y
+    assert np.allclose(FIT @ h, coef, atol=1e-12)
+    assert FIT.shape == (6, len(STENCIL_XY))
+
+
+def _step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, p):
+    """The affine step of crater k at direction p, in numpy (module notes of field)."""
+    c = fc[k, 0:3] @ p
+    xe_, xn_ = fc[k, 3:6] @ p, fc[k, 6:9] @ p
+    s = np.hypot(xe_, xn_)
+    dist = np.arctan2(s, c) * fc[k, K.RHO]
+    x, y = (dist * xe_ / s, dist * xn_ / s) if s > 0 else (0.0, 0.0)
+    az = np.arctan2(xn_, xe_) if s > 0 else 0.0
+    if c < fc[k, K.COS_FAR]:
+        return False, 1.0, 0.0
+    xr = dist / (fc[k, K.RAD] * (1.0 + table.py_func(rims[k], az)))
+    if not xr < xe:
+        return False, 1.0, 0.0
+    prof = fc[k, K.SCALE] * table_value.py_func(tabs[k], xr, xe)
+    amp = roughness_amp.py_func(xr, xe, *rough) * fc[k, K.DEPTH] * fc[k, K.SCALE]
+    prof += amp * fbm2.py_func(seeds[k], x, y, fc[k, K.RAD], ROUGHNESS_OCTAVES, gain)
+    q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
+                        + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
+    if xr <= 1.0:
+        return True, 0.0, q + prof
+    w = 1.0 - ((BLEND_EDGE - xr) / (BLEND_EDGE - 1.0)) ** 2 if xr < BLEND_EDGE else 1.0
+    return True, w, (1.0 - w) * q + prof
+
+
+def test_the_point_kernel_matches_a_numpy_composition(scene):
+    field = crater_field(scene)
+    units = units_of(np.linspace(-20, 20, 40), np.linspace(100, 130, 40))
+    got = field.radii(units, 4.0)
+    last = field.last
+    fc, rank = last["fc"], last["rank"]
+    cr = last["craters"]
+    from craters.catalog import make_catalog
+    from craters.stamp import rim_perturbations_from_phases, stamping_profiles
+    n = len(cr)
+    prof = stamping_profiles(make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n),
+                                          diameter_m=cr.diameter_m, age_gyr=cr.age_gyr,
+                                          degradation=np.full(n, np.nan)),
+                             field.target, ejecta_edge=field.xe)
+    rims = rim_perturbations_from_phases(cr.rim_phases, field.irregularity)
+    order = np.argsort(rank)
+    base = field.base.radius(units)
+    for i, p in enumerate(units):
+        a, b = 1.0, 0.0
+        for k in order:
+            if fc[k, K.ACTIVE] == 0.0:
+                continue
+            with np.errstate(over="ignore"):  # the hash's uint64 arithmetic wraps
+                hit, ak, bk = _step_reference(fc, k, prof.tables, rims, cr.seed, field.rough,
+                                              field.gain, field.xe, p)
+            if hit:
+                b += a * bk
+                a *= ak
+                if a == 0.0:
+                    break
+        want = b + a * base[i]
+        assert got[i] == pytest.approx(want, abs=1e-9), i
+
+
+# ----------------------------------------------------------------------------- locality
+def test_a_height_is_the_same_alone_in_a_batch_and_in_the_whole_body(scene):
+    grid = LatLongGrid(60)
+    res = grid.spacing(crater_field(scene).base.radius_m)
+    units = grid.unit_vectors()
+    every = crater_field(scene).radii(units, 3.0 * res)
+    pick = np.random.default_rng(1).choice(len(units), 40, replace=False)
+    batch = crater_field(scene).radii(units[pick], 3.0 * res)
+    assert batch.tobytes() == every[pick].tobytes()
+    for i in pick[:2]:
+        alone = crater_field(scene).radii(units[i:i + 1], 3.0 * res)
+        assert alone.tobytes() == every[i:i + 1].tobytes()
+    # the library call and the on-demand build give the same values
+    lat, lon = grid.latitudes(), grid.longitudes()
+    r = heights_at(scene, np.degrees(lat[pick[:5]]), np.degrees(lon[pick[:5]]),
+                   resolution_m=res)
+    assert np.allclose(r, every[pick[:5]], rtol=0, atol=1e-9)
+    body = build(Scene.from_settings({"preset": "fbm-cratered", "seed": 5, "on_demand": True,
+                                      "magnitude": 60,
+                                      "craters": ["c=0.5,k=-2,d_min_m=4,d_max_m=15"]}))
+    assert body.radii_m.tobytes() == every.tobytes()
+    assert len(body.craters) > 100
+
+
+def test_a_finer_resolution_changes_heights_only_where_the_added_craters_reach(scene):
+    field = crater_field(scene)
+    units = units_of(*np.meshgrid(np.linspace(30, 36, 70), np.linspace(40, 46, 70)))
+    coarse = field.radii(units, 12.0)
+    fine = field.radii(units, 6.0)
+    cr, fc = field.last["craters"], field.last["fc"]
+    added = (cr.diameter_m >= 6.0) & (cr.diameter_m < 12.0)
+    reach = np.zeros(len(units), bool)
+    for k in np.flatnonzero(added):
+        reach |= units @ fc[k, 0:3] >= fc[k, K.COS_FAR]
+    changed = fine != coarse
+    assert changed.any()
+    assert not (changed & ~reach).any()
+
+
+def test_no_older_crater_shows_inside_a_younger_rim(scene):
+    field = crater_field(scene)
+    field.radii(LatLongGrid(30).unit_vectors(), 4.0)  # every crater of the body
+    fc, rank, cr = field.last["fc"], field.last["rank"], field.last["craters"]
+    ang = np.arccos(np.clip(fc[:, 0:3] @ fc[:, 0:3].T, -1.0, 1.0))
+    rim = 0.97 * fc[:, K.RAD] / fc[:, K.RHO]  # inside the rim at every azimuth
+    # j older than k, j's centre inside k's rim: nothing of j shows there
+    inside = (rank[:, None] > rank[None, :]) & (ang < rim[None, :]) \
+        & (fc[None, :, K.ACTIVE] > 0)
+    js = np.flatnonzero(inside.any(axis=1))
+    assert len(js) >= 3
+    for j in js[:8]:
+        k = np.flatnonzero(inside[j])[0]
+        # j's centre and points on the way to k's centre
+        t = np.linspace(0.0, 1.0, 4)[:, None]
+        pts = (1.0 - t) * fc[j, 0:3] + t * fc[k, 0:3]
+        pts /= np.linalg.norm(pts, axis=1, keepdims=True)
+        with_j = field.radii(pts, 0.999 * cr.diameter_m[j])
+        without = field.radii(pts, 1.001 * cr.diameter_m[j])
+        assert with_j.tobytes() == without.tobytes(), j
+
+
+# ----------------------------------------------------------------------------- tiles
+def test_a_tile_has_its_pixels_and_projection(scene):
+    t = tile(scene, 10.0, 20.0, size_m=8.0, pixel_m=0.5)
+    assert t.heights_m.shape == (16, 16)
+    assert "+proj=gnom" in t.crs_proj4 and "+lat_0=10.0" in t.crs_proj4
+    assert t.transform[:2] == (-4.0, 0.5)
+    verts, faces = tile_mesh(t)
+    assert verts.shape == (256, 3) and faces.shape == (2 * 15 * 15, 3)
+    # outward: the triangles' normals point away from the centre
+    a, b, c = verts[faces[:, 0]], verts[faces[:, 1]], verts[faces[:, 2]]
+    assert (np.einsum("ij,ij->i", np.cross(b - a, c - a), a) > 0).all()
+    with pytest.raises(ValueError, match="size_m"):
+        tile(scene, 10.0, 20.0, size_m=1e9, pixel_m=0.5)
+    with pytest.raises(ValueError, match="pixel_m"):
+        tile(scene, 10.0, 20.0, size_m=8.0, pixel_m=-1.0)
+
+
+def test_on_demand_refuses_a_stretched_body():
+    with pytest.raises(ValueError, match="stretch"):
+        Scene.from_settings({"preset": "paper", "on_demand": True})
