@@ -32,8 +32,17 @@ def _mulhilo(a, b):
 
 @njit(cache=True, parallel=True)
 def _philox_kernel(counters, keys, out):
-    """out[i] = Philox4x64-10(counters[i], keys[i]); rows independent."""
-    for i in prange(counters.shape[0]):
+    """out[i] = Philox4x64-10(counters[i], keys[i]); rows independent (in parallel blocks
+    of 4096: a parallel region costs more than a few thousand rows)."""
+    n = counters.shape[0]
+    for b in prange((n + 4095) // 4096):
+        _philox_rows(counters, keys, out, b * 4096, min(n, (b + 1) * 4096))
+
+
+@njit(cache=True)
+def _philox_rows(counters, keys, out, lo, hi):
+    """Rows lo..hi-1 of :func:`_philox_kernel`."""
+    for i in range(lo, hi):
         c0 = counters[i, 0]
         c1 = counters[i, 1]
         c2 = counters[i, 2]

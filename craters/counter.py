@@ -34,6 +34,7 @@ from ._counter_kernels import (
     _exp_kernel,
     _log_kernel,
     _philox_kernel,
+    _philox_rows,
     _poisson_kernel,
     _power_law_kernel,
 )
@@ -84,7 +85,10 @@ def philox4x64(counters, key) -> np.ndarray:
         raise ValueError(f"`key` must be one key or one per counter ({len(c)}); got {len(k)}")
     out = np.empty((len(c), 4), dtype=np.uint64)
     if len(c):
-        _philox_kernel(c, k, out)
+        if len(c) <= 8192:  # a parallel region costs more than a few thousand rows
+            _philox_rows(c, k, out, 0, len(c))
+        else:
+            _philox_kernel(c, k, out)
     return out
 
 

@@ -178,18 +178,17 @@ def _build_latlong(scene: Scene, progress: bool, *, overwrite: bool, out=None) -
 def _build_on_demand(scene: Scene) -> Body:
     """The lat/long body as terrain on demand (:mod:`latlong.ondemand`): every vertex of
     the grid at the grid's ring spacing (craters at least 3 spacings across), each value
-    the same as :func:`latlong.heights_at` gives it alone."""
-    from .ondemand import crater_field  # the on-demand engine loads only when asked
+    the same as :func:`latlong.heights_at` gives it alone; in one patch here
+    (:func:`latlong.ondemand.patches.build_patches` for more, on dask)."""
+    from .ondemand.patches import build_patches  # the on-demand engine loads when asked
 
-    grid = LatLongGrid(scene.body.magnitude)
-    field = crater_field(scene)
-    radius = field.base.radius_m
-    d_min = 3.0 * grid.spacing(radius)
-    units = grid.unit_vectors()
-    radii = field.radii(units, d_min)
-    cat = field.catalog(units, d_min)
-    metadata = {**_metadata(scene, {}), "on_demand": True, "min_crater_diameter_m": d_min}
-    return Body(grid, radii, radius_m=radius, metadata=metadata, craters=cat, copy=False)
+    return build_patches(scene)
+
+
+def on_demand_metadata(scene: Scene, min_crater_m: float, patches: int) -> dict:
+    """The metadata of a body built on demand."""
+    return {**_metadata(scene, {}), "on_demand": True, "min_crater_diameter_m": min_crater_m,
+            "patches": patches}
 
 
 def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterError:

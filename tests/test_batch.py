@@ -467,3 +467,34 @@ def test_map_tiles_on_dask_yields_every_result_and_raises_a_failure(scheduler):
     with pytest.raises(ZeroDivisionError):
         list(map_tiles(operator.truediv, 1.0, [1.0, 2.0, 0.0, 4.0], scheduler=scheduler,
                        retries=0))
+
+
+# --------------------------------------------------------------------------- on demand
+_ON_DEMAND = {"preset": "fbm-cratered", "seed": 5, "on_demand": True, "magnitude": 40,
+              "craters": ["c=0.5,k=-2,d_min_m=4,d_max_m=15"]}
+
+
+def test_on_demand_patches_give_the_same_bytes_on_any_backend(scheduler):
+    """A body built on demand in 1 patch here = 2 and 16 patches as dask tasks."""
+    from latlong.ondemand.patches import build_patches
+
+    scene = latlong.Scene.from_settings(_ON_DEMAND)
+    one = build_patches(scene)
+    for patches in (2, 16):
+        got = build_patches(scene, patches=patches, scheduler=scheduler)
+        assert got.radii_m.tobytes() == one.radii_m.tobytes()
+        assert got.craters.tobytes() == one.craters.tobytes()
+    assert len(one.craters) > 100
+
+
+@pytest.mark.slow
+def test_on_demand_patches_on_separate_processes(tmp_path):
+    """The same bytes from ``dask scheduler`` / ``dask worker`` processes."""
+    from latlong.ondemand.patches import build_patches
+
+    scene = latlong.Scene.from_settings(_ON_DEMAND)
+    here = build_patches(scene, patches=3)
+    with _separate_cluster(tmp_path) as address:
+        there = build_patches(scene, patches=16, scheduler=address)
+    assert there.radii_m.tobytes() == here.radii_m.tobytes()
+    assert there.craters.tobytes() == here.craters.tobytes()

@@ -15,7 +15,7 @@ import numpy as np
 
 from craters._shared import human_bytes, progress_bar
 from craters.cli.kit import CliError
-from craters.cli.options import FORCE, QUIET, Values, command, declared_keys
+from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
 
 from ..outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
@@ -25,8 +25,17 @@ __all__ = ["GROUPS", "OPTIONS", "register"]
 
 #: Every option of ``latlong build`` (the scene's settings, the outputs, --quiet,
 #: --force): also the keys of a scene file.
+#: How an on-demand build (``--on-demand``) runs: patches, and where.
+ON_DEMAND_RUN = {
+    "patches": Setting(1, "independent patches of vertices of an --on-demand build (the same "
+                       "bytes for any number)", range=(1, 10**9), run=True),
+    "workers": Setting(help="patches on a local dask cluster of this many worker processes "
+                       "(--on-demand)", kind=int, range=(1, 1024), run=True),
+    "scheduler": Setting(help="patches on the dask scheduler at this address, e.g. "
+                         "tcp://127.0.0.1:8786 (--on-demand)", run=True),
+}
 OPTIONS = declared_keys(*SETTING_PARTS, ("output", Outputs),
-                        ("output", {"quiet": QUIET, "force": FORCE}))
+                        ("output", {"quiet": QUIET, "force": FORCE}), ("body", ON_DEMAND_RUN))
 #: The titles of the option groups of ``latlong build --help``.
 GROUPS = {"body": "body", "faulting": "two-phase faulting (--base faulting)",
           "fbm": "Perlin fBm (--base fbm; detail on --base shape)",
@@ -97,7 +106,16 @@ def _build(v: Values) -> int:
             n = LatLongGrid(scene.body.magnitude).n_vertices
             print(f"keeping the {n:.3g} radii ({n * 8 / 1e9:.3g} GB) in a scratch file in "
                   f"{str(scratch)!r} (--radii-on-disk)", file=sys.stderr)
-    made = build(scene, progress=show, scratch_dir=scratch)
+    run = {k: v[k] for k in ("patches", "workers", "scheduler") if k in v.given}
+    if run and not scene.on_demand:
+        raise CliError(f"--{next(iter(run))} applies to an --on-demand build")
+    if scene.on_demand:
+        from latlong.ondemand.patches import build_patches
+
+        made = build_patches(scene, patches=v["patches"], workers=v["workers"],
+                             scheduler=v["scheduler"])
+    else:
+        made = build(scene, progress=show, scratch_dir=scratch)
     bar.update()
     write_outputs(made, scene, outputs, progress=show, done=bar.update)
     bar.close()

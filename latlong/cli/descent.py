@@ -1,8 +1,8 @@
 """``latlong descent``: camera frames of a vertical descent from orbit to touchdown over
 terrain made on demand for each frame (:mod:`latlong.ondemand.descent`), with the
 scene options of ``latlong build``: per frame the camera's files (image, depth, range,
-normals), an 8-bit picture for people, and ``frames.json``; ``strip.png`` puts the
-pictures side by side.
+normals) and an 8-bit picture for people (exposed on its own lit pixels), and
+``frames.json``; ``strip.png`` puts the pictures side by side.
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def _descent(v: Values) -> int:
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
     from PIL import Image
 
-    entries, pictures, scale = [], [], None
+    entries, pictures = [], []
     with run_folder(out, "frames.json") as tmp:
         for i, f in enumerate(descent(scene, v["lat_deg"], v["lon_deg"], alts,
                                       fov_deg=v["fov_deg"], width_px=v["size_px"],
@@ -77,15 +77,17 @@ def _descent(v: Values) -> int:
                                       sun_elevation_deg=v["sun_elevation_deg"])):
             files = write_frame(tmp, i, f.frame)
             r = f.frame.reflectance
-            if scale is None:  # one exposure for the whole descent: the first frame's
-                lit = r[r > 0]
-                scale = float(np.percentile(lit, 99.5)) if len(lit) else 1.0
+            # each picture exposed on its own lit pixels (the 99.5th percentile to white),
+            # as a descent camera's auto-exposure would
+            lit = r[r > 0]
+            scale = float(np.percentile(lit, 99.5)) if len(lit) else 1.0
             pic = display(r, scale)
             files["picture"] = f"picture_{i:04d}.png"
             with atomic_path(tmp / files["picture"]) as p:
                 Image.fromarray(pic).save(p, format="PNG")
             pictures.append(pic)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
+                            "picture_white_if": scale,
                             "terrain": f.terrain, "craters": f.n_craters,
                             "position_m": [float(x) for x in f.frame.pose.position_m],
                             "quaternion_wxyz": [float(x) for x in
@@ -103,7 +105,7 @@ def _descent(v: Values) -> int:
         cam = f.frame.camera
         write_manifest(tmp, {"intrinsics": cam.intrinsics(), "seed": scene.seed,
                              "site_lat_lon_deg": [v["lat_deg"], v["lon_deg"]],
-                             "display_scale_if": scale, "frames": entries})
+                             "frames": entries})
     if not v["quiet"]:
         print(f"wrote {len(entries)} frames, {out / 'strip.png'}, {out / 'frames.json'}")
     return 0

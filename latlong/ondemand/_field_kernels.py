@@ -61,9 +61,9 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     blended into the base quadric towards the rim (weight a = 1 - ((xb - x)/(xb - 1))^2
     from the rim to ``xb`` radii, 1 beyond), so the rim is continuous whatever the older
     terrain is."""
+    if fc[k, C0] * p0 + fc[k, C1] * p1 + fc[k, C2] * p2 < fc[k, COS_FAR]:
+        return False, 1.0, 0.0  # beyond the widest ejecta edge: nothing else to compute
     cosang, dist, x, y, az = _local(fc, k, p0, p1, p2)
-    if cosang < fc[k, COS_FAR]:
-        return False, 1.0, 0.0
     radius = fc[k, RAD]
     xr = dist / (radius * (1.0 + table(rims[k], az)))
     if not xr < xe:
@@ -72,7 +72,10 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     prof = scale * table_value(tabs[k], xr, xe)
     if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
-        prof += amp * fbm2(seeds[k], x, y, radius, octaves, gain)
+        # below a millionth of the radius (a crater diffused flat) the overlay is left out:
+        # a property of the crater, the same wherever it is evaluated
+        if amp > 1e-6 * radius:
+            prof += amp * fbm2(seeds[k], x, y, radius, octaves, gain)
     q = fc[k, RHO] + _quadric(fc, k, x, y)
     if xr <= 1.0:
         return True, 0.0, q + prof
@@ -398,6 +401,29 @@ def _cap_blocks_kernel(fc, craters, level, occ, cos_margin, out_blk, out_crater)
                             out_crater[n] = k
                         n += 1
     return n
+
+
+@njit(cache=True, parallel=True)
+def _stencil_kernel(fc, st_xy, out):
+    """Directions (n, s, 3) of each crater's stencil points: at angle r R / rho from its
+    centre towards azimuth atan2(y, x) (east = x), for the normalised (x, y) of
+    ``st_xy``."""
+    for k in prange(fc.shape[0]):
+        scale = fc[k, RAD] / fc[k, RHO]
+        for s in range(st_xy.shape[0]):
+            tx = st_xy[s, 0] * scale
+            ty = st_xy[s, 1] * scale
+            ang = np.sqrt(tx * tx + ty * ty)
+            if ang > 0.0:
+                ce = tx / ang
+                cn = ty / ang
+            else:
+                ce = 0.0
+                cn = 0.0
+            sa = np.sin(ang)
+            ca = np.cos(ang)
+            for d in range(3):
+                out[k, s, d] = ca * fc[k, C0 + d] + sa * (ce * fc[k, E0 + d] + cn * fc[k, N0 + d])
 
 
 @njit(cache=True)

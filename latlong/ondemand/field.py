@@ -187,18 +187,26 @@ class CraterField:
         n_have = 0
         fc_have = np.zeros((0, K.N_COLS))
         d_have = np.zeros(0)
+        # the points' cells at the finest level asked, once: coarser ones by shifts
+        at_level: dict[int, np.ndarray] = {}
+        level_now = max(self.levels.values())
+        cells_now = _unique(_cells(units, level_now))
+        for lv in sorted(set(self.levels.values()), reverse=True):
+            cells_now = _coarser(cells_now, level_now, lv)
+            level_now = lv
+            at_level[lv] = cells_now
         for b in sorted(self.levels):
             if self._bin_top(b) <= d_min:
                 continue
             level = self.levels[b]
             # the query rule: every crater of the cells around the points' cells
-            cand_cells = np.unique(_neighbours(np.unique(_cells(units, level))))
+            cand_cells = _unique(_neighbours(at_level[level]))
             q_cells = cand_cells
             # the cells around the centres of the needed smaller craters
             own_cells9 = _neighbours(_cells(fc_have[:, K.C0:K.C2 + 1], level), keep_shape=True)
-            cand_cells = np.union1d(cand_cells, own_cells9.ravel())
+            cand_cells = _unique(np.concatenate([cand_cells, own_cells9.ravel()]))
             cand = self._draw(b, cand_cells, d_min)
-            needed_mask = np.isin(cand.cell, q_cells)
+            needed_mask = _in_sorted(cand.cell, q_cells)
             owners = np.arange(n_have, dtype=np.int64)
             cells9 = own_cells9
             # the query-rule craters are owners within this bin too
@@ -209,12 +217,13 @@ class CraterField:
                 owners = np.concatenate([owners, first + n_have])
                 cells9 = np.concatenate([cells9, _neighbours(
                     _cells(cand.fc[first, K.C0:K.C2 + 1], level), keep_shape=True)])
-                extra = np.setdiff1d(np.unique(cells9), cand_cells)
+                extra = _unique(cells9.ravel())
+                extra = extra[~_in_sorted(extra, cand_cells)]
                 if len(extra):  # cells around same-bin owners not drawn yet
                     more = self._draw(b, extra, d_min)
                     cand = _Craters.concat([cand, more])
                     needed_mask = np.concatenate([needed_mask, np.zeros(len(more), bool)])
-                    cand_cells = np.union1d(cand_cells, extra)
+                    cand_cells = _unique(np.concatenate([cand_cells, extra]))
                     fc_all = np.concatenate([fc_have, cand.fc])
                     d_all = np.concatenate([d_have, cand.diameter_m])
                 o, d = _dep_pairs(owners, cells9, cand, n_have, fc_all, d_all)
@@ -295,7 +304,7 @@ class CraterField:
         seeds = np.ascontiguousarray(cr.seed)
         up = np.ascontiguousarray(self.base.up(fc[:, K.C0:K.C2 + 1]))
         # dependencies per owner, youngest first
-        key = np.unique(owner * n + dep)
+        key = _unique(owner * n + dep)
         owner, dep = key // n, key % n
         srt = np.lexsort((rank[dep], owner))
         dep_list = np.ascontiguousarray(dep[srt])
@@ -318,7 +327,7 @@ class CraterField:
         # blocks of points, and the craters that may reach each block
         level = _block_level(len(units), units)
         pcells = _cells(units, level)
-        occ, block_of = np.unique(pcells, return_inverse=True)
+        occ, block_of = _unique_inverse(pcells)
         margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
         order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
         active = order[fc[order, K.ACTIVE] > 0]
@@ -348,7 +357,9 @@ def _dep_pairs(owners, cells9, cand: _Craters, n_have: int, fc_all, d_all):
     if not len(owners) or not len(cand):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     order = np.argsort(cand.cell, kind="stable")
-    ucells, starts = np.unique(cand.cell[order], return_index=True)
+    srt = cand.cell[order]
+    first = np.concatenate([[True], srt[1:] != srt[:-1]]) if len(srt) else np.zeros(0, bool)
+    ucells, starts = srt[first], np.flatnonzero(first)
     starts = np.append(starts, len(order)).astype(np.int64)
     cand_idx = (order + n_have).astype(np.int64)
     cap = max(1024, 8 * len(owners))
@@ -369,6 +380,46 @@ def _cells(units: np.ndarray, level: int) -> np.ndarray:
     return out
 
 
+def _unique(x: np.ndarray) -> np.ndarray:
+    """Sorted distinct values (by sorting: numpy's hashed ``unique`` is some 70 times
+    slower on cell ids, whose low bits repeat)."""
+    a = np.sort(np.asarray(x).ravel())
+    if not len(a):
+        return a
+    return a[np.concatenate([[True], a[1:] != a[:-1]])]
+
+
+def _unique_inverse(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sorted distinct values, index of each element's value)."""
+    order = np.argsort(x, kind="stable")
+    a = x[order]
+    first = np.concatenate([[True], a[1:] != a[:-1]])
+    inverse = np.empty(len(x), dtype=np.int64)
+    inverse[order] = np.cumsum(first) - 1
+    return a[first], inverse
+
+
+def _in_sorted(x: np.ndarray, sorted_unique: np.ndarray) -> np.ndarray:
+    """Whether each element of ``x`` is in ``sorted_unique``."""
+    if not len(sorted_unique):
+        return np.zeros(len(x), bool)
+    pos = np.minimum(np.searchsorted(sorted_unique, x), len(sorted_unique) - 1)
+    return sorted_unique[pos] == x
+
+
+def _coarser(cells: np.ndarray, level: int, to_level: int) -> np.ndarray:
+    """The distinct cells of ``to_level`` holding cells of ``level`` (>= it): a cell's
+    ``i, j`` at a coarser level are its own shifted right (the cube's cells nest: the
+    scaled coordinates differ by powers of two, exactly)."""
+    shift = np.uint64(level - to_level)
+    mask = np.uint64((1 << 27) - 1)
+    face = (cells >> np.uint64(54)) & np.uint64(7)
+    i = ((cells >> np.uint64(27)) & mask) >> shift
+    j = (cells & mask) >> shift
+    return _unique((np.uint64(to_level) << np.uint64(57)) | (face << np.uint64(54))
+                     | (i << np.uint64(27)) | j)
+
+
 def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
     out = np.empty((len(cells), 9), dtype=np.uint64)
     if len(cells):
@@ -378,15 +429,9 @@ def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
 
 def _stencil_points(fc: np.ndarray) -> np.ndarray:
     """(n, 61, 3) directions of each crater's stencil: angle r R / rho from its centre."""
-    t = STENCIL_XY[None, :, :] * (fc[:, K.RAD] / fc[:, K.RHO])[:, None, None]
-    ang = np.sqrt(t[..., 0] ** 2 + t[..., 1] ** 2)
-    safe = np.where(ang > 0, ang, 1.0)
-    ce, cn = t[..., 0] / safe, t[..., 1] / safe
-    s, c = np.sin(ang), np.cos(ang)
-    out = np.empty(t.shape[:2] + (3,))
-    for d in range(3):
-        out[..., d] = c * fc[:, None, K.C0 + d] + s * (ce * fc[:, None, K.E0 + d]
-                                                       + cn * fc[:, None, K.N0 + d])
+    out = np.empty((len(fc), len(STENCIL_XY), 3))
+    if len(fc):
+        K._stencil_kernel(np.ascontiguousarray(fc), STENCIL_XY, out)
     return out
 
 

@@ -93,7 +93,8 @@ def _step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, p):
         return False, 1.0, 0.0
     prof = fc[k, K.SCALE] * table_value.py_func(tabs[k], xr, xe)
     amp = roughness_amp.py_func(xr, xe, *rough) * fc[k, K.DEPTH] * fc[k, K.SCALE]
-    prof += amp * fbm2.py_func(seeds[k], x, y, fc[k, K.RAD], ROUGHNESS_OCTAVES, gain)
+    if amp > 1e-6 * fc[k, K.RAD]:
+        prof += amp * fbm2.py_func(seeds[k], x, y, fc[k, K.RAD], ROUGHNESS_OCTAVES, gain)
     q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
                         + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
     if xr <= 1.0:
@@ -217,3 +218,28 @@ def test_a_tile_has_its_pixels_and_projection(scene):
 def test_on_demand_refuses_a_stretched_body():
     with pytest.raises(ValueError, match="stretch"):
         Scene.from_settings({"preset": "paper", "on_demand": True})
+
+
+def test_stencil_points_match_numpy(scene):
+    from latlong.ondemand.field import _stencil_points
+
+    field = crater_field(scene)
+    field.radii(units_of([0.0], [0.0]), 4.0)
+    fc = field.last["fc"]
+    t = STENCIL_XY[None, :, :] * (fc[:, K.RAD] / fc[:, K.RHO])[:, None, None]
+    ang = np.hypot(t[..., 0], t[..., 1])
+    safe = np.where(ang > 0, ang, 1.0)
+    ce, cn = t[..., 0] / safe, t[..., 1] / safe
+    want = np.cos(ang)[..., None] * fc[:, None, 0:3] + np.sin(ang)[..., None] * (
+        ce[..., None] * fc[:, None, 3:6] + cn[..., None] * fc[:, None, 6:9])
+    assert np.allclose(_stencil_points(fc), want, rtol=0, atol=1e-15)
+
+
+def test_coarser_cells_are_the_points_cells_at_that_level():
+    from latlong.ondemand.field import _cells, _coarser
+
+    u = np.random.default_rng(0).normal(size=(20000, 3))
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    fine = _cells(u, 20)
+    for level in (0, 3, 10, 19):
+        assert np.array_equal(_coarser(fine, 20, level), np.unique(_cells(u, level)))

@@ -1,0 +1,87 @@
+"""A whole lat/long body as terrain on demand, patch by patch: every vertex of the
+``M``-grid at the grid's resolution (craters at least 3 ring spacings across), in
+independent patches of vertices on any backend (:mod:`latlong.parallel.backends`: this
+process, a local dask cluster, or a running scheduler). A patch's radii depend only on
+its vertices (:mod:`.field`), so any number of patches, in any order, on any worker,
+gives the same bytes; memory is bounded by a patch (and the body's radii where they are
+gathered). The crater catalog is gathered the same way: each crater from the patch that
+holds the vertex nearest its centre.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import numpy.lib.recfunctions as rfn
+
+from craters._shared import check_int
+
+from ..body import Body
+from ..grid import LatLongGrid
+from ..scene import Scene
+
+__all__ = ["build_patches", "patch_ranges"]
+
+
+def patch_ranges(n_vertices: int, patches: int) -> list[tuple[int, int]]:
+    """``patches`` contiguous vertex ranges of nearly equal size covering ``n_vertices``."""
+    edges = np.linspace(0, n_vertices, patches + 1).round().astype(np.int64)
+    return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:], strict=True) if b > a]
+
+
+def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]:
+    """(radii, catalog rows owned) of the vertices ``item`` = (start, stop) of the scene's
+    grid (a task: pure, any process)."""
+    from .field import crater_field
+
+    start, stop = item
+    grid = LatLongGrid(scene.body.magnitude)
+    field = crater_field(scene)
+    d_min = 3.0 * grid.spacing(field.base.radius_m)
+    units = grid.unit_vectors_range(start, stop)
+    radii = field.radii(units, d_min)
+    cat = field.catalog(units, d_min)
+    # the vertex nearest each crater's centre (its ring, its place on the ring) is the
+    # owning patch's; the patch's craters hold every crater within reach of its vertices
+    ring = np.clip(np.round((90.0 - cat["lat_deg"]) / 180.0 * 2 * grid.magnitude), 0,
+                   2 * grid.magnitude).astype(np.int64)
+    size = grid.ring_sizes()[ring]
+    place = np.round(np.mod(cat["lon_deg"], 360.0) / 360.0 * size).astype(np.int64) % size
+    vertex = grid.ring_offsets()[ring] + place
+    return radii, cat[(vertex >= start) & (vertex < stop)]
+
+
+def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
+                  scheduler: str | None = None, workers: int | None = None,
+                  progress=None) -> Body:
+    """The scene's body on its ``M``-grid as terrain on demand, in ``patches`` patches
+    (module notes); ``backend``, ``scheduler``, ``workers`` as in
+    :func:`latlong.parallel.tiles.map_tiles`; ``progress(done, total)`` is called as
+    patches arrive."""
+    from ..build import on_demand_metadata
+    from ..parallel.tiles import map_tiles
+    from .field import crater_field
+
+    if not isinstance(scene, Scene):
+        raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+    if not scene.on_demand:
+        raise ValueError("`scene` must be an on-demand scene (on_demand=True)")
+    grid = LatLongGrid(scene.body.magnitude)
+    patches = check_int("patches", patches, 1, grid.n_vertices)
+    items = patch_ranges(grid.n_vertices, patches)
+    radii = np.empty(grid.n_vertices)
+    cats = [None] * len(items)
+    for done, (i, (r, cat)) in enumerate(map_tiles(_patch, scene, items, backend=backend,
+                                                   scheduler=scheduler, workers=workers)):
+        start, stop = items[i]
+        radii[start:stop] = r
+        cats[i] = cat
+        if progress is not None:
+            progress(done + 1, len(items))
+    cat = np.concatenate(cats)
+    order = np.lexsort((cat["id"], cat["age_gyr"]))[::-1]  # oldest first, as stamped
+    cat = cat[order]
+    field = crater_field(scene)
+    d_min = 3.0 * grid.spacing(field.base.radius_m)
+    return Body(grid, radii, radius_m=field.base.radius_m,
+                metadata=on_demand_metadata(scene, d_min, len(items)),
+                craters=rfn.repack_fields(cat), copy=False)

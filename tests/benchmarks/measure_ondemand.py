@@ -1,0 +1,182 @@
+"""Measure terrain on demand (issue 37): tile times at every scale, a descent from orbit to
+touchdown, and how consistent its frames are.
+
+Scene: a lunar-like equilibrium surface, the Moon's radius and crater morphology, power-
+law craters N_cum = 0.08 D^-2 per m^2 (about the lunar equilibrium density: Gault 1970,
+Radio Sci. 5, 273, finds N_cum ~ 10^-1.1 D^-2 for steady-state small craters) from 2 cm
+to 20 km, their ages capped by size so that each size is seen at about its equilibrium
+density (0-3.5 Gyr >= 100 m, 0-1 Gyr 10-100 m, 0-0.1 Gyr 1-10 m, 0-0.01 Gyr < 1 m; the
+diffusion of the craters' profiles erases the older ones of each size).
+
+1. Tiles: a 1024^2 window (``latlong.ondemand.tile.tile``) at 100 m, 10 m, 1 m, 10 cm and
+   1 cm pixels, the second of two runs (warm), seconds and nanoseconds per pixel, and the
+   craters that made it.
+2. Descent: ``--frames`` frames (default 100) from 100 km to 1 m above the site, square
+   pictures ``--size`` wide (default 1024), the total time; per frame the share of the
+   picture's power (8-bit display picture exposed on its own lit pixels, 2-D FFT, DC
+   removed) in the top octave of spatial frequencies (|k| between N/4 and N/2 cycles per
+   picture) and its ratio to the frame nearest 10 km; OpenCV tracking between
+   consecutive frames (Shi-Tomasi + LK + USAC essential matrix,
+   ``measure_feature_tracking``'s tracker) against the true
+   relative poses: rotation error (degrees) and translation-direction error (degrees;
+   a translation error relative to its length of e radians is a share e of it).
+3. A 6-frame strip (100 km, 10 km, 1 km, 100 m, 10 m, 1 m) for the README.
+
+Usage: ``python tests/benchmarks/measure_ondemand.py [--frames 100] [--size 1024]
+[--strip examples/images/descent_ondemand.png] [--json out/ondemand.json]``
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+LAYERS = ["c=0.08,k=-2,d_min_m=100,d_max_m=20000,age_max_gyr=3.5",
+          "c=0.08,k=-2,d_min_m=10,d_max_m=100,age_max_gyr=1",
+          "c=0.08,k=-2,d_min_m=1,d_max_m=10,age_max_gyr=0.1",
+          "c=0.08,k=-2,d_min_m=0.02,d_max_m=1,age_max_gyr=0.01"]
+SITE = [0.0, 0.0]
+SUN_ELEVATION_DEG = [25.0]
+
+
+def scene():
+    from latlong import Scene
+
+    return Scene.from_settings({"base": "sphere", "radius_m": 1737400.0, "body": "moon",
+                                "seed": 1, "on_demand": True, "craters": LAYERS})
+
+
+def tiles(sc) -> list[dict]:
+    from latlong.ondemand.tile import tile
+
+    rows = []
+    for pixel in (100.0, 10.0, 1.0, 0.1, 0.01):
+        tile(sc, *SITE, size_m=1024 * pixel, pixel_m=pixel)
+        t0 = time.perf_counter()
+        t = tile(sc, *SITE, size_m=1024 * pixel, pixel_m=pixel)
+        dt = time.perf_counter() - t0
+        rows.append({"pixel_m": pixel, "seconds": dt, "ns_per_pixel": 1e9 * dt / 1024**2,
+                     "craters": t.n_craters})
+        print(f"tile 1024^2 at {pixel:g} m: {dt:.2f} s ({1e9 * dt / 1024**2:.0f} ns/pixel), "
+              f"{t.n_craters} craters", flush=True)
+    return rows
+
+
+def top_octave_share(img: np.ndarray) -> float:
+    """Share of the picture's power (DC removed) at |k| in [N/4, N/2] cycles/picture."""
+    a = img.astype(np.float64)
+    p = np.abs(np.fft.fft2(a - a.mean())) ** 2
+    n = a.shape[0]
+    k = np.fft.fftfreq(n) * n
+    kk = np.hypot(*np.meshgrid(k, k))
+    total = p[kk > 0].sum()
+    return float(p[(kk >= n / 4) & (kk <= n / 2)].sum() / total) if total > 0 else 0.0
+
+
+def descent_run(sc, frames: int, size: int):
+    from latlong.cli.descent import display
+    from latlong.ondemand.descent import descent, descent_altitudes
+
+    alts = descent_altitudes(1e5, 1.0, frames)
+    out = []
+    t0 = time.perf_counter()
+    for f in descent(sc, *SITE, alts, width_px=size, sun_elevation_deg=SUN_ELEVATION_DEG[0]):
+        r = f.frame.reflectance
+        # each frame exposed on its own lit pixels, as a descent camera's auto-exposure
+        scale = float(np.percentile(r[r > 0], 99.5)) if (r > 0).any() else 1.0
+        out.append((f, display(r, scale)))
+    return out, time.perf_counter() - t0
+
+
+def tracking(run) -> list[dict]:
+    import measure_feature_tracking as mft
+
+    rows = []
+    for (fa, a), (fb, b) in zip(run[:-1], run[1:], strict=True):
+        cam = fa.frame.camera
+        k = np.array([[cam.fx, 0, cam.cx - 0.5], [0, cam.fy, cam.cy - 0.5], [0, 0, 1.0]])
+        p0, p1, _ = mft.track_pair(a, b)
+        row = {"altitude_m": fa.altitude_m, "tracks": len(p0)}
+        if len(p0) >= 8:
+            r_est, t_est, _ = mft.relative_pose(p0, p1, k)
+            ra, pa = fa.frame.pose.rotation, fa.frame.pose.position_m
+            rb, pb = fb.frame.pose.rotation, fb.frame.pose.position_m
+            r_true = rb.T @ ra
+            t_true = rb.T @ (pa - pb)
+            t_true /= np.linalg.norm(t_true)
+            t_est = np.ravel(t_est) / np.linalg.norm(t_est)
+            row["rotation_err_deg"] = mft.rotation_angle_deg(r_est @ r_true.T)
+            row["translation_err_deg"] = float(np.degrees(np.arccos(np.clip(
+                abs(t_est @ t_true), -1.0, 1.0))))
+        rows.append(row)
+    return rows
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--frames", type=int, default=100)
+    ap.add_argument("--size", type=int, default=1024)
+    ap.add_argument("--strip", default=None)
+    ap.add_argument("--json", default=None)
+    ap.add_argument("--skip-tiles", action="store_true")
+    ap.add_argument("--site", default="0,0", help="LAT,LON degrees")
+    ap.add_argument("--sun-elevation-deg", type=float, default=25.0)
+    args = ap.parse_args()
+    SITE[:] = [float(x) for x in args.site.split(",")]
+    SUN_ELEVATION_DEG[0] = args.sun_elevation_deg
+    sc = scene()
+    result: dict = {}
+    if not args.skip_tiles:
+        result["tiles"] = tiles(sc)
+    run, seconds = descent_run(sc, args.frames, args.size)
+    print(f"descent: {args.frames} frames of {args.size}^2 from 100 km to 1 m in "
+          f"{seconds:.1f} s", flush=True)
+    shares = [top_octave_share(p) for _, p in run]
+    ref = int(np.argmin([abs(np.log(f.altitude_m / 1e4)) for f, _ in run]))
+    result["descent"] = {"frames": args.frames, "size": args.size, "seconds": seconds,
+                         "reference_altitude_m": run[ref][0].altitude_m,
+                         "per_frame": [{"altitude_m": f.altitude_m, "terrain": f.terrain,
+                                        "craters": f.n_craters,
+                                        "top_octave_share": s,
+                                        "ratio_to_10km": s / shares[ref] if shares[ref] else 0}
+                                       for (f, _), s in zip(run, shares, strict=True)]}
+    ratios = [s / shares[ref] for s in shares]
+    print(f"top-octave power share / its 10 km value: min {min(ratios):.3g} max "
+          f"{max(ratios):.3g}")
+    for (f, _), s, q in zip(run, shares, ratios, strict=True):
+        print(f"  {f.altitude_m:10.4g} m  share {s:.3e}  ratio {q:.3g}")
+    if len(run) > 1:
+        rows = tracking(run)
+        result["tracking"] = rows
+        ok = [r for r in rows if "rotation_err_deg" in r]
+        if ok:
+            print(f"tracking: {len(ok)} of {len(rows)} pairs; worst rotation "
+                  f"{max(r['rotation_err_deg'] for r in ok):.3g} deg, worst translation "
+                  f"direction {max(r['translation_err_deg'] for r in ok):.3g} deg")
+        for r in rows:
+            print("  ", {k: (round(v, 4) if isinstance(v, float) else v) for k, v in r.items()})
+    if args.strip:
+        from PIL import Image
+
+        picks = [int(np.argmin([abs(np.log(f.altitude_m / a)) for f, _ in run]))
+                 for a in (1e5, 1e4, 1e3, 1e2, 1e1, 1.0)]
+        pics = [run[i][1] for i in picks]
+        gap = np.zeros((pics[0].shape[0], 6), np.uint8)
+        strip = np.concatenate([x for p in pics for x in (p, gap)][:-1], axis=1)
+        Image.fromarray(strip).save(args.strip)
+        print(f"wrote {args.strip}")
+    if args.json:
+        Path(args.json).write_text(json.dumps(result, indent=1) + "\n")
+        print(f"wrote {args.json}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
