@@ -16,6 +16,8 @@ packing, LCSN craters, Gabor noise, marching cubes).
     scene (Scene: settings, presets) -> build(scene) -> Body   (writes nothing)
                                      -> outputs (write_outputs) | batch (seeds x settings, dask)
     implicit/ (packing, metaballs, LCSN layers, Gabor, marching cubes) -> to_body
+    ondemand/ (terrain on demand: heights_at any points, tile windows, descents, bodies
+               in patches; craters drawn by cells, each height from the craters near it)
     loader (load_surface: a body .npz or a mesh file -> a surface, what sensors/ see)
     sensors/ (ray engine over Embree, cameras, LIDAR, photometry: frames + ground truth of
               any surface; they use only latlong.geometry and latlong.meshio)
@@ -25,7 +27,8 @@ Imports point down that picture and into ``craters`` (never ``dem``). ``latlong 
 --help`` describes the command line. More in the subpackages' docstrings:
 :mod:`latlong.mesh` (cratering shape models that are not star-shaped),
 :mod:`latlong.implicit` (``--backend implicit``), :mod:`latlong.sensors` (``latlong
-camera``, ``latlong lidar``), :mod:`latlong.parallel` (``latlong batch``, clusters).
+camera``, ``latlong lidar``), :mod:`latlong.parallel` (``latlong batch``, clusters),
+:mod:`latlong.ondemand` (``latlong tile``, ``latlong descent``, ``--on-demand``).
 
 Building bodies: ``latlong build``
 ----------------------------------
@@ -263,6 +266,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
     )
     from .loader import load_surface
     from .meshio.readers import MeshData
+    from .ondemand import heights_at
     from .perlin import FBM_PRESETS, FbmParams, fbm3, perlin_fbm
     from .presets import PRESETS
     from .preview import PreviewSettings, render_preview
@@ -334,6 +338,7 @@ __all__ = [
     "facet_slopes",
     "gravity",
     "fbm3",
+    "heights_at",
     "fit_gabor",
     "fit_metaballs",
     "from_shape_model",

@@ -33,7 +33,6 @@ from .shapes import from_shape_model
 
 __all__ = ["build", "mesh_spacing_m"]
 
-GENERATOR = "craterform latlong build"
 #: Vertices per block of the whole-body numpy steps (8 MB of radii).
 _BLOCK = 1 << 20
 logger = logging.getLogger(__name__)
@@ -185,12 +184,6 @@ def _build_on_demand(scene: Scene) -> Body:
     return build_patches(scene)
 
 
-def on_demand_metadata(scene: Scene, min_crater_m: float, patches: int) -> dict:
-    """The metadata of a body built on demand."""
-    return {**_metadata(scene, {}), "on_demand": True, "min_crater_diameter_m": min_crater_m,
-            "patches": patches}
-
-
 def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterError:
     """A base whose heights make radii <= 0 (or not finite): the error of the settings
     that made them (the scene's names), not of the body's radii."""
@@ -207,22 +200,7 @@ def _too_rough(scene: Scene, radius_m: float, exc: ParameterError) -> ParameterE
 
 
 def _metadata(scene: Scene, params: dict) -> dict:
-    craters, boulders, target = scene.craters, scene.boulders, scene.target()
-    assert scene.base is not None  # a lat/long or mesh build: Scene.__post_init__ set it
-    return {
-        "generator": GENERATOR,
-        "version": package_version(),
-        "seed": scene.seed,
-        "base": scene.base.name,
-        "preset": scene.preset,
-        "parameters": params,
-        "craters": [dataclasses.asdict(la) for la in craters.layers],
-        "body": scene.body.target,
-        "gravity_m_s2": target.gravity_m_s2,
-        "crater_roughness": craters.roughness,
-        "boulders": [dataclasses.asdict(la) for la in boulders.layers],
-        "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
-    }
+    return scene.body_metadata(params)
 
 
 def mesh_spacing_m(scene: Scene) -> float:

@@ -32,6 +32,7 @@ from craters._shared import (
     ParameterTypeError,
     check_choice,
     load_toml,
+    package_version,
 )
 from craters._shared.settings import Setting, by_key, check_declared, declared, setting
 
@@ -52,6 +53,9 @@ from .settings import (
     SphereBase,
 )
 from .shapes import ShapeModel, read_shape_model
+
+#: What the bodies built from scenes record as their maker.
+GENERATOR = "craterform latlong build"
 
 __all__ = ["SETTINGS", "SETTING_DEFAULTS", "SETTING_PARTS", "Scene"]
 
@@ -213,6 +217,25 @@ class Scene:
         return _craters.get_target("small-body", radius_m=radius, density_kg_m3=b.density_kg_m3,
                                    gravity_m_s2=b.gravity_m_s2,
                                    depth_ratio=b.crater_depth_ratio)
+
+    def body_metadata(self, params: dict) -> dict:
+        """The metadata a body built from this scene records (``params``: the base's)."""
+        craters, boulders, target = self.craters, self.boulders, self.target()
+        assert self.base is not None  # a lat/long or mesh build: __post_init__ set it
+        return {
+            "generator": GENERATOR,
+            "version": package_version(),
+            "seed": self.seed,
+            "base": self.base.name,
+            "preset": self.preset,
+            "parameters": params,
+            "craters": [dataclasses.asdict(la) for la in craters.layers],
+            "body": self.body.target,
+            "gravity_m_s2": target.gravity_m_s2,
+            "crater_roughness": craters.roughness,
+            "boulders": [dataclasses.asdict(la) for la in boulders.layers],
+            "boulder_shape": dataclasses.asdict(boulders.shape) if boulders.layers else None,
+        }
 
     @property
     def backend(self) -> str:

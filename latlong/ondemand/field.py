@@ -8,8 +8,9 @@ in the README, "Terrain on demand"):
    of one level of the cube-sphere hierarchy (:mod:`craters.local`), the level a function
    of the bin and the body (cells at least one ejecta reach wide), never of the request.
    Craters smaller than the requested minimum diameter are left out; that only filters.
-2. **A crater's base** is a quadric fitted (fixed 61-point stencil over its rim disc, a
-   fixed least-squares operator) to the terrain made by the base shape and the *older,
+2. **A crater's base** is a quadric fitted (a fixed 25-point stencil over its rim disc:
+   the centre, 8 points at half the radius, 16 on the rim; a fixed least-squares
+   operator) to the terrain made by the base shape and the *older,
    larger* craters at the stencil points. Smaller craters barely move a plane fitted over
    a larger crater's floor, and leaving them out makes every crater's parameters
    independent of the requested resolution. The slope of that base against "up" (radial,
@@ -65,7 +66,7 @@ IRREGULARITY = 0.02
 #: Octaves of a crater's roughness overlay (radius down to radius / 8): fixed per
 #: crater, so the overlay never depends on the requested resolution.
 ROUGHNESS_OCTAVES = 4
-_RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
+_RINGS = ((0.0, 1), (0.5, 8), (1.0, 16))
 _BIN_MARGIN = 1.05
 
 
@@ -118,6 +119,9 @@ class CraterField:
             if not isinstance(la, CraterLayer):
                 raise ParameterError("craters", "terrain on demand draws power-law crater layers "
                                      f"(c=..,k=..); got a {type(la).__name__}")
+        if scene.boulders.layers:
+            logger.warning("terrain on demand makes no boulders yet: the scene's %d boulder "
+                           "layer(s) are left out", len(scene.boulders.layers))
         self.layers: tuple[CraterLayer, ...] = tuple(
             la for la in layers if isinstance(la, CraterLayer))
         self.target = scene.target()
@@ -266,21 +270,33 @@ class CraterField:
         return max(bin_bounds(la, b)[1] for la in self.layers if b in set(bins(la).tolist()))
 
     def catalog(self, units: np.ndarray, d_min: float) -> np.ndarray:
-        """The crater catalog (oldest first; ``craters.make_catalog`` columns plus ``id``,
-        ``layer``) of the craters that the heights at ``units`` with craters >= ``d_min``
-        are made of: for every vertex of a body, the whole body's craters >= ``d_min``."""
-        cr, _, _ = self.needed(np.ascontiguousarray(units, dtype=np.float64), d_min)
-        u = cr.fc[:, K.C0:K.C2 + 1]
+        """The crater catalog (oldest first) of the craters that the heights at ``units``
+        with craters >= ``d_min`` are made of (for every vertex of a body, the whole
+        body's craters >= ``d_min``): ``craters.make_catalog`` columns (``degradation``:
+        the share of the fresh depth gone, by diffusion and slope erosion) plus ``id``,
+        ``layer``, and as made: ``rim_radius_m``, ``depth_m`` (after slope erosion),
+        ``slope_factor`` (0: erased on ground steeper than the angle of repose)."""
+        self.radii(units, d_min)
+        return self.last_catalog()
+
+    def last_catalog(self) -> np.ndarray:
+        """:meth:`catalog` of the craters of the last :meth:`radii` call."""
+        cr, fc = self.last["craters"], self.last["fc"]
+        u = fc[:, K.C0:K.C2 + 1]
         lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
         lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
         kinds = np.array([la.kind for la in self.layers] or ["crater"])
+        depth = fc[:, K.DEPTH] * fc[:, K.SCALE]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            degradation = np.clip(1.0 - depth / self.last["fresh_depth_m"], 0.0, 1.0)
         cat = make_catalog(lat_deg=lat, lon_deg=lon, diameter_m=cr.diameter_m,
-                           age_gyr=cr.age_gyr, degradation=np.full(len(cr), np.nan),
+                           age_gyr=cr.age_gyr, degradation=degradation,
                            kind=kinds[cr.layer], layer=cr.layer)
+        cat = rfn.append_fields(cat, ("id", "rim_radius_m", "depth_m", "slope_factor"),
+                                (cr.id, fc[:, K.RAD].copy(), depth, fc[:, K.SCALE].copy()),
+                                usemask=False)
         # oldest first: the composition's (age, id) order reversed
-        order = np.lexsort((cr.id, cr.age_gyr))[::-1]
-        cat = rfn.append_fields(cat, "id", cr.id, usemask=False)
-        return cat[order]
+        return cat[np.lexsort((cr.id, cr.age_gyr))[::-1]]
 
     # ------------------------------------------------------------------ heights
     def radii(self, units: np.ndarray, d_min: float) -> np.ndarray:
@@ -290,6 +306,8 @@ class CraterField:
         cr, owner, dep = self.needed(units, d_min)
         n = len(cr)
         if n == 0:
+            self.last = {"craters": cr, "fc": cr.fc, "rank": np.zeros(0, np.int64), "n_pairs": 0,
+                         "fresh_depth_m": np.zeros(0)}
             return base
         fc = cr.fc
         rank = np.empty(n, dtype=np.int64)
@@ -347,7 +365,8 @@ class CraterField:
         K._points_kernel(units, block_of.astype(np.int64).ravel(), blk_start, blk_list, base,
                          fc, tabs, rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe,
                          BLEND_EDGE, rank, diam, out)
-        self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key)}
+        self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key),
+                     "fresh_depth_m": prof.fresh_depth_m}
         return out
 
 
@@ -428,7 +447,7 @@ def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
 
 
 def _stencil_points(fc: np.ndarray) -> np.ndarray:
-    """(n, 61, 3) directions of each crater's stencil: angle r R / rho from its centre."""
+    """(n, 25, 3) directions of each crater's stencil: angle r R / rho from its centre."""
     out = np.empty((len(fc), len(STENCIL_XY), 3))
     if len(fc):
         K._stencil_kernel(np.ascontiguousarray(fc), STENCIL_XY, out)

@@ -39,7 +39,7 @@ def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]
     d_min = 3.0 * grid.spacing(field.base.radius_m)
     units = grid.unit_vectors_range(start, stop)
     radii = field.radii(units, d_min)
-    cat = field.catalog(units, d_min)
+    cat = field.last_catalog()
     # the vertex nearest each crater's centre (its ring, its place on the ring) is the
     # owning patch's; the patch's craters hold every crater within reach of its vertices
     ring = np.clip(np.round((90.0 - cat["lat_deg"]) / 180.0 * 2 * grid.magnitude), 0,
@@ -52,12 +52,12 @@ def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]
 
 def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
                   scheduler: str | None = None, workers: int | None = None,
-                  progress=None) -> Body:
+                  progress=None, out: np.ndarray | None = None) -> Body:
     """The scene's body on its ``M``-grid as terrain on demand, in ``patches`` patches
     (module notes); ``backend``, ``scheduler``, ``workers`` as in
     :func:`latlong.parallel.tiles.map_tiles`; ``progress(done, total)`` is called as
-    patches arrive."""
-    from ..build import on_demand_metadata
+    patches arrive; ``out``: the radii's array (e.g. a scratch file's map,
+    :func:`latlong.scratch.disk_radii`), one float64 per vertex."""
     from ..parallel.tiles import map_tiles
     from .field import crater_field
 
@@ -68,8 +68,10 @@ def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
     grid = LatLongGrid(scene.body.magnitude)
     patches = check_int("patches", patches, 1, grid.n_vertices)
     items = patch_ranges(grid.n_vertices, patches)
-    radii = np.empty(grid.n_vertices)
-    cats = [None] * len(items)
+    radii = np.empty(grid.n_vertices) if out is None else out
+    if radii.shape != (grid.n_vertices,) or radii.dtype != np.float64:
+        raise ValueError(f"`out` must be a float64 array of {grid.n_vertices} radii")
+    cats: list[np.ndarray] = [np.zeros(0)] * len(items)
     for done, (i, (r, cat)) in enumerate(map_tiles(_patch, scene, items, backend=backend,
                                                    scheduler=scheduler, workers=workers)):
         start, stop = items[i]
@@ -83,5 +85,6 @@ def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
     field = crater_field(scene)
     d_min = 3.0 * grid.spacing(field.base.radius_m)
     return Body(grid, radii, radius_m=field.base.radius_m,
-                metadata=on_demand_metadata(scene, d_min, len(items)),
+                metadata={**scene.body_metadata({}), "on_demand": True,
+                          "min_crater_diameter_m": d_min, "patches": len(items)},
                 craters=rfn.repack_fields(cat), copy=False)
