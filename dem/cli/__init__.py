@@ -1,6 +1,7 @@
 """The ``dem`` command line, one module a command: ``dem info``, ``convert``, ``fill``,
 ``expand``, ``enhance``, ``mesh``, ``batch``, ``slopes`` and ``spectrum``; ``camera`` and
-``lidar`` (:mod:`.sensors`: latlong's sensor commands over a site).
+``lidar`` (:mod:`.sensors`: latlong's sensor commands over a site); ``tile`` (a window of
+a DEM with craters made on demand, :mod:`dem.ondemand`).
 
 Every command takes its input (a DEM, or for ``mesh``, ``slopes`` and ``spectrum`` also
 a stack manifest) as its positional argument, or as the key ``input`` of a TOML file
@@ -21,7 +22,7 @@ import sys
 from craters.cli.kit import run_cli
 from craters.cli.options import main_parser
 
-from . import batch, convert, enhance, expand, fill, info, mesh, sensors, slopes, spectrum
+from . import batch, convert, enhance, expand, fill, info, mesh, sensors, slopes, spectrum, tile
 
 __all__ = ["build_parser", "main"]
 
@@ -31,7 +32,7 @@ def build_parser():
     parser, sub = main_parser("dem", "DEMs: gap filling, RMD expansion, layer stacks with "
                               "craters, meshes, info.")
     for command in (info, convert, fill, expand, enhance, mesh, batch, slopes, spectrum,
-                    sensors):
+                    sensors, tile):
         command.register(sub)
     return parser
 

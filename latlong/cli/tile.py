@@ -9,9 +9,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from craters._shared import atomic_path, check_output_path, human_bytes
+from craters._shared import check_output_path, human_bytes
 from craters.cli.kit import CliError
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 
@@ -48,7 +46,7 @@ OPTIONS = {k: s for k, s in declared_keys(
 _GROUPS = {"tile": "window and outputs", **GROUPS}
 
 
-def _check(v: Values) -> list[tuple[str, Path]]:
+def check_outputs(v: Values) -> list[tuple[str, Path]]:
     outs = []
     for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
                           ("picture", (".png",))):
@@ -59,51 +57,16 @@ def _check(v: Values) -> list[tuple[str, Path]]:
     return outs
 
 
-def write_cog(tile, path) -> Path:
-    """The tile's heights as a float32 Cloud Optimized GeoTIFF (atomic)."""
-    import rasterio
-    from rasterio.crs import CRS
-    from rasterio.transform import Affine
-
-    h = tile.heights_m.astype(np.float32)
-    x0, dx, _, y0, _, dy = tile.transform
-    profile = {"driver": "COG", "width": h.shape[1], "height": h.shape[0], "count": 1,
-               "dtype": "float32", "crs": CRS.from_proj4(tile.crs_proj4),
-               "transform": Affine(dx, 0.0, x0, 0.0, dy, y0), "compress": "deflate",
-               "predictor": 3, "nodata": None}
-    with atomic_path(path) as tmp:
-        with rasterio.open(tmp, "w", **profile) as dst:
-            dst.write(h, 1)
-            dst.update_tags(units="m", reference_radius_m=repr(tile.radius_m),
-                            generator="craterform latlong tile")
-    return Path(path)
-
-
 def _tile(v: Values) -> int:
-    from ..meshio.writers import array_source, write_mesh  # noqa: I001
-    from ..ondemand.tile import hillshade, tile, tile_mesh
+    from ..ondemand.tile import tile, write_tile
 
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
-    outs = dict(_check(v))
+    outs = dict(check_outputs(v))
     made = tile(scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"], pixel_m=v["pixel_m"],
                 min_crater_px=v["min_crater_px"])
-    if "output" in outs:
-        write_cog(made, outs["output"])
-    if "mesh" in outs:
-        verts, faces = tile_mesh(made)
-        write_mesh(array_source(verts, faces, "craterform latlong tile",
-                                height_m=made.heights_m.ravel()), outs["mesh"])
-    if "picture" in outs:
-        from PIL import Image
-
-        h = made.heights_m
-        yy, xx = np.mgrid[:h.shape[0], :h.shape[1]]
-        a = np.stack([np.ones(h.size), xx.ravel(), yy.ravel()], axis=1)
-        plane = a @ np.linalg.lstsq(a, h.ravel(), rcond=None)[0]
-        shade = hillshade(h - plane.reshape(h.shape), made.pixel_m)
-        with atomic_path(outs["picture"]) as tmp:
-            Image.fromarray((255.0 * shade).astype(np.uint8)).save(tmp, format="PNG")
+    write_tile(made, cog=outs.get("output"), mesh=outs.get("mesh"),
+               picture=outs.get("picture"))
     if not v["quiet"]:
         ny, nx = made.heights_m.shape
         print(f"tile: {nx} x {ny} pixels of {made.pixel_m:g} m at ({made.lat_deg:g}, "

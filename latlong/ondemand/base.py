@@ -64,7 +64,7 @@ class BaseField:
     def __init__(self, scene: Scene):
         if not isinstance(scene, Scene):
             raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
-        self.scene = scene
+        self.scene: Scene | None = scene
         assert scene.seed is not None  # Scene.__post_init__ draws one when none is given
         self.seed = int(scene.seed)
         base = scene.base

@@ -11,17 +11,19 @@ lines and is exact at the centre; across a window of a few degrees its scale gro
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 
-from craters._shared import ParameterError, check_positive, check_range
+from craters._shared import ParameterError, atomic_path, check_positive, check_range
 
 from ..scene import Scene
 from . import units_of
 from .base import tangent_frame
-from .field import crater_field
+from .field import CraterField, crater_field
 
-__all__ = ["Tile", "hillshade", "tile"]
+__all__ = ["MAX_TILE_PX", "Tile", "hillshade", "tile", "tile_mesh", "tile_of_field",
+           "write_cog", "write_tile"]
 
 #: Largest tile side in pixels (a 16384^2 float64 tile is 2 GiB).
 MAX_TILE_PX = 16384
@@ -86,10 +88,17 @@ def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m
     if not 1 <= size_px <= MAX_TILE_PX:
         raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
                              f"got {size_m:g} m ({size_px} pixels)")
-    field = crater_field(scene)
+    return tile_of_field(crater_field(scene), lat_deg, lon_deg, size_px, pixel_m,
+                         min_crater_px)
+
+
+def tile_of_field(field: CraterField, lat_deg: float, lon_deg: float, size_px: int,
+                  pixel_m: float, min_crater_px: float) -> Tile:
+    """:func:`tile` of a crater field (any base: a scene's, a DEM's), arguments checked."""
     # the projection's sphere: the base's radius at the centre, so pixels are metres on
     # the ground there (an elongated body's ends are far from its mean radius)
     radius = float(field.base.radius(units_of([lat_deg], [lon_deg]))[0])
+    size_m = size_px * pixel_m
     if size_m / radius > 0.5:
         raise ParameterError("size_m", f"must be at most half the reference radius "
                              f"({0.5 * radius:g} m) for a gnomonic window; got {size_m:g}")
@@ -126,3 +135,47 @@ def hillshade(heights_m: np.ndarray, pixel_m: float, *, azimuth_deg: float = 270
     nx, ny, nz = -gx, gy, np.ones_like(gx)
     norm = np.sqrt(nx * nx + ny * ny + nz * nz)
     return np.clip((nx * light[0] + ny * light[1] + nz * light[2]) / norm, 0.0, 1.0)
+
+
+def write_cog(t: Tile, path) -> Path:
+    """The tile's heights as a float32 Cloud Optimized GeoTIFF (atomic)."""
+    import rasterio
+    from rasterio.crs import CRS
+    from rasterio.transform import Affine
+
+    h = t.heights_m.astype(np.float32)
+    x0, dx, _, y0, _, dy = t.transform
+    profile = {"driver": "COG", "width": h.shape[1], "height": h.shape[0], "count": 1,
+               "dtype": "float32", "crs": CRS.from_proj4(t.crs_proj4),
+               "transform": Affine(dx, 0.0, x0, 0.0, dy, y0), "compress": "deflate",
+               "predictor": 3, "nodata": None}
+    with atomic_path(path) as tmp:
+        with rasterio.open(tmp, "w", **profile) as dst:
+            dst.write(h, 1)
+            dst.update_tags(units="m", reference_radius_m=repr(t.radius_m),
+                            generator="craterform tile (terrain on demand)")
+    return Path(path)
+
+
+def write_tile(t: Tile, *, cog=None, mesh=None, picture=None) -> None:
+    """Write a tile: heights as a COG (:func:`write_cog`), the window as a mesh in the
+    body's frame (any mesh suffix, ``height_m`` per vertex), a shaded picture (plane
+    removed, sun from the west at 20 degrees); each atomic."""
+    if cog:
+        write_cog(t, cog)
+    if mesh:
+        from ..meshio.writers import array_source, write_mesh
+
+        verts, faces = tile_mesh(t)
+        write_mesh(array_source(verts, faces, "craterform tile (terrain on demand)",
+                                height_m=t.heights_m.ravel()), mesh)
+    if picture:
+        from PIL import Image
+
+        h = t.heights_m
+        yy, xx = np.mgrid[:h.shape[0], :h.shape[1]]
+        a = np.stack([np.ones(h.size), xx.ravel(), yy.ravel()], axis=1)
+        plane = a @ np.linalg.lstsq(a, h.ravel(), rcond=None)[0]
+        shade = hillshade(h - plane.reshape(h.shape), t.pixel_m)
+        with atomic_path(picture) as tmp:
+            Image.fromarray((255.0 * shade).astype(np.uint8)).save(tmp, format="PNG")

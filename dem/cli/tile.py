@@ -1,0 +1,86 @@
+"""``dem tile``: a window of a DEM with craters made on demand (:mod:`dem.ondemand`)
+around any point at any pixel size: a cloud-optimised GeoTIFF of heights in the local
+gnomonic projection (metres above the sphere of the DEM's radius at the centre), the
+window as a mesh, a shaded picture."""
+
+from __future__ import annotations
+
+import sys
+
+from craters.cli.kit import CliError
+from craters.cli.options import Setting, Values
+
+from .options import INPUT, READ, RUN, dem_command, read_input
+
+__all__ = ["register"]
+
+OPTIONS = {
+    "input": INPUT, **READ,
+    "lat_deg": Setting(help="latitude of the window's centre", unit="deg", range=(-90.0, 90.0),
+                       kind=float, required=True, run=True),
+    "lon_deg": Setting(help="longitude of the window's centre", unit="deg", range="finite",
+                       kind=float, required=True, run=True),
+    "size_m": Setting(help="side of the square window", unit="m", range=">0", kind=float,
+                      required=True, run=True),
+    "pixel_m": Setting(help="pixel size", unit="m", range=">0", kind=float, required=True,
+                       run=True),
+    "min_crater_px": Setting(3.0, "smallest crater drawn, in pixels across", range=(1.0, 1000.0),
+                             run=True),
+    "craters": Setting(help="crater layer c=0.08,k=-2,d_min_m=1,d_max_m=1000[,age_min_gyr,"
+                       "age_max_gyr,degradation,kind] (N_cum = c D^k per m^2, D in metres; "
+                       "repeatable)", many="append", metavar="SPEC", run=True),
+    "seed": Setting(help="random seed of the craters (non-negative integer)", kind=int,
+                    range=(0, 2**63 - 1), run=True, default_text="a fresh one"),
+    "output": Setting(help="heights as a cloud-optimised GeoTIFF (.tif)", flag="-o/--output",
+                      run=True),
+    "mesh": Setting(help="the window as a mesh in the body's frame (.ply .obj .stl .vtp .vtk "
+                    ".glb)", run=True),
+    "picture": Setting(help="shaded picture of the window (.png)", run=True),
+    **RUN,
+}
+
+
+def _tile(v: Values) -> int:
+    from craters._shared import check_output_path
+    from latlong import Scene
+    from latlong.meshio.writers import MESH_SUFFIXES
+    from latlong.ondemand.tile import write_tile
+
+    from ..ondemand import dem_tile
+
+    if not v["craters"]:
+        raise CliError("give at least one --craters layer (the DEM holds the rest)")
+    outs = {}
+    for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
+                          ("picture", (".png",))):
+        if v[key]:
+            try:
+                outs[key] = check_output_path(v[key], force=v["force"], suffixes=suffixes)
+            except ValueError as exc:
+                raise CliError(f"--{key}: {exc}") from None
+    if not outs:
+        raise CliError("nothing to write: give -o/--output, --mesh or --picture")
+    dem = read_input(v)
+    body = v.get("body") or "moon"
+    radius = dem.body_radius_m
+    if radius is None:
+        raise CliError("the DEM's body radius is unknown: give --body-radius-m")
+    scene = Scene.from_settings({"base": "sphere", "radius_m": radius, "body": body,
+                                 "seed": v["seed"], "craters": v["craters"], "on_demand": True})
+    made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],
+                    pixel_m=v["pixel_m"], min_crater_px=v["min_crater_px"])
+    write_tile(made, cog=outs.get("output"), mesh=outs.get("mesh"), picture=outs.get("picture"))
+    if not v["quiet"]:
+        ny, nx = made.heights_m.shape
+        print(f"dem tile: {nx} x {ny} pixels of {made.pixel_m:g} m at ({made.lat_deg:g}, "
+              f"{made.lon_deg:g}) deg, {made.n_craters} craters >= {made.min_crater_m:.3g} m, "
+              f"seed {scene.seed}", file=sys.stderr)
+        for path in outs.values():
+            print(f"wrote {path}")
+    return 0
+
+
+def register(sub) -> None:
+    """Register ``dem tile``."""
+    dem_command(sub, "tile", _tile, OPTIONS,
+                "a window of a DEM with craters made on demand, at any pixel size")

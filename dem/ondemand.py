@@ -1,0 +1,114 @@
+"""Terrain on demand over a real DEM: the DEM as the base shape of a local crater field
+(:mod:`latlong.ondemand`), so that a window around any point, at any pixel size, holds
+the DEM's relief plus exactly the craters the scene draws there, the same whichever
+window or pixel size asks for them.
+
+:class:`DemBase` gives the radius of the body's sphere plus the DEM's height in any
+direction (bilinear between pixel centres; a DEM in a geographic CRS, longitude and
+latitude in degrees); :func:`dem_tile` makes a window of it. Below the DEM's pixel the base is
+its bilinear surface: the craters make the finer relief.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from craters._shared import ParameterError, check_positive, check_range
+from latlong import Scene
+from latlong.ondemand.base import BaseField
+from latlong.ondemand.field import CraterField
+from latlong.ondemand.tile import MAX_TILE_PX, Tile, tile_of_field
+
+from .core import Dem
+
+__all__ = ["DemBase", "dem_tile"]
+
+
+class DemBase(BaseField):
+    """A DEM as the base of a local crater field: radius = the sphere's + the DEM's
+    height (module notes)."""
+
+    def __init__(self, dem: Dem, *, seed: int, radius_m: float | None = None):
+        if not isinstance(dem, Dem):
+            raise TypeError(f"`dem` must be a dem.Dem; got {type(dem).__name__}")
+        radius = dem.body_radius_m if radius_m is None else float(radius_m)
+        if radius is None:
+            raise ParameterError("radius_m", "is needed: the DEM's CRS names no body radius")
+        h = np.asarray(dem.heights, dtype=np.float64)
+        if not np.isfinite(h).all():
+            raise ParameterError("dem", "must have no unknown (NaN) pixels: fill its gaps "
+                                 "first (dem fill)")
+        self.scene = None
+        self.seed = int(seed)
+        self.radius_m = float(radius)
+        self.min_radius_m = float(radius + h.min())
+        self.gravity = False
+        self._fbm = None
+        self._grid = None
+        self._radii = None
+        self.dem = dem
+        self._h = np.ascontiguousarray(h)
+        if dem.crs is not None and not dem.crs.is_geographic:
+            raise ParameterError("dem", "must be in a geographic CRS (longitude, latitude in "
+                                 "degrees) for terrain on demand; reproject it first (e.g. "
+                                 "gdalwarp -t_srs with the body's geographic CRS)")
+
+    def _pixels(self, lat_deg: np.ndarray, lon_deg: np.ndarray):
+        """(row, col) fractional pixel-centre coordinates of points."""
+        t = self.dem.transform
+        lon = t.c + np.mod(lon_deg - t.c, 360.0)  # into the DEM's longitude range
+        return (lat_deg - t.f) / t.e - 0.5, (lon - t.c) / t.a - 0.5
+
+    def radius(self, unit) -> np.ndarray:
+        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
+        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+        row, col = self._pixels(lat, lon)
+        ny, nx = self._h.shape
+        if not ((row >= 0) & (row <= ny - 1) & (col >= 0) & (col <= nx - 1)).all():
+            raise ParameterError("lat_deg", "and {} ask for points outside the DEM's pixel "
+                                 "centres", see=("lon_deg",))
+        i0 = np.minimum(np.floor(row).astype(np.int64), max(ny - 2, 0))
+        j0 = np.minimum(np.floor(col).astype(np.int64), max(nx - 2, 0))
+        fy = row - i0
+        fx = col - j0
+        i1 = np.minimum(i0 + 1, ny - 1)
+        j1 = np.minimum(j0 + 1, nx - 1)
+        h = self._h
+        top = h[i0, j0] * (1.0 - fx) + h[i0, j1] * fx
+        bottom = h[i1, j0] * (1.0 - fx) + h[i1, j1] * fx
+        return self.radius_m + (top * (1.0 - fy) + bottom * fy)
+
+
+def dem_tile(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float,
+             pixel_m: float, min_crater_px: float = 3.0, radius_m: float | None = None) -> Tile:
+    """A window of the DEM with the scene's craters on demand (module notes): the scene
+    gives the crater layers, the body (their shapes) and the seed; the DEM the base."""
+    if not isinstance(scene, Scene):
+        raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+    check_range("lat_deg", lat_deg, -90.0, 90.0)
+    pixel_m = check_positive("pixel_m", pixel_m)
+    size_m = check_positive("size_m", size_m)
+    min_crater_px = check_range("min_crater_px", min_crater_px, 1.0, 1000.0)
+    size_px = int(round(size_m / pixel_m))
+    if not 1 <= size_px <= MAX_TILE_PX:
+        raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
+                             f"got {size_m:g} m ({size_px} pixels)")
+    assert scene.seed is not None  # Scene draws one
+    field = _field(dem, scene, radius_m)
+    return tile_of_field(field, lat_deg, lon_deg, size_px, pixel_m, min_crater_px)
+
+
+_FIELDS: list = []
+
+
+def _field(dem: Dem, scene: Scene, radius_m) -> CraterField:
+    """The crater field of (DEM, scene), made once."""
+    for d, s, r, field in _FIELDS:
+        if d is dem and s is scene and r == radius_m:
+            return field
+    assert scene.seed is not None
+    field = CraterField(scene, DemBase(dem, seed=scene.seed, radius_m=radius_m))
+    _FIELDS.insert(0, (dem, scene, radius_m, field))
+    del _FIELDS[2:]
+    return field

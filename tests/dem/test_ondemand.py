@@ -1,0 +1,53 @@
+"""Terrain on demand over a DEM (dem.ondemand): the DEM as the base, windows of it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import dem
+from dem.ondemand import DemBase, dem_tile
+from latlong import Scene
+from latlong.ondemand import units_of
+
+LOLA = Path(__file__).resolve().parents[1] / "data" / "ldem4_crop.lbl"
+
+
+@pytest.fixture(scope="module")
+def lola():
+    return dem.read(LOLA)
+
+
+@pytest.fixture(scope="module")
+def scene(lola):
+    return Scene.from_settings({"base": "sphere", "radius_m": lola.body_radius_m, "body": "moon",
+                                "seed": 3, "on_demand": True,
+                                "craters": ["c=0.05,k=-2,d_min_m=500,d_max_m=20000"]})
+
+
+def test_the_base_is_the_dem_at_its_pixel_centres(lola):
+    base = DemBase(lola, seed=1)
+    t = lola.transform
+    rows, cols = np.array([3, 100, 250]), np.array([7, 128, 200])
+    lon = t.c + (cols + 0.5) * t.a
+    lat = t.f + (rows + 0.5) * t.e
+    r = base.radius(units_of(lat, lon))
+    assert np.allclose(r - lola.body_radius_m, lola.heights[rows, cols], rtol=0, atol=1e-6)
+    # halfway between two pixel centres: their mean
+    r = base.radius(units_of([lat[1]], [lon[1] + 0.5 * t.a]))
+    want = 0.5 * (lola.heights[100, 128] + lola.heights[100, 129])
+    assert r[0] - lola.body_radius_m == pytest.approx(want, abs=1e-6)
+    with pytest.raises(ValueError, match="outside"):
+        base.radius(units_of([80.0], [180.0]))
+
+
+def test_dem_windows_agree_where_they_overlap(lola, scene):
+    # two windows with the same pixels: one inside the other, the same values there
+    big = dem_tile(lola, scene, 5.0, 180.0, size_m=64000.0, pixel_m=1000.0)
+    small = dem_tile(lola, scene, 5.0, 180.0, size_m=16000.0, pixel_m=1000.0)
+    assert np.array_equal(big.heights_m[24:40, 24:40], small.heights_m)
+    assert big.n_craters > 0
+    relief = np.ptp(big.heights_m)
+    assert 100.0 < relief < 20000.0
