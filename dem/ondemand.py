@@ -21,7 +21,7 @@ from latlong.ondemand.tile import MAX_TILE_PX, Tile, tile_of_field
 
 from .core import Dem
 
-__all__ = ["DemBase", "dem_tile"]
+__all__ = ["DemBase", "dem_descent", "dem_tile"]
 
 
 class DemBase(BaseField):
@@ -112,3 +112,13 @@ def _field(dem: Dem, scene: Scene, radius_m) -> CraterField:
     _FIELDS.insert(0, (dem, scene, radius_m, field))
     del _FIELDS[2:]
     return field
+
+
+def dem_descent(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, altitudes_m, *,
+                radius_m: float | None = None, **camera):
+    """Frames of a vertical descent over a DEM site with the scene's craters on demand
+    (:func:`latlong.ondemand.descent.descent`; ``camera``: its keyword options). Every
+    frame's window must lie inside the DEM."""
+    from latlong.ondemand.descent import descent
+
+    return descent(_field(dem, scene, radius_m), lat_deg, lon_deg, altitudes_m, **camera)

@@ -27,8 +27,8 @@ from ..grid import LatLongGrid
 from ..scene import Scene
 from . import units_of
 from .base import tangent_frame
-from .field import crater_field
-from .tile import tile, tile_mesh
+from .field import CraterField, crater_field
+from .tile import MAX_TILE_PX, tile_mesh, tile_of_field
 
 if TYPE_CHECKING:
     from ..sensors.render import Frame
@@ -63,13 +63,16 @@ def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
     return np.geomspace(start_m, stop_m, frames)
 
 
-def _terrain(scene: Scene, lat_deg, lon_deg, size_m, pixel_m, site_radius):
+def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius):
     """(vertices, faces, craters, kind) of a frame's terrain."""
     if size_m <= 0.5 * site_radius:
-        t = tile(scene, lat_deg, lon_deg, size_m=size_m, pixel_m=pixel_m)
+        size_px = min(MAX_TILE_PX, max(1, int(round(size_m / pixel_m))))
+        t = tile_of_field(field, lat_deg, lon_deg, size_px, pixel_m, 3.0)
         verts, faces = tile_mesh(t)
         return verts, faces, t.n_craters, "window"
-    field = crater_field(scene)
+    if field.base.scene is None:
+        raise ParameterError("altitudes_m", f"must keep the frames' ground within a window "
+                             f"(footprint x {_MARGIN} <= half the site's radius) over a DEM")
     m = int(min(_MAX_MAGNITUDE, max(16, math.ceil(math.pi * field.base.radius_m / (2 * pixel_m)))))
     grid = LatLongGrid(m)
     units = grid.unit_vectors()
@@ -78,23 +81,28 @@ def _terrain(scene: Scene, lat_deg, lon_deg, size_m, pixel_m, site_radius):
     return units * radii[:, None], grid.triangles(), len(field.last["craters"]), "body"
 
 
-def descent(scene: Scene, lat_deg: float, lon_deg: float, altitudes_m, *, fov_deg: float = 30.0,
-            width_px: int = 512, sun_azimuth_deg: float = 90.0,
+def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
+            fov_deg: float = 30.0, width_px: int = 512, sun_azimuth_deg: float = 90.0,
             sun_elevation_deg: float = 25.0, reflectance=None) -> Iterator[DescentFrame]:
-    """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes),
-    square pictures ``width_px`` wide, the sun at ``sun_azimuth_deg`` (clockwise from
-    north) and ``sun_elevation_deg`` above the site's horizon."""
+    """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes) of a
+    scene, or of a crater field (any base, e.g. a DEM's), square pictures ``width_px``
+    wide, the sun at ``sun_azimuth_deg`` (clockwise from north) and ``sun_elevation_deg``
+    above the site's horizon."""
     from ..sensors import Camera, Pose, render  # the sensors load only for descents
     from ..sensors.engine import RayMesh
 
-    if not isinstance(scene, Scene):
-        raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
+    if isinstance(scene, Scene):
+        field = crater_field(scene)
+    elif isinstance(scene, CraterField):  # e.g. over a DEM (dem.ondemand)
+        field = scene
+    else:
+        raise TypeError(f"`scene` must be a latlong.Scene or a CraterField; got "
+                        f"{type(scene).__name__}")
     check_range("fov_deg", fov_deg, 1.0, 120.0)
     width_px = check_int("width_px", width_px, 16, 8192)
     alts = np.asarray(altitudes_m, dtype=np.float64).ravel()
     if not len(alts) or not (np.isfinite(alts).all() and (alts > 0).all()):
         raise ParameterError("altitudes_m", "must be positive numbers")
-    field = crater_field(scene)
     u0 = units_of([lat_deg], [lon_deg])
     east, north = (a[0] for a in tangent_frame(u0))
     up = u0[0]
@@ -106,7 +114,7 @@ def descent(scene: Scene, lat_deg: float, lon_deg: float, altitudes_m, *, fov_de
     for h in alts:
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
-        verts, faces, n_craters, kind = _terrain(scene, lat_deg, lon_deg, _MARGIN * footprint,
+        verts, faces, n_craters, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
                                                  pixel, site_radius)
         # the altitude is above the terrain at the site as this frame's terrain has it
         ground = up * float(field.radii(u0, 3.0 * pixel)[0])

@@ -51,3 +51,16 @@ def test_dem_windows_agree_where_they_overlap(lola, scene):
     assert big.n_craters > 0
     relief = np.ptp(big.heights_m)
     assert 100.0 < relief < 20000.0
+
+
+def test_a_descent_over_the_dem(lola, scene):
+    from dem.ondemand import dem_descent
+
+    frames = list(dem_descent(lola, scene, 5.0, 180.0, [50000.0, 5000.0], width_px=32))
+    assert [f.terrain for f in frames] == ["window", "window"]
+    assert frames[1].ground_pixel_m == pytest.approx(0.1 * frames[0].ground_pixel_m)
+    for f in frames:
+        lit = f.frame.reflectance > 0
+        assert lit.mean() > 0.5  # the ground fills the picture
+    with pytest.raises(ValueError, match="altitudes_m"):
+        list(dem_descent(lola, scene, 5.0, 180.0, [3e6], width_px=32))
