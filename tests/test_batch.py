@@ -41,6 +41,9 @@ layers = 3
 size = 17
 craters = ["c=0.05,k=-2,d_min_m=20000,d_max_m=60000"]
 """
+# a body made on demand (a fraction of a second)
+_ON_DEMAND = {"preset": "fbm-cratered", "seed": 5, "on_demand": True, "magnitude": 40,
+              "craters": ["c=0.5,k=-2,d_min_m=4,d_max_m=15"]}
 # a crater layer the scene accepts but the build refuses (about 1e15 craters)
 TOO_MANY = "c=1e6,k=-2,d_min_m=0.01,d_max_m=1"
 
@@ -394,7 +397,15 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
     expand = ("dem", "expand", str(LOLA), "--levels", "2", "--seed", "4", "-q")
     proc = _cli(*expand, "-o", str(tmp_path / "here.tif"))
     assert proc.returncode == 0, proc.stderr
+    from latlong.ondemand.patches import build_patches
+
+    on_demand = latlong.Scene.from_settings(_ON_DEMAND)
+    here = build_patches(on_demand, patches=3)
     with _separate_cluster(tmp_path) as address:
+        # a body made on demand in 16 patches on the separate workers: the same bytes
+        there = build_patches(on_demand, patches=16, scheduler=address)
+        assert there.radii_m.tobytes() == here.radii_m.tobytes()
+        assert there.craters.tobytes() == here.craters.tobytes()
         # the tiles of one DEM as tasks on the separate workers: the same bytes
         proc = _cli(*expand, "--scheduler", address, "-o", str(tmp_path / "there.tif"))
         assert proc.returncode == 0, proc.stderr
@@ -470,8 +481,6 @@ def test_map_tiles_on_dask_yields_every_result_and_raises_a_failure(scheduler):
 
 
 # --------------------------------------------------------------------------- on demand
-_ON_DEMAND = {"preset": "fbm-cratered", "seed": 5, "on_demand": True, "magnitude": 40,
-              "craters": ["c=0.5,k=-2,d_min_m=4,d_max_m=15"]}
 
 
 def test_on_demand_patches_give_the_same_bytes_on_any_backend(scheduler):
@@ -485,16 +494,3 @@ def test_on_demand_patches_give_the_same_bytes_on_any_backend(scheduler):
         assert got.radii_m.tobytes() == one.radii_m.tobytes()
         assert got.craters.tobytes() == one.craters.tobytes()
     assert len(one.craters) > 100
-
-
-@pytest.mark.slow
-def test_on_demand_patches_on_separate_processes(tmp_path):
-    """The same bytes from ``dask scheduler`` / ``dask worker`` processes."""
-    from latlong.ondemand.patches import build_patches
-
-    scene = latlong.Scene.from_settings(_ON_DEMAND)
-    here = build_patches(scene, patches=3)
-    with _separate_cluster(tmp_path) as address:
-        there = build_patches(scene, patches=16, scheduler=address)
-    assert there.radii_m.tobytes() == here.radii_m.tobytes()
-    assert there.craters.tobytes() == here.craters.tobytes()

@@ -117,10 +117,11 @@ def test_errors_name_the_setting(settings, name, text):
 
 
 def test_every_setting_is_an_option_and_a_toml_key():
-    from latlong.cli.build import OPTIONS
+    from latlong.cli.build import ON_DEMAND_RUN, OPTIONS
     from latlong.outputs import OUTPUT_SETTINGS
 
-    assert set(OPTIONS) == set(SETTINGS) | set(OUTPUT_SETTINGS) | {"quiet", "force"}
+    assert set(OPTIONS) == set(SETTINGS) | set(OUTPUT_SETTINGS) | {"quiet", "force"} \
+        | set(ON_DEMAND_RUN)
 
 
 def test_help_shows_every_default(capsys):
