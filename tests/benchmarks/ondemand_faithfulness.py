@@ -59,7 +59,9 @@ Reported per scene (``--json`` writes every number):
   ``craters.kernels``), whatever older craters lie under it. Counted: vertices checked,
   vertices off by more than 1e-6 m, and older stamped craters whose centre lies inside
   such a checked area (the opportunities) and how many of them show (a vertex of their
-  rim disc off).
+  rim disc off). The top crater also sorts the per-vertex differences by zone: inside
+  its rim, rim to 1.5 radii (where the field blends the older terrain into the base),
+  beyond to the ejecta edge, no crater.
 
 Prints one table per scene and a summary over seeds; ``--png-dir`` saves a picture of
 the worst region (largest |dh| against the matched-draws reference) of each scene's first
@@ -89,7 +91,7 @@ from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_
 from latlong import Body, LatLongGrid, Scene, stamp_craters
 from latlong.cratering import crater_extents_deg
 from latlong.ondemand import _field_kernels as K  # the field's per-crater record columns
-from latlong.ondemand.field import ROUGHNESS_OCTAVES, CraterField
+from latlong.ondemand.field import BLEND_EDGE, ROUGHNESS_OCTAVES, CraterField
 from latlong.settings import ShapeBase
 from latlong.slopes import radius_spectrum, slope_summary, slopes_and_areas
 from latlong.surface import band_areas
@@ -263,6 +265,7 @@ def older_inside_check(field, units, radii, tree):
     active = fc[:, K.ACTIVE] > 0
     order = np.lexsort((cr.id, cr.age_gyr))[::-1]  # oldest first; the last write wins
     top = np.full(len(units), -1, dtype=np.int64)
+    top_x = np.full(len(units), np.inf)  # radii (irregular rim) from the top crater
     cu = fc[:, K.C0:K.C2 + 1]
     for k in order:
         if not active[k]:
@@ -279,7 +282,9 @@ def older_inside_check(field, units, radii, tree):
         rim = _table_np(np.broadcast_to(rims[k], (len(near), rims.shape[1])),
                         np.arctan2(xn, xe_))
         xr = dist / (fc[k, K.RAD] * (1.0 + rim))
-        top[near[(xr < field.xe) & (c >= fc[k, K.COS_FAR])]] = k
+        hit = (xr < field.xe) & (c >= fc[k, K.COS_FAR])
+        top[near[hit]] = k
+        top_x[near[hit]] = xr[hit]
     res = np.empty(len(units))
     _interior_residual(units, radii, top, fc, tabs, rims, np.ascontiguousarray(cr.seed),
                        field.rough, field.gain, ROUGHNESS_OCTAVES, field.xe, res)
@@ -298,7 +303,7 @@ def older_inside_check(field, units, radii, tree):
         near = tree.query_ball_point(cu[j], 2.0 * np.sin(0.5 * fc[j, K.RAD] / fc[j, K.RHO]))
         if off[np.asarray(near, dtype=np.int64)].any():
             shown += 1
-    return {"vertices_checked": int(checked.sum()), "vertices_off": int(off.sum()),
+    return top_x, {"vertices_checked": int(checked.sum()), "vertices_off": int(off.sum()),
             "max_abs_residual_m": float(np.nanmax(np.abs(res))) if checked.any() else 0.0,
             "older_inside_younger_rim": opp, "older_visible_inside_younger_rim": shown}
 
@@ -472,7 +477,17 @@ def run_scene(preset: str, seed: int, magnitude: int, png_dir: Path | None,
     out["spectrum"] = {"bands": list(sp_od), "ondemand": list(sp_od.values()),
                        "seq": list(sp_sq.values()),
                        "diff_matched": list(spectrum_bands(diff, l_max).values())}
-    out["older_inside"] = older_inside_check(s.field, s.units, s.od.radii_m, s.tree)
+    top_x, out["older_inside"] = older_inside_check(s.field, s.units, s.od.radii_m, s.tree)
+    # where the differences are: by the youngest stamped crater reaching each vertex
+    adh = np.abs(s.od.radii_m - s.seqm.radii_m)
+    zones = {"inside rim": top_x <= 1.0, "rim to 1.5 radii (blend)": (top_x > 1.0)
+             & (top_x < BLEND_EDGE), "1.5 radii to ejecta edge": (top_x >= BLEND_EDGE)
+             & np.isfinite(top_x), "no crater": ~np.isfinite(top_x)}
+    out["dh_matched_by_zone"] = {
+        k: {"share_of_vertices": float(z.mean()), "median_m": _med(adh[z]),
+            "p95_m": float(np.percentile(adh[z], 95)) if z.any() else float("nan"),
+            "share_of_sum_sq": float((adh[z] ** 2).sum() / (adh ** 2).sum())}
+        for k, z in zones.items()}
     out["seconds"] = {"ondemand_radii": s.t_od, "seq_stamp": s.t_seq,
                       "total": time.perf_counter() - s.t0}
     if png_dir is not None:
@@ -559,6 +574,9 @@ def print_scene(r: dict) -> None:
     print("  difference (matched) / seq power:     " + "  ".join(
         f"{b}: {a / s:.3f}" for b, a, s in zip(sp["bands"], sp["diff_matched"], sp["seq"],
                                                 strict=True)))
+    print("  |dh| (matched) by the top crater's zone: " + "  ".join(
+        f"{k}: {v['share_of_vertices']:.2f} of vertices, median {v['median_m']:.3f} m, "
+        f"{v['share_of_sum_sq']:.2f} of sum dh^2" for k, v in r["dh_matched_by_zone"].items()))
     o = r["older_inside"]
     print(f"  older crater visible inside a younger rim: {o['older_visible_inside_younger_rim']} "
           f"of {o['older_inside_younger_rim']} (vertices checked {o['vertices_checked']}, off "
