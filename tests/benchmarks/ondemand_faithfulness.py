@@ -63,6 +63,10 @@ Reported per scene (``--json`` writes every number):
   its rim, rim to 1.5 radii (where the field blends the older terrain into the base),
   beyond to the ejecta edge, no crater.
 
+Acceptance (issue 37): slope KS <= 0.05, visible craters per bin within 10 %, d/D median
+within 5 %, no older crater visible inside a younger rim. One thread, per seed at M = 400:
+fbm-cratered ~45 s, faulted-cratered ~20 s, eros ~19 s (at M = 200: 9, 4, 4 s).
+
 Prints one table per scene and a summary over seeds; ``--png-dir`` saves a picture of
 the worst region (largest |dh| against the matched-draws reference) of each scene's first
 seed. Run by hand (one thread is enough; the timing column is per scene):
