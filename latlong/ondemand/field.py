@@ -6,7 +6,8 @@ in the README, "Terrain on demand"):
 
 1. **Catalogue.** Each power-law layer's size bin ``[2**b, 2**(b+1))`` is drawn per cell
    of one level of the cube-sphere hierarchy (:mod:`craters.local`), the level a function
-   of the bin and the body (cells at least one ejecta reach wide), never of the request.
+   of the bin and the body (cells at least an ejecta reach plus a radius wide), never of
+   the request.
    Craters smaller than the requested minimum diameter are left out; that only filters.
 2. **A crater's base** is a quadric fitted (a fixed 25-point stencil over its rim disc:
    the centre, 8 points at half the radius, 16 on the rim; a fixed least-squares
@@ -130,7 +131,7 @@ class CraterField:
         self.gain = 2.0 ** (rough.fractal_dimension - 3.0)
         self.irregularity = IRREGULARITY if irregular else 0.0
         self.xe = float(EJECTA_EDGE)
-        # the level of each size bin: cells at least one ejecta reach wide
+        # the level of each size bin: cells at least an ejecta reach plus a radius wide
         self.levels: dict[int, int] = {}
         for la in self.layers:
             for b in bins(la):
