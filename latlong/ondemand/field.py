@@ -9,14 +9,14 @@ in the README, "Terrain on demand"):
    of the bin and the body (cells at least an ejecta reach plus a radius wide), never of
    the request.
    Craters smaller than the requested minimum diameter are left out; that only filters.
-2. **A crater's base** is a quadric fitted (a fixed 25-point stencil over its rim disc:
-   the centre, 8 points at half the radius, 16 on the rim; a fixed least-squares
-   operator) to the terrain made by the base shape and the *older,
-   larger* craters at the stencil points. Smaller craters barely move a plane fitted over
-   a larger crater's floor, and leaving them out makes every crater's parameters
+2. **A crater's base** is a quadric fitted (a fixed 61-point stencil over its rim disc:
+   the centre and rings of 6, 12, 18 and 24 points at 1/4 .. 1 radius; a fixed
+   least-squares operator) to the terrain made by the base shape and the *older, larger*
+   craters at the stencil points. Smaller craters barely move a plane fitted over a
+   larger crater's floor, and leaving them out makes every crater's parameters
    independent of the requested resolution. The slope of that base against "up" (radial,
-   or a shape model's self-gravity) sets the slope erosion (Martin's lunar paper III),
-   as in the sequential stamp.
+   or a shape model's self-gravity) sets the slope erosion (Martin's lunar paper III), as
+   in the sequential stamp.
 3. **Composition.** Each crater acts on the height before it as an affine map: inside its
    (irregular) rim it replaces the terrain by its base quadric plus its profile (so older
    craters there are erased); outside, its profile (ejecta, roughness) adds to the old
@@ -67,7 +67,7 @@ IRREGULARITY = 0.02
 #: Octaves of a crater's roughness overlay (radius down to radius / 8): fixed per
 #: crater, so the overlay never depends on the requested resolution.
 ROUGHNESS_OCTAVES = 4
-_RINGS = ((0.0, 1), (0.5, 8), (1.0, 16))
+_RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
 _BIN_MARGIN = 1.05
 
 
@@ -448,7 +448,7 @@ def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
 
 
 def _stencil_points(fc: np.ndarray) -> np.ndarray:
-    """(n, 25, 3) directions of each crater's stencil: angle r R / rho from its centre."""
+    """(n, 61, 3) directions of each crater's stencil: angle r R / rho from its centre."""
     out = np.empty((len(fc), len(STENCIL_XY), 3))
     if len(fc):
         K._stencil_kernel(np.ascontiguousarray(fc), STENCIL_XY, out)

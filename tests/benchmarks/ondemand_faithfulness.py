@@ -359,6 +359,10 @@ def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> S
     res = math.pi * radius_m / (2 * magnitude)
     base = field.base.radius(units)
     cat = field.catalog(units, 3.0 * res)
+    # the catalogue as drawn: its degradation reports what the field made (diffusion and
+    # slope erosion); the sequential stamp takes a number there as an override, so it gets
+    # NaN (degradation from the age), as the build's catalogue has
+    cat["degradation"] = np.nan
     t1 = time.perf_counter()
     radii = field.radii(units, 3.0 * res)
     t_od = time.perf_counter() - t1
