@@ -182,15 +182,21 @@ def tangent_frame(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return e, n
 
 
-_CACHE_BASE_FIELD: list = []
+def per_scene(store: list, scene: Scene, make):
+    """``make(scene)`` once per scene (by identity: scenes are frozen, and those holding a
+    shape model's arrays cannot be hashed), the last four kept in ``store``."""
+    for held, value in store:
+        if held is scene:
+            return value
+    value = make(scene)
+    store.insert(0, (scene, value))
+    del store[4:]
+    return value
+
+
+_BASE_FIELDS: list = []
 
 
 def base_field(scene: Scene) -> BaseField:
-    """The scene's :class:`BaseField`, made once per scene (scenes are frozen)."""
-    for held, value in _CACHE_BASE_FIELD:
-        if held is scene:  # scenes are frozen; some hold arrays, so not hashable
-            return value
-    value = BaseField(scene)
-    _CACHE_BASE_FIELD.insert(0, (scene, value))
-    del _CACHE_BASE_FIELD[4:]
-    return value
+    """The scene's :class:`BaseField`, made once per scene."""
+    return per_scene(_BASE_FIELDS, scene, BaseField)

@@ -53,7 +53,7 @@ from craters.stamp import (
 
 from ..scene import Scene
 from . import _field_kernels as K
-from .base import BaseField, base_field, tangent_frame
+from .base import BaseField, base_field, per_scene, tangent_frame
 
 __all__ = ["BLEND_EDGE", "IRREGULARITY", "ROUGHNESS_OCTAVES", "CraterField", "crater_field",
            "heights_at_units"]
@@ -467,18 +467,12 @@ def _block_level(n: int, units: np.ndarray) -> int:
     return bin_level(width, 24)
 
 
-_CACHE_CRATER_FIELD: list = []
+_CRATER_FIELDS: list = []
 
 
 def crater_field(scene: Scene) -> CraterField:
     """The scene's :class:`CraterField`, made once per scene."""
-    for held, value in _CACHE_CRATER_FIELD:
-        if held is scene:  # scenes are frozen; some hold arrays, so not hashable
-            return value
-    value = CraterField(scene)
-    _CACHE_CRATER_FIELD.insert(0, (scene, value))
-    del _CACHE_CRATER_FIELD[4:]
-    return value
+    return per_scene(_CRATER_FIELDS, scene, CraterField)
 
 
 def heights_at_units(scene: Scene, units, *, resolution_m: float) -> np.ndarray:
