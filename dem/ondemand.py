@@ -14,11 +14,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from craters._shared import ParameterError, check_positive, check_range
+from craters._shared import ParameterError
 from latlong import Scene
 from latlong.ondemand.base import BaseField
 from latlong.ondemand.field import CraterField
-from latlong.ondemand.tile import MAX_TILE_PX, Tile, tile_of_field
+from latlong.ondemand.tile import Tile, check_window, tile_of_field
 
 from .core import Dem
 
@@ -99,14 +99,7 @@ def dem_tile(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, *, size_m: 
     gives the crater layers, the body (their shapes) and the seed; the DEM the base."""
     if not isinstance(scene, Scene):
         raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
-    check_range("lat_deg", lat_deg, -90.0, 90.0)
-    pixel_m = check_positive("pixel_m", pixel_m)
-    size_m = check_positive("size_m", size_m)
-    min_crater_px = check_range("min_crater_px", min_crater_px, 1.0, 1000.0)
-    size_px = int(round(size_m / pixel_m))
-    if not 1 <= size_px <= MAX_TILE_PX:
-        raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
-                             f"got {size_m:g} m ({size_px} pixels)")
+    size_px, pixel_m, min_crater_px = check_window(lat_deg, size_m, pixel_m, min_crater_px)
     assert scene.seed is not None  # Scene draws one
     field = _field(dem, scene, radius_m)
     return tile_of_field(field, lat_deg, lon_deg, size_px, pixel_m, min_crater_px)

@@ -80,6 +80,13 @@ def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m
         raise TypeError(f"`scene` must be a latlong.Scene; got {type(scene).__name__}")
     if scene.seed is None:
         raise ParameterError("seed", "is required for terrain on demand")
+    size_px, pixel_m, min_crater_px = check_window(lat_deg, size_m, pixel_m, min_crater_px)
+    return tile_of_field(crater_field(scene), lat_deg, lon_deg, size_px, pixel_m,
+                         min_crater_px)
+
+
+def check_window(lat_deg, size_m, pixel_m, min_crater_px) -> tuple[int, float, float]:
+    """(pixels a side, pixel size, smallest crater in pixels) of a window, checked."""
     check_range("lat_deg", lat_deg, -90.0, 90.0)
     pixel_m = check_positive("pixel_m", pixel_m)
     size_m = check_positive("size_m", size_m)
@@ -88,8 +95,7 @@ def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m
     if not 1 <= size_px <= MAX_TILE_PX:
         raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
                              f"got {size_m:g} m ({size_px} pixels)")
-    return tile_of_field(crater_field(scene), lat_deg, lon_deg, size_px, pixel_m,
-                         min_crater_px)
+    return size_px, pixel_m, min_crater_px
 
 
 def tile_of_field(field: CraterField, lat_deg: float, lon_deg: float, size_px: int,
