@@ -249,31 +249,57 @@ def _atan_kernel(x, out):
 
 
 # --------------------------------------------------------------------------- cells
+@njit(cache=True, inline="always")
+def _face_uv(x, y, z):
+    """(face, u, v) of a direction on the gnomonic cube (craters.cells)."""
+    ax = abs(x)
+    ay = abs(y)
+    az = abs(z)
+    if ax >= ay and ax >= az:
+        a, m, p, q = 0, x, y, z
+    elif ay >= az:
+        a, m, p, q = 1, y, z, x
+    else:
+        a, m, p, q = 2, z, x, y
+    am = abs(m)
+    return 2 * a + (0 if m > 0.0 else 1), p / am, q / am
+
+
+@njit(cache=True, inline="always")
+def _face_point(face, u, v):
+    """(x, y, z) of the point (u, v) of a cube face (not normalised; no allocation)."""
+    a = face // 2
+    s = 1.0 if face % 2 == 0 else -1.0
+    if a == 0:
+        return s, u, v
+    if a == 1:
+        return v, s, u
+    return u, v, s
+
+
+@njit(cache=True, inline="always")
+def _cell_index(level, u):
+    """The cell row or column of face coordinate ``u`` at ``level``."""
+    n = 1 << level
+    return min(max(int(np.floor((u + 1.0) * 0.5 * n)), 0), n - 1)
+
+
+@njit(cache=True, inline="always")
+def _cell_id(level, face, u, v):
+    """The uint64 cell id (craters.cells) of face coordinates (u, v) at ``level``."""
+    return (np.uint64(level) << np.uint64(57)) | (np.uint64(face) << np.uint64(54)) \
+        | (np.uint64(_cell_index(level, u)) << np.uint64(27)) \
+        | np.uint64(_cell_index(level, v))
+
+
 @njit(cache=True)
 def _cell_of_kernel(points, level, out):
     """(face, i, j) of each point's gnomonic cube cell at ``level`` (craters.cells)."""
-    n = 1 << level
     for k in range(points.shape[0]):
-        x = points[k, 0]
-        y = points[k, 1]
-        z = points[k, 2]
-        ax = abs(x)
-        ay = abs(y)
-        az = abs(z)
-        if ax >= ay and ax >= az:
-            a, m, p, q = 0, x, y, z
-        elif ay >= az:
-            a, m, p, q = 1, y, z, x
-        else:
-            a, m, p, q = 2, z, x, y
-        am = abs(m)
-        u = p / am
-        v = q / am
-        i = int(np.floor((u + 1.0) * 0.5 * n))
-        j = int(np.floor((v + 1.0) * 0.5 * n))
-        out[k, 0] = 2 * a + (0 if m > 0.0 else 1)
-        out[k, 1] = min(max(i, 0), n - 1)
-        out[k, 2] = min(max(j, 0), n - 1)
+        f, u, v = _face_uv(points[k, 0], points[k, 1], points[k, 2])
+        out[k, 0] = f
+        out[k, 1] = _cell_index(level, u)
+        out[k, 2] = _cell_index(level, v)
 
 
 @njit(cache=True)

@@ -33,8 +33,16 @@ Grids and point sets:
   least-squares plane from its nine running sums
 * ``idw8(z, known, r, c, step_len, empty)``: 8-direction inverse-distance hole fill;
   ``DR8``, ``DC8``: its directions
+
+Cube-sphere cells (:mod:`craters.cells`):
+
+* ``face_uv(x, y, z)`` -> (face, u, v); ``face_point(face, u, v)`` -> (x, y, z);
+  ``cell_id(level, face, u, v)``: the uint64 id of the cell holding (u, v)
 """
 
+from ._counter_kernels import _cell_id as cell_id
+from ._counter_kernels import _face_point as face_point
+from ._counter_kernels import _face_uv as face_uv
 from ._lcsn_kernels import _lcsn_height as lcsn_height
 from ._raster_kernels import DC8, DR8, PLANE_SUMS0
 from ._raster_kernels import _bilinear as bilinear
@@ -56,7 +64,7 @@ from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
 from ._stamp_kernels import _table_value as table_value
 
-__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "fbm2", "fit_plane",
-           "hash_normal", "idw8", "lcsn_height", "mix64", "outer_weight", "plane_solve",
-           "plane_sums_add", "rim_offsets", "roughness_amp", "roughness_octaves",
-           "slope_factor", "splitmix64", "table", "table_value"]
+__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "face_point",
+           "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height", "mix64",
+           "outer_weight", "plane_solve", "plane_sums_add", "rim_offsets", "roughness_amp",
+           "roughness_octaves", "slope_factor", "splitmix64", "table", "table_value"]

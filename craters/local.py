@@ -31,6 +31,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .boulders import BoulderLayer
+from .boulders.placement import MIN_BURIAL
 from .cells import cell_parts, cell_points
 from .counter import (
     philox4x64,
@@ -42,13 +44,19 @@ from .counter import (
 )
 from .layers import CraterLayer
 
-__all__ = ["CRATER_KEY", "bin_bounds", "bin_level", "bins", "draw_cells", "min_cell_angle"]
+__all__ = ["CRATER_KEY", "ROCK_FACETS", "ROCK_KEY", "bin_bounds", "bin_level", "bins",
+           "draw_cells", "draw_rock_cells", "min_cell_angle"]
 
 #: The second key word of crater draws ("craters\0").
 CRATER_KEY = 0x6372617465727300
+#: The second key word of rock draws ("rocks\0\0\0").
+ROCK_KEY = 0x726F636B73000000
+#: Facet planes of a rock (:func:`draw_rock_cells`).
+ROCK_FACETS = 6
 _BIN_OFFSET = 1 << 31
 _COUNT, _MAIN, _RIM, _POSITION = 0, 1, 2, 16  # counter purposes
 _RIM_COUNTERS = 4  # 16 words for the 15 rim phases
+_ROCK_COUNTERS = 6  # 24 words: 18 for the facets, 3 for elongation, height, burial
 _MAX_CANDIDATES = 64  # position candidates per crater (acceptance >= 0.19 a candidate)
 _TWO_PI = 2.0 * np.pi
 
@@ -62,9 +70,9 @@ def _bin_of(d: float) -> int:
 def bins(layer: CraterLayer) -> np.ndarray:
     """The size bins ``b`` (int64) of a layer: ``[2**b, 2**(b + 1))`` meets
     ``[d_min_m, d_max_m)``."""
-    if not isinstance(layer, CraterLayer):
-        raise TypeError("terrain on demand draws power-law layers (craters.CraterLayer); got "
-                        f"{type(layer).__name__}")
+    if not isinstance(layer, CraterLayer | BoulderLayer):
+        raise TypeError("terrain on demand draws power-law layers (craters.CraterLayer or "
+                        f"craters.BoulderLayer); got {type(layer).__name__}")
     lo = _bin_of(layer.d_min_m)
     hi = _bin_of(layer.d_max_m)
     if np.ldexp(1.0, hi) == layer.d_max_m:
@@ -72,7 +80,7 @@ def bins(layer: CraterLayer) -> np.ndarray:
     return np.arange(lo, hi + 1, dtype=np.int64)
 
 
-def bin_bounds(layer: CraterLayer, b: int) -> tuple[float, float]:
+def bin_bounds(layer: CraterLayer | BoulderLayer, b: int) -> tuple[float, float]:
     """``(lo, hi)`` metres: bin ``b`` clipped to the layer's range."""
     return max(float(np.ldexp(1.0, int(b))), layer.d_min_m), \
         min(float(np.ldexp(1.0, int(b) + 1)), layer.d_max_m)
@@ -101,13 +109,38 @@ def _pow(x: np.ndarray, k: float) -> np.ndarray:
     return portable_exp(k * portable_log(x))
 
 
-def _words(cells: np.ndarray, tag: int, index: np.ndarray, purpose: int, seed: int):
+def _words(cells: np.ndarray, tag: int, index: np.ndarray, purpose: int, seed: int,
+           key: int = CRATER_KEY):
     counters = np.empty((len(cells), 4), dtype=np.uint64)
     counters[:, 0] = cells
     counters[:, 1] = np.uint64(tag)
     counters[:, 2] = index.astype(np.uint64)
     counters[:, 3] = np.uint64(purpose)
-    return philox4x64(counters, [seed, CRATER_KEY])
+    return philox4x64(counters, [seed, key])
+
+
+def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key: int):
+    """The cells' Poisson counts of bin ``b``: (cells, tag, cell of each draw, index in
+    its cell, (lo, hi) metres)."""
+    seed = int(seed)
+    if not 0 <= seed < 2**64:
+        raise ValueError(f"`seed` must be in [0, 2**64); got {seed}")
+    cells = np.ascontiguousarray(np.asarray(cell_ids, dtype=np.uint64).ravel())
+    area = np.asarray(area_m2, dtype=np.float64).ravel()
+    if area.shape != cells.shape:
+        raise ValueError(f"`area_m2` must have one value per cell ({len(cells)}); got "
+                         f"{area.shape}")
+    lo, hi = bin_bounds(layer, b)
+    tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
+    density = layer.c * float(_pow(np.array([lo]), layer.k)[0] - _pow(np.array([hi]), layer.k)[0])
+    zero = np.zeros(len(cells), dtype=np.int64)
+    u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed, key)[:, 0])
+    counts = poisson_from_uniform(u, area * density)
+    cell = np.repeat(cells, counts)
+    # each draw's index within its cell: 0, 1, .. counts - 1, cell after cell
+    index = np.arange(len(cell), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts,
+                                                             counts)
+    return tag, cell, index, (lo, hi)
 
 
 def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level: int,
@@ -131,23 +164,9 @@ def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level
     ``rim_phases`` (n, 15), ``seed`` (uint64 roughness seed), ``id`` (uint64), ``cell``
     (uint64), ``index``.
     """
+    tag, cell, index, (lo, hi) = _counted(layer, layer_index, int(seed), b, cell_ids,
+                                          area_m2, CRATER_KEY)
     seed = int(seed)
-    if not 0 <= seed < 2**64:
-        raise ValueError(f"`seed` must be in [0, 2**64); got {seed}")
-    cells = np.ascontiguousarray(np.asarray(cell_ids, dtype=np.uint64).ravel())
-    area = np.asarray(area_m2, dtype=np.float64).ravel()
-    if area.shape != cells.shape:
-        raise ValueError(f"`area_m2` must have one value per cell ({len(cells)}); got "
-                         f"{area.shape}")
-    lo, hi = bin_bounds(layer, b)
-    tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
-    density = layer.c * float(_pow(np.array([lo]), layer.k)[0] - _pow(np.array([hi]), layer.k)[0])
-    zero = np.zeros(len(cells), dtype=np.int64)
-    u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed)[:, 0])
-    counts = poisson_from_uniform(u, area * density)
-    cell = np.repeat(cells, counts)
-    index = np.concatenate([np.arange(n, dtype=np.int64) for n in counts]) if len(cells) \
-        else zero
     n = len(cell)
     main = _words(cell, tag, index, _MAIN, seed)
     um = uniform_from_words(main)
@@ -161,7 +180,55 @@ def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level
             "index": index}
 
 
-def _positions(cell: np.ndarray, tag: int, index: np.ndarray, seed: int) -> np.ndarray:
+def draw_rock_cells(layer: BoulderLayer, layer_index: int, *, seed: int, b: int, level: int,
+                    cell_ids, area_m2, elongation: float = 1.4, flatten: float = 0.6) -> dict:
+    """The rocks of size bin ``b`` of a boulder ``layer`` in the given cells (ids of
+    ``level``): as :func:`draw_cells` (the same counts, diameters and positions, under
+    the key :data:`ROCK_KEY`), and each rock's shape in its own frame:
+
+    - ``azimuth_rad`` of its long axis, uniform;
+    - ``elongation`` (long / short axis of its footprint), uniform in [1, ``elongation``];
+    - ``height_m``: ``flatten`` x diameter x a uniform factor in [0.7, 1.3];
+    - ``burial_frac`` of that height below the ground, uniform in [MIN_BURIAL,
+      ``layer.burial_max``];
+    - ``facets`` (n, ROCK_FACETS, 3): the planes cutting the ellipsoid into an angular
+      block, each (direction of its downhill normal in radians, offset, slope), in units
+      of the half-height and the footprint's semi-axes: the first half cut the top
+      (offset 0.6-0.95, slope 0.2-1), the others the sides (offset 1-1.5, slope 1.5-3),
+      which makes the footprint a polygon.
+
+    Returns ``unit``, ``diameter_m``, those, ``seed`` (uint64), ``id`` (uint64),
+    ``cell``, ``index``.
+    """
+    tag, cell, index, (lo, hi) = _counted(layer, layer_index, int(seed), b, cell_ids,
+                                          area_m2, ROCK_KEY)
+    seed = int(seed)
+    n = len(cell)
+    main = _words(cell, tag, index, _MAIN, seed, ROCK_KEY)
+    um = uniform_from_words(main)
+    diameter = power_law_from_uniform(um[:, 0], lo, hi, layer.k) if n else np.zeros(0)
+    shape = np.concatenate([uniform_from_words(_words(cell, tag, index, _RIM + r, seed,
+                                                      ROCK_KEY))
+                            for r in range(_ROCK_COUNTERS)], axis=1)
+    facets = shape[:, :3 * ROCK_FACETS].reshape(n, ROCK_FACETS, 3)
+    top = np.arange(ROCK_FACETS) < ROCK_FACETS // 2
+    facets = np.stack([facets[..., 0] * _TWO_PI,
+                       np.where(top, 0.6 + 0.35 * facets[..., 1], 1.0 + 0.5 * facets[..., 1]),
+                       np.where(top, 0.2 + 0.8 * facets[..., 2], 1.5 + 1.5 * facets[..., 2])],
+                      axis=-1)
+    extra = shape[:, 3 * ROCK_FACETS:]
+    unit = _positions(cell, tag, index, seed, ROCK_KEY)
+    return {"unit": unit, "diameter_m": diameter,
+            "azimuth_rad": um[:, 1] * _TWO_PI,
+            "elongation": 1.0 + (float(elongation) - 1.0) * extra[:, 0],
+            "height_m": float(flatten) * diameter * (0.7 + 0.6 * extra[:, 1]),
+            "burial_frac": MIN_BURIAL + (layer.burial_max - MIN_BURIAL) * extra[:, 2],
+            "facets": facets, "seed": main[:, 2] >> np.uint64(1), "id": main[:, 3],
+            "cell": cell, "index": index}
+
+
+def _positions(cell: np.ndarray, tag: int, index: np.ndarray, seed: int,
+               key: int = CRATER_KEY) -> np.ndarray:
     """Uniform directions in each crater's cell: candidates uniform in the cell's
     tangent-plane square, accepted with probability J / J_max (J = (1 + u^2 + v^2)^-1.5,
     the gnomonic area element); the last candidate if none of 64 is (never seen: at
@@ -180,7 +247,7 @@ def _positions(cell: np.ndarray, tag: int, index: np.ndarray, seed: int) -> np.n
     for k in range(_MAX_CANDIDATES):
         if not len(todo):
             break
-        w = uniform_from_words(_words(cell[todo], tag, index[todo], _POSITION + k, seed))
+        w = uniform_from_words(_words(cell[todo], tag, index[todo], _POSITION + k, seed, key))
         uu = u0[todo] + w[:, 0] * scale[todo]
         vv = v0[todo] + w[:, 1] * scale[todo]
         s = 1.0 + uu * uu + vv * vv

@@ -27,8 +27,10 @@ __all__ = ["GROUPS", "OPTIONS", "register"]
 #: --force): also the keys of a scene file.
 #: How an on-demand build (``--on-demand``) runs: patches, and where.
 ON_DEMAND_RUN = {
-    "patches": Setting(1, "independent patches of vertices of an --on-demand build (the same "
-                       "bytes for any number)", range=(1, 10**9), run=True),
+    "patches": Setting(help="independent patches of vertices of an --on-demand build (the same "
+                       "bytes for any number; default: patches of at most 4 194 304 vertices, "
+                       "so memory is bounded by a patch)", kind=int, range=(1, 10**9),
+                       run=True),
     "workers": Setting(help="patches on a local dask cluster of this many worker processes "
                        "(--on-demand)", kind=int, range=(1, 1024), run=True),
     "scheduler": Setting(help="patches on the dask scheduler at this address, e.g. "
@@ -110,10 +112,16 @@ def _build(v: Values) -> int:
     if run and not scene.on_demand:
         raise CliError(f"--{next(iter(run))} applies to an --on-demand build")
     if scene.on_demand:
-        from latlong.ondemand.patches import build_patches
+        from latlong.ondemand.patches import build_patches, patch_count
+        from latlong.scratch import disk_radii
 
-        made = build_patches(scene, patches=v["patches"], workers=v["workers"],
-                             scheduler=v["scheduler"])
+        n = LatLongGrid(scene.body.magnitude).n_vertices
+        patches = patch_count(n, v["patches"])
+        patch_bar = progress_bar(total=patches, enabled=show, desc="patches")
+        made = build_patches(scene, patches=patches, workers=v["workers"],
+                             scheduler=v["scheduler"], progress=lambda *_: patch_bar.update(),
+                             out=None if scratch is None else disk_radii(n, scratch))
+        patch_bar.close()
     else:
         made = build(scene, progress=show, scratch_dir=scratch)
     bar.update()

@@ -88,7 +88,7 @@ def _descent(v: Values) -> int:
             pictures.append(pic)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
                             "picture_white_if": scale,
-                            "terrain": f.terrain, "craters": f.n_craters,
+                            "terrain": f.terrain, "craters": f.n_craters, "rocks": f.n_rocks,
                             "position_m": [float(x) for x in f.frame.pose.position_m],
                             "quaternion_wxyz": [float(x) for x in
                                                 f.frame.pose.quaternion_wxyz],
@@ -96,7 +96,8 @@ def _descent(v: Values) -> int:
                             "files": files})
             if not v["quiet"]:
                 print(f"frame {i}: altitude {f.altitude_m:.4g} m, ground pixel "
-                      f"{f.ground_pixel_m:.3g} m, {f.n_craters} craters ({f.terrain})",
+                      f"{f.ground_pixel_m:.3g} m, {f.n_craters} craters, {f.n_rocks} rocks "
+                      f"({f.terrain})",
                       file=sys.stderr)
         gap = np.zeros((pictures[0].shape[0], 4), np.uint8)
         strip = np.concatenate([x for p in pictures for x in (p, gap)][:-1], axis=1)

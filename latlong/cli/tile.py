@@ -71,8 +71,9 @@ def _tile(v: Values) -> int:
         ny, nx = made.heights_m.shape
         print(f"tile: {nx} x {ny} pixels of {made.pixel_m:g} m at ({made.lat_deg:g}, "
               f"{made.lon_deg:g}) deg, heights {made.heights_m.min():.4g}..."
-              f"{made.heights_m.max():.4g} m, {made.n_craters} craters >= "
-              f"{made.min_crater_m:.3g} m, seed {scene.seed}", file=sys.stderr)
+              f"{made.heights_m.max():.4g} m, {made.n_craters} craters and "
+              f"{made.n_rocks} rocks >= {made.min_crater_m:.3g} m, seed {scene.seed}",
+              file=sys.stderr)
         for path in outs.values():
             print(f"wrote {path} ({human_bytes(Path(path).stat().st_size)})")
     return 0

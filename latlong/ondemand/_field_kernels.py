@@ -10,7 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import fbm2, roughness_amp, slope_factor, table, table_value
+from craters.kernels import face_point, fbm2, roughness_amp, slope_factor, table, table_value
 
 # crater record columns (float64 array "fc", one row per crater)
 C0, C1, C2 = 0, 1, 2          # centre direction (unit)
@@ -24,7 +24,8 @@ SCALE = 18                    # slope-erosion factor of the relief
 DEPTH = 19                    # rim crest to floor of the table (m)
 ACTIVE = 20                   # 1 when stamped (0: erased by slope erosion, or no params yet)
 FAR = 21                      # the widest ejecta edge's angle (radians)
-N_COLS = 22
+CHORD2 = 22                   # squared chord of that angle, (2 sin(FAR / 2))^2
+N_COLS = 23
 
 
 @njit(cache=True, inline="always")
@@ -48,6 +49,17 @@ def _local(fc, k, p0, p1, p2):
 
 
 @njit(cache=True, inline="always")
+def _far(rec, k, col, p0, p1, p2):
+    """Whether direction p is farther from record k's centre than the angle whose squared
+    chord is ``rec[k, col]``: by the chord, exact to the last bits at any angle (a cosine
+    test loses everything below ~1e-8 rad: centimetres on the Moon)."""
+    d0 = p0 - rec[k, C0]
+    d1 = p1 - rec[k, C1]
+    d2 = p2 - rec[k, C2]
+    return d0 * d0 + d1 * d1 + d2 * d2 > rec[k, col]
+
+
+@njit(cache=True, inline="always")
 def _quadric(fc, k, x, y):
     return (fc[k, P0] + fc[k, GX] * x + fc[k, GY] * y + fc[k, QA] * x * x
             + fc[k, QB] * x * y + fc[k, QC] * y * y)
@@ -61,7 +73,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     blended into the base quadric towards the rim (weight a = 1 - ((xb - x)/(xb - 1))^2
     from the rim to ``xb`` radii, 1 beyond), so the rim is continuous whatever the older
     terrain is."""
-    if fc[k, C0] * p0 + fc[k, C1] * p1 + fc[k, C2] * p2 < fc[k, COS_FAR]:
+    if _far(fc, k, CHORD2, p0, p1, p2):
         return False, 1.0, 0.0  # beyond the widest ejecta edge: nothing else to compute
     cosang, dist, x, y, az = _local(fc, k, p0, p1, p2)
     radius = fc[k, RAD]
@@ -70,7 +82,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
     prof = scale * table_value(tabs[k], xr, xe)
-    if rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0:
+    if octaves > 0 and (rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0):
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
         # below a millionth of the radius (a crater diffused flat) the overlay is left out:
         # a property of the crater, the same wherever it is evaluated
@@ -141,14 +153,15 @@ def _params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, fit, 
 def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
                    rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
     """Base quadric and slope-erosion factor of crater k: the terrain of its older, larger
-    craters (``dep_list[dep_start[k]:dep_start[k+1]]``, youngest first) at its stencil
-    points, fitted by the fixed least-squares operator ``fit`` (6, n_stencil) in the
-    crater's normalised coordinates."""
+    craters (``dep_list[dep_start[k]:dep_start[k+1]]``, youngest first; their profiles
+    without the roughness overlay, ``octaves`` unused: zero-mean noise a fit over the
+    stencil averages out) at its stencil points, fitted by the fixed least-squares
+    operator ``fit`` (6, n_stencil) in the crater's normalised coordinates."""
     n_st = stencil.shape[1]
     h = np.empty(n_st)
     for s in range(n_st):
         h[s] = _compose(dep_list, dep_start[k], dep_start[k + 1], fc, tabs, rims, seeds,
-                        rough, gain, octaves, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
+                        rough, gain, 0, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
                         stencil[k, s, 2], st_base[k, s], age_key[k], age_key, diam[k],
                         diam) - fc[k, RHO]
     coef = np.zeros(6)
@@ -196,108 +209,64 @@ def _points_kernel(points, block_of, blk_start, blk_list, base, fc, tabs, rims, 
                           points[i, 2], base[i], -1, age_key, 0.0, diam)
 
 
-# ----------------------------------------------------------------------------- cells
 @njit(cache=True, inline="always")
-def _face_uv(x, y, z):
-    """(face, u, v) of a direction on the gnomonic cube (craters.cells)."""
-    ax = abs(x)
-    ay = abs(y)
-    az = abs(z)
-    if ax >= ay and ax >= az:
-        a, m, p, q = 0, x, y, z
-    elif ay >= az:
-        a, m, p, q = 1, y, z, x
-    else:
-        a, m, p, q = 2, z, x, y
-    am = abs(m)
-    return 2 * a + (0 if m > 0.0 else 1), p / am, q / am
+def _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam, out_owner,
+              out_dep, at, write):
+    """The pairs of owner ``owners[s]`` (:func:`_dep_kernel`), written from ``at`` when
+    ``write``; returns how many."""
+    n = 0
+    o = owners[s]
+    own = fc[o, RAD] / fc[o, RHO] * (1.0 + 1e-9)  # the owner's angular radius, widened
+    chord_own = 2.0 * np.sin(0.5 * own)
+    for t in range(9):
+        cell = own_cell9[s, t]
+        dup = False
+        for t2 in range(t):
+            if own_cell9[s, t2] == cell:
+                dup = True
+        if dup:
+            continue
+        pos = np.searchsorted(cand_cells, cell)
+        if pos >= cand_cells.shape[0] or cand_cells[pos] != cell:
+            continue
+        for q in range(cand_start[pos], cand_start[pos + 1]):
+            k = cand_sorted[q]
+            if not diam[k] > diam[o]:
+                continue
+            # within the ejecta edge's angle plus the owner's: the chords add up to at
+            # least the chord of the sum (a superset: exact at small angles, no cosine)
+            d0 = fc[k, C0] - fc[o, C0]
+            d1 = fc[k, C1] - fc[o, C1]
+            d2 = fc[k, C2] - fc[o, C2]
+            lim = np.sqrt(fc[k, CHORD2]) + chord_own
+            if fc[k, FAR] + own >= np.pi or d0 * d0 + d1 * d1 + d2 * d2 <= lim * lim:
+                if write:
+                    out_owner[at + n] = o
+                    out_dep[at + n] = k
+                n += 1
+    return n
 
 
-@njit(cache=True, inline="always")
-def _cell_id(level, face, u, v):
-    n = 1 << level
-    i = min(max(int(np.floor((u + 1.0) * 0.5 * n)), 0), n - 1)
-    j = min(max(int(np.floor((v + 1.0) * 0.5 * n)), 0), n - 1)
-    return (np.uint64(level) << np.uint64(57)) | (np.uint64(face) << np.uint64(54)) \
-        | (np.uint64(i) << np.uint64(27)) | np.uint64(j)
-
-
-@njit(cache=True)
-def _cells_kernel(points, level, out):
-    """Cell id of each direction at ``level``."""
-    for k in range(points.shape[0]):
-        f, u, v = _face_uv(points[k, 0], points[k, 1], points[k, 2])
-        out[k] = _cell_id(level, f, u, v)
-
-
-@njit(cache=True, inline="always")
-def _face_point(face, u, v):
-    a = face // 2
-    s = 1.0 if face % 2 == 0 else -1.0
-    w = np.empty(3)
-    w[a] = s
-    w[(a + 1) % 3] = u
-    w[(a + 2) % 3] = v
-    return w
-
-
-@njit(cache=True)
-def _neighbourhood_kernel(ids, out):
-    """The 9 cells around each cell (itself and the 8 next to it, across face edges; at a
-    cube corner one of them repeats): ``out`` (n, 9) uint64."""
-    mask = np.uint64((1 << 27) - 1)
-    for k in range(ids.shape[0]):
-        c = ids[k]
-        level = int(c >> np.uint64(57))
-        face = int((c >> np.uint64(54)) & np.uint64(7))
-        i = int((c >> np.uint64(27)) & mask)
-        j = int(c & mask)
-        scale = 2.0 / (1 << level)
-        t = 0
-        for di in (-1, 0, 1):
-            for dj in (-1, 0, 1):
-                u = -1.0 + (i + 0.5 + di) * scale
-                v = -1.0 + (j + 0.5 + dj) * scale
-                w = _face_point(face, u, v)
-                f2, u2, v2 = _face_uv(w[0], w[1], w[2])
-                out[k, t] = _cell_id(level, f2, u2, v2)
-                t += 1
-
-
-@njit(cache=True)
-def _dep_kernel(owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam, out_owner,
-                out_dep):
+@njit(cache=True, parallel=True)
+def _dep_kernel(owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam):
     """Pairs (owner, candidate) where a candidate crater of the bin (``cand_sorted``,
     grouped by cell ``cand_cells`` with ranges ``cand_start``) is larger than the owner
     and its ejecta reach the owner's rim disc (centres within the candidate's widest
-    ejecta edge plus the owner's radius). Returns the number of pairs (writes as many
-    as fit)."""
-    n = 0
-    for s in range(owners.shape[0]):
-        o = owners[s]
-        for t in range(9):
-            cell = own_cell9[s, t]
-            dup = False
-            for t2 in range(t):
-                if own_cell9[s, t2] == cell:
-                    dup = True
-            if dup:
-                continue
-            pos = np.searchsorted(cand_cells, cell)
-            if pos >= cand_cells.shape[0] or cand_cells[pos] != cell:
-                continue
-            for q in range(cand_start[pos], cand_start[pos + 1]):
-                k = cand_sorted[q]
-                if not diam[k] > diam[o]:
-                    continue
-                c = fc[k, C0] * fc[o, C0] + fc[k, C1] * fc[o, C1] + fc[k, C2] * fc[o, C2]
-                lim = fc[k, FAR] + fc[o, RAD] / fc[o, RHO] * (1.0 + 1e-9)
-                if lim >= np.pi or c >= np.cos(lim):
-                    if n < out_owner.shape[0]:
-                        out_owner[n] = o
-                        out_dep[n] = k
-                    n += 1
-    return n
+    ejecta edge plus the owner's radius), owner by owner in the order given: (owners,
+    deps). Owners in parallel, counted first, then written at their offsets."""
+    n_own = owners.shape[0]
+    counts = np.zeros(n_own + 1, dtype=np.int64)
+    none = np.empty(0, dtype=np.int64)
+    for s in prange(n_own):
+        counts[s + 1] = _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted,
+                                  fc, diam, none, none, 0, False)
+    offsets = np.cumsum(counts)
+    out_owner = np.empty(offsets[n_own], dtype=np.int64)
+    out_dep = np.empty(offsets[n_own], dtype=np.int64)
+    for s in prange(n_own):
+        _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam,
+                  out_owner, out_dep, offsets[s], True)
+    return out_owner, out_dep
 
 
 @njit(cache=True)
@@ -326,7 +295,7 @@ def _cap_blocks_kernel(fc, craters, level, occ, cos_margin, out_blk, out_crater)
                 i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
                 j = int(cell & np.uint64((1 << 27) - 1))
                 sc = 2.0 / (1 << lv)
-                w = _face_point(face, -1.0 + (i + 0.5) * sc, -1.0 + (j + 0.5) * sc)
+                w = face_point(face, -1.0 + (i + 0.5) * sc, -1.0 + (j + 0.5) * sc)
                 nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
                 if (w[0] * c[0] + w[1] * c[1] + w[2] * c[2]) / nw >= cos_tot:
                     if n < out_blk.shape[0]:

@@ -51,6 +51,8 @@ class DescentFrame:
     """The rendered :class:`latlong.sensors.render.Frame`."""
     n_craters: int
     """Craters that made the frame's terrain."""
+    n_rocks: int
+    """Rocks drawn for the frame's terrain."""
     terrain: str
     """``window`` or ``body``."""
 
@@ -64,12 +66,12 @@ def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
 
 
 def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius):
-    """(vertices, faces, craters, kind) of a frame's terrain."""
+    """(vertices, faces, (craters, rocks), kind) of a frame's terrain."""
     if size_m <= 0.5 * site_radius:
         size_px = min(MAX_TILE_PX, max(1, int(round(size_m / pixel_m))))
         t = tile_of_field(field, lat_deg, lon_deg, size_px, pixel_m, 3.0)
         verts, faces = tile_mesh(t)
-        return verts, faces, t.n_craters, "window"
+        return verts, faces, (t.n_craters, t.n_rocks), "window"
     if field.base.scene is None:
         raise ParameterError("altitudes_m", f"must keep the frames' ground within a window "
                              f"(footprint x {_MARGIN} <= half the site's radius) over a DEM")
@@ -78,7 +80,8 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
     units = grid.unit_vectors()
     d_min = 3.0 * grid.spacing(field.base.radius_m)
     radii = field.radii(units, d_min)
-    return units * radii[:, None], grid.triangles(), len(field.last["craters"]), "body"
+    counts = len(field.last["craters"]), len(field.rocks.last["diameter_m"])
+    return units * radii[:, None], grid.triangles(), counts, "body"
 
 
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
@@ -114,7 +117,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     for h in alts:
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
-        verts, faces, n_craters, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
+        verts, faces, counts, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
                                                  pixel, site_radius)
         # the altitude is above the terrain at the site as this frame's terrain has it
         ground = up * float(field.radii(u0, 3.0 * pixel)[0])
@@ -123,4 +126,4 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         # the rays it saves on one frame)
         mesh = RayMesh(verts, faces, build_quality="low")
         frame = render(mesh, camera, pose, sun, reflectance=reflectance)
-        yield DescentFrame(float(h), pixel, frame, n_craters, kind)
+        yield DescentFrame(float(h), pixel, frame, *counts, kind)

@@ -12,11 +12,12 @@ in the README, "Terrain on demand"):
 2. **A crater's base** is a quadric fitted (a fixed 61-point stencil over its rim disc:
    the centre and rings of 6, 12, 18 and 24 points at 1/4 .. 1 radius; a fixed
    least-squares operator) to the terrain made by the base shape and the *older, larger*
-   craters at the stencil points. Smaller craters barely move a plane fitted over a
-   larger crater's floor, and leaving them out makes every crater's parameters
-   independent of the requested resolution. The slope of that base against "up" (radial,
-   or a shape model's self-gravity) sets the slope erosion (Martin's lunar paper III), as
-   in the sequential stamp.
+   craters at the stencil points (their profiles without the roughness overlay: zero-mean
+   noise the fit averages out, and half the cost of a fit). Smaller craters barely move
+   a plane fitted over a larger crater's floor, and leaving them out makes every
+   crater's parameters independent of the requested resolution. The slope of that base
+   against "up" (radial, or a shape model's self-gravity) sets the slope erosion
+   (Martin's lunar paper III), as in the sequential stamp.
 3. **Composition.** Each crater acts on the height before it as an affine map: inside its
    (irregular) rim it replaces the terrain by its base quadric plus its profile (so older
    craters there are erased); outside, its profile (ejecta, roughness) adds to the old
@@ -34,7 +35,6 @@ point of a needed crater, until nothing changes. The values do not depend on tha
 from __future__ import annotations
 
 import dataclasses
-import logging
 
 import numpy as np
 import numpy.lib.recfunctions as rfn
@@ -42,8 +42,7 @@ import numpy.lib.recfunctions as rfn
 from craters import CraterLayer
 from craters._shared import ParameterError, check_positive
 from craters.catalog import make_catalog
-from craters.cells import cell_parts, cell_points, cell_solid_angle
-from craters.local import bin_bounds, bin_level, bins, draw_cells, min_cell_angle
+from craters.local import bin_bounds, bin_level, bins, draw_cells
 from craters.morphology import EJECTA_EDGE
 from craters.stamp import (
     resolve_roughness,
@@ -54,19 +53,32 @@ from craters.stamp import (
 from ..scene import Scene
 from . import _field_kernels as K
 from .base import BaseField, base_field, per_scene, tangent_frame
+from .cellsets import (
+    block_level,
+    block_pairs,
+    cell_areas,
+    cells_of,
+    coarser,
+    in_sorted,
+    neighbours,
+    unique_inverse,
+    unique_sorted,
+)
+from .rocks import RockField
 
 __all__ = ["BLEND_EDGE", "IRREGULARITY", "ROUGHNESS_OCTAVES", "CraterField", "crater_field",
            "heights_at_units"]
 
-logger = logging.getLogger(__name__)
 
 #: Radii (x = r / R) out to which the older terrain is blended into a crater's base.
 BLEND_EDGE = 1.5
 #: Largest rim-radius perturbation (the sequential stamp's default).
 IRREGULARITY = 0.02
-#: Octaves of a crater's roughness overlay (radius down to radius / 8): fixed per
-#: crater, so the overlay never depends on the requested resolution.
-ROUGHNESS_OCTAVES = 4
+#: Octaves of a crater's roughness overlay (radius down to radius / 4): fixed per
+#: crater, so the overlay never depends on the requested resolution (the smallest craters
+#: drawn, 3 pixels across, get roughness down to 0.4 pixel; smaller craters carry on
+#: below).
+ROUGHNESS_OCTAVES = 3
 _RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
 _BIN_MARGIN = 1.05
 
@@ -120,9 +132,7 @@ class CraterField:
             if not isinstance(la, CraterLayer):
                 raise ParameterError("craters", "terrain on demand draws power-law crater layers "
                                      f"(c=..,k=..); got a {type(la).__name__}")
-        if scene.boulders.layers:
-            logger.warning("terrain on demand makes no boulders yet: the scene's %d boulder "
-                           "layer(s) are left out", len(scene.boulders.layers))
+        self.rocks = RockField(scene, self.base)
         self.layers: tuple[CraterLayer, ...] = tuple(
             la for la in layers if isinstance(la, CraterLayer))
         self.target = scene.target()
@@ -144,10 +154,7 @@ class CraterField:
     def _draw(self, b: int, cells: np.ndarray, d_min: float) -> _Craters:
         """Craters of bin ``b`` (all layers) in ``cells``, at least ``d_min`` across."""
         level = self.levels[b]
-        lv, face, i, j = cell_parts(cells)
-        centres = cell_points(level, face, i, j, 0.5, 0.5)
-        step = 0.25 * min_cell_angle(level)
-        area = cell_solid_angle(level, face, i, j) * self.base.area_factor(centres, step)
+        area = cell_areas(self.base, level, cells)
         parts = []
         for idx, la in enumerate(self.layers):
             if b not in set(bins(la).tolist()) or bin_bounds(la, b)[1] <= d_min:
@@ -179,6 +186,7 @@ class CraterField:
         far = self.xe * radius * (1.0 + self.irregularity) * (1.0 + 1e-9) / fc[:, K.RHO]
         fc[:, K.COS_FAR] = np.cos(np.minimum(far, np.pi))
         fc[:, K.FAR] = np.minimum(far, np.pi)
+        fc[:, K.CHORD2] = (2.0 * np.sin(0.5 * fc[:, K.FAR])) ** 2
         return _Craters(fc, got["diameter_m"], got["age_gyr"], got["id"], got["cell"],
                         got["rim_phases"], got["seed"], np.full(n, layer, dtype=np.int64))
 
@@ -194,10 +202,11 @@ class CraterField:
         d_have = np.zeros(0)
         # the points' cells at the finest level asked, once: coarser ones by shifts
         at_level: dict[int, np.ndarray] = {}
-        level_now = max(self.levels.values())
-        cells_now = _unique(_cells(units, level_now))
-        for lv in sorted(set(self.levels.values()), reverse=True):
-            cells_now = _coarser(cells_now, level_now, lv)
+        drawn = {lv for b, lv in self.levels.items() if self._bin_top(b) > d_min}
+        level_now = max(drawn, default=0)
+        cells_now = unique_sorted(cells_of(units, level_now))
+        for lv in sorted(drawn, reverse=True):
+            cells_now = coarser(cells_now, level_now, lv)
             level_now = lv
             at_level[lv] = cells_now
         for b in sorted(self.levels):
@@ -205,13 +214,13 @@ class CraterField:
                 continue
             level = self.levels[b]
             # the query rule: every crater of the cells around the points' cells
-            cand_cells = _unique(_neighbours(at_level[level]))
+            cand_cells = unique_sorted(neighbours(at_level[level]))
             q_cells = cand_cells
             # the cells around the centres of the needed smaller craters
-            own_cells9 = _neighbours(_cells(fc_have[:, K.C0:K.C2 + 1], level), keep_shape=True)
-            cand_cells = _unique(np.concatenate([cand_cells, own_cells9.ravel()]))
+            own_cells9 = neighbours(cells_of(fc_have[:, K.C0:K.C2 + 1], level), keep_shape=True)
+            cand_cells = unique_sorted(np.concatenate([cand_cells, own_cells9.ravel()]))
             cand = self._draw(b, cand_cells, d_min)
-            needed_mask = _in_sorted(cand.cell, q_cells)
+            needed_mask = in_sorted(cand.cell, q_cells)
             owners = np.arange(n_have, dtype=np.int64)
             cells9 = own_cells9
             # the query-rule craters are owners within this bin too
@@ -220,15 +229,15 @@ class CraterField:
                 fc_all = np.concatenate([fc_have, cand.fc])
                 d_all = np.concatenate([d_have, cand.diameter_m])
                 owners = np.concatenate([owners, first + n_have])
-                cells9 = np.concatenate([cells9, _neighbours(
-                    _cells(cand.fc[first, K.C0:K.C2 + 1], level), keep_shape=True)])
-                extra = _unique(cells9.ravel())
-                extra = extra[~_in_sorted(extra, cand_cells)]
+                cells9 = np.concatenate([cells9, neighbours(
+                    cells_of(cand.fc[first, K.C0:K.C2 + 1], level), keep_shape=True)])
+                extra = unique_sorted(cells9.ravel())
+                extra = extra[~in_sorted(extra, cand_cells)]
                 if len(extra):  # cells around same-bin owners not drawn yet
                     more = self._draw(b, extra, d_min)
                     cand = _Craters.concat([cand, more])
                     needed_mask = np.concatenate([needed_mask, np.zeros(len(more), bool)])
-                    cand_cells = _unique(np.concatenate([cand_cells, extra]))
+                    cand_cells = unique_sorted(np.concatenate([cand_cells, extra]))
                     fc_all = np.concatenate([fc_have, cand.fc])
                     d_all = np.concatenate([d_have, cand.diameter_m])
                 o, d = _dep_pairs(owners, cells9, cand, n_have, fc_all, d_all)
@@ -306,10 +315,16 @@ class CraterField:
         base = self.base.radius(units)
         cr, owner, dep = self.needed(units, d_min)
         n = len(cr)
+        # blocks of points, and the craters (rocks) that may reach each block
+        level = block_level(len(units), units)
+        occ, block_of = unique_inverse(cells_of(units, level))
+        block_of = block_of.astype(np.int64).ravel()
         if n == 0:
             self.last = {"craters": cr, "fc": cr.fc, "rank": np.zeros(0, np.int64), "n_pairs": 0,
                          "fresh_depth_m": np.zeros(0)}
-            return base
+            out = base.copy()
+            self.rocks.add(units, out, d_min, level, occ, block_of, block_pairs)
+            return out
         fc = cr.fc
         rank = np.empty(n, dtype=np.int64)
         rank[np.lexsort((cr.id, cr.age_gyr))] = np.arange(n)  # 0: the youngest
@@ -323,7 +338,7 @@ class CraterField:
         seeds = np.ascontiguousarray(cr.seed)
         up = np.ascontiguousarray(self.base.up(fc[:, K.C0:K.C2 + 1]))
         # dependencies per owner, youngest first
-        key = _unique(owner * n + dep)
+        key = unique_sorted(owner * n + dep)
         owner, dep = key // n, key % n
         srt = np.lexsort((rank[dep], owner))
         dep_list = np.ascontiguousarray(dep[srt])
@@ -343,29 +358,14 @@ class CraterField:
                          rims,
                          seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
                          rank, diam, up, 20.0, 45.0, True)
-        # blocks of points, and the craters that may reach each block
-        level = _block_level(len(units), units)
-        pcells = _cells(units, level)
-        occ, block_of = _unique_inverse(pcells)
-        margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
         order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
         active = order[fc[order, K.ACTIVE] > 0]
-        cap = max(1024, 16 * len(active))
-        while True:
-            ob = np.empty(cap, dtype=np.int64)
-            oc = np.empty(cap, dtype=np.int64)
-            cnt = K._cap_blocks_kernel(fc, active, level, occ, margin, ob, oc)
-            if cnt <= cap:
-                break
-            cap = cnt
-        ob, oc = ob[:cnt], oc[:cnt]
-        srt = np.lexsort((rank[oc], ob))
-        blk_list = np.ascontiguousarray(oc[srt])
-        blk_start = np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64)
+        blk_start, blk_list = block_pairs(fc, active, level, occ, rank)
         out = np.empty(len(units))
-        K._points_kernel(units, block_of.astype(np.int64).ravel(), blk_start, blk_list, base,
+        K._points_kernel(units, block_of, blk_start, blk_list, base,
                          fc, tabs, rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe,
                          BLEND_EDGE, rank, diam, out)
+        self.rocks.add(units, out, d_min, level, occ, block_of, block_pairs)
         self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key),
                      "fresh_depth_m": prof.fresh_depth_m}
         return out
@@ -382,69 +382,8 @@ def _dep_pairs(owners, cells9, cand: _Craters, n_have: int, fc_all, d_all):
     ucells, starts = srt[first], np.flatnonzero(first)
     starts = np.append(starts, len(order)).astype(np.int64)
     cand_idx = (order + n_have).astype(np.int64)
-    cap = max(1024, 8 * len(owners))
-    while True:
-        o = np.empty(cap, dtype=np.int64)
-        d = np.empty(cap, dtype=np.int64)
-        cnt = K._dep_kernel(owners.astype(np.int64), np.ascontiguousarray(cells9), ucells,
-                            starts, cand_idx, fc_all, d_all, o, d)
-        if cnt <= cap:
-            return o[:cnt], d[:cnt]
-        cap = cnt
-
-
-def _cells(units: np.ndarray, level: int) -> np.ndarray:
-    out = np.empty(len(units), dtype=np.uint64)
-    if len(units):
-        K._cells_kernel(np.ascontiguousarray(units, dtype=np.float64), level, out)
-    return out
-
-
-def _unique(x: np.ndarray) -> np.ndarray:
-    """Sorted distinct values (by sorting: numpy's hashed ``unique`` is some 70 times
-    slower on cell ids, whose low bits repeat)."""
-    a = np.sort(np.asarray(x).ravel())
-    if not len(a):
-        return a
-    return a[np.concatenate([[True], a[1:] != a[:-1]])]
-
-
-def _unique_inverse(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(sorted distinct values, index of each element's value)."""
-    order = np.argsort(x, kind="stable")
-    a = x[order]
-    first = np.concatenate([[True], a[1:] != a[:-1]])
-    inverse = np.empty(len(x), dtype=np.int64)
-    inverse[order] = np.cumsum(first) - 1
-    return a[first], inverse
-
-
-def _in_sorted(x: np.ndarray, sorted_unique: np.ndarray) -> np.ndarray:
-    """Whether each element of ``x`` is in ``sorted_unique``."""
-    if not len(sorted_unique):
-        return np.zeros(len(x), bool)
-    pos = np.minimum(np.searchsorted(sorted_unique, x), len(sorted_unique) - 1)
-    return sorted_unique[pos] == x
-
-
-def _coarser(cells: np.ndarray, level: int, to_level: int) -> np.ndarray:
-    """The distinct cells of ``to_level`` holding cells of ``level`` (>= it): a cell's
-    ``i, j`` at a coarser level are its own shifted right (the cube's cells nest: the
-    scaled coordinates differ by powers of two, exactly)."""
-    shift = np.uint64(level - to_level)
-    mask = np.uint64((1 << 27) - 1)
-    face = (cells >> np.uint64(54)) & np.uint64(7)
-    i = ((cells >> np.uint64(27)) & mask) >> shift
-    j = (cells & mask) >> shift
-    return _unique((np.uint64(to_level) << np.uint64(57)) | (face << np.uint64(54))
-                     | (i << np.uint64(27)) | j)
-
-
-def _neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
-    out = np.empty((len(cells), 9), dtype=np.uint64)
-    if len(cells):
-        K._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
-    return out if keep_shape else out.ravel()
+    return K._dep_kernel(owners.astype(np.int64), np.ascontiguousarray(cells9), ucells, starts,
+                         cand_idx, fc_all, d_all)
 
 
 def _stencil_points(fc: np.ndarray) -> np.ndarray:
@@ -453,18 +392,6 @@ def _stencil_points(fc: np.ndarray) -> np.ndarray:
     if len(fc):
         K._stencil_kernel(np.ascontiguousarray(fc), STENCIL_XY, out)
     return out
-
-
-def _block_level(n: int, units: np.ndarray) -> int:
-    """A level of blocks holding some tens of points each (any level gives the same
-    values: blocks only narrow the craters each point tests)."""
-    if n < 2:
-        return 20
-    m = units.mean(axis=0)
-    norm = float(np.linalg.norm(m))
-    span = np.pi if norm < 0.5 else float(np.arccos(np.clip((units @ (m / norm)).min(), -1, 1)))
-    width = max(2.0 * span / np.sqrt(n / 32.0), 1e-9)
-    return bin_level(width, 24)
 
 
 _CRATER_FIELDS: list = []

@@ -19,7 +19,19 @@ from ..body import Body
 from ..grid import LatLongGrid
 from ..scene import Scene
 
-__all__ = ["build_patches", "patch_ranges"]
+__all__ = ["PATCH_VERTICES", "build_patches", "patch_count", "patch_ranges"]
+
+#: Most vertices in a patch when the number of patches is not given (about 0.5 GB of
+#: working memory a patch).
+PATCH_VERTICES = 1 << 22
+
+
+def patch_count(n_vertices: int, patches: int | None = None) -> int:
+    """``patches`` checked against ``n_vertices``, or by default enough patches of at
+    most :data:`PATCH_VERTICES` vertices."""
+    if patches is None:
+        patches = -(-int(n_vertices) // PATCH_VERTICES)
+    return check_int("patches", patches, 1, max(1, int(n_vertices)))
 
 
 def patch_ranges(n_vertices: int, patches: int) -> list[tuple[int, int]]:
@@ -50,14 +62,15 @@ def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]
     return radii, cat[(vertex >= start) & (vertex < stop)]
 
 
-def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
+def build_patches(scene: Scene, *, patches: int | None = None, backend: str | None = None,
                   scheduler: str | None = None, workers: int | None = None,
                   progress=None, out: np.ndarray | None = None) -> Body:
     """The scene's body on its ``M``-grid as terrain on demand, in ``patches`` patches
-    (module notes); ``backend``, ``scheduler``, ``workers`` as in
-    :func:`latlong.parallel.tiles.map_tiles`; ``progress(done, total)`` is called as
-    patches arrive; ``out``: the radii's array (e.g. a scratch file's map,
-    :func:`latlong.scratch.disk_radii`), one float64 per vertex."""
+    (module notes; default: patches of at most :data:`PATCH_VERTICES`); ``backend``,
+    ``scheduler``, ``workers`` as in :func:`latlong.parallel.tiles.map_tiles`;
+    ``progress(done, total)`` is called as patches arrive; ``out``: the radii's array
+    (e.g. a scratch file's map, :func:`latlong.scratch.disk_radii`), one float64 per
+    vertex."""
     from ..parallel.tiles import map_tiles
     from .field import crater_field
 
@@ -66,7 +79,7 @@ def build_patches(scene: Scene, *, patches: int = 1, backend: str | None = None,
     if not scene.on_demand:
         raise ValueError("`scene` must be an on-demand scene (on_demand=True)")
     grid = LatLongGrid(scene.body.magnitude)
-    patches = check_int("patches", patches, 1, grid.n_vertices)
+    patches = patch_count(grid.n_vertices, patches)
     items = patch_ranges(grid.n_vertices, patches)
     radii = np.empty(grid.n_vertices) if out is None else out
     if radii.shape != (grid.n_vertices,) or radii.dtype != np.float64:

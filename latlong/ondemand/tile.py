@@ -44,6 +44,8 @@ class Tile:
     """The smallest crater diameter drawn (m)."""
     n_craters: int = 0
     """Craters that make the window (with those around it that shape their bases)."""
+    n_rocks: int = 0
+    """Rocks drawn around the window (:mod:`.rocks`)."""
 
     @property
     def crs_proj4(self) -> str:
@@ -112,7 +114,8 @@ def tile_of_field(field: CraterField, lat_deg: float, lon_deg: float, size_px: i
     d_min = min_crater_px * pixel_m
     r = field.radii(units, d_min)
     return Tile((r - radius).reshape(size_px, size_px), float(lat_deg), float(lon_deg),
-                pixel_m, radius, d_min, len(field.last["craters"]))
+                pixel_m, radius, d_min, len(field.last["craters"]),
+                len(field.rocks.last["diameter_m"]))
 
 
 def tile_mesh(t: Tile) -> tuple[np.ndarray, np.ndarray]:

@@ -6,7 +6,8 @@ law craters N_cum = 0.08 D^-2 per m^2 (about the lunar equilibrium density: Gaul
 Radio Sci. 5, 273, finds N_cum ~ 10^-1.1 D^-2 for steady-state small craters) from 2 cm
 to 20 km, their ages capped by size so that each size is seen at about its equilibrium
 density (0-3.5 Gyr >= 100 m, 0-1 Gyr 10-100 m, 0-0.1 Gyr 1-10 m, 0-0.01 Gyr < 1 m; the
-diffusion of the craters' profiles erases the older ones of each size).
+diffusion of the craters' profiles erases the older ones of each size), and rocks of 5 mm
+to 5 m (N_cum = 7e-4 D^-2.11 per m^2, examples/moon_site.toml).
 
 1. Tiles: a 1024^2 window (``latlong.ondemand.tile.tile``) at 100 m, 10 m, 1 m, 10 cm and
    1 cm pixels, the second of two runs (warm), seconds and nanoseconds per pixel, and the
@@ -42,6 +43,7 @@ LAYERS = ["c=0.08,k=-2,d_min_m=100,d_max_m=20000,age_max_gyr=3.5",
           "c=0.08,k=-2,d_min_m=10,d_max_m=100,age_max_gyr=1",
           "c=0.08,k=-2,d_min_m=1,d_max_m=10,age_max_gyr=0.1",
           "c=0.08,k=-2,d_min_m=0.02,d_max_m=1,age_max_gyr=0.01"]
+ROCKS = ["c=7e-4,k=-2.11,d_min_m=0.005,d_max_m=5,burial_max=0.5"]
 SITE = [0.0, 0.0]
 SUN_ELEVATION_DEG = [25.0]
 
@@ -50,7 +52,8 @@ def scene():
     from latlong import Scene
 
     return Scene.from_settings({"base": "sphere", "radius_m": 1737400.0, "body": "moon",
-                                "seed": 1, "on_demand": True, "craters": LAYERS})
+                                "seed": 1, "on_demand": True, "craters": LAYERS,
+                                "boulders": ROCKS})
 
 
 def tiles(sc) -> list[dict]:

@@ -1,0 +1,57 @@
+"""Numba kernels of rocks on demand (:mod:`latlong.ondemand.rocks`). A point's value is
+computed by one thread from its own data, a maximum over the rocks that reach it (no
+order, no sums): the same whatever other points are asked with it. Reference in numpy:
+``tests/latlong/test_ondemand_rocks.py``."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from ._field_kernels import _far, _local
+
+# rock record columns after the crater record's first twelve (centre, east, north, RHO,
+# RAD = the footprint's largest radius, COS_FAR = cos of its angle)
+CA, SA = 12, 13      # cos, sin of the long axis' azimuth (from east)
+A, B = 14, 15        # footprint semi-axes (m)
+CZ = 16              # half the rock's height (m)
+Z0 = 17              # height of the ellipsoid's centre above the ground (m)
+F0 = 18              # facets: (cos phi, sin phi, offset, slope) each
+N_FACETS = 6
+CHORD2 = F0 + 4 * N_FACETS   # squared chord of the footprint's angle
+N_ROCK_COLS = CHORD2 + 1
+
+
+@njit(cache=True, inline="always")
+def _rock_height(rc, k, p0, p1, p2):
+    """Height (m) of rock k above the ground at direction p: the ellipsoid of half-height
+    CZ centred Z0 above the ground, cut by its facet planes; 0 outside."""
+    if _far(rc, k, CHORD2, p0, p1, p2):
+        return 0.0
+    _, _, x, y, _ = _local(rc, k, p0, p1, p2)
+    xi = (x * rc[k, CA] + y * rc[k, SA]) / rc[k, A]
+    eta = (y * rc[k, CA] - x * rc[k, SA]) / rc[k, B]
+    q2 = xi * xi + eta * eta
+    if not q2 < 1.0:
+        return 0.0
+    f = np.sqrt(1.0 - q2)
+    for m in range(N_FACETS):
+        c = F0 + 4 * m
+        g = rc[k, c + 2] - rc[k, c + 3] * (xi * rc[k, c] + eta * rc[k, c + 1])
+        if g < f:
+            f = g
+    z = rc[k, Z0] + rc[k, CZ] * f
+    return z if z > 0.0 else 0.0
+
+
+@njit(cache=True, parallel=True)
+def _rocks_kernel(points, block_of, blk_start, blk_list, rc, out):
+    """Adds to each point the tallest rock over it (of its block's rocks)."""
+    for i in prange(points.shape[0]):
+        blk = block_of[i]
+        top = 0.0
+        for t in range(blk_start[blk], blk_start[blk + 1]):
+            h = _rock_height(rc, blk_list[t], points[i, 0], points[i, 1], points[i, 2])
+            if h > top:
+                top = h
+        out[i] += top

@@ -1,0 +1,115 @@
+"""Sets of cube-sphere cells for terrain on demand: the cells of points, their
+neighbourhoods, sorted distinct ids, and blocks of points with the records (craters,
+rocks) that may reach each block. Shared by :mod:`.field` and :mod:`.rocks`."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from craters.cells import cell_parts, cell_points, cell_solid_angle
+from craters.local import bin_level, min_cell_angle
+
+from . import _cell_kernels as C
+from . import _field_kernels as K
+
+__all__ = ["block_level", "block_pairs", "cell_areas", "cells_of", "coarser", "in_sorted",
+           "neighbours", "unique_inverse", "unique_sorted"]
+
+
+def cells_of(units: np.ndarray, level: int) -> np.ndarray:
+    """Cell id (uint64) at ``level`` of each direction ``units`` (n, 3)."""
+    out = np.empty(len(units), dtype=np.uint64)
+    if len(units):
+        C._cells_kernel(np.ascontiguousarray(units, dtype=np.float64), level, out)
+    return out
+
+
+def unique_sorted(x: np.ndarray) -> np.ndarray:
+    """Sorted distinct values (by sorting: numpy's hashed ``unique`` is some 70 times
+    slower on cell ids, whose low bits repeat)."""
+    a = np.sort(np.asarray(x).ravel())
+    if not len(a):
+        return a
+    return a[np.concatenate([[True], a[1:] != a[:-1]])]
+
+
+def unique_inverse(x: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(sorted distinct values, index of each element's value)."""
+    order = np.argsort(x, kind="stable")
+    a = x[order]
+    first = np.concatenate([[True], a[1:] != a[:-1]])
+    inverse = np.empty(len(x), dtype=np.int64)
+    inverse[order] = np.cumsum(first) - 1
+    return a[first], inverse
+
+
+def in_sorted(x: np.ndarray, sorted_unique: np.ndarray) -> np.ndarray:
+    """Whether each element of ``x`` is in ``sorted_unique``."""
+    if not len(sorted_unique):
+        return np.zeros(len(x), bool)
+    pos = np.minimum(np.searchsorted(sorted_unique, x), len(sorted_unique) - 1)
+    return sorted_unique[pos] == x
+
+
+def coarser(cells: np.ndarray, level: int, to_level: int) -> np.ndarray:
+    """The distinct cells of ``to_level`` holding cells of ``level`` (>= it): a cell's
+    ``i, j`` at a coarser level are its own shifted right (the cube's cells nest: the
+    scaled coordinates differ by powers of two, exactly)."""
+    shift = np.uint64(level - to_level)
+    mask = np.uint64((1 << 27) - 1)
+    face = (cells >> np.uint64(54)) & np.uint64(7)
+    i = ((cells >> np.uint64(27)) & mask) >> shift
+    j = (cells & mask) >> shift
+    return unique_sorted((np.uint64(to_level) << np.uint64(57)) | (face << np.uint64(54))
+                     | (i << np.uint64(27)) | j)
+
+
+def neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
+    """The 9 cells around each cell (itself included), (n, 9) or flat."""
+    out = np.empty((len(cells), 9), dtype=np.uint64)
+    if len(cells):
+        C._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
+    return out if keep_shape else out.ravel()
+
+
+def block_level(n: int, units: np.ndarray) -> int:
+    """A level of blocks holding some tens of points each (any level gives the same
+    values: blocks only narrow the craters each point tests)."""
+    if n < 2:
+        return 20
+    m = units.mean(axis=0)
+    norm = float(np.linalg.norm(m))
+    span = np.pi if norm < 0.5 else float(np.arccos(np.clip((units @ (m / norm)).min(), -1, 1)))
+    width = max(2.0 * span / np.sqrt(n / 32.0), 1e-9)
+    return bin_level(width, 24)
+
+
+def block_pairs(records: np.ndarray, active: np.ndarray, level: int, occ: np.ndarray,
+                rank: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(start, list): for each occupied block (sorted cell ids ``occ`` at ``level``) the
+    ``active`` records (rows of ``records``: centre, east, north, reference radius, radius,
+    cos of the reach; :mod:`._field_kernels`) that may reach it, ordered by ``rank``;
+    block ``b``'s are ``list[start[b]:start[b + 1]]``."""
+    margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
+    cap = max(1024, 16 * len(active))
+    while True:
+        ob = np.empty(cap, dtype=np.int64)
+        oc = np.empty(cap, dtype=np.int64)
+        cnt = K._cap_blocks_kernel(records, active, level, occ, margin, ob, oc)
+        if cnt <= cap:
+            break
+        cap = cnt
+    ob, oc = ob[:cnt], oc[:cnt]
+    srt = np.lexsort((rank[oc], ob))
+    return (np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64),
+            np.ascontiguousarray(oc[srt]))
+
+
+def cell_areas(base, level: int, cells: np.ndarray) -> np.ndarray:
+    """Area (m^2) of each cell of ``level`` on the surface of ``base``
+    (:class:`.base.BaseField`): its solid angle times the area per steradian at its
+    centre."""
+    _, face, i, j = cell_parts(cells)
+    centres = cell_points(level, face, i, j, 0.5, 0.5)
+    step = 0.25 * min_cell_angle(level)
+    return cell_solid_angle(level, face, i, j) * base.area_factor(centres, step)
