@@ -26,6 +26,7 @@ from .export import EXPORT_SUFFIXES, body_mesh_source, export_body
 from .geometry.meshes import polydata
 from .geometry.normals import lat_long_vertex_normals, tangent_frames, unit_rows, vertex_normals
 from .grid import LatLongGrid
+from .scratch import drop_pages
 
 __all__ = ["Body", "EXPORT_SUFFIXES", "load"]
 
@@ -344,11 +345,13 @@ _CHECK_CHUNK = 1 << 20  # vertices per block of the checks below (bounded tempor
 def _check_radii(radii: np.ndarray) -> None:
     """Finite and > 0 everywhere, checked block by block (no whole-grid temporaries)."""
     n = radii.shape[0]
+    bad = 0
     for s in range(0, n, _CHECK_CHUNK):
-        if not np.isfinite(radii[s:s + _CHECK_CHUNK]).all():
+        block = radii[s:s + _CHECK_CHUNK]
+        if not np.isfinite(block).all():
             raise ParameterError("radii_m", "must be finite")
-    bad = sum(int(np.count_nonzero(radii[s:s + _CHECK_CHUNK] <= 0))
-              for s in range(0, n, _CHECK_CHUNK))
+        bad += int(np.count_nonzero(block <= 0))
+        drop_pages(radii, s, s + len(block))  # radii on disk: what was read leaves memory
     if bad:
         raise ParameterError(
             "radii_m", f"must be > 0 everywhere; {bad} vertices have radius <= 0 "

@@ -17,6 +17,7 @@ from craters._shared import human_bytes, progress_bar
 from craters.cli.kit import CliError
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
+from latlong.scratch import drop_pages
 
 from ..outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
 from ..scene import SETTING_PARTS, SETTINGS
@@ -91,6 +92,7 @@ def _distance_range(body) -> tuple[float, float]:
         e = min(s + (1 << 20), body.n_vertices)
         d = body.radii_m[s:e] if plain else np.linalg.norm(body.vertices(s, e), axis=1)
         lo, hi = min(lo, float(d.min())), max(hi, float(d.max()))
+        drop_pages(body.radii_m, s, e)
     return lo, hi
 
 

@@ -40,3 +40,22 @@ def _neighbourhood_kernel(ids, out):
                 f2, u2, v2 = face_uv(w0, w1, w2)
                 out[k, t] = cell_id(level, f2, u2, v2)
                 t += 1
+
+
+@njit(cache=True, parallel=True)
+def _window_kernel(c, e, n, coords, out):
+    """Unit directions of the pixel centres of a gnomonic window: ``c + x e + y n``
+    normalised, x = coords[col], y = -coords[row] (numpy's order of operations, for the
+    same bits: :func:`latlong.ondemand.tile.tile_units`)."""
+    size = coords.shape[0]
+    for r in prange(size):
+        y = -coords[r]
+        for q in range(size):
+            x = coords[q]
+            v0 = c[0] + x * e[0] + y * n[0]
+            v1 = c[1] + x * e[1] + y * n[1]
+            v2 = c[2] + x * e[2] + y * n[2]
+            norm = np.sqrt(v0 * v0 + v1 * v1 + v2 * v2)
+            out[r, q, 0] = v0 / norm
+            out[r, q, 1] = v1 / norm
+            out[r, q, 2] = v2 / norm

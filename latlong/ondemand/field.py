@@ -81,6 +81,9 @@ IRREGULARITY = 0.02
 ROUGHNESS_OCTAVES = 3
 _RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
 _BIN_MARGIN = 1.05
+#: Most craters whose parameters (base quadric, slope erosion) a field keeps between
+#: calls (a descent's frames and a build's patches share most of their larger craters).
+PARAMS_CACHE = 500_000
 
 
 def _stencil_xy() -> np.ndarray:
@@ -133,6 +136,7 @@ class CraterField:
                 raise ParameterError("craters", "terrain on demand draws power-law crater layers "
                                      f"(c=..,k=..); got a {type(la).__name__}")
         self.rocks = RockField(scene, self.base)
+        self._params: dict[tuple[int, int], np.ndarray] = {}
         self.layers: tuple[CraterLayer, ...] = tuple(
             la for la in layers if isinstance(la, CraterLayer))
         self.target = scene.target()
@@ -343,21 +347,36 @@ class CraterField:
         srt = np.lexsort((rank[dep], owner))
         dep_list = np.ascontiguousarray(dep[srt])
         dep_start = np.searchsorted(owner[srt], np.arange(n + 1)).astype(np.int64)
-        stencil = _stencil_points(fc)
-        st_base = self.base.radius(stencil.reshape(-1, 3)).reshape(n, -1)
+        # craters whose parameters an earlier call computed (a crater's parameters are a
+        # function of the crater alone: the same bits whenever they are computed)
+        keys = list(zip(cr.cell.tolist(), cr.id.tolist(), strict=True))
+        known = np.array([k in self._params for k in keys], dtype=bool)
+        if known.any():
+            fc[known, K.P0:K.ACTIVE + 1] = np.array(
+                [self._params[k] for k, h in zip(keys, known, strict=True) if h])
+            fc[known, K.DEPTH] = prof.depth_m[known]
+        new = np.flatnonzero(~known)
+        stencil = np.zeros((n, len(STENCIL_XY), 3))
+        st_base = np.zeros((n, len(STENCIL_XY)))
+        if len(new):
+            stencil[new] = _stencil_points(fc[new])
+            st_base[new] = self.base.radius(stencil[new].reshape(-1, 3)).reshape(len(new), -1)
         todo = np.lexsort((cr.id, -cr.diameter_m)).astype(np.int64)
         diam = np.ascontiguousarray(cr.diameter_m)
         rough = self.rough
-        sc = self.scene.craters
-        del sc
         gen = np.zeros(n, dtype=np.int64)
         K._generations_kernel(todo, dep_start, dep_list, gen)
         todo = todo[np.argsort(gen[todo], kind="stable")]
+        todo = todo[~known[todo]]
         gen_start = np.searchsorted(gen[todo], np.arange(gen.max() + 2)).astype(np.int64)
         K._params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, FIT, fc, tabs,
                          rims,
                          seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
                          rank, diam, up, 20.0, 45.0, True)
+        if len(self._params) + len(new) > PARAMS_CACHE:
+            self._params.clear()
+        rows = fc[new, K.P0:K.ACTIVE + 1]
+        self._params.update(zip([keys[i] for i in new], rows, strict=True))
         order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
         active = order[fc[order, K.ACTIVE] > 0]
         blk_start, blk_list = block_pairs(fc, active, level, occ, rank)

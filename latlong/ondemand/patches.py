@@ -18,6 +18,7 @@ from craters._shared import check_int
 from ..body import Body
 from ..grid import LatLongGrid
 from ..scene import Scene
+from ..scratch import drop_pages
 
 __all__ = ["PATCH_VERTICES", "build_patches", "patch_count", "patch_ranges"]
 
@@ -89,6 +90,7 @@ def build_patches(scene: Scene, *, patches: int | None = None, backend: str | No
                                                    scheduler=scheduler, workers=workers)):
         start, stop = items[i]
         radii[start:stop] = r
+        drop_pages(radii, start, stop)  # radii on disk: the patch leaves memory now
         cats[i] = cat
         if progress is not None:
             progress(done + 1, len(items))

@@ -11,6 +11,7 @@ lines and is exact at the centre; across a window of a few degrees its scale gro
 from __future__ import annotations
 
 import dataclasses
+import functools
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,7 @@ import numpy as np
 from craters._shared import ParameterError, atomic_path, check_positive, check_range
 
 from ..scene import Scene
-from . import units_of
+from . import _cell_kernels, units_of
 from .base import tangent_frame
 from .field import CraterField, crater_field
 
@@ -67,10 +68,9 @@ def tile_units(lat_deg: float, lon_deg: float, size_px: int, pixel_m: float,
     c = units_of([lat_deg], [lon_deg])
     e, n = tangent_frame(c)
     coords = (np.arange(size_px) + 0.5 - 0.5 * size_px) * pixel_m / radius_m
-    x = coords[None, :]
-    y = -coords[:, None]
-    v = c[0] + x[..., None] * e[0] + y[..., None] * n[0]
-    return v / np.sqrt((v * v).sum(axis=-1, keepdims=True))
+    out = np.empty((size_px, size_px, 3))
+    _cell_kernels._window_kernel(c[0], e[0], n[0], coords, out)
+    return out
 
 
 def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m: float,
@@ -125,11 +125,18 @@ def tile_mesh(t: Tile) -> tuple[np.ndarray, np.ndarray]:
     ny, nx = t.heights_m.shape
     units = tile_units(t.lat_deg, t.lon_deg, nx, t.pixel_m, t.radius_m).reshape(-1, 3)
     verts = units * (t.radius_m + t.heights_m.reshape(-1, 1))
+    return verts, _grid_faces(ny, nx)
+
+
+@functools.lru_cache(maxsize=2)
+def _grid_faces(ny: int, nx: int) -> np.ndarray:
+    """The triangles of an ny x nx pixel grid (read-only: a descent's frames share them)."""
     idx = np.arange(ny * nx).reshape(ny, nx)
     a, b = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()   # north row: west, east
     c, d = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()     # south row
     faces = np.concatenate([np.stack([a, c, b], 1), np.stack([b, c, d], 1)])
-    return verts, faces
+    faces.flags.writeable = False
+    return faces
 
 
 def hillshade(heights_m: np.ndarray, pixel_m: float, *, azimuth_deg: float = 270.0,

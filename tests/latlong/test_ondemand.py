@@ -261,3 +261,28 @@ def test_a_centimetre_crater_on_the_moon_reaches_its_whole_ejecta_blanket():
     with_k = field.radii(pts, 0.999 * cr.diameter_m[k])
     without = field.radii(pts, 1.001 * cr.diameter_m[k])
     assert (with_k != without).all()
+
+
+def test_parameters_kept_between_calls_give_the_same_bytes(scene):
+    from latlong.ondemand.field import CraterField
+
+    units = units_of(*np.meshgrid(np.linspace(-10, -4, 50), np.linspace(70, 76, 50)))
+    warm = CraterField(scene)
+    warm.radii(LatLongGrid(40).unit_vectors(), 4.0)  # parameters of every crater kept
+    kept = len(warm._params)
+    again = warm.radii(units, 4.0)
+    assert kept > 100 and len(warm._params) == kept  # nothing new computed
+    assert again.tobytes() == CraterField(scene).radii(units, 4.0).tobytes()
+
+
+def test_window_directions_match_numpy():
+    from latlong.ondemand.base import tangent_frame
+    from latlong.ondemand.tile import tile_units
+
+    got = tile_units(12.5, -40.0, 37, 3.0, 1000.0)
+    c = units_of([12.5], [-40.0])
+    e, n = tangent_frame(c)
+    coords = (np.arange(37) + 0.5 - 0.5 * 37) * 3.0 / 1000.0
+    v = c[0] + coords[None, :, None] * e[0] + (-coords[:, None])[..., None] * n[0]
+    want = v / np.sqrt((v * v).sum(axis=-1, keepdims=True))
+    assert got.tobytes() == want.tobytes()

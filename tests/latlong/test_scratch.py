@@ -149,3 +149,16 @@ def test_cli_builds_on_disk_with_the_same_bytes(run_cli, tmp_path, one_line_erro
     proc = run_cli(*common, "--radii-on-disk", "maybe", "-o", str(tmp_path / "c.ply"))
     one_line_error(proc, "--radii-on-disk", "auto", "yes", "no")
     assert not (tmp_path / "c.ply").exists()
+
+
+def test_dropping_pages_keeps_the_values():
+    from latlong.scratch import disk_radii, drop_pages
+
+    a = disk_radii(300_000, trim_interval_s=3600.0)
+    a[:] = np.arange(300_000) * 0.5
+    drop_pages(a, 1000, 250_000)  # pages leave memory, the file keeps the data
+    drop_pages(a, 5, 5)  # an empty range: nothing
+    assert np.array_equal(a, np.arange(300_000) * 0.5)
+    b = np.ones(10)
+    drop_pages(b, 0, 10)  # not on disk: untouched
+    assert (b == 1).all()
