@@ -1,7 +1,8 @@
 """The ``dem`` command line, one module a command: ``dem info``, ``convert``, ``fill``,
 ``expand``, ``enhance``, ``mesh``, ``batch``, ``slopes`` and ``spectrum``; ``camera`` and
 ``lidar`` (:mod:`.sensors`: latlong's sensor commands over a site); ``tile`` (a window of
-a DEM with craters made on demand, :mod:`dem.ondemand`).
+a DEM with craters and rocks made on demand, :mod:`dem.ondemand`) and ``descent`` (camera
+frames of a descent over a DEM site, terrain made on demand per frame).
 
 Every command takes its input (a DEM, or for ``mesh``, ``slopes`` and ``spectrum`` also
 a stack manifest) as its positional argument, or as the key ``input`` of a TOML file
@@ -22,7 +23,20 @@ import sys
 from craters.cli.kit import run_cli
 from craters.cli.options import main_parser
 
-from . import batch, convert, enhance, expand, fill, info, mesh, sensors, slopes, spectrum, tile
+from . import (
+    batch,
+    convert,
+    descent,
+    enhance,
+    expand,
+    fill,
+    info,
+    mesh,
+    sensors,
+    slopes,
+    spectrum,
+    tile,
+)
 
 __all__ = ["build_parser", "main"]
 
@@ -32,7 +46,7 @@ def build_parser():
     parser, sub = main_parser("dem", "DEMs: gap filling, RMD expansion, layer stacks with "
                               "craters, meshes, info.")
     for command in (info, convert, fill, expand, enhance, mesh, batch, slopes, spectrum,
-                    sensors, tile):
+                    sensors, tile, descent):
         command.register(sub)
     return parser
 

@@ -12,7 +12,19 @@ from craters.cli.options import Setting, Values
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
-__all__ = ["register"]
+__all__ = ["LAYERS", "register", "scene_of"]
+
+#: The layers made on demand over a DEM: craters, rocks, their seed.
+LAYERS = {
+    "craters": Setting(help="crater layer c=0.08,k=-2,d_min_m=1,d_max_m=1000[,age_min_gyr,"
+                       "age_max_gyr,degradation,kind] (N_cum = c D^k per m^2, D in metres; "
+                       "repeatable)", many="append", metavar="SPEC", run=True),
+    "boulders": Setting(help="rock layer c=7e-4,k=-2.11,d_min_m=0.05,d_max_m=5[,burial_max] "
+                        "(N_cum = c D^k per m^2; faceted rocks in the height field; "
+                        "repeatable)", many="append", metavar="SPEC", run=True),
+    "seed": Setting(help="random seed of the craters and rocks (non-negative integer)",
+                    kind=int, range=(0, 2**63 - 1), run=True, default_text="a fresh one"),
+}
 
 OPTIONS = {
     "input": INPUT, **READ,
@@ -26,11 +38,7 @@ OPTIONS = {
                        run=True),
     "min_crater_px": Setting(3.0, "smallest crater drawn, in pixels across", range=(1.0, 1000.0),
                              run=True),
-    "craters": Setting(help="crater layer c=0.08,k=-2,d_min_m=1,d_max_m=1000[,age_min_gyr,"
-                       "age_max_gyr,degradation,kind] (N_cum = c D^k per m^2, D in metres; "
-                       "repeatable)", many="append", metavar="SPEC", run=True),
-    "seed": Setting(help="random seed of the craters (non-negative integer)", kind=int,
-                    range=(0, 2**63 - 1), run=True, default_text="a fresh one"),
+    **LAYERS,
     "output": Setting(help="heights as a cloud-optimised GeoTIFF (.tif)", flag="-o/--output",
                       run=True),
     "mesh": Setting(help="the window as a mesh in the body's frame (.ply .obj .stl .vtp .vtk "
@@ -40,16 +48,30 @@ OPTIONS = {
 }
 
 
+def scene_of(dem, v: Values):
+    """The on-demand scene of a DEM command: a sphere of the DEM's body radius with the
+    options' crater and rock layers and seed."""
+    from latlong import Scene
+
+    if not v["craters"] and not v["boulders"]:
+        raise CliError("give at least one --craters or --boulders layer (the DEM holds the "
+                       "rest)")
+    radius = dem.body_radius_m
+    if radius is None:
+        raise CliError("the DEM's body radius is unknown: give --body-radius-m")
+    return Scene.from_settings({"base": "sphere", "radius_m": radius,
+                                "body": v.get("body") or "moon", "seed": v["seed"],
+                                "craters": v["craters"] or [], "boulders": v["boulders"] or [],
+                                "on_demand": True})
+
+
 def _tile(v: Values) -> int:
     from craters._shared import check_output_path
-    from latlong import Scene
     from latlong.meshio.writers import MESH_SUFFIXES
     from latlong.ondemand.tile import write_tile
 
     from ..ondemand import dem_tile
 
-    if not v["craters"]:
-        raise CliError("give at least one --craters layer (the DEM holds the rest)")
     outs = {}
     for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
                           ("picture", (".png",))):
@@ -61,19 +83,15 @@ def _tile(v: Values) -> int:
     if not outs:
         raise CliError("nothing to write: give -o/--output, --mesh or --picture")
     dem = read_input(v)
-    body = v.get("body") or "moon"
-    radius = dem.body_radius_m
-    if radius is None:
-        raise CliError("the DEM's body radius is unknown: give --body-radius-m")
-    scene = Scene.from_settings({"base": "sphere", "radius_m": radius, "body": body,
-                                 "seed": v["seed"], "craters": v["craters"], "on_demand": True})
+    scene = scene_of(dem, v)
     made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],
                     pixel_m=v["pixel_m"], min_crater_px=v["min_crater_px"])
     write_tile(made, cog=outs.get("output"), mesh=outs.get("mesh"), picture=outs.get("picture"))
     if not v["quiet"]:
         ny, nx = made.heights_m.shape
         print(f"dem tile: {nx} x {ny} pixels of {made.pixel_m:g} m at ({made.lat_deg:g}, "
-              f"{made.lon_deg:g}) deg, {made.n_craters} craters >= {made.min_crater_m:.3g} m, "
+              f"{made.lon_deg:g}) deg, {made.n_craters} craters and {made.n_rocks} rocks >= "
+              f"{made.min_crater_m:.3g} m, "
               f"seed {scene.seed}", file=sys.stderr)
         for path in outs.values():
             print(f"wrote {path}")

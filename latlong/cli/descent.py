@@ -9,15 +9,14 @@ from __future__ import annotations
 
 import sys
 
-import numpy as np
-
 from craters.cli.kit import CliError
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 
 from ..scene import SETTING_PARTS, SETTINGS, Scene
 from .build import GROUPS
 
-__all__ = ["OPTIONS", "register"]
+__all__ = ["DESCENT", "OPTIONS", "camera_options", "check_descent_folder", "register",
+           "write_descent_run"]
 
 DESCENT = {
     "lat_deg": Setting(help="latitude of the landing site", unit="deg", range=(-90.0, 90.0),
@@ -46,69 +45,50 @@ OPTIONS = {k: s for k, s in declared_keys(
 _GROUPS = {"descent": "descent and outputs", **GROUPS}
 
 
-def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
-    """An 8-bit picture of an I/F image: ``scale`` to white, gamma 1/2.2."""
-    return (255.0 * np.clip(reflectance / scale, 0.0, 1.0) ** (1.0 / 2.2) + 0.5).astype(np.uint8)
-
-
 def _descent(v: Values) -> int:
-    from craters._shared import atomic_path
-    from latlong.sensors.camera_files import write_frame, write_manifest
-    from latlong.sensors.runs import check_output_folder, run_folder
-
     from ..ondemand.descent import descent, descent_altitudes
 
     if v["stop_m"] > v["start_m"]:
         raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
-    try:
-        out = check_output_folder(v["output"], force=v["force"])
-    except ValueError as exc:
-        raise CliError(f"-o/--output: {exc}") from None
+    out = check_descent_folder(v)
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
-    from PIL import Image
+    frames = descent(scene, v["lat_deg"], v["lon_deg"], alts, **camera_options(v))
+    return write_descent_run(frames, out, v, seed=scene.seed)
 
-    entries, pictures = [], []
-    with run_folder(out, "frames.json") as tmp:
-        for i, f in enumerate(descent(scene, v["lat_deg"], v["lon_deg"], alts,
-                                      fov_deg=v["fov_deg"], width_px=v["size_px"],
-                                      sun_azimuth_deg=v["sun_azimuth_deg"],
-                                      sun_elevation_deg=v["sun_elevation_deg"])):
-            files = write_frame(tmp, i, f.frame)
-            r = f.frame.reflectance
-            # each picture exposed on its own lit pixels (the 99.5th percentile to white),
-            # as a descent camera's auto-exposure would
-            lit = r[r > 0]
-            scale = float(np.percentile(lit, 99.5)) if len(lit) else 1.0
-            pic = display(r, scale)
-            files["picture"] = f"picture_{i:04d}.png"
-            with atomic_path(tmp / files["picture"]) as p:
-                Image.fromarray(pic).save(p, format="PNG")
-            pictures.append(pic)
-            entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
-                            "picture_white_if": scale,
-                            "terrain": f.terrain, "craters": f.n_craters, "rocks": f.n_rocks,
-                            "position_m": [float(x) for x in f.frame.pose.position_m],
-                            "quaternion_wxyz": [float(x) for x in
-                                                f.frame.pose.quaternion_wxyz],
-                            "sun_direction": [float(x) for x in f.frame.sun.direction],
-                            "files": files})
-            if not v["quiet"]:
-                print(f"frame {i}: altitude {f.altitude_m:.4g} m, ground pixel "
-                      f"{f.ground_pixel_m:.3g} m, {f.n_craters} craters, {f.n_rocks} rocks "
-                      f"({f.terrain})",
-                      file=sys.stderr)
-        gap = np.zeros((pictures[0].shape[0], 4), np.uint8)
-        strip = np.concatenate([x for p in pictures for x in (p, gap)][:-1], axis=1)
-        with atomic_path(tmp / "strip.png") as p:
-            Image.fromarray(strip).save(p, format="PNG")
-        cam = f.frame.camera
-        write_manifest(tmp, {"intrinsics": cam.intrinsics(), "seed": scene.seed,
-                             "site_lat_lon_deg": [v["lat_deg"], v["lon_deg"]],
-                             "frames": entries})
+
+def check_descent_folder(v: Values):
+    """The checked output folder of a descent command (``-o``, ``--force``)."""
+    from latlong.sensors.runs import check_output_folder
+
+    try:
+        return check_output_folder(v["output"], force=v["force"])
+    except ValueError as exc:
+        raise CliError(f"-o/--output: {exc}") from None
+
+
+def camera_options(v: Values) -> dict:
+    """The camera keywords of :func:`latlong.ondemand.descent.descent` from the options."""
+    return {"fov_deg": v["fov_deg"], "width_px": v["size_px"],
+            "sun_azimuth_deg": v["sun_azimuth_deg"], "sun_elevation_deg": v["sun_elevation_deg"]}
+
+
+def write_descent_run(frames, out, v: Values, *, seed) -> int:
+    """Write a descent's frames (:func:`latlong.ondemand.descent.write_descent`) with the
+    command's progress lines; exit status 0."""
+    from ..ondemand.descent import write_descent
+
+    def report(i, f):
+        if not v["quiet"]:
+            print(f"frame {i}: altitude {f.altitude_m:.4g} m, ground pixel "
+                  f"{f.ground_pixel_m:.3g} m, {f.n_craters} craters, {f.n_rocks} rocks "
+                  f"({f.terrain})", file=sys.stderr)
+
+    n = write_descent(frames, out, seed=seed, site_lat_lon_deg=(v["lat_deg"], v["lon_deg"]),
+                      report=report)
     if not v["quiet"]:
-        print(f"wrote {len(entries)} frames, {out / 'strip.png'}, {out / 'frames.json'}")
+        print(f"wrote {n} frames, {out / 'strip.png'}, {out / 'frames.json'}")
     return 0
 
 

@@ -33,7 +33,7 @@ from .tile import MAX_TILE_PX, tile_mesh, tile_of_field
 if TYPE_CHECKING:
     from ..sensors.render import Frame
 
-__all__ = ["DescentFrame", "descent", "descent_altitudes"]
+__all__ = ["DescentFrame", "descent", "descent_altitudes", "display", "write_descent"]
 
 _MARGIN = 1.6
 _MAX_MAGNITUDE = 1500
@@ -127,3 +127,60 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         mesh = RayMesh(verts, faces, build_quality="low")
         frame = render(mesh, camera, pose, sun, reflectance=reflectance)
         yield DescentFrame(float(h), pixel, frame, *counts, kind)
+
+
+def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
+    """An 8-bit picture of an I/F image: ``scale`` to white, gamma 1/2.2."""
+    return (255.0 * np.clip(reflectance / scale, 0.0, 1.0) ** (1.0 / 2.2) + 0.5).astype(np.uint8)
+
+
+def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
+    """Write the :class:`DescentFrame` s of ``frames`` (an iterable, e.g. :func:`descent`)
+    into the new folder ``out`` (written whole or not at all,
+    :func:`latlong.sensors.runs.run_folder`): per frame the camera's files (image, depth,
+    range, normals) and an 8-bit ``picture_NNNN.png`` exposed on its own lit pixels (the
+    99.5th percentile to white, as a descent camera's auto-exposure would);
+    ``strip.png`` puts the pictures side by side; ``frames.json`` the intrinsics and per
+    frame the altitude, ground pixel, exposure, terrain, craters, rocks, pose, sun and
+    files. ``report(i, frame)`` is called as frames are written. Returns the number of
+    frames."""
+    from PIL import Image
+
+    from craters._shared import atomic_path
+
+    from ..sensors.camera_files import write_frame, write_manifest
+    from ..sensors.runs import run_folder
+
+    entries, pictures = [], []
+    f = None
+    with run_folder(out, "frames.json") as tmp:
+        for i, f in enumerate(frames):
+            files = write_frame(tmp, i, f.frame)
+            r = f.frame.reflectance
+            lit = r[r > 0]
+            scale = float(np.percentile(lit, 99.5)) if len(lit) else 1.0
+            pic = display(r, scale)
+            files["picture"] = f"picture_{i:04d}.png"
+            with atomic_path(tmp / files["picture"]) as p:
+                Image.fromarray(pic).save(p, format="PNG")
+            pictures.append(pic)
+            entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
+                            "picture_white_if": scale,
+                            "terrain": f.terrain, "craters": f.n_craters, "rocks": f.n_rocks,
+                            "position_m": [float(x) for x in f.frame.pose.position_m],
+                            "quaternion_wxyz": [float(x) for x in
+                                                f.frame.pose.quaternion_wxyz],
+                            "sun_direction": [float(x) for x in f.frame.sun.direction],
+                            "files": files})
+            if report is not None:
+                report(i, f)
+        if f is None:
+            raise ParameterError("frames", "must hold at least one frame")
+        gap = np.zeros((pictures[0].shape[0], 4), np.uint8)
+        strip = np.concatenate([x for p in pictures for x in (p, gap)][:-1], axis=1)
+        with atomic_path(tmp / "strip.png") as p:
+            Image.fromarray(strip).save(p, format="PNG")
+        write_manifest(tmp, {"intrinsics": f.frame.camera.intrinsics(), "seed": seed,
+                             "site_lat_lon_deg": [float(x) for x in site_lat_lon_deg],
+                             "frames": entries})
+    return len(entries)

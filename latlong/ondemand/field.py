@@ -74,11 +74,11 @@ __all__ = ["BLEND_EDGE", "IRREGULARITY", "ROUGHNESS_OCTAVES", "CraterField", "cr
 BLEND_EDGE = 1.5
 #: Largest rim-radius perturbation (the sequential stamp's default).
 IRREGULARITY = 0.02
-#: Octaves of a crater's roughness overlay (radius down to radius / 4): fixed per
+#: Octaves of a crater's roughness overlay (radius down to radius / 2): fixed per
 #: crater, so the overlay never depends on the requested resolution (the smallest craters
-#: drawn, 3 pixels across, get roughness down to 0.4 pixel; smaller craters carry on
-#: below).
-ROUGHNESS_OCTAVES = 3
+#: drawn, 3 pixels across, get roughness down to 0.75 pixel, as the sequential stamp's
+#: overlay stops at two grid spacings; smaller craters and rocks carry on below).
+ROUGHNESS_OCTAVES = 2
 _RINGS = ((0.0, 1), (0.25, 6), (0.5, 12), (0.75, 18), (1.0, 24))
 _BIN_MARGIN = 1.05
 #: Most craters whose parameters (base quadric, slope erosion) a field keeps between

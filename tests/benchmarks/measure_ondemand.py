@@ -84,8 +84,7 @@ def top_octave_share(img: np.ndarray) -> float:
 
 
 def descent_run(sc, frames: int, size: int):
-    from latlong.cli.descent import display
-    from latlong.ondemand.descent import descent, descent_altitudes
+    from latlong.ondemand.descent import descent, descent_altitudes, display
 
     alts = descent_altitudes(1e5, 1.0, frames)
     out = []

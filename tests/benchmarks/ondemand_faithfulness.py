@@ -350,8 +350,10 @@ def dh_stats(dh, depth_scale):
 def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> SimpleNamespace:
     """The on-demand body and the two sequential references (module notes)."""
     t0 = time.perf_counter()
+    # no boulders: the sequential stamp places them as meshes, the field as relief; the
+    # comparison is of the crater models
     scene = Scene.from_settings({"preset": preset, "seed": seed, "magnitude": magnitude,
-                                 "crater_roughness": roughness})
+                                 "crater_roughness": roughness, "boulders": []})
     grid = LatLongGrid(magnitude)
     units = grid.unit_vectors()
     field = CraterField(scene)  # not crater_field: its lru_cache cannot hash shape scenes

@@ -65,3 +65,24 @@ def test_a_descent_over_the_dem(lola, scene):
         assert lit.mean() > 0.5  # the ground fills the picture
     with pytest.raises(ValueError, match="altitudes_m"):
         list(dem_descent(lola, scene, 5.0, 180.0, [3e6], width_px=32))
+
+
+def test_dem_descent_writes_the_frames_strip_and_manifest(tmp_path):
+    import json
+
+    from dem.cli import main
+
+    out = tmp_path / "d"
+    code = main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "--start-m",
+                 "20000", "--stop-m", "2", "--frames", "3", "--size-px", "32", "--craters",
+                 "c=0.08,k=-2,d_min_m=0.1,d_max_m=20000", "--boulders",
+                 "c=7e-4,k=-2.11,d_min_m=0.05,d_max_m=5", "--seed", "1", "-q", "-o", str(out)])
+    assert code == 0
+    meta = json.loads((out / "frames.json").read_text())
+    assert [round(f["altitude_m"]) for f in meta["frames"]] == [20000, 200, 2]
+    assert all(f["craters"] > 0 for f in meta["frames"])
+    assert (out / "strip.png").is_file() and (out / "picture_0002.png").is_file()
+    # no layer: refused in one line, nothing written
+    assert main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "-o",
+                 str(tmp_path / "e")]) == 2
+    assert not (tmp_path / "e").exists()

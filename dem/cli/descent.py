@@ -1,0 +1,43 @@
+"""``dem descent``: camera frames of a vertical descent over a DEM site, the DEM as the
+base and craters (and rocks) made on demand for each frame at its own ground pixel
+(:func:`dem.ondemand.dem_descent`); the files of ``latlong descent``."""
+
+from __future__ import annotations
+
+from craters.cli.kit import CliError
+from craters.cli.options import Values
+from latlong.cli.descent import (
+    DESCENT,
+    camera_options,
+    check_descent_folder,
+    write_descent_run,
+)
+
+from .options import INPUT, READ, RUN, dem_command, read_input
+from .tile import LAYERS, scene_of
+
+__all__ = ["register"]
+
+OPTIONS = {"input": INPUT, **READ, **LAYERS, **DESCENT, **RUN}
+
+
+def _descent(v: Values) -> int:
+    from latlong.ondemand.descent import descent_altitudes
+
+    from ..ondemand import dem_descent
+
+    if v["stop_m"] > v["start_m"]:
+        raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
+    out = check_descent_folder(v)
+    dem = read_input(v)
+    scene = scene_of(dem, v)
+    alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
+    frames = dem_descent(dem, scene, v["lat_deg"], v["lon_deg"], alts, **camera_options(v))
+    return write_descent_run(frames, out, v, seed=scene.seed)
+
+
+def register(sub) -> None:
+    """Register ``dem descent``."""
+    dem_command(sub, "descent", _descent, OPTIONS,
+                "camera frames of a descent over a DEM site, craters and rocks made on demand "
+                "for each frame")
