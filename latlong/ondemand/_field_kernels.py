@@ -153,15 +153,16 @@ def _params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, fit, 
 def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
                    rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
     """Base quadric and slope-erosion factor of crater k: the terrain of its older, larger
-    craters (``dep_list[dep_start[k]:dep_start[k+1]]``, youngest first; their profiles
-    without the roughness overlay, ``octaves`` unused: zero-mean noise a fit over the
-    stencil averages out) at its stencil points, fitted by the fixed least-squares
-    operator ``fit`` (6, n_stencil) in the crater's normalised coordinates."""
+    craters (``dep_list[dep_start[k]:dep_start[k+1]]``, youngest first, roughness overlay
+    included: at a smaller crater's scale a larger crater's overlay is a smooth offset,
+    metres on the Moon, not noise a fit averages out) at its stencil points, fitted by
+    the fixed least-squares operator ``fit`` (6, n_stencil) in the crater's normalised
+    coordinates."""
     n_st = stencil.shape[1]
     h = np.empty(n_st)
     for s in range(n_st):
         h[s] = _compose(dep_list, dep_start[k], dep_start[k + 1], fc, tabs, rims, seeds,
-                        rough, gain, 0, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
+                        rough, gain, octaves, xe, xb, stencil[k, s, 0], stencil[k, s, 1],
                         stencil[k, s, 2], st_base[k, s], age_key[k], age_key, diam[k],
                         diam) - fc[k, RHO]
     coef = np.zeros(6)

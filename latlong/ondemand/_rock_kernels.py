@@ -8,6 +8,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import fbm2
+
 from ._field_kernels import _far, _local
 
 # rock record columns after the crater record's first twelve (centre, east, north, RHO,
@@ -18,14 +20,18 @@ CZ = 16              # half the rock's height (m)
 Z0 = 17              # height of the ellipsoid's centre above the ground (m)
 F0 = 18              # facets: (cos phi, sin phi, offset, slope) each
 N_FACETS = 6
+#: Roughness of a rock's surface (fBm of 3 octaves from half its long semi-axis, gain
+#: 0.5), in units of its half-height: facets that are not planes.
+ROCK_ROUGHNESS = 0.12
 CHORD2 = F0 + 4 * N_FACETS   # squared chord of the footprint's angle
 N_ROCK_COLS = CHORD2 + 1
 
 
 @njit(cache=True, inline="always")
-def _rock_height(rc, k, p0, p1, p2):
+def _rock_height(rc, seeds, k, p0, p1, p2):
     """Height (m) of rock k above the ground at direction p: the ellipsoid of half-height
-    CZ centred Z0 above the ground, cut by its facet planes; 0 outside."""
+    CZ centred Z0 above the ground, cut by its facet planes, roughened by its own fBm
+    (``seeds[k]``); 0 outside."""
     if _far(rc, k, CHORD2, p0, p1, p2):
         return 0.0
     _, _, x, y, _ = _local(rc, k, p0, p1, p2)
@@ -40,18 +46,20 @@ def _rock_height(rc, k, p0, p1, p2):
         g = rc[k, c + 2] - rc[k, c + 3] * (xi * rc[k, c] + eta * rc[k, c + 1])
         if g < f:
             f = g
+    f += ROCK_ROUGHNESS * fbm2(seeds[k], x, y, 0.5 * rc[k, A], 3, 0.5)
     z = rc[k, Z0] + rc[k, CZ] * f
     return z if z > 0.0 else 0.0
 
 
 @njit(cache=True, parallel=True)
-def _rocks_kernel(points, block_of, blk_start, blk_list, rc, out):
+def _rocks_kernel(points, block_of, blk_start, blk_list, rc, seeds, out):
     """Adds to each point the tallest rock over it (of its block's rocks)."""
     for i in prange(points.shape[0]):
         blk = block_of[i]
         top = 0.0
         for t in range(blk_start[blk], blk_start[blk + 1]):
-            h = _rock_height(rc, blk_list[t], points[i, 0], points[i, 1], points[i, 2])
+            h = _rock_height(rc, seeds, blk_list[t], points[i, 0], points[i, 1],
+                             points[i, 2])
             if h > top:
                 top = h
         out[i] += top

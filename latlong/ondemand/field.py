@@ -12,8 +12,8 @@ in the README, "Terrain on demand"):
 2. **A crater's base** is a quadric fitted (a fixed 61-point stencil over its rim disc:
    the centre and rings of 6, 12, 18 and 24 points at 1/4 .. 1 radius; a fixed
    least-squares operator) to the terrain made by the base shape and the *older, larger*
-   craters at the stencil points (their profiles without the roughness overlay: zero-mean
-   noise the fit averages out, and half the cost of a fit). Smaller craters barely move
+   craters at the stencil points (roughness overlay included: at a smaller crater's scale
+   a larger crater's overlay is a smooth offset, not noise). Smaller craters barely move
    a plane fitted over a larger crater's floor, and leaving them out makes every
    crater's parameters independent of the requested resolution. The slope of that base
    against "up" (radial, or a shape model's self-gravity) sets the slope erosion

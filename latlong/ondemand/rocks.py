@@ -4,7 +4,8 @@ rocks the whole body has there.
 
 Each rock is an ellipsoid (footprint semi-axes ``D/2 sqrt(e)`` and ``D/2 / sqrt(e)``,
 height ``flatten D`` x a factor in [0.7, 1.3], the scene's boulder shape) buried by its
-burial fraction and cut by six facet planes into an angular block. It stands on the
+burial fraction, cut by six facet planes into an angular block and roughened by its own
+fBm (3 octaves from half its long semi-axis, 0.12 of its half-height). It stands on the
 terrain made by the base shape and the craters; where rocks overlap the tallest counts (a
 maximum, so no order enters). Rocks smaller than the requested minimum size (3 pixels)
 are left out: that only filters, so a finer request changes heights only inside the added
@@ -85,6 +86,7 @@ class RockField:
                 parts.append(got)
         if not parts:
             return {"rc": np.zeros((0, R.N_ROCK_COLS)), "diameter_m": np.zeros(0),
+                    "seed": np.zeros(0, np.uint64),
                     "id": np.zeros(0, np.uint64), "layer": np.zeros(0, np.int64),
                     "height_m": np.zeros(0), "burial_frac": np.zeros(0)}
         got = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
@@ -132,5 +134,6 @@ class RockField:
             return 0
         active = np.arange(len(rc), dtype=np.int64)
         start, lst = block_pairs(rc, active, level, occ, active)
-        R._rocks_kernel(units, block_of, start, lst, rc, out)
+        R._rocks_kernel(units, block_of, start, lst, rc, np.ascontiguousarray(got["seed"]),
+                        out)
         return len(rc)

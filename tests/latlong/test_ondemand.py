@@ -286,3 +286,50 @@ def test_window_directions_match_numpy():
     v = c[0] + coords[None, :, None] * e[0] + (-coords[:, None])[..., None] * n[0]
     want = v / np.sqrt((v * v).sum(axis=-1, keepdims=True))
     assert got.tobytes() == want.tobytes()
+
+
+def test_a_crater_base_is_the_fit_of_its_older_larger_craters_with_their_roughness(scene):
+    # the params kernel against numpy: FIT @ (the older, larger craters' composition at
+    # the crater's stencil points, roughness overlay included: at a small crater's scale a
+    # large crater's overlay is a smooth offset, and leaving it out floated small craters'
+    # floors metres off the ground on the Moon)
+    from craters.catalog import make_catalog
+    from craters.stamp import rim_perturbations_from_phases, stamping_profiles
+    from latlong.ondemand.field import CraterField, _stencil_points
+
+    field = CraterField(scene)
+    field.radii(units_of(np.linspace(-20, 20, 30), np.linspace(100, 130, 30)), 4.0)
+    fc, rank, cr = field.last["fc"], field.last["rank"], field.last["craters"]
+    n = len(cr)
+    prof = stamping_profiles(make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n),
+                                          diameter_m=cr.diameter_m, age_gyr=cr.age_gyr,
+                                          degradation=np.full(n, np.nan)),
+                             field.target, ejecta_edge=field.xe)
+    rims = rim_perturbations_from_phases(cr.rim_phases, field.irregularity)
+    order = np.argsort(rank)
+    stencil = _stencil_points(fc)
+    checked = 0
+    for k in np.argsort(-cr.diameter_m)[len(cr) // 3:][:12]:  # craters with larger ones
+        h = []
+        for p in stencil[k]:
+            a, b = 1.0, 0.0
+            for j in order:
+                if fc[j, K.ACTIVE] == 0.0 or rank[j] <= rank[k] \
+                        or not cr.diameter_m[j] > cr.diameter_m[k]:
+                    continue
+                with np.errstate(over="ignore"):
+                    hit, aj, bj = _step_reference(fc, j, prof.tables, rims, cr.seed,
+                                                  field.rough, field.gain, field.xe, p)
+                if hit:
+                    b += a * bj
+                    a *= aj
+                    if a == 0.0:
+                        break
+            h.append(b + a * field.base.radius(p[None])[0] - fc[k, K.RHO])
+        coef = FIT @ np.array(h)
+        radius = fc[k, K.RAD]
+        want = [coef[0], coef[1] / radius, coef[2] / radius]
+        assert np.allclose([fc[k, K.P0], fc[k, K.GX], fc[k, K.GY]], want, rtol=0,
+                           atol=1e-6), k
+        checked += 1
+    assert checked == 12
