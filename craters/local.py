@@ -67,7 +67,7 @@ def _bin_of(d: float) -> int:
     return int(e) - 1
 
 
-def bins(layer: CraterLayer) -> np.ndarray:
+def bins(layer: CraterLayer | BoulderLayer) -> np.ndarray:
     """The size bins ``b`` (int64) of a layer: ``[2**b, 2**(b + 1))`` meets
     ``[d_min_m, d_max_m)``."""
     if not isinstance(layer, CraterLayer | BoulderLayer):

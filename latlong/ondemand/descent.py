@@ -126,7 +126,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         # the rays it saves on one frame)
         mesh = RayMesh(verts, faces, build_quality="low")
         frame = render(mesh, camera, pose, sun, reflectance=reflectance)
-        yield DescentFrame(float(h), pixel, frame, *counts, kind)
+        n_craters, n_rocks = counts
+        yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind)
 
 
 def display(reflectance: np.ndarray, scale: float) -> np.ndarray:

@@ -2,8 +2,8 @@
 Eros-like scene, the radius computed alone, in a batch of 10^6 points and inside the
 whole-body build at the same resolution are the same float64 bytes.
 
-Scene: the ``eros`` preset (the NEAR shape model, its crater layers; its boulders are
-not made on demand yet) with ``on_demand = true`` at ``--magnitude`` (default the
+Scene: the ``eros`` preset (the NEAR shape model, its crater layers, its 40-100 m
+boulders as rocks in the relief) with ``on_demand = true`` at ``--magnitude`` (default the
 preset's 700: 2.94 M vertices). The body is built patch by patch
 (:func:`latlong.ondemand.patches.build_patches`, ``--patches``, in this process); the
 batch is the 1000 vertices among 10^6 - 1000 other random vertices; each "alone" value
