@@ -9,6 +9,7 @@ import sys
 
 from craters.cli.kit import CliError
 from craters.cli.options import Setting, Values
+from latlong.cli.tile import TILE_OUTPUTS, WINDOW
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
@@ -26,26 +27,7 @@ LAYERS = {
                     kind=int, range=(0, 2**63 - 1), run=True, default_text="a fresh one"),
 }
 
-OPTIONS = {
-    "input": INPUT, **READ,
-    "lat_deg": Setting(help="latitude of the window's centre", unit="deg", range=(-90.0, 90.0),
-                       kind=float, required=True, run=True),
-    "lon_deg": Setting(help="longitude of the window's centre", unit="deg", range="finite",
-                       kind=float, required=True, run=True),
-    "size_m": Setting(help="side of the square window", unit="m", range=">0", kind=float,
-                      required=True, run=True),
-    "pixel_m": Setting(help="pixel size", unit="m", range=">0", kind=float, required=True,
-                       run=True),
-    "min_crater_px": Setting(3.0, "smallest crater drawn, in pixels across", range=(1.0, 1000.0),
-                             run=True),
-    **LAYERS,
-    "output": Setting(help="heights as a cloud-optimised GeoTIFF (.tif)", flag="-o/--output",
-                      run=True),
-    "mesh": Setting(help="the window as a mesh in the body's frame (.ply .obj .stl .vtp .vtk "
-                    ".glb)", run=True),
-    "picture": Setting(help="shaded picture of the window (.png)", run=True),
-    **RUN,
-}
+OPTIONS = {"input": INPUT, **READ, **WINDOW, **LAYERS, **TILE_OUTPUTS, **RUN}
 
 
 def scene_of(dem, v: Values):

@@ -10,10 +10,11 @@ from __future__ import annotations
 import sys
 
 from craters.cli.kit import CliError
-from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
+from craters.cli.options import Setting, Values, command
 
-from ..scene import SETTING_PARTS, SETTINGS, Scene
+from ..scene import SETTINGS, Scene
 from .build import GROUPS
+from .tile import on_demand_options
 
 __all__ = ["DESCENT", "OPTIONS", "camera_options", "check_descent_folder", "register",
            "write_descent_run"]
@@ -38,10 +39,7 @@ DESCENT = {
     "output": Setting(help="output folder", flag="-o/--output", required=True, run=True),
 }
 #: Every option of ``latlong descent``: the scene's settings, the descent, the outputs.
-OPTIONS = {k: s for k, s in declared_keys(
-    *(part for part in SETTING_PARTS if part[0] not in ("implicit", "render")),
-    ("descent", DESCENT), ("output", {"quiet": QUIET, "force": FORCE})).items()
-    if k not in ("on_demand", "max_memory_gb", "radii_on_disk", "surface", "spacing_m")}
+OPTIONS = on_demand_options("descent", DESCENT)
 _GROUPS = {"descent": "descent and outputs", **GROUPS}
 
 

@@ -17,9 +17,10 @@ from ..meshio.writers import MESH_SUFFIXES
 from ..scene import SETTING_PARTS, SETTINGS, Scene
 from .build import GROUPS
 
-__all__ = ["OPTIONS", "register"]
+__all__ = ["OPTIONS", "TILE_OUTPUTS", "WINDOW", "on_demand_options", "register"]
 
-TILE = {
+#: A window of terrain on demand (``latlong tile``, ``dem tile``).
+WINDOW = {
     "lat_deg": Setting(help="latitude of the window's centre", unit="deg", range=(-90.0, 90.0),
                        kind=float, required=True, run=True),
     "lon_deg": Setting(help="longitude of the window's centre", unit="deg", range="finite",
@@ -30,6 +31,9 @@ TILE = {
                        run=True),
     "min_crater_px": Setting(3.0, "smallest crater drawn, in pixels across", range=(1.0, 1000.0),
                              run=True),
+}
+#: What a window is written as (``latlong tile``, ``dem tile``).
+TILE_OUTPUTS = {
     "output": Setting(help="heights as a Cloud Optimized GeoTIFF (.tif, float32 metres above "
                       "the sphere of the base's radius at the centre)", flag="-o/--output",
                       run=True),
@@ -38,11 +42,20 @@ TILE = {
     "picture": Setting(help="shaded picture of the window (.png, plane removed, sun from the "
                        "west at 20 degrees)", run=True),
 }
+
+
+def on_demand_options(group: str, table: dict) -> dict:
+    """The options of a command on terrain on demand: the scene's settings (less those of
+    whole-body builds and of the implicit backend), ``table`` as ``group``, --quiet and
+    --force."""
+    return {k: s for k, s in declared_keys(
+        *(part for part in SETTING_PARTS if part[0] not in ("implicit", "render")),
+        (group, table), ("output", {"quiet": QUIET, "force": FORCE})).items()
+        if k not in ("on_demand", "max_memory_gb", "radii_on_disk", "surface", "spacing_m")}
+
+
 #: Every option of ``latlong tile``: the scene's settings, the window, the outputs.
-OPTIONS = {k: s for k, s in declared_keys(
-    *(part for part in SETTING_PARTS if part[0] not in ("implicit", "render")),
-    ("tile", TILE), ("output", {"quiet": QUIET, "force": FORCE})).items()
-    if k not in ("on_demand", "max_memory_gb", "radii_on_disk", "surface", "spacing_m")}
+OPTIONS = on_demand_options("tile", {**WINDOW, **TILE_OUTPUTS})
 _GROUPS = {"tile": "window and outputs", **GROUPS}
 
 

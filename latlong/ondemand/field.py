@@ -327,7 +327,7 @@ class CraterField:
             self.last = {"craters": cr, "fc": cr.fc, "rank": np.zeros(0, np.int64), "n_pairs": 0,
                          "fresh_depth_m": np.zeros(0)}
             out = base.copy()
-            self.rocks.add(units, out, d_min, level, occ, block_of, block_pairs)
+            self.rocks.add(units, out, d_min, level, occ, block_of)
             return out
         fc = cr.fc
         rank = np.empty(n, dtype=np.int64)
@@ -384,7 +384,7 @@ class CraterField:
         K._points_kernel(units, block_of, blk_start, blk_list, base,
                          fc, tabs, rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe,
                          BLEND_EDGE, rank, diam, out)
-        self.rocks.add(units, out, d_min, level, occ, block_of, block_pairs)
+        self.rocks.add(units, out, d_min, level, occ, block_of)
         self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key),
                      "fresh_depth_m": prof.fresh_depth_m}
         return out

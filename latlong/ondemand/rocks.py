@@ -28,7 +28,7 @@ from craters.local import ROCK_FACETS, bin_bounds, bin_level, bins, draw_rock_ce
 from ..scene import Scene
 from . import _rock_kernels as R
 from .base import BaseField, tangent_frame
-from .cellsets import cell_areas, cells_of, coarser, neighbours, unique_sorted
+from .cellsets import block_pairs, cell_areas, cells_of, coarser, neighbours, unique_sorted
 
 __all__ = ["RockField"]
 
@@ -122,11 +122,10 @@ class RockField:
         return rc
 
     def add(self, units: np.ndarray, out: np.ndarray, d_min: float, level: int,
-            occ: np.ndarray, block_of: np.ndarray, block_pairs) -> int:
+            occ: np.ndarray, block_of: np.ndarray) -> int:
         """Adds the rocks at least ``d_min`` across to the radii ``out`` at ``units``,
         through the blocks of the crater field (``level``, the occupied block cells
-        ``occ``, each point's block, and the function finding each block's records).
-        Returns the number of rocks."""
+        ``occ``, each point's block). Returns the number of rocks."""
         got = self.rocks(units, d_min)
         rc = np.ascontiguousarray(got["rc"])
         self.last = got

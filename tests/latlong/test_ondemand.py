@@ -103,37 +103,49 @@ def _step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, p):
     return True, w, (1.0 - w) * q + prof
 
 
-def test_the_point_kernel_matches_a_numpy_composition(scene):
-    field = crater_field(scene)
-    units = units_of(np.linspace(-20, 20, 40), np.linspace(100, 130, 40))
-    got = field.radii(units, 4.0)
-    last = field.last
-    fc, rank = last["fc"], last["rank"]
-    cr = last["craters"]
+def _reference_tables(field):
+    """(profile tables, rim perturbations) of the craters of the field's last call."""
     from craters.catalog import make_catalog
     from craters.stamp import rim_perturbations_from_phases, stamping_profiles
+
+    cr = field.last["craters"]
     n = len(cr)
     prof = stamping_profiles(make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n),
                                           diameter_m=cr.diameter_m, age_gyr=cr.age_gyr,
                                           degradation=np.full(n, np.nan)),
                              field.target, ejecta_edge=field.xe)
-    rims = rim_perturbations_from_phases(cr.rim_phases, field.irregularity)
-    order = np.argsort(rank)
+    return prof.tables, rim_perturbations_from_phases(cr.rim_phases, field.irregularity)
+
+
+def _compose_reference(field, tables, p, base_radius, keep=lambda j: True):
+    """The height at direction p over ``base_radius`` from the craters of the field's last
+    call that ``keep`` (youngest first, stopping at the first rim), in numpy; ``tables``:
+    :func:`_reference_tables`."""
+    fc, rank, cr = field.last["fc"], field.last["rank"], field.last["craters"]
+    tabs, rims = tables
+    a, b = 1.0, 0.0
+    for k in np.argsort(rank):
+        if fc[k, K.ACTIVE] == 0.0 or not keep(k):
+            continue
+        with np.errstate(over="ignore"):  # the hash's uint64 arithmetic wraps
+            hit, ak, bk = _step_reference(fc, k, tabs, rims, cr.seed, field.rough,
+                                          field.gain, field.xe, p)
+        if hit:
+            b += a * bk
+            a *= ak
+            if a == 0.0:
+                break
+    return b + a * base_radius
+
+
+def test_the_point_kernel_matches_a_numpy_composition(scene):
+    field = crater_field(scene)
+    units = units_of(np.linspace(-20, 20, 40), np.linspace(100, 130, 40))
+    got = field.radii(units, 4.0)
     base = field.base.radius(units)
+    tables = _reference_tables(field)
     for i, p in enumerate(units):
-        a, b = 1.0, 0.0
-        for k in order:
-            if fc[k, K.ACTIVE] == 0.0:
-                continue
-            with np.errstate(over="ignore"):  # the hash's uint64 arithmetic wraps
-                hit, ak, bk = _step_reference(fc, k, prof.tables, rims, cr.seed, field.rough,
-                                              field.gain, field.xe, p)
-            if hit:
-                b += a * bk
-                a *= ak
-                if a == 0.0:
-                    break
-        want = b + a * base[i]
+        want = _compose_reference(field, tables, p, base[i])
         assert got[i] == pytest.approx(want, abs=1e-9), i
 
 
@@ -293,39 +305,20 @@ def test_a_crater_base_is_the_fit_of_its_older_larger_craters_with_their_roughne
     # the crater's stencil points, roughness overlay included: at a small crater's scale a
     # large crater's overlay is a smooth offset, and leaving it out floated small craters'
     # floors metres off the ground on the Moon)
-    from craters.catalog import make_catalog
-    from craters.stamp import rim_perturbations_from_phases, stamping_profiles
     from latlong.ondemand.field import CraterField, _stencil_points
 
     field = CraterField(scene)
     field.radii(units_of(np.linspace(-20, 20, 30), np.linspace(100, 130, 30)), 4.0)
     fc, rank, cr = field.last["fc"], field.last["rank"], field.last["craters"]
-    n = len(cr)
-    prof = stamping_profiles(make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n),
-                                          diameter_m=cr.diameter_m, age_gyr=cr.age_gyr,
-                                          degradation=np.full(n, np.nan)),
-                             field.target, ejecta_edge=field.xe)
-    rims = rim_perturbations_from_phases(cr.rim_phases, field.irregularity)
-    order = np.argsort(rank)
     stencil = _stencil_points(fc)
+    tables = _reference_tables(field)
     checked = 0
     for k in np.argsort(-cr.diameter_m)[len(cr) // 3:][:12]:  # craters with larger ones
-        h = []
-        for p in stencil[k]:
-            a, b = 1.0, 0.0
-            for j in order:
-                if fc[j, K.ACTIVE] == 0.0 or rank[j] <= rank[k] \
-                        or not cr.diameter_m[j] > cr.diameter_m[k]:
-                    continue
-                with np.errstate(over="ignore"):
-                    hit, aj, bj = _step_reference(fc, j, prof.tables, rims, cr.seed,
-                                                  field.rough, field.gain, field.xe, p)
-                if hit:
-                    b += a * bj
-                    a *= aj
-                    if a == 0.0:
-                        break
-            h.append(b + a * field.base.radius(p[None])[0] - fc[k, K.RHO])
+        def older_larger(j, k=k):
+            return rank[j] > rank[k] and cr.diameter_m[j] > cr.diameter_m[k]
+
+        h = [_compose_reference(field, tables, p, field.base.radius(p[None])[0], older_larger)
+             - fc[k, K.RHO] for p in stencil[k]]
         coef = FIT @ np.array(h)
         radius = fc[k, K.RAD]
         want = [coef[0], coef[1] / radius, coef[2] / radius]
