@@ -13,6 +13,7 @@ from craters.local import bins, draw_cells
 from latlong import LatLongGrid, Scene, build
 from latlong.ondemand import _field_kernels as K
 from latlong.ondemand import heights_at, units_of
+from latlong.ondemand.cellsets import unique_inverse, unique_sorted
 from latlong.ondemand.field import BLEND_EDGE, FIT, ROUGHNESS_OCTAVES, STENCIL_XY, crater_field
 from latlong.ondemand.tile import tile, tile_mesh
 
@@ -255,6 +256,17 @@ def test_coarser_cells_are_the_points_cells_at_that_level():
     fine = cells_of(u, 20)
     for level in (0, 3, 10, 19):
         assert np.array_equal(coarser(fine, 20, level), np.unique(cells_of(u, level)))
+
+
+def test_distinct_cells_and_their_inverse_match_numpy_with_runs_and_without():
+    rng = np.random.default_rng(3)
+    runs = np.repeat(rng.integers(0, 50, 300, dtype=np.uint64) << np.uint64(40),
+                     rng.integers(1, 9, 300))
+    for x in (runs, rng.permutation(runs), runs[:1], runs[:0]):
+        want, want_inv = np.unique(x, return_inverse=True)
+        got, got_inv = unique_inverse(x)
+        assert np.array_equal(got, want) and np.array_equal(unique_sorted(x), want)
+        assert got.dtype == x.dtype and np.array_equal(got_inv, want_inv.ravel())
 
 
 def test_a_centimetre_crater_on_the_moon_reaches_its_whole_ejecta_blanket():
