@@ -59,3 +59,40 @@ def _window_kernel(c, e, n, coords, out):
             out[r, q, 0] = v0 / norm
             out[r, q, 1] = v1 / norm
             out[r, q, 2] = v2 / norm
+
+
+@njit(cache=True, parallel=True)
+def _reach_kernel(centres, angles, level, occ, out):
+    """Whether a cap (unit centre, angular radius) may touch an occupied cell (sorted ids
+    ``occ`` at ``level``): a superset test. The cap's box on its centre's cube face is
+    padded by its angle times the face's largest stretch over the box (sec^2 = 1 + u^2 +
+    v^2 of the gnomonic face, at most 3 at its corners) and every cell of the box is
+    looked up, row by row (a row of the box is one run of the sorted ids); a box leaving
+    the face or taller than 4096 rows counts as touching."""
+    nside = 1 << level
+    for k in prange(centres.shape[0]):
+        f, u, v = face_uv(centres[k, 0], centres[k, 1], centres[k, 2])
+        # the stretch is sec^2 = 1 + u^2 + v^2 at most over the box padded by 3 x angle
+        wide = 3.0 * angles[k]
+        stretch = 1.0 + (abs(u) + wide) ** 2 + (abs(v) + wide) ** 2
+        pad = min(stretch, 3.0) * angles[k] * (1.0 + 1e-9) + 1e-12
+        if u - pad <= -1.0 or u + pad >= 1.0 or v - pad <= -1.0 or v + pad >= 1.0:
+            out[k] = True
+            continue
+        i0 = int(np.floor((u - pad + 1.0) * 0.5 * nside))
+        i1 = int(np.floor((u + pad + 1.0) * 0.5 * nside))
+        j0 = int(np.floor((v - pad + 1.0) * 0.5 * nside))
+        j1 = int(np.floor((v + pad + 1.0) * 0.5 * nside))
+        if i1 - i0 > 4096:
+            out[k] = True
+            continue
+        # each row i of the box is one run of ``occ`` (ids sort by face, i, then j)
+        hit = False
+        for i in range(i0, i1 + 1):
+            row = (np.uint64(level) << np.uint64(57)) | (np.uint64(f) << np.uint64(54)) \
+                | (np.uint64(i) << np.uint64(27))
+            lo = np.searchsorted(occ, row | np.uint64(j0))
+            if lo < occ.shape[0] and occ[lo] <= (row | np.uint64(j1)):
+                hit = True
+                break
+        out[k] = hit

@@ -13,7 +13,7 @@ from . import _cell_kernels as C
 from . import _field_kernels as K
 
 __all__ = ["block_level", "block_pairs", "cell_areas", "cells_of", "coarser", "in_sorted",
-           "neighbours", "unique_inverse", "unique_sorted"]
+           "neighbours", "reaching", "unique_inverse", "unique_sorted"]
 
 
 def cells_of(units: np.ndarray, level: int) -> np.ndarray:
@@ -119,6 +119,17 @@ def block_pairs(records: np.ndarray, active: np.ndarray, level: int, occ: np.nda
     srt = np.lexsort((rank[oc], ob))
     return (np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64),
             np.ascontiguousarray(oc[srt]))
+
+
+def reaching(records: np.ndarray, level: int, occ: np.ndarray) -> np.ndarray:
+    """Whether each record's reach (its widest ejecta edge: :mod:`._field_kernels`) may
+    touch one of the occupied blocks (sorted cell ids ``occ`` at ``level``): a superset
+    of :func:`block_pairs`' records, so a record it rejects is in no block's list."""
+    out = np.zeros(len(records), dtype=bool)
+    if len(records) and len(occ):
+        C._reach_kernel(np.ascontiguousarray(records[:, K.C0:K.C2 + 1]),
+                        np.ascontiguousarray(records[:, K.FAR]), level, occ, out)
+    return out
 
 
 def cell_areas(base, level: int, cells: np.ndarray) -> np.ndarray:

@@ -61,6 +61,7 @@ from .cellsets import (
     coarser,
     in_sorted,
     neighbours,
+    reaching,
     unique_inverse,
     unique_sorted,
 )
@@ -194,10 +195,13 @@ class CraterField:
         return _Craters(fc, got["diameter_m"], got["age_gyr"], got["id"], got["cell"],
                         got["rim_phases"], got["seed"], np.full(n, layer, dtype=np.int64))
 
-    def needed(self, units: np.ndarray, d_min: float):
+    def needed(self, units: np.ndarray, d_min: float, blocks: tuple[int, np.ndarray]):
         """The craters the heights at ``units`` need (module notes), and (owner, dep)
         index pairs: crater ``dep`` is larger than ``owner`` and its ejecta may reach
-        the owner's rim disc (a superset of what the owner's base fit reads)."""
+        the owner's rim disc (a superset of what the owner's base fit reads). The
+        points' blocks (their level and sorted occupied cells) narrow the craters drawn
+        around them to those that reach a block (the others are in no point's list:
+        leaving them and their dependencies out changes no value)."""
         parts: list[_Craters] = []
         owners_all: list[np.ndarray] = []
         deps_all: list[np.ndarray] = []
@@ -225,6 +229,7 @@ class CraterField:
             cand_cells = unique_sorted(np.concatenate([cand_cells, own_cells9.ravel()]))
             cand = self._draw(b, cand_cells, d_min)
             needed_mask = in_sorted(cand.cell, q_cells)
+            needed_mask[needed_mask] = reaching(cand.fc[needed_mask], *blocks)
             owners = np.arange(n_have, dtype=np.int64)
             cells9 = own_cells9
             # the query-rule craters are owners within this bin too
@@ -317,12 +322,12 @@ class CraterField:
         """Radius (m) in each direction ``units`` (n, 3) with craters >= ``d_min``."""
         units = np.ascontiguousarray(units, dtype=np.float64)
         base = self.base.radius(units)
-        cr, owner, dep = self.needed(units, d_min)
-        n = len(cr)
         # blocks of points, and the craters (rocks) that may reach each block
         level = block_level(len(units), units)
         occ, block_of = unique_inverse(cells_of(units, level))
         block_of = block_of.astype(np.int64).ravel()
+        cr, owner, dep = self.needed(units, d_min, (level, occ))
+        n = len(cr)
         if n == 0:
             self.last = {"craters": cr, "fc": cr.fc, "rank": np.zeros(0, np.int64), "n_pairs": 0,
                          "fresh_depth_m": np.zeros(0)}

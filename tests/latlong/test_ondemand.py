@@ -299,6 +299,37 @@ def test_parameters_kept_between_calls_give_the_same_bytes(scene):
     assert again.tobytes() == CraterField(scene).radii(units, 4.0).tobytes()
 
 
+def test_reaching_keeps_every_crater_that_reaches_a_point_and_drops_far_ones():
+    from latlong.ondemand.base import tangent_frame
+    from latlong.ondemand.cellsets import cells_of, reaching, unique_sorted
+
+    rng = np.random.default_rng(5)
+    # points of a window near a cube corner and near a face centre
+    for lat, lon in ((35.26, 45.0), (0.3, 0.2)):
+        c = units_of([lat], [lon])
+        e, n = tangent_frame(c)
+        xy = rng.uniform(-0.01, 0.01, (4000, 2))
+        pts = c + xy[:, :1] * e + xy[:, 1:] * n
+        pts /= np.linalg.norm(pts, axis=1, keepdims=True)
+        level = 12
+        occ = unique_sorted(cells_of(pts, level))
+        # caps of every size around the window, some far from it
+        m = 3000
+        off = rng.uniform(-0.05, 0.05, (m, 2))
+        cu = c + off[:, :1] * e + off[:, 1:] * n
+        cu /= np.linalg.norm(cu, axis=1, keepdims=True)
+        rec = np.zeros((m, K.N_COLS))
+        rec[:, K.C0:K.C2 + 1] = cu
+        rec[:, K.FAR] = 10.0 ** rng.uniform(-5, -1.5, m)
+        got = reaching(rec, level, occ)
+        # by brute force: the angle from each cap's centre to its nearest point
+        ang = np.arccos(np.clip(cu @ pts.T, -1, 1)).min(axis=1)
+        assert not (ang <= rec[:, K.FAR])[~got].any()  # every cap holding a point kept
+        # no point near: dropped (but where the box leaves its cube face, at the corner)
+        far = ang > 5.0 * rec[:, K.FAR] + 0.002
+        assert far.sum() > 300 and got[far].mean() < 0.05
+
+
 def test_window_directions_match_numpy():
     from latlong.ondemand.base import tangent_frame
     from latlong.ondemand.tile import tile_units
