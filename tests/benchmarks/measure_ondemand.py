@@ -4,9 +4,12 @@ touchdown, and how consistent its frames are.
 Scene: a lunar-like equilibrium surface, the Moon's radius and crater morphology, power-
 law craters N_cum = 0.08 D^-2 per m^2 (about the lunar equilibrium density: Gault 1970,
 Radio Sci. 5, 273, finds N_cum ~ 10^-1.1 D^-2 for steady-state small craters) from 2 cm
-to 20 km, their ages capped by size so that each size is seen at about its equilibrium
-density (0-3.5 Gyr >= 100 m, 0-1 Gyr 10-100 m, 0-0.1 Gyr 1-10 m, 0-0.01 Gyr < 1 m; the
-diffusion of the craters' profiles erases the older ones of each size), and rocks of 5 mm
+to 20 km, one layer per octave of diameter, each layer's ages uniform up to the age at
+which diffusion has removed 90 % of its largest crater's fresh depth (``lifetime_gyr``:
+the project's diffusion model, Fassett & Thomson 2014/2015's D-dependent diffusivity;
+~10 Myr at 1 m, ~1.5 Gyr at 100 m, capped at 3.5 Gyr), so that every size shows the
+same mix of fresh and worn craters, as a steady state does (with one layer per decade
+the mix jumped at each decade and so did the pictures' fine detail); and rocks of 5 mm
 to 5 m (N_cum = 7e-4 D^-2.11 per m^2, examples/moon_site.toml).
 
 1. Tiles: a 1024^2 window (``latlong.ondemand.tile.tile``) at 100 m, 10 m, 1 m, 10 cm and
@@ -47,10 +50,28 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-LAYERS = ["c=0.08,k=-2,d_min_m=100,d_max_m=20000,age_max_gyr=3.5",
-          "c=0.08,k=-2,d_min_m=10,d_max_m=100,age_max_gyr=1",
-          "c=0.08,k=-2,d_min_m=1,d_max_m=10,age_max_gyr=0.1",
-          "c=0.08,k=-2,d_min_m=0.02,d_max_m=1,age_max_gyr=0.01"]
+
+
+def lifetime_gyr(diameter_m: float, worn: float = 0.9) -> float:
+    """Age (Gyr) at which diffusion has removed ``worn`` of a fresh lunar crater's depth."""
+    from craters.diffusion import kappa_m2_yr, tau_from_degradation
+
+    tau = float(np.ravel(tau_from_degradation([diameter_m], [worn]))[0])
+    return tau * (0.5 * diameter_m) ** 2 / float(np.ravel(kappa_m2_yr([diameter_m]))[0]) / 1e9
+
+
+def octave_layers(d_lo_m: float = 0.02, d_hi_m: float = 20000.0) -> list[str]:
+    """One crater layer per octave of diameter, ages up to the octave's top's lifetime."""
+    out, a = [], d_lo_m
+    while a < d_hi_m:
+        b = min(2.0 * a, d_hi_m)
+        out.append(f"c=0.08,k=-2,d_min_m={a:.6g},d_max_m={b:.6g},"
+                   f"age_max_gyr={min(3.5, lifetime_gyr(b)):.4g}")
+        a = b
+    return out
+
+
+LAYERS = octave_layers()
 ROCKS = ["c=7e-4,k=-2.11,d_min_m=0.005,d_max_m=5,burial_max=0.5"]
 SITE = [0.0, 0.0]
 SUN_ELEVATION_DEG = [25.0]

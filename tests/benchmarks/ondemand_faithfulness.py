@@ -355,8 +355,13 @@ def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> S
     t0 = time.perf_counter()
     # no boulders: the sequential stamp places them as meshes, the field as relief; the
     # comparison is of the crater models
-    scene = Scene.from_settings({"preset": preset, "seed": seed, "magnitude": magnitude,
-                                 "crater_roughness": roughness, "boulders": []})
+    # "NAME:unstretched": the preset without its axis stretch (terrain on demand refuses
+    # stretched bodies; stretching both surfaces afterwards would compare elongated
+    # on-demand craters with round sequential ones)
+    name, _, variant = preset.partition(":")
+    extra = {"stretch": [1.0, 1.0, 1.0]} if variant == "unstretched" else {}
+    scene = Scene.from_settings({"preset": name, "seed": seed, "magnitude": magnitude,
+                                 "crater_roughness": roughness, "boulders": [], **extra})
     grid = LatLongGrid(magnitude)
     units = grid.unit_vectors()
     field = CraterField(scene)  # not crater_field: its lru_cache cannot hash shape scenes
@@ -673,7 +678,8 @@ def _seeds(text: str) -> list[int]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--preset", action="append", help="(repeatable; default: fbm-cratered)")
+    ap.add_argument("--preset", action="append", help="(repeatable; default: fbm-cratered; "
+                    "NAME:unstretched drops the preset's axis stretch)")
     ap.add_argument("--magnitude", type=int, default=200, help="(default: 200)")
     ap.add_argument("--seeds", default="1-3", help="e.g. 1-20 or 1,4,7 (default: 1-3)")
     ap.add_argument("--json", type=Path, help="write every number here")
