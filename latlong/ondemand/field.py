@@ -148,6 +148,11 @@ class CraterField:
         self.xe = float(EJECTA_EDGE)
         # the level of each size bin: cells at least an ejecta reach plus a radius wide
         self.levels: dict[int, int] = {}
+        self._bins = [frozenset(int(b) for b in bins(la)) for la in self.layers]
+        # the largest diameter of each bin over the layers that have it
+        self._tops = {b: max(bin_bounds(la, b)[1] for la, bs in zip(self.layers, self._bins,
+                                                                    strict=True) if b in bs)
+                      for b in set().union(*self._bins)}
         for la in self.layers:
             for b in bins(la):
                 # a crater's ejecta reach plus the radius of a smaller crater it shapes
@@ -162,7 +167,7 @@ class CraterField:
         area = cell_areas(self.base, level, cells)
         parts = []
         for idx, la in enumerate(self.layers):
-            if b not in set(bins(la).tolist()) or bin_bounds(la, b)[1] <= d_min:
+            if b not in self._bins[idx] or bin_bounds(la, b)[1] <= d_min:
                 continue
             got = draw_cells(la, idx, seed=self.base.seed, b=b, level=level, cell_ids=cells,
                              area_m2=area)
@@ -221,6 +226,7 @@ class CraterField:
             if self._bin_top(b) <= d_min:
                 continue
             level = self.levels[b]
+            first_pair = len(owners_all)
             # the query rule: every crater of the cells around the points' cells
             cand_cells = unique_sorted(neighbours(at_level[level]))
             q_cells = cand_cells
@@ -270,8 +276,10 @@ class CraterField:
                 y[hi] = remap[x[hi] - n_have]
                 return y
 
-            owners_all = [fix(x) for x in owners_all]
-            deps_all = [fix(x) for x in deps_all]
+            # this bin's pairs point at its candidates: renumber them (earlier bins' pairs
+            # hold kept indices below n_have already)
+            owners_all[first_pair:] = [fix(x) for x in owners_all[first_pair:]]
+            deps_all[first_pair:] = [fix(x) for x in deps_all[first_pair:]]
             kept = cand.take(keep)
             parts.append(kept)
             fc_have = np.concatenate([fc_have, kept.fc])
@@ -286,7 +294,7 @@ class CraterField:
         return craters, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
 
     def _bin_top(self, b: int) -> float:
-        return max(bin_bounds(la, b)[1] for la in self.layers if b in set(bins(la).tolist()))
+        return self._tops[b]
 
     def catalog(self, units: np.ndarray, d_min: float) -> np.ndarray:
         """The crater catalog (oldest first) of the craters that the heights at ``units``
