@@ -55,6 +55,10 @@ class DescentFrame:
     """Rocks drawn for the frame's terrain."""
     terrain: str
     """``window`` or ``body``."""
+    craters: np.ndarray
+    """The craters of the frame's terrain that show (oldest first; the row of a crater is
+    its id in the frame's ``crater_id`` label image): :meth:`CraterField.catalog`'s
+    columns."""
 
 
 def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
@@ -93,6 +97,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     above the site's horizon."""
     from ..sensors import Camera, Pose, render  # the sensors load only for descents
     from ..sensors.engine import RayMesh
+    from ..sensors.scene_geometry import SceneGeometry
 
     if isinstance(scene, Scene):
         field = crater_field(scene)
@@ -119,15 +124,20 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         pixel = footprint / width_px
         verts, faces, counts, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
                                                  pixel, site_radius)
+        catalog = field.last_catalog()  # the terrain's craters (oldest first)
+        catalog = catalog[catalog["slope_factor"] > 0]  # those erased by slope show nothing
         # the altitude is above the terrain at the site as this frame's terrain has it
         ground = up * float(field.radii(u0, 3.0 * pixel)[0])
         pose = Pose.look_at(ground + h * up, ground, up=north)
         # one frame per mesh: Embree's quick build pays (a medium BVH costs more than
         # the rays it saves on one frame)
         mesh = RayMesh(verts, faces, build_quality="low")
-        frame = render(mesh, camera, pose, sun, reflectance=reflectance)
+        truth = SceneGeometry(verts, faces, np.full(len(faces), -1, dtype=np.int32),
+                              craters=catalog, source="terrain on demand")
+        frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth)
         n_craters, n_rocks = counts
-        yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind)
+        yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
+                           catalog)
 
 
 def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
@@ -139,8 +149,10 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
     """Write the :class:`DescentFrame` s of ``frames`` (an iterable, e.g. :func:`descent`)
     into the new folder ``out`` (written whole or not at all,
     :func:`latlong.sensors.runs.run_folder`): per frame the camera's files (image, depth,
-    range, normals) and an 8-bit ``picture_NNNN.png`` exposed on its own lit pixels (the
-    99.5th percentile to white, as a descent camera's auto-exposure would);
+    range, normals, the crater-id label image), the craters that show in the frame's
+    terrain ``craters_NNNN.csv`` (row = label id) and an 8-bit ``picture_NNNN.png``
+    exposed on its own lit pixels (the 99.5th percentile to white, as a descent camera's
+    auto-exposure would);
     ``strip.png`` puts the pictures side by side; ``frames.json`` the intrinsics and per
     frame the altitude, ground pixel, exposure, terrain, craters, rocks, pose, sun and
     files. ``report(i, frame)`` is called as frames are written. Returns the number of
@@ -148,6 +160,7 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
     from PIL import Image
 
     from craters._shared import atomic_path
+    from craters.catalog import write_catalog
 
     from ..sensors.camera_files import write_frame, write_manifest
     from ..sensors.runs import run_folder
@@ -164,6 +177,8 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
             files["picture"] = f"picture_{i:04d}.png"
             with atomic_path(tmp / files["picture"]) as p:
                 Image.fromarray(pic).save(p, format="PNG")
+            files["craters"] = f"craters_{i:04d}.csv"
+            write_catalog(f.craters, tmp / files["craters"])
             pictures.append(pic)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
                             "picture_white_if": scale,

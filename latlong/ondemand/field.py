@@ -302,7 +302,9 @@ class CraterField:
         body's craters >= ``d_min``): ``craters.make_catalog`` columns (``degradation``:
         the share of the fresh depth gone, by diffusion and slope erosion) plus ``id``,
         ``layer``, and as made: ``rim_radius_m``, ``depth_m`` (after slope erosion),
-        ``slope_factor`` (0: erased on ground steeper than the angle of repose)."""
+        ``slope_factor`` (0: erased on ground steeper than the angle of repose),
+        ``centre_x_m, centre_y_m, centre_z_m`` (the centre on its base, body frame: what
+        :func:`latlong.sensors.labels.crater_labels` measures from)."""
         self.radii(units, d_min)
         return self.last_catalog()
 
@@ -319,8 +321,13 @@ class CraterField:
         cat = make_catalog(lat_deg=lat, lon_deg=lon, diameter_m=cr.diameter_m,
                            age_gyr=cr.age_gyr, degradation=degradation,
                            kind=kinds[cr.layer], layer=cr.layer)
-        cat = rfn.append_fields(cat, ("id", "rim_radius_m", "depth_m", "slope_factor"),
-                                (cr.id, fc[:, K.RAD].copy(), depth, fc[:, K.SCALE].copy()),
+        # the centre on the ground the crater was made in (its base at the centre): the
+        # position the sensors' labels measure a crater from
+        centre = u * (fc[:, K.RHO] + fc[:, K.P0])[:, None]
+        cat = rfn.append_fields(cat, ("id", "rim_radius_m", "depth_m", "slope_factor",
+                                      "centre_x_m", "centre_y_m", "centre_z_m"),
+                                (cr.id, fc[:, K.RAD].copy(), depth, fc[:, K.SCALE].copy(),
+                                 centre[:, 0], centre[:, 1], centre[:, 2]),
                                 usemask=False)
         # oldest first: the composition's (age, id) order reversed
         return cat[np.lexsort((cr.id, cr.age_gyr))[::-1]]

@@ -228,6 +228,26 @@ def test_a_tile_has_its_pixels_and_projection(scene):
         tile(scene, 10.0, 20.0, size_m=8.0, pixel_m=-1.0)
 
 
+def test_descent_frames_label_the_craters_of_their_own_terrain(scene):
+    from latlong.ondemand.descent import descent
+
+    frames = list(descent(scene, 10.0, 40.0, [60.0, 20.0], width_px=64))
+    for f in frames:
+        ids = f.frame.crater_id
+        hit = ids >= 0
+        assert hit.mean() > 0.1 and ids.max() < len(f.craters)
+        assert (f.craters["slope_factor"] > 0).all()  # craters erased by slope show nothing
+        # each labelled pixel lies inside the rim of the crater it names
+        cat = f.craters[ids[hit]]
+        c = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], axis=1)
+        p = f.frame.position_m[hit]
+        cos = np.einsum("ij,ij->i", p, c) / np.linalg.norm(p, axis=1) / np.linalg.norm(c, axis=1)
+        arc = np.linalg.norm(c, axis=1) * np.arccos(np.clip(cos, -1.0, 1.0))
+        assert (arc <= cat["rim_radius_m"] * (1.0 + 1e-6)).all()
+    # the craters are the window's, not those of the single point asked after it
+    assert len(frames[0].craters) > 20
+
+
 def test_on_demand_refuses_a_stretched_body():
     with pytest.raises(ValueError, match="stretch"):
         Scene.from_settings({"preset": "paper", "on_demand": True})
