@@ -50,6 +50,9 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial import cKDTree
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ondemand_faithfulness import weighted_ks  # noqa: E402  (the body harness's KS)
+
 LOLA = Path(__file__).resolve().parents[1] / "data" / "ldem4_crop.lbl"
 SITE = (5.0, 180.0)
 LAYERS = ((240.0, 3.5), (60.0, 1.0), (15.0, 0.1))  # pixel m, oldest crater Gyr
@@ -65,13 +68,6 @@ def scene_of(radius_m: float, pixel_m: float, age_max: float, seed: int):
              f"age_max_gyr={age_max:g}")
     return Scene.from_settings({"base": "sphere", "radius_m": radius_m, "body": "moon",
                                 "seed": seed, "on_demand": True, "craters": [layer]})
-
-
-def ks(a: np.ndarray, b: np.ndarray) -> float:
-    a, b = np.sort(a), np.sort(b)
-    x = np.concatenate([a, b])
-    return float(np.abs(np.searchsorted(a, x, "right") / len(a)
-                        - np.searchsorted(b, x, "right") / len(b)).max())
 
 
 def tile_xy(units: np.ndarray, lat: float, lon: float, radius: float, pixel: float):
@@ -193,7 +189,8 @@ def run_layer(lola, pixel: float, age_max: float, seed: int, png_dir: Path | Non
             "stamped_od": int(np.sum(cat["slope_factor"] > 0)),
             "dh_median_m": float(np.median(dh)), "dh_p95_m": float(np.percentile(dh, 95)),
             "slope_median_deg": [float(np.median(s_od)), float(np.median(s_sq))],
-            "slope_ks": ks(s_od, s_sq), "visible_per_bin": count,
+            "slope_ks": weighted_ks(s_od, np.ones(len(s_od)), s_sq, np.ones(len(s_sq))),
+            "visible_per_bin": count,
             "dd_median": [float(np.median(dd_od)) if dd_od else float("nan"),
                           float(np.median(dd_sq)) if dd_sq else float("nan")],
             "dd_n": [len(dd_od), len(dd_sq)], "dd_od": dd_od, "dd_seq": dd_sq,
