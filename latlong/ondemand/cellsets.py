@@ -117,7 +117,8 @@ def block_pairs(records: np.ndarray, active: np.ndarray, level: int, occ: np.nda
 def reaching(records: np.ndarray, level: int, occ: np.ndarray) -> np.ndarray:
     """Whether each record's reach (its widest ejecta edge: :mod:`._field_kernels`) may
     touch one of the occupied blocks (sorted cell ids ``occ`` at ``level``): a superset
-    of :func:`block_pairs`' records, so a record it rejects is in no block's list."""
+    of the records that reach a point in them, so a record it rejects changes no value
+    (:func:`block_pairs` may still list it: its block radius is a looser bound)."""
     out = np.zeros(len(records), dtype=bool)
     if len(records) and len(occ):
         C._reach_kernel(np.ascontiguousarray(records[:, K.C0:K.C2 + 1]),

@@ -205,7 +205,7 @@ class CraterField:
         index pairs: crater ``dep`` is larger than ``owner`` and its ejecta may reach
         the owner's rim disc (a superset of what the owner's base fit reads). The
         points' blocks (their level and sorted occupied cells) narrow the craters drawn
-        around them to those that reach a block (the others are in no point's list:
+        around them to those that may reach a point of a block (the others reach no point:
         leaving them and their dependencies out changes no value)."""
         parts: list[_Craters] = []
         owners_all: list[np.ndarray] = []
