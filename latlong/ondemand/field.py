@@ -25,6 +25,13 @@ in the README, "Terrain on demand"):
    rim stays continuous whatever lies under it). The height at a point is the
    composition over the craters that reach it, youngest first in the fixed (age, id)
    order, stopping at the first rim that holds the point; then the base shape.
+   The sequential stamp instead shifts the older terrain outside the rim by its offset
+   from the base at the rim (an azimuth table sampled from everything older), which
+   would make a crater depend on every older crater at its rim; the blend keeps the
+   point local but damps the older terrain's roughness within 1.5 radii. Where that
+   roughness is all a crater's relief (craters diffused flat on the faulted preset:
+   measured d/D -35 % on one seed, -12 % with the blend to 1.2 radii, which moves the
+   fBm preset from +6 % to +10 %), the two models differ; craters with relief agree.
 
 Which craters are needed for a set of points is found bin by bin, smallest first: those
 in the cells around the points, and then every larger crater that reaches a stencil
