@@ -8,6 +8,7 @@ from craters.cli.kit import CliError
 from craters.cli.options import Values
 from latlong.cli.descent import (
     DESCENT,
+    LIDAR,
     camera_options,
     check_descent_folder,
     write_descent_run,
@@ -18,7 +19,7 @@ from .tile import LAYERS, scene_of
 
 __all__ = ["register"]
 
-OPTIONS = {"input": INPUT, **READ, **LAYERS, **DESCENT, **RUN}
+OPTIONS = {"input": INPUT, **READ, **LAYERS, **DESCENT, **LIDAR, **RUN}
 
 
 def _descent(v: Values) -> int:

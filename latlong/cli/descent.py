@@ -2,22 +2,26 @@
 terrain made on demand for each frame (:mod:`latlong.ondemand.descent`), with the
 scene options of ``latlong build``: per frame the camera's files (image, depth, range,
 normals) and an 8-bit picture for people (exposed on its own lit pixels), and
-``frames.json``; ``strip.png`` puts the pictures side by side.
+``frames.json``; ``strip.png`` puts the pictures side by side. ``--lidar`` also fires a
+LIDAR (the ``--lidar-*`` options: :class:`~latlong.sensors.LidarSettings`' settings) from
+the camera's pose in every frame.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
-from craters.cli.kit import CliError
-from craters.cli.options import Setting, Values, command
+from craters._shared import ParameterError
+from craters.cli.kit import CliError, parse_seed
+from craters.cli.options import Setting, Values, command, declared_keys
 
 from ..scene import SETTINGS, Scene
 from .build import GROUPS
 from .tile import on_demand_options
 
-__all__ = ["DESCENT", "OPTIONS", "camera_options", "check_descent_folder", "register",
-           "write_descent_run"]
+__all__ = ["DESCENT", "LIDAR", "OPTIONS", "camera_options", "check_descent_folder",
+           "lidar_settings", "register", "write_descent_run"]
 
 DESCENT = {
     "lat_deg": Setting(help="latitude of the landing site", unit="deg", range=(-90.0, 90.0),
@@ -38,9 +42,29 @@ DESCENT = {
                                  range=(0.5, 90.0), run=True),
     "output": Setting(help="output folder", flag="-o/--output", required=True, run=True),
 }
+
+
+def _lidar_table() -> dict[str, Setting]:
+    from latlong.sensors import LidarSettings
+
+    from .sensor_options import wxh
+
+    out = {"lidar": Setting(False, "also fire a LIDAR from the camera's pose in every frame "
+                            "(lidar_NNNN.las, lidar_range_NNNN.npy; the --lidar-* options)",
+                            run=True, group="lidar")}
+    for k, s in declared_keys(LidarSettings, beams={
+            "parse": wxh("beam counts", "128x96", 4096)}).items():
+        out[f"lidar_{k}"] = dataclasses.replace(s, key=f"lidar_{k}", run=True, group="lidar")
+    out["lidar_seed"] = Setting(0, "the LIDAR's range-noise seed", kind=int, parse=parse_seed,
+                                range=(0, 2**63 - 1), run=True, group="lidar")
+    return out
+
+
+#: The LIDAR options of the descent commands (``--lidar`` and ``--lidar-*``).
+LIDAR = _lidar_table()
 #: Every option of ``latlong descent``: the scene's settings, the descent, the outputs.
-OPTIONS = on_demand_options("descent", DESCENT)
-_GROUPS = {"descent": "descent and outputs", **GROUPS}
+OPTIONS = on_demand_options("descent", {**DESCENT, **LIDAR})
+_GROUPS = {"descent": "descent and outputs", "lidar": "LIDAR (with --lidar)", **GROUPS}
 
 
 def _descent(v: Values) -> int:
@@ -56,6 +80,24 @@ def _descent(v: Values) -> int:
     return write_descent_run(frames, out, v, seed=scene.seed)
 
 
+def lidar_settings(v: Values):
+    """The :class:`~latlong.sensors.LidarSettings` of ``--lidar-*`` (None without
+    ``--lidar``); an error names the flag."""
+    from latlong.sensors import LidarSettings
+
+    if not v["lidar"]:
+        return None
+    names = [f.name for f in dataclasses.fields(LidarSettings)]
+    try:
+        return LidarSettings(**{k: v[f"lidar_{k}"] for k in names})
+    except ParameterError as exc:
+        raise CliError(exc.shown_as(_lidar_flag(exc.name), name_of=_lidar_flag)) from None
+
+
+def _lidar_flag(name: str) -> str:
+    return f"--lidar-{name.replace('_', '-')}"
+
+
 def check_descent_folder(v: Values):
     """The checked output folder of a descent command (``-o``, ``--force``)."""
     from latlong.sensors.runs import check_output_folder
@@ -69,7 +111,8 @@ def check_descent_folder(v: Values):
 def camera_options(v: Values) -> dict:
     """The camera keywords of :func:`latlong.ondemand.descent.descent` from the options."""
     return {"fov_deg": v["fov_deg"], "width_px": v["size_px"],
-            "sun_azimuth_deg": v["sun_azimuth_deg"], "sun_elevation_deg": v["sun_elevation_deg"]}
+            "sun_azimuth_deg": v["sun_azimuth_deg"], "sun_elevation_deg": v["sun_elevation_deg"],
+            "lidar": lidar_settings(v), "lidar_seed": v["lidar_seed"]}
 
 
 def write_descent_run(frames, out, v: Values, *, seed) -> int:
@@ -79,12 +122,19 @@ def write_descent_run(frames, out, v: Values, *, seed) -> int:
 
     def report(i, f):
         if not v["quiet"]:
+            lidar = "" if f.lidar is None else f", {len(f.lidar)} LIDAR returns"
             print(f"frame {i}: altitude {f.altitude_m:.4g} m, ground pixel "
                   f"{f.ground_pixel_m:.3g} m, {f.n_craters} craters, {f.n_rocks} rocks "
-                  f"({f.terrain})", file=sys.stderr)
+                  f"({f.terrain}){lidar}", file=sys.stderr)
 
-    n = write_descent(frames, out, seed=seed, site_lat_lon_deg=(v["lat_deg"], v["lon_deg"]),
-                      report=report)
+    try:
+        n = write_descent(frames, out, seed=seed, site_lat_lon_deg=(v["lat_deg"], v["lon_deg"]),
+                          report=report, lidar=lidar_settings(v), lidar_seed=v["lidar_seed"])
+    except ParameterError as exc:
+        if exc.name != "lidar":  # the LIDAR's reach beyond the terrain window
+            raise
+        raise CliError(exc.shown_as("--lidar-fov-deg", name_of=lambda n: "--fov-deg")) \
+            from None
     if not v["quiet"]:
         print(f"wrote {n} frames, {out / 'strip.png'}, {out / 'frames.json'}")
     return 0

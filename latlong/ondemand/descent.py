@@ -9,7 +9,11 @@ window 1.6 footprints wide in the gnomonic projection at the site, or, when that
 be more than half the site's radius, every vertex of a lat/long grid whose spacing is the
 ground pixel (the body as a whole). A crater seen at 10 km is the same crater at 100 m
 (:mod:`.field`: the terrain is a function of position), now with its smaller craters.
-Shadows are cast by what the window holds.
+Shadows are cast by what the window holds. With a LIDAR (``lidar``: its
+:class:`~latlong.sensors.LidarSettings`) each frame also fires it from the camera's pose
+over the same terrain (:func:`latlong.sensors.lidar_frame`): returns labelled with the
+frame's craters, range noise keyed by (``lidar_seed``, frame), its beams inside the
+frame's terrain window.
 """
 
 from __future__ import annotations
@@ -31,6 +35,7 @@ from .field import CraterField, crater_field
 from .tile import MAX_TILE_PX, tile_mesh, tile_of_field
 
 if TYPE_CHECKING:
+    from ..sensors import LidarFrame, LidarSettings
     from ..sensors.render import Frame
 
 __all__ = ["DescentFrame", "descent", "descent_altitudes", "display", "write_descent"]
@@ -59,6 +64,9 @@ class DescentFrame:
     """The craters of the frame's terrain that show (oldest first; the row of a crater is
     its id in the frame's ``crater_id`` label image): :meth:`CraterField.catalog`'s
     columns."""
+    lidar: LidarFrame | None = None
+    """The LIDAR's returns from the camera's pose (with ``descent(lidar=...)``), labelled
+    with :attr:`craters`."""
 
 
 def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
@@ -90,12 +98,14 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
 
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
             fov_deg: float = 30.0, width_px: int = 512, sun_azimuth_deg: float = 90.0,
-            sun_elevation_deg: float = 25.0, reflectance=None) -> Iterator[DescentFrame]:
+            sun_elevation_deg: float = 25.0, reflectance=None,
+            lidar: LidarSettings | None = None, lidar_seed: int = 0) -> Iterator[DescentFrame]:
     """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes) of a
     scene, or of a crater field (any base, e.g. a DEM's), square pictures ``width_px``
     wide, the sun at ``sun_azimuth_deg`` (clockwise from north) and ``sun_elevation_deg``
-    above the site's horizon."""
-    from ..sensors import Camera, Pose, render  # the sensors load only for descents
+    above the site's horizon; with ``lidar`` also that LIDAR's returns per frame, range
+    noise keyed by (``lidar_seed``, frame)."""
+    from ..sensors import Camera, LidarSettings, Pose, lidar_frame, render
     from ..sensors.engine import RayMesh
     from ..sensors.scene_geometry import SceneGeometry
 
@@ -119,7 +129,12 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     sun = (math.cos(el) * (math.sin(az) * east + math.cos(az) * north) + math.sin(el) * up)
     camera = Camera.from_fov(fov_deg, width_px, width_px)
     tan_half = math.tan(math.radians(fov_deg) / 2.0)
-    for h in alts:
+    if lidar is not None:
+        if not isinstance(lidar, LidarSettings):
+            raise TypeError(f"`lidar` must be LidarSettings; got {type(lidar).__name__}")
+        _check_lidar_inside(lidar, fov_deg)
+        lidar_seed = check_int("lidar_seed", lidar_seed, 0, 2**63 - 1)
+    for i, h in enumerate(alts):
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
         verts, faces, counts, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
@@ -135,9 +150,28 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         truth = SceneGeometry(verts, faces, np.full(len(faces), -1, dtype=np.int32),
                               craters=catalog, source="terrain on demand")
         frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth)
+        returns = None if lidar is None else lidar_frame(
+            mesh, lidar, pose.position_m, pose.quaternion_wxyz,
+            rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)
         n_craters, n_rocks = counts
         yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
-                           catalog)
+                           catalog, returns)
+
+
+def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:
+    """Refuse a LIDAR whose beams (with their divergence) leave the frames' terrain window
+    (``_MARGIN`` camera footprints wide): they would see its edge, not the ground."""
+    from ..sensors import beam_pattern
+
+    axes, _ = beam_pattern(lidar)
+    half = np.arctan(np.max(np.abs(axes[:, :2]), axis=1) / axes[:, 2]).max() \
+        + 0.5e-3 * lidar.divergence_mrad
+    limit = math.atan(_MARGIN * math.tan(math.radians(fov_deg) / 2.0))
+    if not (axes[:, 2] > 0).all() or half > limit:
+        raise ParameterError("lidar", f"beams must stay within {math.degrees(limit):.4g} deg "
+                             f"of the axis (the terrain window: {_MARGIN} x the camera's "
+                             f"footprint at {{}} {fov_deg:g}); the LIDAR's reach "
+                             f"{math.degrees(half):.4g} deg", see=("fov_deg",))
 
 
 def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
@@ -145,7 +179,8 @@ def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
     return (255.0 * np.clip(reflectance / scale, 0.0, 1.0) ** (1.0 / 2.2) + 0.5).astype(np.uint8)
 
 
-def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
+def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=None,
+                  lidar_seed=None) -> int:
     """Write the :class:`DescentFrame` s of ``frames`` (an iterable, e.g. :func:`descent`)
     into the new folder ``out`` (written whole or not at all,
     :func:`latlong.sensors.runs.run_folder`): per frame the camera's files (image, depth,
@@ -155,14 +190,17 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
     auto-exposure would);
     ``strip.png`` puts the pictures side by side; ``frames.json`` the intrinsics and per
     frame the altitude, ground pixel, exposure, terrain, craters, rocks, pose, sun and
-    files. ``report(i, frame)`` is called as frames are written. Returns the number of
-    frames."""
+    files; frames with LIDAR returns add ``lidar_NNNN.las`` (LAS 1.4, crater labels as
+    extra bytes) and ``lidar_range_NNNN.npy`` (first-return range image), and the
+    manifest the LIDAR's settings ``lidar`` and ``lidar_seed``. ``report(i, frame)`` is
+    called as frames are written. Returns the number of frames."""
     from PIL import Image
 
     from craters._shared import atomic_path
     from craters.catalog import write_catalog
 
     from ..sensors.camera_files import write_frame, write_manifest
+    from ..sensors.lidar_files import settings_json, write_las
     from ..sensors.runs import run_folder
 
     entries, pictures = [], []
@@ -180,6 +218,13 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
             files["craters"] = f"craters_{i:04d}.csv"
             write_catalog(f.craters, tmp / files["craters"])
             pictures.append(pic)
+            extra = {}
+            if f.lidar is not None:
+                files["lidar"] = f"lidar_{i:04d}.las"
+                files["lidar_range"] = f"lidar_range_{i:04d}.npy"
+                write_las(f.lidar, tmp / files["lidar"], point_source_id=i)
+                np.save(tmp / files["lidar_range"], f.lidar.range_image, allow_pickle=False)
+                extra["lidar_returns"] = len(f.lidar)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,
                             "picture_white_if": scale,
                             "terrain": f.terrain, "craters": f.n_craters, "rocks": f.n_rocks,
@@ -187,7 +232,7 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
                             "quaternion_wxyz": [float(x) for x in
                                                 f.frame.pose.quaternion_wxyz],
                             "sun_direction": [float(x) for x in f.frame.sun.direction],
-                            "files": files})
+                            **extra, "files": files})
             if report is not None:
                 report(i, f)
         if f is None:
@@ -196,7 +241,10 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None) -> int:
         strip = np.concatenate([x for p in pictures for x in (p, gap)][:-1], axis=1)
         with atomic_path(tmp / "strip.png") as p:
             Image.fromarray(strip).save(p, format="PNG")
+        lidar_keys = {} if lidar is None else {"lidar": settings_json(lidar),
+                                                "lidar_intrinsics": lidar.intrinsics(),
+                                                "lidar_seed": lidar_seed}
         write_manifest(tmp, {"intrinsics": f.frame.camera.intrinsics(), "seed": seed,
                              "site_lat_lon_deg": [float(x) for x in site_lat_lon_deg],
-                             "frames": entries})
+                             **lidar_keys, "frames": entries})
     return len(entries)

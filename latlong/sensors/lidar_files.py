@@ -34,7 +34,7 @@ from .poses import Poses
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
 
-__all__ = ["LIDAR_FORMAT", "lidar_run", "write_las"]
+__all__ = ["LIDAR_FORMAT", "lidar_run", "settings_json", "write_las"]
 
 LIDAR_FORMAT = "craterform.lidar/1"
 _LAS_DATE = datetime.date(2000, 1, 1)  # fixed: the same run gives the same bytes
@@ -80,7 +80,8 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0) -> Path:
     return path
 
 
-def _settings_json(settings: LidarSettings) -> dict:
+def settings_json(settings: LidarSettings) -> dict:
+    """The LIDAR's settings as JSON values (a run's manifest)."""
     out = {}
     for f in dataclasses.fields(settings):
         v = getattr(settings, f.name)
@@ -131,7 +132,7 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
                            "n_returns": len(fr), "files": names})
         manifest = {"format": LIDAR_FORMAT, "generator": f"craterform {package_version()}",
                     "model": model_name or geometry.source, "seed": seed,
-                    "settings": _settings_json(settings), "intrinsics": settings.intrinsics(),
+                    "settings": settings_json(settings), "intrinsics": settings.intrinsics(),
                     "frames": frames}
         with open(tmp / "lidar.json", "w") as fh:
             json.dump(manifest, fh, indent=1)

@@ -76,12 +76,22 @@ def test_dem_descent_writes_the_frames_strip_and_manifest(tmp_path):
     code = main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "--start-m",
                  "20000", "--stop-m", "2", "--frames", "3", "--size-px", "32", "--craters",
                  "c=0.08,k=-2,d_min_m=0.1,d_max_m=20000", "--boulders",
-                 "c=7e-4,k=-2.11,d_min_m=0.05,d_max_m=5", "--seed", "1", "-q", "-o", str(out)])
+                 "c=7e-4,k=-2.11,d_min_m=0.05,d_max_m=5", "--seed", "1", "-q", "-o", str(out),
+                 "--lidar", "--lidar-beams", "8x8", "--lidar-max-range-m", "30000"])
     assert code == 0
     meta = json.loads((out / "frames.json").read_text())
     assert [round(f["altitude_m"]) for f in meta["frames"]] == [20000, 200, 2]
     assert all(f["craters"] > 0 for f in meta["frames"])
     assert (out / "strip.png").is_file() and (out / "picture_0002.png").is_file()
+    # the LIDAR: every beam returns, its settings and seed in the manifest
+    assert meta["lidar"]["beams"] == [8, 8] and meta["lidar_seed"] == 0
+    assert all(f["lidar_returns"] == 64 for f in meta["frames"])
+    assert (out / "lidar_0002.las").is_file() and (out / "lidar_range_0002.npy").is_file()
+    # a LIDAR wider than the frames' terrain: one line naming the flag, nothing written
+    assert main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "--frames", "1",
+                 "--craters", "c=0.08,k=-2,d_min_m=10,d_max_m=100", "--lidar",
+                 "--lidar-fov-deg", "60", "-o", str(tmp_path / "w")]) == 2
+    assert not (tmp_path / "w").exists()
     # no layer: refused in one line, nothing written
     assert main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "-o",
                  str(tmp_path / "e")]) == 2

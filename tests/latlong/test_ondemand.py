@@ -248,6 +248,24 @@ def test_descent_frames_label_the_craters_of_their_own_terrain(scene):
     assert len(frames[0].craters) > 20
 
 
+def test_descent_lidar_sees_the_frames_terrain_as_the_camera_does(scene):
+    from latlong.ondemand.descent import descent
+    from latlong.sensors import LidarSettings
+
+    # a flash LIDAR with the camera's pixels as beams: the same rays on the same mesh
+    lidar = LidarSettings(beams=(48, 48), fov_deg=30.0)
+    frames = list(descent(scene, 10.0, 40.0, [60.0, 20.0], width_px=48, lidar=lidar))
+    for f in frames:
+        r = f.lidar.range_image
+        assert np.isfinite(r).all() and len(f.lidar) == 48 * 48
+        assert np.allclose(r, f.frame.range_m, rtol=1e-6, atol=0.0)
+        # returns name the craters the camera's label image names at the same pixel
+        assert np.array_equal(f.lidar.crater_id, f.frame.crater_id.ravel()[f.lidar.beam])
+    with pytest.raises(ValueError, match="lidar"):
+        next(descent(scene, 10.0, 40.0, [60.0], width_px=48,
+                     lidar=LidarSettings(fov_deg=80.0)))
+
+
 def test_on_demand_refuses_a_stretched_body():
     with pytest.raises(ValueError, match="stretch"):
         Scene.from_settings({"preset": "paper", "on_demand": True})
