@@ -6,7 +6,15 @@ A power-law layer (:class:`craters.CraterLayer`) is split into size bins
 cell of one level of the cube-sphere hierarchy (:mod:`craters.cells`): a Poisson count
 of mean ``area x (N(lo) - N(hi))``, then per crater its diameter (inverse power law),
 age (uniform in the layer's range), position (uniform in the cell's solid angle),
-rim-shape phases and roughness seed. Every number comes from the Philox words of the
+rim-shape phases and roughness seed. A model-age layer (:class:`craters.ModelAgeLayer`)
+is drawn the same way from its production function and chronology: the bin's density
+``N1(T) (S(lo) - S(hi))`` (``S`` the production function's shape, ``N1`` the
+chronology), diameters by inverting ``S`` within the bin and formation ages by inverting
+``N1`` over [0, T] (``P(age <= t) = N1(t) / N1(T)``), both by bisection in portable
+arithmetic; with an ``equilibrium`` cap a saturated bin keeps the equilibrium density
+and only the youngest craters (ages drawn from the youngest share ``cap / N`` of the
+flux: what the sequential cap keeps, as a density rather than a count per area).
+Every number comes from the Philox words of the
 counter ``(cell id, layer << 32 | bin + 2**31, crater index, purpose)`` under the key
 ``(seed, 0x6372617465727300)`` through exact or portable transforms
 (:mod:`craters.counter`), so a crater depends on nothing but its own counter: any set of
@@ -29,11 +37,14 @@ True
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .boulders import BoulderLayer
 from .boulders.placement import MIN_BURIAL
 from .cells import cell_parts, cell_points
+from .chronology import get_chronology_system, get_equilibrium
 from .counter import (
     philox4x64,
     poisson_from_uniform,
@@ -42,7 +53,7 @@ from .counter import (
     power_law_from_uniform,
     uniform_from_words,
 )
-from .layers import CraterLayer
+from .layers import CraterLayer, ModelAgeLayer
 
 __all__ = ["CRATER_KEY", "ROCK_FACETS", "ROCK_KEY", "bin_bounds", "bin_level", "bins",
            "draw_cells", "draw_rock_cells", "min_cell_angle"]
@@ -59,6 +70,8 @@ _RIM_COUNTERS = 4  # 16 words for the 15 rim phases
 _ROCK_COUNTERS = 6  # 24 words: 18 for the facets, 3 for elongation, height, burial
 _MAX_CANDIDATES = 64  # position candidates per crater (acceptance >= 0.19 a candidate)
 _TWO_PI = 2.0 * np.pi
+_LN10 = math.log(10.0)
+_BISECTIONS = 64  # halvings of a bracket: past the last bit of a double
 
 
 def _bin_of(d: float) -> int:
@@ -67,12 +80,13 @@ def _bin_of(d: float) -> int:
     return int(e) - 1
 
 
-def bins(layer: CraterLayer | BoulderLayer) -> np.ndarray:
+def bins(layer: CraterLayer | ModelAgeLayer | BoulderLayer) -> np.ndarray:
     """The size bins ``b`` (int64) of a layer: ``[2**b, 2**(b + 1))`` meets
     ``[d_min_m, d_max_m)``."""
-    if not isinstance(layer, CraterLayer | BoulderLayer):
-        raise TypeError("terrain on demand draws power-law layers (craters.CraterLayer or "
-                        f"craters.BoulderLayer); got {type(layer).__name__}")
+    if not isinstance(layer, CraterLayer | ModelAgeLayer | BoulderLayer):
+        raise TypeError("terrain on demand draws crater layers (craters.CraterLayer, "
+                        "craters.ModelAgeLayer) and boulder layers (craters.BoulderLayer); "
+                        f"got {type(layer).__name__}")
     lo = _bin_of(layer.d_min_m)
     hi = _bin_of(layer.d_max_m)
     if np.ldexp(1.0, hi) == layer.d_max_m:
@@ -80,7 +94,7 @@ def bins(layer: CraterLayer | BoulderLayer) -> np.ndarray:
     return np.arange(lo, hi + 1, dtype=np.int64)
 
 
-def bin_bounds(layer: CraterLayer | BoulderLayer, b: int) -> tuple[float, float]:
+def bin_bounds(layer: CraterLayer | ModelAgeLayer | BoulderLayer, b: int) -> tuple[float, float]:
     """``(lo, hi)`` metres: bin ``b`` clipped to the layer's range."""
     return max(float(np.ldexp(1.0, int(b))), layer.d_min_m), \
         min(float(np.ldexp(1.0, int(b) + 1)), layer.d_max_m)
@@ -119,6 +133,70 @@ def _words(cells: np.ndarray, tag: int, index: np.ndarray, purpose: int, seed: i
     return philox4x64(counters, [seed, key])
 
 
+def _p10(y) -> np.ndarray:
+    """10 ** y, portably."""
+    return portable_exp(np.asarray(y, dtype=np.float64) * _LN10)
+
+
+def _pf_shape(layer: ModelAgeLayer, d_m) -> np.ndarray:
+    """N(>D) / N(>1 km) of the layer's production function at ``d_m`` metres, portably
+    (the polynomial in log10 D_km by Horner, without a0)."""
+    x = portable_log(np.asarray(d_m, dtype=np.float64) * 1e-3) / _LN10
+    out = np.zeros_like(x)
+    for a in get_chronology_system(layer.npf).production.coefficients[:0:-1]:
+        out = (out + a) * x
+    return _p10(out)
+
+
+def _n1(layer: ModelAgeLayer, t_gyr) -> np.ndarray:
+    """N(>1 km) per km^2 of the layer's chronology at ``t_gyr``, portably."""
+    c0, c1, c2, c3 = get_chronology_system(layer.npf).chronology.coefficients
+    t = np.asarray(t_gyr, dtype=np.float64)
+    return c0 * (portable_exp(c1 * t) - 1.0) + c2 * t * t + c3 * t
+
+
+def _bin_density(layer, lo: float, hi: float) -> tuple[float, float]:
+    """(craters per m^2 in [lo, hi), the youngest share of the flux they come from)."""
+    if not isinstance(layer, ModelAgeLayer):
+        return layer.c * float(_pow(np.array([lo]), layer.k)[0]
+                               - _pow(np.array([hi]), layer.k)[0]), 1.0
+    s = _pf_shape(layer, np.array([lo, hi]))
+    density = float(_n1(layer, np.array([layer.age_gyr]))[0]) * float(s[0] - s[1]) * 1e-6
+    if layer.equilibrium is None or not density > 0:
+        return density, 1.0
+    b0, b1 = get_equilibrium(layer.equilibrium).coefficients
+    e = _p10(b0 + b1 * portable_log(np.array([lo, hi]) * 1e-3) / _LN10)
+    cap = float(e[0] - e[1]) * 1e-6
+    return (cap, cap / density) if cap < density else (density, 1.0)
+
+
+def _bisect(f, target: np.ndarray, a: float, b: float, increasing: bool) -> np.ndarray:
+    """x in [a, b] with f(x) = target (f monotone), by bisection: the same bytes
+    everywhere when f is portable."""
+    lo = np.full(target.shape, float(a))
+    hi = np.full(target.shape, float(b))
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        below = (f(mid) < target) if increasing else (f(mid) > target)
+        lo = np.where(below, mid, lo)
+        hi = np.where(below, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def _model_age_draws(layer: ModelAgeLayer, lo: float, hi: float, share: float,
+                     u_d: np.ndarray, u_age: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Diameters in [lo, hi) and formation ages of a model-age layer's bin from uniforms."""
+    s = _pf_shape(layer, np.array([lo, hi]))
+    target = s[0] - u_d * (s[0] - s[1])
+    x = _bisect(lambda v: _pf_shape(layer, _p10(v) * 1e3), target,
+                math.log10(lo * 1e-3), math.log10(hi * 1e-3), increasing=False)
+    d = np.clip(_p10(x) * 1e3, lo, np.nextafter(hi, 0.0))
+    age = layer.age_gyr
+    n_t = float(_n1(layer, np.array([age]))[0])
+    ages = _bisect(lambda t: _n1(layer, t), u_age * share * n_t, 0.0, age, increasing=True)
+    return d, np.clip(ages, 0.0, age)
+
+
 def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key: int):
     """The cells' Poisson counts of bin ``b``: (cells, tag, cell of each draw, index in
     its cell, (lo, hi) metres)."""
@@ -132,7 +210,7 @@ def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key:
                          f"{area.shape}")
     lo, hi = bin_bounds(layer, b)
     tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
-    density = layer.c * float(_pow(np.array([lo]), layer.k)[0] - _pow(np.array([hi]), layer.k)[0])
+    density, _ = _bin_density(layer, lo, hi)
     zero = np.zeros(len(cells), dtype=np.int64)
     u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed, key)[:, 0])
     counts = poisson_from_uniform(u, area * density)
@@ -143,8 +221,8 @@ def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key:
     return tag, cell, index, (lo, hi)
 
 
-def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level: int,
-               cell_ids, area_m2) -> dict:
+def draw_cells(layer: CraterLayer | ModelAgeLayer, layer_index: int, *, seed: int, b: int,
+               level: int, cell_ids, area_m2) -> dict:
     """The craters of size bin ``b`` of ``layer`` in the given cells (ids of ``level``).
 
     Parameters
@@ -170,8 +248,12 @@ def draw_cells(layer: CraterLayer, layer_index: int, *, seed: int, b: int, level
     n = len(cell)
     main = _words(cell, tag, index, _MAIN, seed)
     um = uniform_from_words(main)
-    diameter = power_law_from_uniform(um[:, 0], lo, hi, layer.k) if n else np.zeros(0)
-    age = layer.age_min_gyr + um[:, 1] * (layer.age_max_gyr - layer.age_min_gyr)
+    if isinstance(layer, ModelAgeLayer):
+        diameter, age = _model_age_draws(layer, lo, hi, _bin_density(layer, lo, hi)[1],
+                                         um[:, 0], um[:, 1])
+    else:
+        diameter = power_law_from_uniform(um[:, 0], lo, hi, layer.k) if n else np.zeros(0)
+        age = layer.age_min_gyr + um[:, 1] * (layer.age_max_gyr - layer.age_min_gyr)
     rim = np.concatenate([uniform_from_words(_words(cell, tag, index, _RIM + r, seed))
                           for r in range(_RIM_COUNTERS)], axis=1)[:, :15] * _TWO_PI
     unit = _positions(cell, tag, index, seed)

@@ -4,7 +4,8 @@ Sequential stamping (:func:`latlong.stamp_craters`) fits each crater's base to w
 every older crater left, so a value can depend on craters anywhere. Here (DESIGN notes
 in the README, "Terrain on demand"):
 
-1. **Catalogue.** Each power-law layer's size bin ``[2**b, 2**(b+1))`` is drawn per cell
+1. **Catalogue.** Each crater layer's (power law or model age) size bin
+   ``[2**b, 2**(b+1))`` is drawn per cell
    of one level of the cube-sphere hierarchy (:mod:`craters.local`), the level a function
    of the bin and the body (cells at least an ejecta reach plus a radius wide), never of
    the request.
@@ -46,8 +47,8 @@ import dataclasses
 import numpy as np
 import numpy.lib.recfunctions as rfn
 
-from craters import CraterLayer
-from craters._shared import ParameterError, check_positive
+from craters import CraterLayer, ModelAgeLayer
+from craters._shared import check_positive
 from craters.catalog import make_catalog
 from craters.local import bin_bounds, bin_level, bins, draw_cells
 from craters.morphology import EJECTA_EDGE
@@ -138,15 +139,9 @@ class CraterField:
     def __init__(self, scene: Scene, base: BaseField | None = None):
         self.scene = scene
         self.base = base if base is not None else base_field(scene)
-        layers = scene.craters.layers
-        for la in layers:
-            if not isinstance(la, CraterLayer):
-                raise ParameterError("craters", "terrain on demand draws power-law crater layers "
-                                     f"(c=..,k=..); got a {type(la).__name__}")
         self.rocks = RockField(scene, self.base)
         self._params: dict[tuple[int, int], np.ndarray] = {}
-        self.layers: tuple[CraterLayer, ...] = tuple(
-            la for la in layers if isinstance(la, CraterLayer))
+        self.layers: tuple[CraterLayer | ModelAgeLayer, ...] = tuple(scene.craters.layers)
         self.target = scene.target()
         rough, irregular = resolve_roughness(scene.craters.roughness)
         self.rough = np.array([rough.bowl, rough.wall, rough.ejecta])

@@ -174,6 +174,17 @@ def test_a_height_is_the_same_alone_in_a_batch_and_in_the_whole_body(scene):
     assert len(body.craters) > 100
 
 
+def test_a_model_age_scene_on_demand_is_local_too():
+    sc = Scene.from_settings({"base": "sphere", "radius_m": 1737400.0, "body": "moon",
+                              "seed": 2, "on_demand": True,
+                              "craters": ["npf=moon,age_gyr=3.5,d_min_m=20,d_max_m=2000"]})
+    t = tile(sc, 1.0, 2.0, size_m=3000.0, pixel_m=30.0)
+    assert t.n_craters > 100 and np.ptp(t.heights_m) > 10.0
+    u = units_of(np.linspace(0.99, 1.01, 30), np.linspace(1.99, 2.01, 30))
+    every = crater_field(sc).radii(u, 90.0)
+    assert crater_field(sc).radii(u[7:8], 90.0).tobytes() == every[7:8].tobytes()
+
+
 def test_a_finer_resolution_changes_heights_only_where_the_added_craters_reach(scene):
     field = crater_field(scene)
     units = units_of(*np.meshgrid(np.linspace(30, 36, 70), np.linspace(40, 46, 70)))
