@@ -44,6 +44,8 @@ class DemBase(BaseField):
         self.radius_m = float(radius)
         self.min_radius_m = float(radius + h.min())
         self.gravity = False
+        self.stretch = np.ones(3)
+        self._stretched = False
         self._fbm = None
         self._grid = None
         self._radii = None

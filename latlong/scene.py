@@ -121,7 +121,7 @@ class Scene:
                               "cell by cell, every height a function of its position, "
                               "memory bounded by the region asked, not the whole body")
     """Terrain on demand (:mod:`latlong.ondemand`): no whole-body memory estimate (what
-    is made is bounded by the region asked); needs an unstretched lat/long body."""
+    is made is bounded by the region asked); needs a lat/long body (stretched or not)."""
 
     def __post_init__(self):
         check_declared(self)
@@ -177,9 +177,6 @@ class Scene:
         except ParameterError as exc:
             raise exc.renamed("boulders") from None
         if self.on_demand:
-            if tuple(body.stretch) != NO_STRETCH:
-                raise ParameterError("stretch", "must be 1,1,1 for terrain on demand (an "
-                                     "unstretched body)")
             if isinstance(base, ShapeBase) and base.surface != "latlong":
                 raise ParameterError("surface", "must be latlong for terrain on demand")
             return

@@ -25,7 +25,8 @@ __all__ = ["BaseField", "CraterField", "base_field", "crater_field", "heights_at
 
 def units_of(lat_deg, lon_deg) -> np.ndarray:
     """Unit vectors (n, 3) of latitudes and longitudes in degrees (the grid's
-    directions: planetocentric on an unstretched body)."""
+    directions: planetocentric on an unstretched body; on a stretched one, the surface's
+    own directions, :mod:`latlong.ondemand.base`)."""
     lat = np.radians(np.asarray(lat_deg, dtype=np.float64).ravel())
     lon = np.radians(np.asarray(lon_deg, dtype=np.float64).ravel())
     if lat.shape != lon.shape:

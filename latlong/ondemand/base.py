@@ -12,9 +12,16 @@ the same value whatever other directions are asked with it:
   faults are global and a shape model holds nothing finer than its facets, so both are
   made once per scene and read pointwise; a shape's fBm detail is pointwise.
 
+On a stretched body (axis stretch ``S``) a direction ``w`` of the stretched surface is
+the grid direction ``u = S^-1 w / |S^-1 w|`` stretched, so the radius along ``w`` is the
+base's radius along ``u`` times ``|S u| = 1 / |S^-1 w|``: everything on demand works in
+the surface's own directions, as on any star-shaped body, and a build on the grid asks
+for ``w = S u / |S u|`` (:func:`grid_directions`).
+
 It also gives what crater statistics need from the base: the surface area over a solid
-angle and the "up" slopes are measured against (radial, or against the self-gravity of a
-shape model, from a coarse grid of :func:`latlong.mesh.down_directions`).
+angle and the "up" slopes are measured against (radial; the stretched sphere's normal
+``S^-2 w`` on a stretched body, as the sequential stamp; or against the self-gravity of
+a shape model, from a coarse grid of :func:`latlong.mesh.down_directions`).
 """
 
 from __future__ import annotations
@@ -34,7 +41,7 @@ from ..scene import Scene
 from ..settings import ShapeBase, SphereBase
 from ..shapes import from_shape_model
 
-__all__ = ["MAX_BASE_MAGNITUDE", "BaseField", "base_field"]
+__all__ = ["MAX_BASE_MAGNITUDE", "BaseField", "base_field", "grid_catalog", "grid_directions"]
 
 #: Largest magnitude of the base grid of faulting and shape-model bases.
 MAX_BASE_MAGNITUDE = 1024
@@ -72,6 +79,8 @@ class BaseField:
         self._grid: LatLongGrid | None = None
         self._radii: np.ndarray | None = None
         self.gravity = isinstance(base, ShapeBase)
+        self.stretch = np.asarray(scene.body.stretch, dtype=np.float64)
+        self._stretched = bool((self.stretch != 1.0).any())
         rng = np.random.default_rng([self.seed, 1])
         reference = scene.body.radius_m
         if base is None or isinstance(base, SphereBase):
@@ -107,10 +116,20 @@ class BaseField:
         self.min_radius_m = self.radius_m if self._radii is None else float(self._radii.min())
         if self._fbm is not None:
             self.min_radius_m -= abs(float(self._fbm[4]))
+        self.min_radius_m *= float(self.stretch.min())
 
     def radius(self, unit) -> np.ndarray:
-        """Base radius (m) in each direction ``unit`` (n, 3) (unit vectors)."""
-        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        """Base radius (m) in each direction ``unit`` (n, 3) (unit vectors) of the surface
+        (module notes on stretched bodies)."""
+        w = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        if not self._stretched:
+            return self._grid_radius(w)
+        v = w / self.stretch
+        nv = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+        return self._grid_radius(v / nv[:, None]) / nv
+
+    def _grid_radius(self, u: np.ndarray) -> np.ndarray:
+        """The unstretched base's radius along grid directions ``u``."""
         if self._radii is not None:
             assert self._grid is not None
             colat = np.arctan2(np.hypot(u[:, 0], u[:, 1]), u[:, 2])
@@ -156,12 +175,42 @@ class BaseField:
         magnitude-48 grid)."""
         u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
         if not self.gravity:
-            return u.copy()
+            if not self._stretched:
+                return u.copy()
+            g = u / (self.stretch * self.stretch)  # the stretched sphere's normal
+            return g / np.sqrt((g * g).sum(axis=1, keepdims=True))
         grid, comps = self._up_grid
         colat = np.arctan2(np.hypot(u[:, 0], u[:, 1]), u[:, 2])
         lon = np.mod(np.arctan2(u[:, 1], u[:, 0]), 2.0 * np.pi)
         g = np.stack([grid.interpolate(c, colat, lon) for c in comps], axis=1)
         return g / np.linalg.norm(g, axis=1, keepdims=True)
+
+
+def grid_directions(base: BaseField, units: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(surface directions ``w = S u / |S u|``, ``|S u|``) of grid directions ``units``
+    on the base's body (``units`` and ones when unstretched): a grid vertex's radius
+    ``R(w) / |S u|`` puts it where the stretched body has it."""
+    u = np.asarray(units, dtype=np.float64).reshape(-1, 3)
+    if not base._stretched:
+        return u, np.ones(len(u))
+    v = u * base.stretch
+    n = np.sqrt(v[:, 0] * v[:, 0] + v[:, 1] * v[:, 1] + v[:, 2] * v[:, 2])
+    return v / n[:, None], n
+
+
+def grid_catalog(base: BaseField, catalog: np.ndarray) -> np.ndarray:
+    """``catalog`` with ``lat_deg``/``lon_deg`` of the grid directions ``u = S^-1 w /
+    |S^-1 w|`` of its centres (a stretched Body's catalogues, as the sequential stamp's,
+    name grid directions); the same array when unstretched."""
+    if not base._stretched or not len(catalog):
+        return catalog
+    lat, lon = np.radians(catalog["lat_deg"]), np.radians(catalog["lon_deg"])
+    v = np.stack([np.cos(lat) * np.cos(lon), np.cos(lat) * np.sin(lon), np.sin(lat)],
+                 axis=1) / base.stretch
+    out = catalog.copy()
+    out["lat_deg"] = np.degrees(np.arctan2(v[:, 2], np.hypot(v[:, 0], v[:, 1])))
+    out["lon_deg"] = np.degrees(np.arctan2(v[:, 1], v[:, 0]))
+    return out
 
 
 def _normalized(v: np.ndarray) -> np.ndarray:

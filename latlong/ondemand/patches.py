@@ -19,6 +19,7 @@ from ..body import Body
 from ..grid import LatLongGrid
 from ..scene import Scene
 from ..scratch import drop_pages
+from .base import grid_catalog, grid_directions
 
 __all__ = ["PATCH_VERTICES", "build_patches", "patch_count", "patch_ranges"]
 
@@ -50,9 +51,9 @@ def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]
     grid = LatLongGrid(scene.body.magnitude)
     field = crater_field(scene)
     d_min = 3.0 * grid.spacing(field.base.radius_m)
-    units = grid.unit_vectors_range(start, stop)
-    radii = field.radii(units, d_min)
-    cat = field.last_catalog()
+    w, scale = grid_directions(field.base, grid.unit_vectors_range(start, stop))
+    radii = field.radii(w, d_min) / scale  # on a stretched body: where the Body puts it
+    cat = grid_catalog(field.base, field.last_catalog())
     # the vertex nearest each crater's centre (its ring, its place on the ring) is the
     # owning patch's; the patch's craters hold every crater within reach of its vertices
     ring = np.clip(np.round((90.0 - cat["lat_deg"]) / 180.0 * 2 * grid.magnitude), 0,
@@ -99,7 +100,7 @@ def build_patches(scene: Scene, *, patches: int | None = None, backend: str | No
     cat = cat[order]
     field = crater_field(scene)
     d_min = 3.0 * grid.spacing(field.base.radius_m)
-    return Body(grid, radii, radius_m=field.base.radius_m,
+    return Body(grid, radii, radius_m=field.base.radius_m, stretch=scene.body.stretch,
                 metadata={**scene.body_metadata({}), "on_demand": True,
                           "min_crater_diameter_m": d_min, "patches": len(items)},
                 craters=rfn.repack_fields(cat), copy=False)

@@ -95,6 +95,7 @@ from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_
 from latlong import Body, LatLongGrid, Scene, stamp_craters
 from latlong.cratering import crater_extents_deg
 from latlong.ondemand import _field_kernels as K  # the field's per-crater record columns
+from latlong.ondemand.base import grid_catalog, grid_directions
 from latlong.ondemand.field import BLEND_EDGE, ROUGHNESS_OCTAVES, CraterField
 from latlong.settings import ShapeBase
 from latlong.slopes import radius_spectrum, slope_summary, slopes_and_areas
@@ -355,9 +356,10 @@ def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> S
     t0 = time.perf_counter()
     # no boulders: the sequential stamp places them as meshes, the field as relief; the
     # comparison is of the crater models
-    # "NAME:unstretched": the preset without its axis stretch (terrain on demand refuses
-    # stretched bodies; stretching both surfaces afterwards would compare elongated
-    # on-demand craters with round sequential ones)
+    # "NAME:unstretched": the preset without its axis stretch. On a stretched body the
+    # field works in the surface's directions w = S u / |S u| (latlong.ondemand.base):
+    # the on-demand radii are R(w) / |S u| (where the Body puts vertex u), the catalogue
+    # the sequential stamp takes names grid directions (grid_catalog)
     name, _, variant = preset.partition(":")
     extra = {"stretch": [1.0, 1.0, 1.0]} if variant == "unstretched" else {}
     scene = Scene.from_settings({"preset": name, "seed": seed, "magnitude": magnitude,
@@ -365,16 +367,17 @@ def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> S
     grid = LatLongGrid(magnitude)
     units = grid.unit_vectors()
     field = CraterField(scene)  # not crater_field: its lru_cache cannot hash shape scenes
+    w, scale = grid_directions(field.base, units)
     radius_m = float(field.base.radius_m)
     res = math.pi * radius_m / (2 * magnitude)
-    base = field.base.radius(units)
-    cat = field.catalog(units, 3.0 * res)
+    base = field.base.radius(w) / scale
+    cat = grid_catalog(field.base, field.catalog(w, 3.0 * res))
     # the catalogue as drawn: its degradation reports what the field made (diffusion and
     # slope erosion); the sequential stamp takes a number there as an override, so it gets
     # NaN (degradation from the age), as the build's catalogue has
     cat["degradation"] = np.nan
     t1 = time.perf_counter()
-    radii = field.radii(units, 3.0 * res)
+    radii = field.radii(w, 3.0 * res) / scale
     t_od = time.perf_counter() - t1
     cr = field.last["craters"]
     assert len(np.unique(cr.id)) == len(cr) and set(cr.id.tolist()) == set(cat["id"].tolist())
@@ -390,6 +393,7 @@ def build_surfaces(preset: str, seed: int, magnitude: int, roughness: bool) -> S
         np.ascontiguousarray(rims), np.ascontiguousarray(cr.seed[ci[ok]])))
     return SimpleNamespace(
         scene=scene, grid=grid, units=units, tree=cKDTree(units), field=field, res=res,
+        w=w, scale=scale, wtree=cKDTree(w),
         radius_m=radius_m, base=base, body0=body0, cat=cat, ok=ok, ci=ci, cr=cr,
         fc=field.last["fc"], od=Body(grid, radii, radius_m=radius_m, stretch=scene.body.stretch),
         seq=seq, seqm=seqm, t0=t0, t_od=t_od, t_seq=t_seq)
@@ -404,7 +408,7 @@ def height_stats(s: SimpleNamespace) -> dict:
     # vertices the too-large craters (on demand only) reach are left out of dh
     far = np.zeros(len(s.units), bool)
     for k in s.ci[~s.ok]:
-        far[s.tree.query_ball_point(fc[k, K.C0:K.C2 + 1],
+        far[s.wtree.query_ball_point(fc[k, K.C0:K.C2 + 1],
                                     2.0 * np.sin(min(fc[k, K.FAR], np.pi) / 2.0))] = True
     area = float(band_areas(s.body0).sum())  # what the build draws its population on
     expected = sum(la.c * (max(d_min, la.d_min_m) ** la.k - la.d_max_m ** la.k)
@@ -456,12 +460,18 @@ def crater_stats(s: SimpleNamespace) -> dict:
     b_hi = int(np.floor(np.log2(cr.diameter_m.max())))
     big = cr.diameter_m >= DD_MIN_RES * s.res
     fresh = fc[:, K.DEPTH] >= FRESH_DD * cr.diameter_m  # the profile's depth (catalogue)
-    base_c = s.field.base.radius(cu)
+    # depth_ratios takes grid directions and the unstretched base radius (u = S^-1 w / n,
+    # R(w) n with n = |S^-1 w|: the same point)
+    v = cu / np.asarray(s.scene.body.stretch)
+    nv = np.linalg.norm(v, axis=1)
+    base_c = s.field.base.radius(cu) * nv
+    cu_grid = v / nv[:, None]
     dd = {}
     for name, body, vis in (("ondemand", s.od, vis_od), ("seq", s.seq, vis_sq)):
         sel = np.flatnonzero(vis & big)
         dd[name] = np.full(len(cr), np.nan)
-        dd[name][sel] = depth_ratios(body, s.tree, cu[sel], base_c[sel], cr.diameter_m[sel],
+        dd[name][sel] = depth_ratios(body, s.tree, cu_grid[sel], base_c[sel],
+                                     cr.diameter_m[sel],
                                      s.scene.body.stretch)
     both = np.isfinite(dd["ondemand"]) & np.isfinite(dd["seq"])
 
@@ -495,7 +505,8 @@ def run_scene(preset: str, seed: int, magnitude: int, png_dir: Path | None,
     out["spectrum"] = {"bands": list(sp_od), "ondemand": list(sp_od.values()),
                        "seq": list(sp_sq.values()),
                        "diff_matched": list(spectrum_bands(diff, l_max).values())}
-    top_x, out["older_inside"] = older_inside_check(s.field, s.units, s.od.radii_m, s.tree)
+    top_x, out["older_inside"] = older_inside_check(s.field, s.w, s.od.radii_m * s.scale,
+                                                    s.wtree)
     # where the differences are: by the youngest stamped crater reaching each vertex
     adh = np.abs(s.od.radii_m - s.seqm.radii_m)
     zones = {"inside rim": top_x <= 1.0, "rim to 1.5 radii (blend)": (top_x > 1.0)

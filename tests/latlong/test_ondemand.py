@@ -277,9 +277,33 @@ def test_descent_lidar_sees_the_frames_terrain_as_the_camera_does(scene):
                      lidar=LidarSettings(fov_deg=80.0)))
 
 
-def test_on_demand_refuses_a_stretched_body():
-    with pytest.raises(ValueError, match="stretch"):
-        Scene.from_settings({"preset": "paper", "on_demand": True})
+def test_a_stretched_body_on_demand_is_its_stretched_surface():
+    from latlong.ondemand import heights_at_units
+
+    def stretched(craters):
+        return Scene.from_settings({"base": "sphere", "radius_m": 100.0, "seed": 3,
+                                    "stretch": [2.0, 1.0, 0.8], "magnitude": 40,
+                                    "on_demand": True, "craters": craters})
+
+    v = build(stretched([])).vertices()
+    assert np.allclose((v[:, 0] / 200) ** 2 + (v[:, 1] / 100) ** 2 + (v[:, 2] / 80) ** 2, 1.0,
+                       rtol=0, atol=1e-12)
+    sc = stretched(["c=0.5,k=-2,d_min_m=4,d_max_m=15"])
+    body = build(sc)
+    v = body.vertices()
+    r = np.linalg.norm(v, axis=1)
+    pick = np.random.default_rng(2).choice(len(v), 200, replace=False)
+    # a vertex lies where heights_at puts the surface along its direction
+    got = heights_at_units(sc, v[pick] / r[pick, None],
+                           resolution_m=body.grid.spacing(crater_field(sc).base.radius_m))
+    assert np.allclose(got, r[pick], rtol=1e-13, atol=0)
+    assert len(body.craters) > 50 and np.abs(r - np.linalg.norm(
+        build(stretched([])).vertices(), axis=1)).max() > 0.5
+    # slopes are measured against the stretched sphere's normal, as the sequential stamp
+    u = units_of([30.0], [40.0])
+    up = crater_field(sc).base.up(u)[0]
+    n = u[0] / np.array([4.0, 1.0, 0.64])
+    assert np.allclose(up, n / np.linalg.norm(n), atol=1e-15)
 
 
 def test_stencil_points_match_numpy(scene):
