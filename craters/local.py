@@ -46,6 +46,7 @@ from .boulders.placement import MIN_BURIAL
 from .cells import cell_parts, cell_points
 from .chronology import get_chronology_system, get_equilibrium
 from .counter import (
+    MAX_POISSON_MEAN,
     philox4x64,
     poisson_from_uniform,
     portable_exp,
@@ -211,9 +212,20 @@ def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key:
     lo, hi = bin_bounds(layer, b)
     tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
     density, _ = _bin_density(layer, lo, hi)
-    zero = np.zeros(len(cells), dtype=np.int64)
-    u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed, key)[:, 0])
-    counts = poisson_from_uniform(u, area * density)
+    mean = area * density
+    # a mean beyond what one inversion holds is the sum of `parts` Poisson counts of
+    # mean / parts (exactly Poisson), the j-th from counter index j (j = 0: the one draw)
+    parts = np.maximum(1, np.ceil(mean / MAX_POISSON_MEAN)).astype(np.int64)
+    if (parts == 1).all():
+        zero = np.zeros(len(cells), dtype=np.int64)
+        u = uniform_from_words(_words(cells, tag, zero, _COUNT, seed, key)[:, 0])
+        counts = poisson_from_uniform(u, mean)
+    else:
+        rep = np.repeat(np.arange(len(cells)), parts)
+        j = np.arange(len(rep), dtype=np.int64) - np.repeat(np.cumsum(parts) - parts, parts)
+        u = uniform_from_words(_words(cells[rep], tag, j, _COUNT, seed, key)[:, 0])
+        sub = poisson_from_uniform(u, (mean / parts)[rep])
+        counts = np.add.reduceat(sub, np.cumsum(parts) - parts) if len(rep) else sub
     cell = np.repeat(cells, counts)
     # each draw's index within its cell: 0, 1, .. counts - 1, cell after cell
     index = np.arange(len(cell), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts,

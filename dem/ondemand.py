@@ -8,6 +8,13 @@ direction (Catmull-Rom bicubic through the pixel centres, C1; a DEM in a geograp
 longitude and latitude in degrees); :func:`dem_tile` makes a window of it and
 :func:`dem_descent` flies a descent over it. Below the DEM's pixel the base is its smooth
 interpolant: the craters make the finer relief.
+
+:class:`StackBase` does the same over an enhanced layer stack (:func:`dem.enhance`, its
+``manifest.json``): at each point the finest layer that holds it, blended into the next
+coarser one over the finer layer's outer :data:`EDGE_PX` pixels (no seam where a layer
+ends; the layers of a stack agree where they overlap, so the blend only hides their
+interpolants' difference). The stack is the coarse truth, craters and rocks included:
+give on-demand layers that continue below what the stack holds.
 """
 
 from __future__ import annotations
@@ -21,8 +28,12 @@ from latlong.ondemand.field import CraterField
 from latlong.ondemand.tile import Tile, check_window, tile_of_field
 
 from .core import Dem
+from .stack import Stack
 
-__all__ = ["DemBase", "dem_descent", "dem_tile"]
+__all__ = ["EDGE_PX", "DemBase", "StackBase", "dem_descent", "dem_tile"]
+
+#: Pixels of a finer stack layer over which it is blended into the coarser one.
+EDGE_PX = 8.0
 
 
 class DemBase(BaseField):
@@ -39,16 +50,7 @@ class DemBase(BaseField):
         if not np.isfinite(h).all():
             raise ParameterError("dem", "must have no unknown (NaN) pixels: fill its gaps "
                                  "first (dem fill)")
-        self.scene = None
-        self.seed = int(seed)
-        self.radius_m = float(radius)
-        self.min_radius_m = float(radius + h.min())
-        self.gravity = False
-        self.stretch = np.ones(3)
-        self._stretched = False
-        self._fbm = None
-        self._grid = None
-        self._radii = None
+        _raster_base(self, seed, float(radius), float(radius + h.min()))
         self.dem = dem
         self._h = np.ascontiguousarray(h)
         if dem.crs is not None and not dem.crs.is_geographic:
@@ -86,6 +88,49 @@ class DemBase(BaseField):
         return self.radius_m + out
 
 
+class StackBase(BaseField):
+    """An enhanced layer stack as the base of a local crater field (module notes)."""
+
+    def __init__(self, stack: Stack, *, seed: int, radius_m: float | None = None):
+        if not isinstance(stack, Stack):
+            raise TypeError(f"`stack` must be a dem.Stack; got {type(stack).__name__}")
+        self.levels = [DemBase(d, seed=seed, radius_m=radius_m) for d in stack.layers]
+        _raster_base(self, seed, self.levels[0].radius_m,
+                     min(b.min_radius_m for b in self.levels))
+        self.dem = stack.layers[0]
+
+    def radius(self, unit) -> np.ndarray:
+        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
+        r = self.levels[0].radius(u)  # refuses points outside the coarsest layer
+        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
+        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+        for level in self.levels[1:]:
+            row, col = level._pixels(lat, lon)
+            ny, nx = level._h.shape
+            edge = np.minimum(np.minimum(row, ny - 1 - row), np.minimum(col, nx - 1 - col))
+            t = np.clip(edge / EDGE_PX, 0.0, 1.0)
+            w = t * t * (3.0 - 2.0 * t)  # smoothstep: C1 into the coarser layer
+            inside = np.flatnonzero(w > 0.0)
+            if len(inside):
+                r[inside] += w[inside] * (level.radius(u[inside]) - r[inside])
+        return r
+
+
+def _raster_base(base: BaseField, seed: int, radius_m: float, min_radius_m: float) -> None:
+    """The :class:`BaseField` state of a raster base: no scene, a sphere of ``radius_m``
+    under the raster's heights, radial "up", no stretch, no grid or fBm of a scene."""
+    base.scene = None
+    base.seed = int(seed)
+    base.radius_m = radius_m
+    base.min_radius_m = min_radius_m
+    base.gravity = False
+    base.stretch = np.ones(3)
+    base._stretched = False
+    base._fbm = None
+    base._grid = None
+    base._radii = None
+
+
 def _catmull_rom(t: np.ndarray) -> list[np.ndarray]:
     """The four Catmull-Rom weights of the samples at -1, 0, 1, 2 for fractions ``t``
     (a C1 surface through the pixel centres: no facets at the DEM's pixel)."""
@@ -95,8 +140,9 @@ def _catmull_rom(t: np.ndarray) -> list[np.ndarray]:
             0.5 * (-3.0 * t3 + 4.0 * t2 + t), 0.5 * (t3 - t2)]
 
 
-def dem_tile(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float,
-             pixel_m: float, min_crater_px: float = 3.0, radius_m: float | None = None) -> Tile:
+def dem_tile(dem: Dem | Stack, scene: Scene, lat_deg: float, lon_deg: float, *,
+             size_m: float, pixel_m: float, min_crater_px: float = 3.0,
+             radius_m: float | None = None) -> Tile:
     """A window of the DEM with the scene's craters on demand (module notes): the scene
     gives the crater layers, the body (their shapes) and the seed; the DEM the base."""
     if not isinstance(scene, Scene):
@@ -110,20 +156,22 @@ def dem_tile(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, *, size_m: 
 _FIELDS: list = []
 
 
-def _field(dem: Dem, scene: Scene, radius_m) -> CraterField:
+def _field(dem: Dem | Stack, scene: Scene, radius_m) -> CraterField:
     """The crater field of (DEM, scene), made once."""
     for d, s, r, field in _FIELDS:
         if d is dem and s is scene and r == radius_m:
             return field
     assert scene.seed is not None
-    field = CraterField(scene, DemBase(dem, seed=scene.seed, radius_m=radius_m))
+    base = StackBase(dem, seed=scene.seed, radius_m=radius_m) if isinstance(dem, Stack) \
+        else DemBase(dem, seed=scene.seed, radius_m=radius_m)
+    field = CraterField(scene, base)
     _FIELDS.insert(0, (dem, scene, radius_m, field))
     del _FIELDS[2:]
     return field
 
 
-def dem_descent(dem: Dem, scene: Scene, lat_deg: float, lon_deg: float, altitudes_m, *,
-                radius_m: float | None = None, **camera):
+def dem_descent(dem: Dem | Stack, scene: Scene, lat_deg: float, lon_deg: float,
+                altitudes_m, *, radius_m: float | None = None, **camera):
     """Frames of a vertical descent over a DEM site with the scene's craters on demand
     (:func:`latlong.ondemand.descent.descent`; ``camera``: its keyword options). Every
     frame's window must lie inside the DEM."""

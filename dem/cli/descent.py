@@ -1,4 +1,5 @@
-"""``dem descent``: camera frames of a vertical descent over a DEM site, the DEM as the
+"""``dem descent``: camera frames of a vertical descent over a DEM site (or an enhanced
+layer stack, the finest layer holding each point), the DEM as the
 base and craters (and rocks) made on demand for each frame at its own ground pixel
 (:func:`dem.ondemand.dem_descent`); the files of ``latlong descent``."""
 
@@ -14,12 +15,12 @@ from latlong.cli.descent import (
     write_descent_run,
 )
 
-from .options import INPUT, READ, RUN, dem_command, read_input
-from .tile import LAYERS, scene_of
+from .options import READ, RUN, dem_command
+from .tile import LAYERS, SITE, read_site, scene_of
 
 __all__ = ["register"]
 
-OPTIONS = {"input": INPUT, **READ, **LAYERS, **DESCENT, **LIDAR, **RUN}
+OPTIONS = {"input": SITE, **READ, **LAYERS, **DESCENT, **LIDAR, **RUN}
 
 
 def _descent(v: Values) -> int:
@@ -30,7 +31,7 @@ def _descent(v: Values) -> int:
     if v["stop_m"] > v["start_m"]:
         raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
     out = check_descent_folder(v)
-    dem = read_input(v)
+    dem = read_site(v)
     scene = scene_of(dem, v)
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
     frames = dem_descent(dem, scene, v["lat_deg"], v["lon_deg"], alts, **camera_options(v))

@@ -1,10 +1,13 @@
 """``dem tile``: a window of a DEM with craters made on demand (:mod:`dem.ondemand`)
 around any point at any pixel size: a cloud-optimised GeoTIFF of heights in the local
 gnomonic projection (metres above the sphere of the DEM's radius at the centre), the
-window as a mesh, a shaded picture."""
+window as a mesh, a shaded picture. The input may be an enhanced layer stack (its
+``manifest.json`` or folder, ``dem enhance``): the finest layer holding each point is the
+base (:class:`dem.ondemand.StackBase`)."""
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 
 from craters.cli.kit import CliError
@@ -13,13 +16,14 @@ from latlong.cli.tile import TILE_OUTPUTS, WINDOW
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
-__all__ = ["LAYERS", "register", "scene_of"]
+__all__ = ["LAYERS", "SITE", "read_site", "register", "scene_of"]
 
 #: The layers made on demand over a DEM: craters, rocks, their seed.
 LAYERS = {
     "craters": Setting(help="crater layer c=0.08,k=-2,d_min_m=1,d_max_m=1000[,age_min_gyr,"
-                       "age_max_gyr,degradation,kind] (N_cum = c D^k per m^2, D in metres; "
-                       "repeatable)", many="append", metavar="SPEC", run=True),
+                       "age_max_gyr,degradation,kind] (N_cum = c D^k per m^2, D in metres) "
+                       "or npf=moon,age_gyr=3.8,d_min_m=10,d_max_m=1000[,equilibrium] (a "
+                       "model age; repeatable)", many="append", metavar="SPEC", run=True),
     "boulders": Setting(help="rock layer c=7e-4,k=-2.11,d_min_m=0.05,d_max_m=5[,burial_max] "
                         "(N_cum = c D^k per m^2; faceted rocks in the height field; "
                         "repeatable)", many="append", metavar="SPEC", run=True),
@@ -27,13 +31,37 @@ LAYERS = {
                     kind=int, range=(0, 2**63 - 1), run=True, default_text="a fresh one"),
 }
 
-OPTIONS = {"input": INPUT, **READ, **WINDOW, **LAYERS, **TILE_OUTPUTS, **RUN}
+#: The input of the on-demand commands: a DEM or a layer stack.
+SITE = dataclasses.replace(INPUT, help="a DEM (GeoTIFF, PDS .lbl/.img) or an enhanced layer "
+                           "stack (its manifest.json or folder)")
+OPTIONS = {"input": SITE, **READ, **WINDOW, **LAYERS, **TILE_OUTPUTS, **RUN}
+
+
+def read_site(v: Values):
+    """The input of ``dem tile`` / ``dem descent``: a DEM, or a layer stack (a manifest
+    or its folder)."""
+    from pathlib import Path
+
+    path = Path(v["input"])
+    if path.is_dir() or path.suffix.lower() == ".json":
+        from ..stack import read_stack
+
+        try:
+            return read_stack(path)
+        except (OSError, ValueError) as exc:
+            raise CliError(f"INPUT: {exc}") from None
+    return read_input(v)
 
 
 def scene_of(dem, v: Values):
-    """The on-demand scene of a DEM command: a sphere of the DEM's body radius with the
-    options' crater and rock layers and seed."""
+    """The on-demand scene of a DEM command: a sphere of the DEM's (a stack's coarsest
+    layer's) body radius with the options' crater and rock layers and seed."""
     from latlong import Scene
+
+    from ..stack import Stack
+
+    if isinstance(dem, Stack):
+        dem = dem.layers[0]
 
     if not v["craters"] and not v["boulders"]:
         raise CliError("give at least one --craters or --boulders layer (the DEM holds the "
@@ -64,7 +92,7 @@ def _tile(v: Values) -> int:
                 raise CliError(f"--{key}: {exc}") from None
     if not outs:
         raise CliError("nothing to write: give -o/--output, --mesh or --picture")
-    dem = read_input(v)
+    dem = read_site(v)
     scene = scene_of(dem, v)
     made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],
                     pixel_m=v["pixel_m"], min_crater_px=v["min_crater_px"])

@@ -96,3 +96,46 @@ def test_dem_descent_writes_the_frames_strip_and_manifest(tmp_path):
     assert main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "-o",
                  str(tmp_path / "e")]) == 2
     assert not (tmp_path / "e").exists()
+
+
+@pytest.fixture(scope="module")
+def stack(lola):
+    return dem.enhance({"layers": 3, "size": 65, "target": [180.0, 0.0], "seed": 4,
+                        "craters": []}, dem=lola)
+
+
+def test_a_stack_base_is_its_finest_layer_inside_and_blends_without_a_seam(stack, scene):
+    from dem.ondemand import EDGE_PX, StackBase
+
+    base = StackBase(stack, seed=1)
+    fine, coarse = (DemBase(d, seed=1) for d in (stack.layers[-1], stack.layers[-2]))
+    t = stack.layers[-1].transform
+    ny, nx = stack.layers[-1].shape
+    # inside the blend band's inner edge: the finest layer; far outside: the coarser one
+    inner = units_of([t.f + (ny / 2) * t.e], [t.c + (nx / 2) * t.a])
+    assert base.radius(inner)[0] == fine.radius(inner)[0]
+    outer = units_of([t.f + (ny / 2) * t.e], [t.c - 3.0 * t.a])
+    assert base.radius(outer)[0] == coarse.radius(outer)[0]
+    # across the finest layer's west edge: steps between neighbours of a few cm at most
+    # (the layers' relief there spans metres), no jump where the layer starts
+    lon = t.c + np.linspace(-4.0, EDGE_PX + 4.0, 600) * t.a
+    r = base.radius(units_of(np.full(600, t.f + (ny / 2) * t.e), lon))
+    assert np.abs(np.diff(r)).max() < 0.05 * np.ptp(r)
+    # a window over the stack
+    made = dem_tile(stack, scene, 0.0, 180.0, size_m=20000.0, pixel_m=200.0)
+    assert np.isfinite(made.heights_m).all() and made.n_craters > 0
+
+
+def test_dem_tile_reads_a_stack_manifest(stack, tmp_path):
+    from dem.cli import main
+
+    stack.write(tmp_path / "st")
+    out = tmp_path / "t.tif"
+    assert main(["tile", str(tmp_path / "st" / "manifest.json"), "--lat-deg", "0",
+                 "--lon-deg", "180", "--size-m", "4000", "--pixel-m", "40", "--craters",
+                 "c=0.08,k=-2,d_min_m=100,d_max_m=1000", "--seed", "1", "-q", "-o",
+                 str(out)]) == 0
+    assert out.is_file()
+    assert main(["tile", str(tmp_path / "nothing.json"), "--lat-deg", "0", "--lon-deg", "180",
+                 "--size-m", "4000", "--pixel-m", "40", "--craters",
+                 "c=0.08,k=-2,d_min_m=100,d_max_m=1000", "-o", str(tmp_path / "u.tif")]) == 2

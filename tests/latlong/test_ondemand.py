@@ -49,6 +49,20 @@ def test_cells_draw_the_expected_counts_in_their_cells_and_bins():
     assert ((got["age_gyr"] >= 0.0) & (got["age_gyr"] < 3.5)).all()
 
 
+def test_a_cell_mean_beyond_one_inversion_is_a_sum_of_poisson_counts():
+    la = CraterLayer(0.5, -2.0, 1.0, 8.0)
+    ids, omega = _cells(10, n=20)
+    area = omega * 250000.0**2  # ~4 600 craters a cell: ten draws of a tenth each
+    got = draw_cells(la, 0, seed=3, b=1, level=10, cell_ids=ids, area_m2=area)
+    want = area * la.expected_count(1.0, 2.0, 4.0)
+    assert want.min() > 1000
+    assert abs(len(got["diameter_m"]) - want.sum()) < 4 * np.sqrt(want.sum())
+    order = np.argsort(ids)
+    count = np.bincount(order[np.searchsorted(ids[order], got["cell"])], minlength=len(ids))
+    assert 0.72 < np.var(count - want) / want.mean() < 1.28  # Poisson: 1 (400 cells)
+    assert len(np.unique(got["id"])) == len(got["id"])
+
+
 def test_a_cell_draws_the_same_craters_whatever_else_is_drawn():
     la = CraterLayer(0.5, -2.0, 1.0, 8.0)
     ids, omega = _cells(10, n=30)
