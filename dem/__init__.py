@@ -132,7 +132,9 @@ target), so the stack spans 2^(layers-1) in resolution at a fixed cost per layer
 Craters come from **one** population for the area of layer 0, split so that each crater
 goes into the finest layer that contains it entirely (ejecta edge 1.5 D, one pixel clear
 of the border) if that layer resolves it (D >= 2 pixels); the others are counted as
-rejected (``manifest.json``: drawn = stamped + erased on steep ground + rejected). It is
+rejected; a crater inside the rim of a larger, younger one (of any layer) was erased by
+it and is dropped (``manifest.json``: drawn = stamped + erased on steep ground + erased
+by a younger crater + rejected). It is
 drawn band by band in diameter over the area where each band can be kept (the same
 Poisson law, without generating the ~1e11 craters too small to keep). A layer's craters
 are stamped before the next layer is expanded, and the coarser layers are then

@@ -203,7 +203,8 @@ def enhance(config, *, dem: Dem | None = None, progress: bool = False) -> Stack:
     >>> s.shapes, s.pixel_sizes_m(), s.is_consistent()
     ([(17, 17), (17, 17), (17, 17)], [100.0, 50.0, 25.0], True)
     >>> c = s.info["craters"]
-    >>> c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    >>> c["drawn"] == (sum(c["stamped"]) + sum(c["erased_on_steep_ground"])
+    ...                + sum(c["erased_by_younger_crater"]) + c["rejected"])
     True
     """
     run = prepare(config, dem)
@@ -351,8 +352,10 @@ def stack_info(run: Run, stamped, rocks) -> dict:
     accounting = run.accounting
     n_stamped = [len(c) for c in stamped]
     accounting["stamped"] = n_stamped
-    accounting["erased_on_steep_ground"] = [a - s for a, s in
-                                            zip(accounting["assigned"], n_stamped, strict=True)]
+    accounting["erased_on_steep_ground"] = [
+        a - e - s for a, e, s in zip(accounting["assigned"],
+                                     accounting["erased_by_younger_crater"], n_stamped,
+                                     strict=True)]
     rock_accounting = run.rock_accounting
     if rock_accounting is not None:
         n_rocks = [0 if r is None else len(r) for r in rocks]

@@ -27,8 +27,14 @@ all of those lie inside layer b's area. A Poisson process restricted to disjoint
 so drawing band b (``craters.population`` over layer b's area, the law truncated to the
 band) and only *counting* the craters of the band outside layer b's area (one Poisson
 number each, as for the diameters below the finest layer's ``m`` pixels) yields exactly
-the distribution of "one catalog for layer 0, then split". Every count is recorded:
-drawn = stamped + erased on steep ground + rejected.
+the distribution of "one catalog for layer 0, then split".
+
+A crater whose centre lies inside the rim of a larger, *younger* crater of any layer was
+erased when that crater formed: it is dropped before stamping (:func:`erased_by_younger`),
+so no layer shows (or lists) an older crater inside a younger rim -- across layers too,
+where the finer layer's stamping could not know the coarser crater's age. Every count is
+recorded: drawn = stamped + erased on steep ground + erased by a younger crater +
+rejected.
 
 Boulders (``min_boulder_px``) are split by the same banded draw (:func:`plan_boulders`):
 each goes into the finest layer that holds its whole footprint (``0.87 D`` from its
@@ -302,10 +308,36 @@ def plan_craters(specs, geometry: StackGeometry, *, min_px: float, reach_radii: 
     per_layer, accounting = _plan_banded(specs, geometry, drawn, min_px=min_px, seed=seed)
     empty = craters.make_catalog(x_m=[], y_m=[], diameter_m=[], layer=np.zeros(0, np.int64),
                                  index=np.zeros(0, np.int64))
-    catalogs = [craters.sort_oldest_first(np.concatenate(parts) if parts else empty)
-                for parts in per_layer]
+    catalogs = [np.concatenate(parts) if parts else empty for parts in per_layer]
+    gone = erased_by_younger(catalogs)
+    accounting["erased_by_younger_crater"] = [int(g.sum()) for g in gone]
+    catalogs = [craters.sort_oldest_first(c[~g]) for c, g in zip(catalogs, gone, strict=True)]
     accounting.update(min_crater_px=min_px, reach_radii=reach_radii)
     return catalogs, accounting
+
+
+def erased_by_younger(catalogs) -> list[np.ndarray]:
+    """Per catalog, which craters have their centre inside the rim (``diameter_m / 2``
+    from its centre, ``x_m, y_m`` in one frame) of a larger crater of *any* catalog that
+    is younger (``age_gyr``): craters that crater erased when it formed."""
+    from scipy.spatial import cKDTree
+
+    sizes = [len(c) for c in catalogs]
+    if not sum(sizes):
+        return [np.zeros(n, bool) for n in sizes]
+    x = np.concatenate([c["x_m"] for c in catalogs])
+    y = np.concatenate([c["y_m"] for c in catalogs])
+    d = np.concatenate([c["diameter_m"] for c in catalogs])
+    age = np.concatenate([c["age_gyr"] for c in catalogs])
+    tree = cKDTree(np.column_stack([x, y]))
+    near = tree.query_ball_point(np.column_stack([x, y]), 0.5 * d)
+    counts = np.fromiter((len(v) for v in near), dtype=np.int64, count=len(near))
+    owner = np.repeat(np.arange(len(d)), counts)  # the containing (larger) crater
+    inner = np.fromiter((i for v in near for i in v), dtype=np.int64, count=int(counts.sum()))
+    hit = (d[inner] < d[owner]) & (age[inner] > age[owner])
+    gone = np.zeros(len(d), bool)
+    gone[inner[hit]] = True
+    return np.split(gone, np.cumsum(sizes)[:-1])
 
 
 def plan_boulders(specs, geometry: StackGeometry, *, min_px: float, seed: int):

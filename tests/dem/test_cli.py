@@ -316,7 +316,8 @@ def test_enhance_and_mesh_through_the_entry_point(run_cli, tmp_path, lola_tif):
     info = stack.info
     c = info["craters"]
     assert info["seed"] == 9 and sum(c["stamped"]) > 20
-    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    assert c["drawn"] == (sum(c["stamped"]) + sum(c["erased_on_steep_ground"])
+                          + sum(c["erased_by_younger_crater"]) + c["rejected"])
     ids = np.concatenate([cat["index"] for cat in stack.catalogs])
     assert len(ids) == len(set(ids.tolist()))
     # the target pixel is the centre of every layer

@@ -13,7 +13,7 @@ from affine import Affine
 import craters
 import dem
 from craters._shared import parameter_of
-from dem.planning import layer_windows, plan_craters, stack_geometry
+from dem.planning import erased_by_younger, layer_windows, plan_craters, stack_geometry
 
 REACH = craters.DEFAULT_EJECTA_EDGE * 1.02  # ejecta edge with the default rim irregularity
 
@@ -62,12 +62,36 @@ def test_layers_are_nested_and_2x_finer(stack, base):
         assert fine.level == coarse.level + 1
 
 
+def test_no_crater_is_older_than_a_larger_crater_whose_rim_holds_it(stack):
+    from dem.planning import erased_by_younger
+
+    cats = [c for c in stack.catalogs if len(c)]
+    x, y, d, a = (np.concatenate([c[k] for c in cats])
+                  for k in ("x_m", "y_m", "diameter_m", "age_gyr"))
+    dist = np.hypot(x[:, None] - x[None], y[:, None] - y[None])  # brute force, all layers
+    inside = (dist <= 0.5 * d[None]) & (d[:, None] < d[None]) & (a[:, None] > a[None])
+    assert not inside.any()
+    assert sum(stack.info["craters"]["erased_by_younger_crater"]) > 0  # there were some
+    # the filter against brute force on a drawn set, across two catalogs
+    rng = np.random.default_rng(5)
+    parts = [craters.make_catalog(x_m=rng.uniform(0, 1000, n), y_m=rng.uniform(0, 1000, n),
+                                  diameter_m=rng.pareto(1.0, n) * 20 + 5,
+                                  age_gyr=rng.uniform(0, 3.5, n)) for n in (300, 200)]
+    gone = np.concatenate(erased_by_younger(parts))
+    x, y, d, a = (np.concatenate([c[k] for c in parts])
+                  for k in ("x_m", "y_m", "diameter_m", "age_gyr"))
+    dist = np.hypot(x[:, None] - x[None], y[:, None] - y[None])
+    want = ((dist <= 0.5 * d[None]) & (d[:, None] < d[None]) & (a[:, None] > a[None])).any(1)
+    assert np.array_equal(gone, want) and want.sum() > 10
+
+
 def test_crater_accounting_adds_up_and_nothing_is_listed_twice(stack):
     c = stack.info["craters"]
     n = len(stack)
-    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
-    assert c["assigned"] == [s + e for s, e in zip(c["stamped"], c["erased_on_steep_ground"],
-                                                   strict=True)]
+    assert c["drawn"] == (sum(c["stamped"]) + sum(c["erased_on_steep_ground"])
+                          + sum(c["erased_by_younger_crater"]) + c["rejected"])
+    assert c["assigned"] == [s + e + y for s, e, y in zip(
+        c["stamped"], c["erased_on_steep_ground"], c["erased_by_younger_crater"], strict=True)]
     assert c["drawn"] == sum(b["drawn"] for b in c["bands"]) + c["rejected_below_finest"]
     for b in c["bands"]:
         assert b["drawn"] == b["assigned"] + b["rejected"]
@@ -168,9 +192,11 @@ def test_band_split_has_the_law_of_one_catalog_split_afterwards(text, runs):
             lim = half * p - REACH * dia / 2 - p  # centred layers: |x| <= (W-1)/2 p
             home[(np.abs(x) <= lim) & (np.abs(y) <= lim)] = k
         ok = (home >= 0) & (dia >= min_px * p0 / 2.0**np.maximum(home, 0))
-        for k in range(n_layers):
-            direct[run, k] = np.sum(ok & (home == k))
-            d_direct[k] += dia[ok & (home == k)].tolist()
+        # then the craters a larger, younger kept crater holds are erased, as planned
+        parts = [cat[ok & (home == k)] for k in range(n_layers)]
+        for k, (part, gone) in enumerate(zip(parts, erased_by_younger(parts), strict=True)):
+            direct[run, k] = np.sum(~gone)
+            d_direct[k] += part["diameter_m"][~gone].tolist()
     for k in range(n_layers):
         diff = banded[:, k].mean() - direct[:, k].mean()
         se = math.sqrt((banded[:, k].var() + direct[:, k].var()) / runs)
@@ -277,7 +303,8 @@ def test_model_age_craters_in_a_stack(lola_crop, tmp_path):
     specs = ["npf=moon,age_gyr=3.8,d_min_m=500,d_max_m=200000,equilibrium=trask"]
     s = dem.enhance({"layers": 4, "size": 65, "seed": 3, "craters": specs}, dem=lola_crop)
     c = s.info["craters"]
-    assert c["drawn"] == sum(c["stamped"]) + sum(c["erased_on_steep_ground"]) + c["rejected"]
+    assert c["drawn"] == (sum(c["stamped"]) + sum(c["erased_on_steep_ground"])
+                          + sum(c["erased_by_younger_crater"]) + c["rejected"])
     assert sum(c["stamped"]) > 5
     s.write(tmp_path / "st")
     got = craters.read_scc(tmp_path / "st" / "craters_01.scc")
