@@ -62,6 +62,17 @@ def test_layers_are_nested_and_2x_finer(stack, base):
         assert fine.level == coarse.level + 1
 
 
+def test_the_finest_layer_holds_a_target_on_a_coarse_pixel_corner(base):
+    # the corner of four layer-0 pixels: followed layer by layer, not only to layer 0's
+    # pixel (half a pixel of layer 0 away: 25 m here, 5 km on LOLA's 4 ppd)
+    target = (400000.0 + 64 * 50.0, 3000000.0 - 64 * 50.0)
+    s = dem.enhance({"layers": 6, "size": 65, "seed": 1, "target": list(target),
+                     "craters": []}, dem=base)
+    fine = s.layers[-1]
+    centre = np.array(fine.xy(32, 32))
+    assert np.abs(centre - target).max() <= fine.pixel_size_m[0]  # 1.56 m pixels
+
+
 def test_no_crater_is_older_than_a_larger_crater_whose_rim_holds_it(stack):
     from dem.planning import erased_by_younger
 
