@@ -28,14 +28,23 @@ _GRAD = np.array([[1.0, 0.0], [0.70710678118654752, 0.70710678118654752], [0.0, 
 @njit(cache=True, inline="always")
 def _table_value(tab, x, xe):
     """A crater's profile table (heights at ``tab.shape[0]`` evenly spaced radii over
-    [0, xe], :func:`craters.diffusion.profile_tables`) at ``x`` radii, linearly; 0 at and
-    beyond ``xe``."""
+    [0, xe], :func:`craters.diffusion.profile_tables`) at ``x`` radii: the Catmull-Rom
+    spline through the samples (C1: a linear interpolant's slope steps at every sample
+    showed as rings in low-sun close-ups of worn craters, 1.8 deg every 6 m on a 1 km
+    crater), even about the centre (zero slope on the axis), continued by 0 beyond the
+    last sample; 0 at and beyond ``xe``."""
     n = tab.shape[0]
     f = x / xe * (n - 1)
     if f >= n - 1:
         return 0.0
     i = int(f)
-    return tab[i] + (f - i) * (tab[i + 1] - tab[i])
+    t = f - i
+    p1 = tab[i]
+    p2 = tab[i + 1]
+    p0 = tab[i - 1] if i > 0 else p2
+    p3 = tab[i + 2] if i + 2 < n else 0.0
+    return p1 + 0.5 * t * ((p2 - p0) + t * ((2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3)
+                                              + t * (3.0 * (p1 - p2) + p3 - p0)))
 
 
 @njit(cache=True, inline="always")

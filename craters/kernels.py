@@ -8,7 +8,7 @@ Gaussian. They take no validation: callers validate first.
 Crater profile and stamping:
 
 * ``table_value(tab, x, x_e)``: a crater's profile table (heights at evenly spaced radii
-  over [0, x_e], :func:`craters.diffusion.profile_tables`) at x radii
+  over [0, x_e], :func:`craters.diffusion.profile_tables`) at x radii (Catmull-Rom, C1)
 * ``outer_weight(x, x_e)``: the share of the plane-to-terrain offset at the rim carried
   at x outside the rim
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane

@@ -4,6 +4,7 @@ bit for bit (issue 20)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from craters._diffusion_kernels import _blend_tables, _rim_and_floor, _rim_spectra, _scale_rims
 from craters.stamp import N_RIM, rim_perturbations
@@ -93,3 +94,15 @@ def test_fresh_profile_in_blocks_equals_one_block(monkeypatch):
     whole = morphology.fresh_profile(x, d)
     monkeypatch.setattr(morphology, "_BLOCK", 500)  # 5 rows a block, a ragged last one
     np.testing.assert_array_equal(morphology.fresh_profile(x, d), whole)
+
+
+@pytest.mark.parametrize("degradation", [0.1, 0.2, 0.4])
+def test_worn_profiles_are_smooth_between_the_transform_nodes(degradation):
+    # the tables come from the Fourier-Bessel series at their own radii: their curvature
+    # (second differences) changes slowly from sample to sample; resampled linearly from
+    # the transform's nodes it alternated (third differences ~0.9 of the second: rings in
+    # low-sun close-ups)
+    from craters.diffusion import profile_tables, tau_from_degradation
+
+    h = profile_tables([1000.0], tau_from_degradation([1000.0], [degradation]))[0]
+    assert np.abs(np.diff(h, 3)).max() < 0.25 * np.abs(np.diff(h, 2)).max()

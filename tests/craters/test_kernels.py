@@ -154,17 +154,49 @@ def test_slope_factor_is_linear_in_slope(slope):
     assert 1.0 - kept == pytest.approx(float(craters.slope_erosion(0.2, slope)))
 
 
-def test_table_value_is_linear_interpolation(rng):
+def catmull_rom_table(tab, x, xe):
+    """numpy reference of the stamping kernels' profile lookup (``craters.kernels.
+    table_value``): the Catmull-Rom spline through the table's samples over [0, xe], even
+    about 0, zeros beyond the last sample, 0 at and beyond ``xe``."""
+    tab = np.asarray(tab, dtype=np.float64)
+    x = np.asarray(x, dtype=np.float64)
+    n = len(tab)
+    ext = np.concatenate([[tab[1]], tab, [0.0, 0.0]])  # ext[j + 1] = tab[j]
+    f = x / xe * (n - 1)
+    i = np.clip(np.floor(f).astype(np.int64), 0, n - 2)
+    t = f - i
+    p0, p1, p2, p3 = ext[i], ext[i + 1], ext[i + 2], ext[i + 3]
+    # the cardinal (tension 0.5) Hermite form: tangents (p2 - p0) / 2, (p3 - p1) / 2
+    h00, h10 = 2 * t**3 - 3 * t**2 + 1, t**3 - 2 * t**2 + t
+    h01, h11 = -2 * t**3 + 3 * t**2, t**3 - t**2
+    v = h00 * p1 + h10 * 0.5 * (p2 - p0) + h01 * p2 + h11 * 0.5 * (p3 - p1)
+    return np.where(f >= n - 1, 0.0, v)
+
+
+def test_table_value_is_the_c1_catmull_rom_spline(rng):
     from craters._stamp_kernels import _table_kernel
 
     tabs = rng.normal(size=(3, 256))
-    x = np.concatenate([rng.uniform(0.0, 3.2, 500), [0.0, 3.0, 3.0 - 1e-12, 5.0]])
+    grid = np.linspace(0.0, 3.0, 256)
+    x = np.concatenate([rng.uniform(0.0, 3.2, 500), grid[:7], [3.0, 3.0 - 1e-12, 5.0]])
     out = np.empty((3, len(x)))
     _table_kernel(tabs, x, 3.0, out)
-    grid = np.linspace(0.0, 3.0, 256)
     for c in range(3):
-        want = np.where(x >= 3.0, 0.0, np.interp(x, grid, tabs[c]))
-        assert np.allclose(out[c], want, rtol=0, atol=1e-12)
+        assert np.allclose(out[c], catmull_rom_table(tabs[c], x, 3.0), rtol=0,
+                           atol=1e-12)
+    # through the samples, and C1: the slope on both sides of a sample agrees
+    assert np.array_equal(out[0, 500:507], tabs[0, :7])
+    h = 1e-7
+    at = grid[10:200:7]
+    left, mid, right = (np.empty((3, len(at))) for _ in range(3))
+    for arr, dx in ((left, -h), (mid, 0.0), (right, h)):
+        _table_kernel(tabs, at + dx, 3.0, arr)
+    slope_l, slope_r = (mid - left) / h, (right - mid) / h
+    assert np.allclose(slope_l, slope_r, rtol=0, atol=1e-4 * np.abs(slope_l).max())
+    # zero slope on the axis
+    near0 = np.empty((3, 1))
+    _table_kernel(tabs, np.array([1e-9]), 3.0, near0)
+    assert np.allclose(near0[:, 0], tabs[:, 0], rtol=0, atol=1e-9)
 
 
 @pytest.mark.parametrize(("wavelength", "spacing"), [(1.0, 1.0), (8.0, 1.0), (9.0, 1.0),

@@ -36,11 +36,17 @@ def rim_radii(h, cy, cx, pixel, r_max, n_az=360):
 
 
 def table_profile(r_over_radius, catalog, row=0):
-    """The numpy reference of the stamping kernels' profile: the crater's table
-    (craters.stamping_profiles) interpolated linearly, 0 beyond the ejecta edge."""
+    """The stamping kernels' profile of one crater alone: its table
+    (craters.stamping_profiles) through the table lookup (tested against numpy in
+    test_kernels.py), 0 beyond the ejecta edge."""
+    from craters._stamp_kernels import _table_kernel
+
     prof = craters.stamping_profiles(catalog)
-    x = np.linspace(0.0, craters.DEFAULT_EJECTA_EDGE, prof.tables.shape[1])
-    return np.interp(r_over_radius, x, prof.tables[row], right=0.0)
+    x = np.asarray(r_over_radius, dtype=np.float64)
+    out = np.empty((1, x.size))
+    _table_kernel(np.ascontiguousarray(prof.tables[row:row + 1]), x.ravel(),
+                  float(craters.DEFAULT_EJECTA_EDGE), out)
+    return out[0].reshape(x.shape)
 
 
 def test_fresh_1km_on_flat_grid(grid_r):
