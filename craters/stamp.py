@@ -462,7 +462,7 @@ def stamp(heights, pixel_size_m: float, crater: Crater, *, roughness=True, rng=N
     >>> h = stamp(np.zeros((101, 101)), 20.0, Crater(1000.0, 1000.0, 1000.0),
     ...           roughness=False)
     >>> round(float(h[50, 50]), 1), round(float(h.max()), 1)
-    (-160.0, 36.0)
+    (-160.0, 36.1)
     """
     if not isinstance(crater, Crater):
         raise TypeError(f"`crater` must be a Crater; got {type(crater).__name__}")
