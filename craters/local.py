@@ -199,8 +199,8 @@ def _model_age_draws(layer: ModelAgeLayer, lo: float, hi: float, share: float,
 
 
 def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key: int):
-    """The cells' Poisson counts of bin ``b``: (cells, tag, cell of each draw, index in
-    its cell, (lo, hi) metres)."""
+    """The cells' Poisson counts of bin ``b``: (tag, cell of each draw, index in its cell,
+    (lo, hi) metres, the youngest share of the flux the draws come from)."""
     seed = int(seed)
     if not 0 <= seed < 2**64:
         raise ValueError(f"`seed` must be in [0, 2**64); got {seed}")
@@ -211,7 +211,7 @@ def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key:
                          f"{area.shape}")
     lo, hi = bin_bounds(layer, b)
     tag = (int(layer_index) << 32) | (int(b) + _BIN_OFFSET)
-    density, _ = _bin_density(layer, lo, hi)
+    density, share = _bin_density(layer, lo, hi)
     mean = area * density
     # a mean beyond what one inversion holds is the sum of `parts` Poisson counts of
     # mean / parts (exactly Poisson), the j-th from counter index j (j = 0: the one draw)
@@ -230,7 +230,7 @@ def _counted(layer, layer_index: int, seed: int, b: int, cell_ids, area_m2, key:
     # each draw's index within its cell: 0, 1, .. counts - 1, cell after cell
     index = np.arange(len(cell), dtype=np.int64) - np.repeat(np.cumsum(counts) - counts,
                                                              counts)
-    return tag, cell, index, (lo, hi)
+    return tag, cell, index, (lo, hi), share
 
 
 def draw_cells(layer: CraterLayer | ModelAgeLayer, layer_index: int, *, seed: int, b: int,
@@ -254,15 +254,14 @@ def draw_cells(layer: CraterLayer | ModelAgeLayer, layer_index: int, *, seed: in
     ``rim_phases`` (n, 15), ``seed`` (uint64 roughness seed), ``id`` (uint64), ``cell``
     (uint64), ``index``.
     """
-    tag, cell, index, (lo, hi) = _counted(layer, layer_index, int(seed), b, cell_ids,
-                                          area_m2, CRATER_KEY)
+    tag, cell, index, (lo, hi), share = _counted(layer, layer_index, int(seed), b,
+                                                 cell_ids, area_m2, CRATER_KEY)
     seed = int(seed)
     n = len(cell)
     main = _words(cell, tag, index, _MAIN, seed)
     um = uniform_from_words(main)
     if isinstance(layer, ModelAgeLayer):
-        diameter, age = _model_age_draws(layer, lo, hi, _bin_density(layer, lo, hi)[1],
-                                         um[:, 0], um[:, 1])
+        diameter, age = _model_age_draws(layer, lo, hi, share, um[:, 0], um[:, 1])
     else:
         diameter = power_law_from_uniform(um[:, 0], lo, hi, layer.k) if n else np.zeros(0)
         age = layer.age_min_gyr + um[:, 1] * (layer.age_max_gyr - layer.age_min_gyr)
@@ -294,8 +293,8 @@ def draw_rock_cells(layer: BoulderLayer, layer_index: int, *, seed: int, b: int,
     Returns ``unit``, ``diameter_m``, those, ``seed`` (uint64), ``id`` (uint64),
     ``cell``, ``index``.
     """
-    tag, cell, index, (lo, hi) = _counted(layer, layer_index, int(seed), b, cell_ids,
-                                          area_m2, ROCK_KEY)
+    tag, cell, index, (lo, hi), _ = _counted(layer, layer_index, int(seed), b, cell_ids,
+                                             area_m2, ROCK_KEY)
     seed = int(seed)
     n = len(cell)
     main = _words(cell, tag, index, _MAIN, seed, ROCK_KEY)

@@ -65,10 +65,11 @@ class DemBase(BaseField):
         return (lat_deg - t.f) / t.e - 0.5, (lon - t.c) / t.a - 0.5
 
     def radius(self, unit) -> np.ndarray:
-        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
-        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
-        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
-        row, col = self._pixels(lat, lon)
+        return self.radius_at(*_lat_lon(unit))
+
+    def radius_at(self, lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
+        """:meth:`radius` at latitudes and longitudes (degrees)."""
+        row, col = self._pixels(lat_deg, lon_deg)
         ny, nx = self._h.shape
         if not ((row >= 0) & (row <= ny - 1) & (col >= 0) & (col <= nx - 1)).all():
             raise ParameterError("lat_deg", "and {} ask for points outside the DEM's pixel "
@@ -100,10 +101,8 @@ class StackBase(BaseField):
         self.dem = stack.layers[0]
 
     def radius(self, unit) -> np.ndarray:
-        u = np.ascontiguousarray(np.asarray(unit, dtype=np.float64).reshape(-1, 3))
-        r = self.levels[0].radius(u)  # refuses points outside the coarsest layer
-        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
-        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+        lat, lon = _lat_lon(unit)
+        r = self.levels[0].radius_at(lat, lon)  # refuses points outside the coarsest layer
         for level in self.levels[1:]:
             row, col = level._pixels(lat, lon)
             ny, nx = level._h.shape
@@ -112,8 +111,16 @@ class StackBase(BaseField):
             w = t * t * (3.0 - 2.0 * t)  # smoothstep: C1 into the coarser layer
             inside = np.flatnonzero(w > 0.0)
             if len(inside):
-                r[inside] += w[inside] * (level.radius(u[inside]) - r[inside])
+                r[inside] += w[inside] * (level.radius_at(lat[inside], lon[inside])
+                                          - r[inside])
         return r
+
+
+def _lat_lon(unit) -> tuple[np.ndarray, np.ndarray]:
+    """Latitudes and longitudes (degrees) of directions ``unit`` (n, 3)."""
+    u = np.asarray(unit, dtype=np.float64).reshape(-1, 3)
+    return (np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0))),
+            np.degrees(np.arctan2(u[:, 1], u[:, 0])))
 
 
 def _raster_base(base: BaseField, seed: int, radius_m: float, min_radius_m: float) -> None:

@@ -34,8 +34,9 @@ def _descent(v: Values) -> int:
     dem = read_site(v)
     scene = scene_of(dem, v)
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
-    frames = dem_descent(dem, scene, v["lat_deg"], v["lon_deg"], alts, **camera_options(v))
-    return write_descent_run(frames, out, v, seed=scene.seed)
+    camera = camera_options(v)
+    frames = dem_descent(dem, scene, v["lat_deg"], v["lon_deg"], alts, **camera)
+    return write_descent_run(frames, out, v, seed=scene.seed, lidar=camera["lidar"])
 
 
 def register(sub) -> None:

@@ -76,8 +76,9 @@ def _descent(v: Values) -> int:
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
-    frames = descent(scene, v["lat_deg"], v["lon_deg"], alts, **camera_options(v))
-    return write_descent_run(frames, out, v, seed=scene.seed)
+    camera = camera_options(v)
+    frames = descent(scene, v["lat_deg"], v["lon_deg"], alts, **camera)
+    return write_descent_run(frames, out, v, seed=scene.seed, lidar=camera["lidar"])
 
 
 def lidar_settings(v: Values):
@@ -115,9 +116,10 @@ def camera_options(v: Values) -> dict:
             "lidar": lidar_settings(v), "lidar_seed": v["lidar_seed"]}
 
 
-def write_descent_run(frames, out, v: Values, *, seed) -> int:
-    """Write a descent's frames (:func:`latlong.ondemand.descent.write_descent`) with the
-    command's progress lines; exit status 0."""
+def write_descent_run(frames, out, v: Values, *, seed, lidar=None) -> int:
+    """Write a descent's frames (:func:`latlong.ondemand.descent.write_descent`; ``lidar``:
+    the LidarSettings they were flown with, :func:`camera_options`) with the command's
+    progress lines; exit status 0."""
     from ..ondemand.descent import write_descent
 
     def report(i, f):
@@ -129,7 +131,7 @@ def write_descent_run(frames, out, v: Values, *, seed) -> int:
 
     try:
         n = write_descent(frames, out, seed=seed, site_lat_lon_deg=(v["lat_deg"], v["lon_deg"]),
-                          report=report, lidar=lidar_settings(v), lidar_seed=v["lidar_seed"])
+                          report=report, lidar=lidar, lidar_seed=v["lidar_seed"])
     except ParameterError as exc:
         if exc.name != "lidar":  # the LIDAR's reach beyond the terrain window
             raise
