@@ -60,9 +60,11 @@ A fresh crater's shape follows its target body (:data:`TARGETS`: ``moon``, ``mar
 ``mercury``, ``earth``, ``ceres``, ``vesta``, and :func:`small_body` (radius_m,
 density_kg_m3) for an asteroid, whose gravity follows from its size; ``--body``,
 ``--gravity-m-s2`` on every command). Below the body's simple/complex transition (Moon
-~15 km; Mars 8 km, Garvin & Frawley 1998; Mercury 10.3 km, Pike 1988; measured where
-published, else scaled as 1/g from the Moon's) a crater is a bowl with Pike's (1977)
-simple depth 0.196 D^1.010 and rim 0.036 D^1.014 (D in km) and Fassett & Thomson's
+~15 km; Mars 7 km, Garvin, Sakimoto & Frawley 2003; Mercury 10.3 km, Pike 1988; measured
+where published, else scaled as 1/g from the Moon's) a crater is a bowl with its body's
+fresh depth law (Moon: Pike's (1977) simple depth 0.196 D^1.010 and rim 0.036 D^1.014, D
+in km, from 400 m; below, shallower in a weak regolith: d/D 0.13 at 40-100 m, 0.15 at
+100-200 m, 0.17 at 200-400 m, Stopar et al. 2017; Mars 0.21 D^0.81) and Fassett & Thomson's
 (2014) fresh interior; above it, continuously through a transitional range (0.8–1.6
 D_t), a flat floor that widens with D, terraced walls, a central peak (height
 0.032 D^0.9 km, base 0.22 D) and Pike's complex depth 1.044 D^0.301 and rim 0.236

@@ -136,7 +136,10 @@ def validate_catalog(cat: np.ndarray) -> np.ndarray:
 
 
 def sort_oldest_first(cat: np.ndarray) -> np.ndarray:
-    """The catalog ordered by decreasing age (stable), the stamping order."""
+    """The catalog ordered by decreasing age (stable), the stamping order; without an
+    ``age_gyr`` column every crater is fresh (age 0) and the order is kept."""
+    if "age_gyr" not in (cat.dtype.names or ()):
+        return cat
     order = np.argsort(-cat["age_gyr"], kind="stable")
     return cat[order]
 

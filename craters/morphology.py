@@ -90,6 +90,12 @@ def fresh_morphometry(diameter_m, target: str | Target = "moon") -> dict[str, np
     scale = dt_km / 15.0  # self-similar carry-over of the lunar complex-crater laws
     depth = 1000.0 * np.minimum(_law(t.simple_depth, d_km), _law(t.complex_depth, d_km))
     rim = 1000.0 * np.minimum(_law(t.simple_rim, d_km), _law(t.complex_rim, d_km))
+    if t.small_depth_ratio:  # small craters measured shallower (Target.small_depth_ratio)
+        kd, kr = np.array(t.small_depth_ratio, dtype=np.float64).T
+        ratio = np.interp(np.log(d), np.log(kd), kr)
+        shallow = np.where(d < kd[-1], np.minimum(depth, d * ratio), depth)
+        rim = rim * (shallow / depth)
+        depth = shallow
     lo, hi = _TRANSITION
     w = _smoothstep(np.log(d / (lo * t.transition_m)) / np.log(hi / lo))
     q = _smoothstep(np.log(d / (_RING_ONSET[0] * t.peak_ring_m))

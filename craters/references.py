@@ -156,6 +156,17 @@ REFERENCES = _entries(
        "Geometric properties of Martian impact craters: Preliminary results from the Mars "
        "Orbiter Laser Altimeter", "Geophysical Research Letters 25(24), 4405-4408",
        "10.1029/1998GL900177"),
+    _R("garvin2003", ("Garvin, J. B.", "Sakimoto, S. E. H.", "Frawley, J. J."), 2003,
+       "Craters on Mars: Global geometric properties from gridded MOLA topography",
+       "Sixth International Conference on Mars, abstract 3277, Lunar and Planetary Institute "
+       "(title not confirmed)"),
+    _R("stopar2017", ("Stopar, J. D.", "Robinson, M. S.", "Barnouin, O. S.", "McEwen, A. S.",
+                      "Speyerer, E. J.", "Henriksen, M. R.", "Sutton, S. S."), 2017,
+       "Relative depths of simple craters and the nature of the lunar regolith",
+       "Icarus 298, 34-48 (DOI not confirmed)"),
+    _R("barnouin2012", ("Barnouin, O. S.", "Zuber, M. T.", "Smith, D. E.", "et al."), 2012,
+       "The morphology of craters on Mercury: Results from MESSENGER flybys",
+       "Icarus 219(1), 414-427 (title not confirmed)"),
     _R("grieve1987", ("Grieve, R. A. F.",), 1987, "Terrestrial impact structures",
        "Annual Review of Earth and Planetary Sciences 15, 245-270 (title not confirmed; DOI not "
        "confirmed)"),

@@ -20,10 +20,19 @@ Sources:
   Peak-ring basins from ~200 km (Baker et al. 2011, Icarus 214, 377: protobasins and
   peak-ring basins above ~200 km). Diffusivity: Fassett & Thomson (2014, JGR Planets 119,
   2255) kappa = 5.5e-6 m^2/yr at D = 1 km, scaling as D^0.9 (Fassett & Thomson 2015).
-* Mars: Garvin & Frawley (1998, GRL 25, 4405; MOLA): simple d = 0.14 D^0.90, complex
-  d = 0.25 D^0.49, transition 8 +- 0.5 km.
+  Small fresh craters are shallower than Pike's law (a weak regolith): Stopar et al.
+  (2017, Icarus 298, 34; LROC NAC DTMs of 950 craters) class A d/D 0.13 at 40-100 m,
+  0.15 at 100-200 m, 0.17 at 200-400 m, ~0.21 above (:attr:`Target.small_depth_ratio`).
+* Mars: Garvin, Sakimoto & Frawley (2003, 6th Int. Conf. on Mars, abstract 3277; ~6000
+  craters in gridded MOLA topography): fresh simple d = 0.21 D^0.81, complex d = 0.36
+  D^0.49 (7-100 km), transition ~7 km (the 1998 MOLA-track fits, Garvin & Frawley 1998,
+  GRL 25, 4405: 0.14 D^0.90 and 0.25 D^0.49 from 98 craters, were 30 % shallower).
+  Rim heights: the depth times the Moon's rim/depth ratio at the same D / D_t. Below
+  1 km, under the fit's range, d/D stays at its 1 km value 0.21 (the power law with
+  b = 0.81 would pass 0.3 at 150 m, deeper than any fresh simple crater).
 * Mercury: Pike (1988, in Mercury, Univ. Arizona Press): simple d = 0.199 D^0.995,
-  complex d = 0.353 D^0.496, transition 10.3 km.
+  complex d = 0.353 D^0.496, transition 10.3 km (MESSENGER laser altimetry of fresh
+  craters agrees with these Mariner 10 values: Barnouin et al. 2012, Icarus 219, 414).
 * Ceres: Hiesinger et al. (2016, Science 353): transition 7.5-12 km (10 km used), far
   below 1/g scaling (an icy, weak crust).
 * Earth: transition ~2 km in sedimentary, ~4 km in crystalline targets (Grieve 1987);
@@ -71,6 +80,13 @@ class Target:
     """Fresh complex craters: rim-crest-to-floor depth (a, b)."""
     complex_rim: tuple[float, float]
     """Fresh complex craters: rim height (a, b)."""
+    small_depth_ratio: tuple[tuple[float, float], ...] = ()
+    """Fresh d/D of small craters measured shallower than the simple law: knots
+    ``(diameter_m, d/D)`` in increasing diameter. Below the last knot the depth is the
+    smaller of the simple law and D times the knots' d/D (linear in log D, constant
+    below the first knot); the last knot's d/D is not below the law's there, so the two
+    meet continuously, and above it the law holds alone. Rim heights in proportion.
+    Empty: the simple law at all sizes."""
     kappa_1km_m2_yr: float = 5.5e-6
     """Topographic diffusivity at D = 1 km, m^2/yr (Fassett & Thomson 2014, lunar)."""
     kappa_exponent: float = 0.9
@@ -88,6 +104,17 @@ class Target:
             a, b = getattr(self, key)
             check_positive(key, a)
             check_positive(key, b)
+        knots = self.small_depth_ratio
+        if knots:
+            d = [k[0] for k in knots]
+            if any(v <= 0 for k in knots for v in k) or d != sorted(set(d)):
+                raise ParameterError("small_depth_ratio", "must be (diameter_m, d/D) pairs "
+                                     f"> 0 in increasing diameter; got {knots!r}")
+            d_top, r_top = knots[-1]
+            law = self.simple_depth[0] * (d_top / 1000.0) ** (self.simple_depth[1] - 1.0)
+            if r_top < law:
+                raise ParameterError("small_depth_ratio", f"the last knot's d/D {r_top:g} "
+                                     f"must be >= the simple law's {law:.4g} at {d_top:g} m")
 
     def with_gravity(self, gravity_m_s2: float) -> Target:
         """The same body under another surface gravity: the transition and peak-ring
@@ -115,6 +142,12 @@ _PIKE_SIMPLE_DEPTH = (0.196, 1.010)
 _PIKE_SIMPLE_RIM = (0.036, 1.014)
 _PIKE_COMPLEX_DEPTH = (1.044, 0.301)
 _PIKE_COMPLEX_RIM = (0.236, 0.399)
+
+
+# fresh (class A) lunar craters below 400 m (Stopar et al. 2017, Icarus 298, 34): d/D
+# 0.13 at 40-100 m, 0.15 at 100-200 m, 0.17 at 200-400 m, 0.21 from 400 m; knots at the
+# bins' geometric centres (Target.small_depth_ratio), Pike's law from 400 m
+_STOPAR_FRESH = ((63.0, 0.13), (141.0, 0.15), (283.0, 0.17), (400.0, 0.21))
 
 
 def _from_moon(name: str, radius_m: float, gravity: float, source: str, **measured) -> Target:
@@ -147,10 +180,12 @@ def _from_moon(name: str, radius_m: float, gravity: float, source: str, **measur
 TARGETS: dict[str, Target] = {
     "moon": Target("moon", 1_737_400.0, 1.62, 15_000.0, 200_000.0, _PIKE_SIMPLE_DEPTH,
                    _PIKE_SIMPLE_RIM, _PIKE_COMPLEX_DEPTH, _PIKE_COMPLEX_RIM,
-                   source="Pike 1977; Baker et al. 2011; Fassett & Thomson 2014"),
-    "mars": _from_moon("mars", 3_389_500.0, 3.71, "Garvin & Frawley 1998 (MOLA)",
-                       transition_m=8_000.0, simple_depth=(0.14, 0.90),
-                       complex_depth=(0.25, 0.49)),
+                   small_depth_ratio=_STOPAR_FRESH,
+                   source="Pike 1977; Stopar et al. 2017; Baker et al. 2011; "
+                          "Fassett & Thomson 2014"),
+    "mars": _from_moon("mars", 3_389_500.0, 3.71, "Garvin, Sakimoto & Frawley 2003 (MOLA)",
+                       transition_m=7_000.0, simple_depth=(0.21, 0.81),
+                       complex_depth=(0.36, 0.49), small_depth_ratio=((1000.0, 0.21),)),
     "mercury": _from_moon("mercury", 2_439_700.0, 3.70, "Pike 1988",
                           transition_m=10_300.0, simple_depth=(0.199, 0.995),
                           complex_depth=(0.353, 0.496)),
@@ -195,7 +230,7 @@ def get_target(body: str | Target = "moon", *, gravity_m_s2: float | None = None
     Examples
     --------
     >>> get_target("mars").transition_m, get_target("moon", gravity_m_s2=3.24).transition_m
-    (8000.0, 7500.0)
+    (7000.0, 7500.0)
     """
     if isinstance(body, Target):
         target = body

@@ -220,7 +220,7 @@ def fill_crater_gaps(dem: Dem, craters_, *, frame: LocalFrame | None = None,
     >>> f = fill_crater_gaps(d, [craters.Crater(0.0, 0.0, 200.0)], smooth_craters=True,
     ...                      rng=1)
     >>> round(float(truth[20, 20]), 1), round(float(f.heights[20, 20]), 1)
-    (-31.5, -31.5)
+    (-26.2, -26.2)
     """
     frame = resolve_frame(dem, frame)
     cat = craters.sort_oldest_first(_as_catalog(craters_))
@@ -381,7 +381,7 @@ def replace_crater(target, crater, *, frame: LocalFrame | None = None,
     >>> d = Dem(np.zeros((61, 61)), pixel_size_m=10.0)
     >>> r = replace_crater(d, craters.Crater(0.0, 0.0, 150.0), smooth_craters=True, rng=0)
     >>> round(float(r.heights[30, 30]), 1), float(r.heights[0, 0])
-    (-23.6, 0.0)
+    (-18.6, 0.0)
     """
     if not isinstance(crater, craters.Crater):
         raise TypeError(f"`crater` must be a craters.Crater; got {type(crater).__name__}")

@@ -221,7 +221,7 @@ def golden():
     record = json.loads(GOLDEN.read_text())
     made_on, here = record.pop("<platform>"), platform_fingerprint()
     differ = {k: (made_on.get(k), v) for k, v in here.items() if made_on.get(k) != v}
-    if differ:
+    if differ and not WRITE:  # regenerating records this platform (outputs fixture)
         pytest.skip(f"the golden hashes were made on another platform: {differ}")
     return record
 

@@ -1,9 +1,10 @@
 """Issue 21 acceptance figures for crater shapes (plain script, from the repository's top).
 
 Fresh lunar depth and rim height through ``craters profile`` against Pike (1977) at
-0.1-100 km, the largest jump between neighbouring diameters across the simple->complex
+0.5-100 km (Pike's law holds from 400 m), the largest jump between neighbouring diameters across the simple->complex
 transition, the flat floor and central peak of 30 and 100 km craters, Mars (Garvin &
-Frawley 1998) and Mercury (Pike 1988) transitions and complex depths, diffusion of a 1 km
+Sakimoto & Frawley 2003) and Mercury (Pike 1988) transitions and simple and complex
+depths, fresh 40-400 m lunar craters stamped on a raster against Stopar et al. 2017, diffusion of a 1 km
 crater against the test suite's independent finite-difference solve, and what
 ``degradation=1`` leaves. Usage: ``python tests/benchmarks/measure_crater_morphology.py``.
 """
@@ -19,8 +20,12 @@ import numpy as np
 import craters
 
 PIKE = {"simple": ((0.196, 1.010), (0.036, 1.014)), "complex": ((1.044, 0.301), (0.236, 0.399))}
-FITS = {"mars": ("Garvin & Frawley 1998", 0.25, 0.49, (7.5, 8.5)),
-        "mercury": ("Pike 1988", 0.353, 0.496, (9.0, 12.0))}
+# body: source, fresh simple (a, b), complex (a, b) (d = a D^b, km), transition range (km),
+# simple diameters (km, below where the two laws cross)
+FITS = {"mars": ("Garvin, Sakimoto & Frawley 2003", (0.21, 0.81), (0.36, 0.49), (6.0, 8.0),
+                 (1, 2, 4)),
+        "mercury": ("Pike 1988", (0.199, 0.995), (0.353, 0.496), (9.0, 12.0), (1, 2, 3))}
+STOPAR = ((40, 100, 0.13), (100, 200, 0.15), (200, 400, 0.17))  # Stopar et al. 2017
 
 
 def cli(d: float, body: str = "moon") -> tuple[dict, np.ndarray]:
@@ -37,7 +42,7 @@ def cli(d: float, body: str = "moon") -> tuple[dict, np.ndarray]:
 
 def lunar() -> None:
     print("Fresh lunar craters vs Pike (1977):")
-    for dkm, kind in ((0.1, "simple"), (1, "simple"), (5, "simple"), (30, "complex"),
+    for dkm, kind in ((0.5, "simple"), (1, "simple"), (5, "simple"), (30, "complex"),
                       (100, "complex")):
         m, _ = cli(dkm * 1000)
         (a, b), (c, e) = PIKE[kind]
@@ -65,15 +70,44 @@ def lunar() -> None:
 
 def planets() -> None:
     print("Mars and Mercury:")
-    for body, (src, a, b, rng) in FITS.items():
+    for body, (src, simple, complex_, rng, simple_km) in FITS.items():
         t = craters.get_target(body)
         print(f"  {body}: transition {t.transition_m / 1e3:.1f} km (published "
               f"{rng[0]}-{rng[1]} km, {src})")
-        for dkm in (20, 50, 100):
+        for dkm, (a, b) in [(d, simple) for d in simple_km] + [(d, complex_)
+                                                             for d in (20, 50, 100)]:
             m, _ = cli(dkm * 1000, body)
             law = 1000 * a * dkm**b
             print(f"    D {dkm} km: depth {m['depth_m']:.0f} m vs {src} {law:.0f} m "
                   f"({100 * (m['depth_m'] / law - 1):+.1f} %)")
+
+
+def stopar(n: int = 200, pixel_m: float = 0.5) -> None:
+    """Fresh 40-400 m lunar craters (N_cum ~ D^-2) stamped one by one on a flat raster of
+    ``pixel_m`` with the default roughness; d/D = (median of 8 sectors' highest rim
+    pixel - lowest pixel within R/2) / D, median per Stopar et al. 2017 bin."""
+    rng = np.random.default_rng(2017)
+    print(f"Fresh small lunar craters stamped at {pixel_m} m/px vs Stopar et al. 2017:")
+    for lo, hi, ref in STOPAR:
+        u = rng.random(n)
+        d = 1.0 / (1.0 / lo - u * (1.0 / lo - 1.0 / hi))     # N_cum ~ D^-2 in [lo, hi]
+        ratios = []
+        for dm in d:
+            size = int(np.ceil(1.6 * dm / pixel_m)) | 1
+            c = (size // 2) * pixel_m
+            cat = np.zeros(1, dtype=[("x_m", "f8"), ("y_m", "f8"), ("diameter_m", "f8")])
+            cat[0] = (c, c, dm)
+            h = craters.stamp_many(np.zeros((size, size)), pixel_m, cat,
+                                   rng=int(rng.integers(1 << 30)))
+            yy, xx = (np.mgrid[:size, :size] * pixel_m - c)
+            r = np.hypot(xx, yy) / (dm / 2)
+            ann = (r > 0.8) & (r < 1.2)
+            sector = ((np.arctan2(yy, xx) + np.pi) // (np.pi / 4)).astype(int) % 8
+            crest = np.median([h[ann & (sector == k)].max() for k in range(8)])
+            ratios.append((crest - h[r < 0.5].min()) / dm)
+        med = float(np.median(ratios))
+        print(f"  {lo:3d}-{hi:3d} m: median d/D {med:.4f} (Stopar {ref}, "
+              f"{100 * (med / ref - 1):+.1f} %) over {n} craters")
 
 
 def depth_ratio(r: np.ndarray, h: np.ndarray, d: float) -> float:
@@ -102,5 +136,6 @@ def diffusion() -> None:
 
 if __name__ == "__main__":
     lunar()
+    stopar()
     planets()
     diffusion()
