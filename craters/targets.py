@@ -49,7 +49,7 @@ from typing import Any
 
 from ._shared import ParameterError, check_choice, check_positive, check_range
 
-__all__ = ["TARGETS", "Target", "get_target", "small_body"]
+__all__ = ["SMALL_BODY_REFERENCE_M", "TARGETS", "Target", "get_target", "small_body"]
 
 G_NEWTON = 6.674e-11  # m^3 kg^-1 s^-2
 _MOON_G = 1.62
@@ -197,13 +197,21 @@ TARGETS: dict[str, Target] = {
 }
 
 
+#: Reference diameter of a small body's fresh d/D when it varies with size, metres.
+SMALL_BODY_REFERENCE_M = 10.0
+
+
 def small_body(radius_m: float, density_kg_m3: float = 2000.0,
-               depth_ratio: float = 0.2) -> Target:
+               depth_ratio: float = 0.2, depth_exponent: float = 1.0) -> Target:
     """A generic small body: surface gravity ``4/3 pi G rho R`` of a sphere of that size
     and bulk density, asteroid fresh craters (d/D = ``depth_ratio``, default 0.2 (Marchi et
     al. 2015); rim/depth as Pike's (1977) lunar simple craters), transition and peak-ring
     diameters by 1/g from the Moon's. A measured body's own d/D goes in ``depth_ratio``,
     e.g. Bennu 0.10 +- 0.03 for craters >= 10 m (Daly et al. 2020, GRL 47, e2020GL089672).
+    With ``depth_exponent`` b != 1 the depth is ``d = depth_ratio D (D / 10 m)^(b - 1)``
+    (``depth_ratio`` is then the d/D at :data:`SMALL_BODY_REFERENCE_M`): b < 1 makes
+    larger craters relatively shallower, as measured on Bennu (0.13 +- 0.04 below 10 m,
+    0.10 +- 0.03 above; Daly et al. 2020).
 
     Examples
     --------
@@ -214,18 +222,23 @@ def small_body(radius_m: float, density_kg_m3: float = 2000.0,
     r = check_positive("radius_m", radius_m)
     rho = check_positive("density_kg_m3", density_kg_m3)
     dd = check_range("depth_ratio", depth_ratio, 0.01, 0.5)
+    b = check_range("depth_exponent", depth_exponent, 0.5, 1.5)
     g = 4.0 / 3.0 * math.pi * G_NEWTON * rho * r
-    source = ("Marchi et al. 2015 d/D" if dd == 0.2 else f"d/D = {dd:g}") + "; 1/g scaling"
-    return _from_moon("small-body", r, g, source,
-                      simple_depth=(dd, 1.0), simple_rim=(dd * 0.036 / 0.196, 1.0))
+    source = ("Marchi et al. 2015 d/D" if dd == 0.2 and b == 1.0 else
+              f"d/D = {dd:g}" + ("" if b == 1.0 else f" (D / 10 m)^{b - 1.0:g}"))
+    a = dd * (SMALL_BODY_REFERENCE_M / 1000.0) ** (1.0 - b)   # d = a D^b, km
+    return _from_moon("small-body", r, g, source + "; 1/g scaling",
+                      simple_depth=(a, b), simple_rim=(a * 0.036 / 0.196, b))
 
 
 def get_target(body: str | Target = "moon", *, gravity_m_s2: float | None = None,
                radius_m: float | None = None, density_kg_m3: float | None = None,
-               depth_ratio: float | None = None) -> Target:
+               depth_ratio: float | None = None,
+               depth_exponent: float | None = None) -> Target:
     """A target by name (:data:`TARGETS` or ``small-body``), optionally under another
     gravity. ``small-body`` needs ``radius_m`` (and takes ``density_kg_m3``, default
-    2000, and the fresh ``depth_ratio``, default 0.2) unless ``gravity_m_s2`` is given.
+    2000, and the fresh ``depth_ratio``, default 0.2, and ``depth_exponent``, default 1,
+    :func:`small_body`) unless ``gravity_m_s2`` is given.
 
     Examples
     --------
@@ -243,9 +256,11 @@ def get_target(body: str | Target = "moon", *, gravity_m_s2: float | None = None
                                      see=("radius_m", "gravity_m_s2"))
             target = small_body(radius_m if radius_m is not None else 1000.0,
                                 density_kg_m3 if density_kg_m3 is not None else 2000.0,
-                                depth_ratio if depth_ratio is not None else 0.2)
-        elif depth_ratio is not None:
-            raise ParameterError("depth_ratio", f"applies to small-body only (the {body}'s "
+                                depth_ratio if depth_ratio is not None else 0.2,
+                                depth_exponent if depth_exponent is not None else 1.0)
+        elif depth_ratio is not None or depth_exponent is not None:
+            key = "depth_ratio" if depth_ratio is not None else "depth_exponent"
+            raise ParameterError(key, f"applies to small-body only (the {body}'s "
                                  "crater depths follow its published laws)")
         else:
             target = TARGETS[body]

@@ -213,7 +213,8 @@ class Scene:
         radius = b.radius_m * float(np.prod(b.stretch)) ** (1.0 / 3.0)
         return _craters.get_target("small-body", radius_m=radius, density_kg_m3=b.density_kg_m3,
                                    gravity_m_s2=b.gravity_m_s2,
-                                   depth_ratio=b.crater_depth_ratio)
+                                   depth_ratio=b.crater_depth_ratio,
+                                   depth_exponent=b.crater_depth_exponent)
 
     def body_metadata(self, params: dict) -> dict:
         """The metadata a body built from this scene records (``params``: the base's)."""

@@ -88,7 +88,15 @@ class BodySettings:
         default_text=f"{default_of(_craters.small_body, 'depth_ratio'):g}, Marchi et al. "
         "2015; Bennu's measured 0.10")
     """Fresh crater depth/diameter of a small body, [0.01, 0.5]; default 0.2 (Marchi et
-    al. 2015); e.g. Bennu 0.10 (Daly et al. 2020)."""
+    al. 2015); e.g. Bennu 0.10 (Daly et al. 2020). With ``crater_depth_exponent`` != 1,
+    the d/D of a 10 m crater."""
+    crater_depth_exponent: float | None = setting(
+        None, "exponent b of a small body's fresh crater depth d = ratio D (D / 10 m)^(b - 1) "
+        "(b < 1: larger craters relatively shallower)", range=(0.5, 1.5),
+        default_text="1, d/D the same at all sizes")
+    """Exponent of a small body's fresh depth law, [0.5, 1.5]; default 1 (d/D the same at
+    all sizes); the Bennu preset's 0.756 gives Daly et al.'s (2020) 0.13 below 10 m and 0.10
+    above."""
     max_memory_gb: float | None = setting(
         None, "memory the build may use (1e9 bytes): a magnitude whose estimate (radii and "
         "bounded buffers, written as .npz) is larger is refused up front, or built with its "
@@ -109,9 +117,10 @@ class BodySettings:
 
     def __post_init__(self):
         check_declared(self)
-        if self.crater_depth_ratio is not None and self.target != "small-body":
-            raise ParameterError("crater_depth_ratio", f"applies to small-body only (the "
-                                 f"{self.target}'s crater depths follow its published laws)")
+        for key in ("crater_depth_ratio", "crater_depth_exponent"):
+            if getattr(self, key) is not None and self.target != "small-body":
+                raise ParameterError(key, f"applies to small-body only (the {self.target}'s "
+                                     "crater depths follow its published laws)")
         check_memory(self.magnitude, self.max_memory_gb, radii_on_disk=self.radii_on_disk)
         if self.stretch is not None:
             _set(self, "stretch", parse_stretch(self.stretch))

@@ -24,6 +24,10 @@ PUBLISHED = {
          "2002)")),
         ("craters 0.1-0.2 km", "craters", 100.0, 200.0, (-2.3, -1.7), 100.0, (3.0, 5.0),
          "R = 0.08 (0.06-0.10) below 0.2 km (Berthoud et al. 2001)"),
+        ("craters 50-100 m", "craters", 50.0, 100.0, (-2.3, -1.7), 50.0, (10.7, 24.0),
+         "R = 0.08 down to 50 m (Berthoud et al. 2001): 16 per km^2 >= 50 m, x/1.5 .. x1.5"),
+        ("craters 20-50 m", "craters", 20.0, 50.0, (-1.3, -0.7), 20.0, (26.7, 60.0),
+         "~40 per km^2 >= 20 m, not ~400 (NEAR MSI, NEAR team; Chapman 2002), x/1.5 .. x1.5"),
         ("boulders", "boulders", 40.0, 100.0, (-3.39, -3.11), 40.0, (0.21, 0.29),
          ("6760 >= 15 m on 1125 km^2 (Thomas 2001), b = -3.25 +- 0.14 (Michikami & "
          "Hagermann 2021), extrapolated to 40 m")),
@@ -50,7 +54,7 @@ def main() -> None:
                         "up to the area's resolution)")
     args = parser.parse_args()
     for name, rows in PUBLISHED.items():
-        coarse = {"eros": {"magnitude": 120}, "bennu": {"magnitude": 80},
+        coarse = {"eros": {"magnitude": 120}, "bennu": {"magnitude": 120},
                   "itokawa": {"spacing_m": 6.0}}[name] if args.quick else {}
         pooled = {"craters": [], "boulders": []}
         areas = []

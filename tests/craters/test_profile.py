@@ -209,3 +209,13 @@ def test_kappa_scaling_of_fassett_and_thomson():
 def test_bad_states(kw, match):
     with pytest.raises(ValueError, match=match):
         radial_profile([0.0], 1000.0, **kw)
+
+
+def test_small_body_depth_exponent_makes_larger_craters_shallower():
+    t = craters.small_body(245.0, 1190.0, 0.118, 0.756)
+    for d, want in ((10.0, 0.118), (40.0, 0.118 * 4.0 ** -0.244), (2.5, 0.118 * 4.0 ** 0.244)):
+        assert float(fresh_morphometry(d, t)["depth_m"]) / d == pytest.approx(want, rel=1e-9)
+    with pytest.raises(ValueError, match="depth_exponent.*small-body only"):
+        craters.get_target("moon", depth_exponent=0.8)
+    with pytest.raises(ValueError, match="depth_exponent"):
+        craters.small_body(245.0, 1190.0, 0.1, 2.0)
