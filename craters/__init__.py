@@ -73,7 +73,8 @@ ejecta thins as r^-3 (McGetchin et al. 1973). Ageing is topographic diffusion
 (Fassett & Thomson 2014: κ = 5.5 m²/Myr at 1 km, ∝ D^0.9): a crater of age T is its
 fresh profile diffused for κT, solved exactly in Hankel space and cached per (D, κT) for
 stamping, so old craters are shallow and rimless (a 1 km lunar crater: d/D 0.196 fresh,
-0.161 at 1 Gyr, 0.103 at 3.5 Gyr) and ``degradation`` (the share of the fresh depth
+0.174 at 1 Gyr, 0.103 at 3.5 Gyr, 0.011 at 3.9 Gyr: diffusion is paced by the impact
+flux, :func:`diffusion_age_gyr`) and ``degradation`` (the share of the fresh depth
 removed, an explicit override) = 1 leaves no relief. Catalogs list each crater's
 ``morphology`` (simple, transitional, complex, peak-ring), its depth, rim height, floor
 diameter, peak height and κt as stamped. ``python examples/plot_crater_morphology.py``
@@ -145,7 +146,13 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         sample_pf_diameters,
         saturation_diameter_m,
     )
-    from .diffusion import kappa_m2_yr, profile_tables, tau_from_age, tau_from_degradation
+    from .diffusion import (
+        diffusion_age_gyr,
+        kappa_m2_yr,
+        profile_tables,
+        tau_from_age,
+        tau_from_degradation,
+    )
     from .layers import LAYER_TYPES, ModelAgeLayer, as_crater_layer
     from .lcsn import (
         LCSN_PRESETS,
@@ -225,6 +232,7 @@ __all__ = [
     "formation_ages",
     "get_chronology_system",
     "get_target",
+    "diffusion_age_gyr",
     "kappa_m2_yr",
     "lcsn_degrade",
     "lcsn_kernel",

@@ -91,6 +91,13 @@ class Target:
     """Topographic diffusivity at D = 1 km, m^2/yr (Fassett & Thomson 2014, lunar)."""
     kappa_exponent: float = 0.9
     """kappa(D) = kappa_1km (D / 1 km)^kappa_exponent (Fassett & Thomson 2015)."""
+    flux_clock: str | None = None
+    """Chronology system (:data:`craters.CHRONOLOGY_SYSTEMS`) whose cumulative impact flux
+    paces the diffusion (:func:`craters.diffusion.tau_from_age`); None: constant rate."""
+    kappa_calibration_gyr: float = 3.5
+    """Age of the surfaces the diffusivity was measured on, Gyr (Fassett & Thomson 2014:
+    mare craters): with a ``flux_clock`` a crater of that age diffuses for exactly
+    ``kappa T``."""
     scaled: tuple[str, ...] = ()
     """Fields carried over from the Moon by 1/g (not measured on this body)."""
     source: str = ""
@@ -98,7 +105,7 @@ class Target:
 
     def __post_init__(self):
         for key in ("radius_m", "gravity_m_s2", "transition_m", "peak_ring_m",
-                    "kappa_1km_m2_yr"):
+                    "kappa_1km_m2_yr", "kappa_calibration_gyr"):
             check_positive(key, getattr(self, key))
         for key in ("simple_depth", "simple_rim", "complex_depth", "complex_rim"):
             a, b = getattr(self, key)
@@ -180,15 +187,16 @@ def _from_moon(name: str, radius_m: float, gravity: float, source: str, **measur
 TARGETS: dict[str, Target] = {
     "moon": Target("moon", 1_737_400.0, 1.62, 15_000.0, 200_000.0, _PIKE_SIMPLE_DEPTH,
                    _PIKE_SIMPLE_RIM, _PIKE_COMPLEX_DEPTH, _PIKE_COMPLEX_RIM,
-                   small_depth_ratio=_STOPAR_FRESH,
+                   small_depth_ratio=_STOPAR_FRESH, flux_clock="moon",
                    source="Pike 1977; Stopar et al. 2017; Baker et al. 2011; "
                           "Fassett & Thomson 2014"),
     "mars": _from_moon("mars", 3_389_500.0, 3.71, "Garvin, Sakimoto & Frawley 2003 (MOLA)",
                        transition_m=7_000.0, simple_depth=(0.21, 0.81),
-                       complex_depth=(0.36, 0.49), small_depth_ratio=((1000.0, 0.21),)),
+                       complex_depth=(0.36, 0.49), small_depth_ratio=((1000.0, 0.21),),
+                       flux_clock="mars"),
     "mercury": _from_moon("mercury", 2_439_700.0, 3.70, "Pike 1988",
                           transition_m=10_300.0, simple_depth=(0.199, 0.995),
-                          complex_depth=(0.353, 0.496)),
+                          complex_depth=(0.353, 0.496), flux_clock="mercury"),
     "earth": _from_moon("earth", 6_371_000.0, 9.81, "Grieve 1987 (transition)",
                         transition_m=3_000.0),
     "ceres": _from_moon("ceres", 469_700.0, 0.28, "Hiesinger et al. 2016 (transition)",
