@@ -186,7 +186,9 @@ def test_cratered_preset_outputs_and_determinism(run_cli, tmp_path):
     for tag, env in (("a", {}), ("b", {}), ("t1", {"NUMBA_NUM_THREADS": "1"})):
         d = tmp_path / tag
         d.mkdir()
+        # craters from 3 m (~7 000): the preset's 1 m makes ~62 000, mostly below this mesh
         proc = run_cli("latlong", "build", "--preset", "fbm-cratered", "--magnitude", "60",
+                       "--craters", "c=0.5,k=-2,d_min_m=3,d_max_m=15",
                        "--seed", "1", "-o", str(d / "a.npz"), "--catalog", str(d / "a.csv"),
                        "--preview", str(d / "a.png"), "-q", env=env)
         assert proc.returncode == 0, proc.stderr
