@@ -46,6 +46,8 @@ SMALLER: list[tuple[str, str, str]] = [
     (r"--magnitude \d+", "--magnitude 24", "bodies of 3458 vertices instead of ~1 M"),
     (r"--preset (eros|bennu) ", r"--preset \1 --magnitude 24 ",
      "the real-body presets default to large magnitudes"),
+    (r"--preset eros ", "--preset eros --craters c=0.0377,k=-1.9,d_min_m=200,d_max_m=1180 ",
+     "the preset's 44 000 craters of 20 m-1.2 km; 1 800 from 200 m"),
     (r"--preset bennu ", "--preset bennu --boulders c=0.238,k=-2.9,d_min_m=20,d_max_m=40 ",
      "the preset's 3300 boulders of 4-40 m make a 93 MB mesh; 30 of 20-40 m"),
     (r"--preset fbm-cratered ", ("--preset fbm-cratered --craters c=0.5,k=-2,d_min_m=4,"
