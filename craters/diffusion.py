@@ -38,8 +38,7 @@ from .morphology import EJECTA_EDGE, fresh_morphometry, fresh_profile
 from .targets import Target, get_target
 
 __all__ = ["DOMAIN", "N_TABLE", "TAU_FRESH", "diffuse_profiles", "diffusion_age_gyr",
-           "kappa_m2_yr",
-           "profile_tables", "tau_from_age", "tau_from_degradation"]
+           "kappa_m2_yr", "profile_tables", "tau_from_age", "tau_from_degradation"]
 
 #: Radius of the diffusion domain, in crater radii (the profile is 0 beyond).
 DOMAIN = 6.0

@@ -233,7 +233,8 @@ def small_body(radius_m: float, density_kg_m3: float = 2000.0,
     b = check_range("depth_exponent", depth_exponent, 0.5, 1.5)
     g = 4.0 / 3.0 * math.pi * G_NEWTON * rho * r
     source = ("Marchi et al. 2015 d/D" if dd == 0.2 and b == 1.0 else
-              f"d/D = {dd:g}" + ("" if b == 1.0 else f" (D / 10 m)^{b - 1.0:g}"))
+              f"d/D = {dd:g}" + ("" if b == 1.0 else
+                                 f" (D / {SMALL_BODY_REFERENCE_M:g} m)^{b - 1.0:g}"))
     a = dd * (SMALL_BODY_REFERENCE_M / 1000.0) ** (1.0 - b)   # d = a D^b, km
     return _from_moon("small-body", r, g, source + "; 1/g scaling",
                       simple_depth=(a, b), simple_rim=(a * 0.036 / 0.196, b))

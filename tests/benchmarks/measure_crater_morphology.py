@@ -16,6 +16,7 @@ import sys
 import tempfile
 
 import numpy as np
+from crater_depth import rim_minus_floor
 
 import craters
 
@@ -84,8 +85,8 @@ def planets() -> None:
 
 def stopar(n: int = 200, pixel_m: float = 0.5) -> None:
     """Fresh 40-400 m lunar craters (N_cum ~ D^-2) stamped one by one on a flat raster of
-    ``pixel_m`` with the default roughness; d/D = (median of 8 sectors' highest rim
-    pixel - lowest pixel within R/2) / D, median per Stopar et al. 2017 bin."""
+    ``pixel_m`` with the default roughness; d/D = ``crater_depth.rim_minus_floor`` (rim at
+    0.8-1.2 R, floor within R/2) / D, median per Stopar et al. 2017 bin."""
     rng = np.random.default_rng(2017)
     print(f"Fresh small lunar craters stamped at {pixel_m} m/px vs Stopar et al. 2017:")
     for lo, hi, ref in STOPAR:
@@ -100,11 +101,8 @@ def stopar(n: int = 200, pixel_m: float = 0.5) -> None:
             h = craters.stamp_many(np.zeros((size, size)), pixel_m, cat,
                                    rng=int(rng.integers(1 << 30)))
             yy, xx = (np.mgrid[:size, :size] * pixel_m - c)
-            r = np.hypot(xx, yy) / (dm / 2)
-            ann = (r > 0.8) & (r < 1.2)
-            sector = ((np.arctan2(yy, xx) + np.pi) // (np.pi / 4)).astype(int) % 8
-            crest = np.median([h[ann & (sector == k)].max() for k in range(8)])
-            ratios.append((crest - h[r < 0.5].min()) / dm)
+            depth = rim_minus_floor(h, np.hypot(xx, yy) / (dm / 2), np.arctan2(yy, xx))
+            ratios.append(depth / dm)
         med = float(np.median(ratios))
         print(f"  {lo:3d}-{hi:3d} m: median d/D {med:.4f} (Stopar {ref}, "
               f"{100 * (med / ref - 1):+.1f} %) over {n} craters")

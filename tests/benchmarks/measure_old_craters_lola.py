@@ -18,6 +18,7 @@ import csv
 from pathlib import Path
 
 import numpy as np
+from crater_depth import rim_minus_floor
 
 import craters
 
@@ -41,13 +42,7 @@ def lola_depth_km(dem_km: np.ndarray, lat0: float, lon0: float, d_km: float) -> 
     r = 2 * R_MOON_KM * np.arcsin(np.sqrt(np.clip(a, 0, 1))) / r_km
     az = np.arctan2(np.sin(lo - lo0) * np.cos(la),
                     np.cos(la0) * np.sin(la) - np.sin(la0) * np.cos(la) * np.cos(lo - lo0))
-    z = dem_km[rows]
-    inner, ann = r <= 0.6, (r >= 0.8) & (r <= 1.2)
-    sector = ((az + np.pi) / (2 * np.pi) * 8).astype(int) % 8
-    rims = [z[ann & (sector == s)].max() for s in range(8) if (ann & (sector == s)).any()]
-    if len(rims) < 8 or not inner.any():
-        return None
-    return float(np.median(rims) - z[inner].min())
+    return rim_minus_floor(dem_km[rows], r, az, floor_r=0.6)
 
 
 def main() -> None:

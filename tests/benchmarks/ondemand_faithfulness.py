@@ -90,6 +90,8 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
+from crater_depth import rim_minus_floor
+
 from craters.kernels import fbm2, roughness_amp, table_value
 from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_profiles
 from latlong import Body, LatLongGrid, Scene, stamp_craters
@@ -194,11 +196,10 @@ def depth_ratios(body: Body, tree, centres_u, base_rho, diam, stretch):
         a = np.stack([np.ones(ann.sum()), x[ann], y[ann]], axis=1)
         coef, *_ = np.linalg.lstsq(a, h[ann], rcond=None)
         hd = h - (coef[0] + coef[1] * x + coef[2] * y)
-        sector = (np.floor((np.arctan2(y[ann], x[ann]) + np.pi) / (np.pi / 4)).astype(int)) % 8
-        maxima = [hd[ann][sector == k].max() for k in range(8) if (sector == k).any()]
-        if len(maxima) < 6:
-            continue
-        out[c] = (np.median(maxima) - hd[floor].min()) / diam[c]
+        depth = rim_minus_floor(hd, xr, np.arctan2(y, x), annulus=(0.7, 1.3), floor_r=0.5,
+                                min_sectors=6)
+        if depth is not None:
+            out[c] = depth / diam[c]
     return out
 
 
