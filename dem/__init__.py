@@ -211,6 +211,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         expand,
         expand_to_file,
         expansion_sizes,
+        local_relief,
     )
     from .fractal import (
         FractalFit,
@@ -271,6 +272,7 @@ __all__ = [
     "fractal_fit",
     "laplacian",
     "local_frame",
+    "local_relief",
     "local_roughness",
     "read",
     "read_stack",

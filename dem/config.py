@@ -35,6 +35,7 @@ from craters._shared import (
 from craters._shared.settings import check_declared, setting
 
 from .fractal import MAX_ROUGHNESS
+from .terrains import TERRAINS
 
 __all__ = ["EnhanceConfig", "SourceCraterLayer", "parse_source_spec", "parse_xy"]
 
@@ -196,6 +197,14 @@ class EnhanceConfig:
         metavar="R", default_text="from the input; for expand and enhance the local relief "
         "of each input pixel")
     """Uniform RMS neighbour slope (m/m) of the expansion; default: local relief."""
+    terrain: str | None = setting(
+        None, "terrain type: the RMD detail follows its LOLA deviogram (median slope at 17 m, "
+        "Hurst exponent, breakover; Rosenburg et al. 2011) below the source's pixels",
+        choices=tuple(TERRAINS), metavar="NAME",
+        default_text="the source's own relief continued with its own F")
+    """Terrain type (:data:`dem.terrains.TERRAINS`) whose deviogram the RMD detail of every
+    layer follows below the breakover (shaped in space by the source's local relief); not
+    with ``roughness`` or ``fractal_dimension``. Default: the source's relief continued."""
     seed: int | None = setting(None, "random seed, a non-negative integer",
                                range=(0, 2**63 - 1), metavar="S", also=("rng",),
                                default_text="a fresh one, recorded in the outputs")
@@ -236,6 +245,12 @@ class EnhanceConfig:
         if self.source_crater_px == 0:
             put("source_crater_px", None)
         check_declared(self, keep=_AS_GIVEN)
+        if self.terrain is not None:
+            for other in ("roughness", "fractal_dimension"):
+                if getattr(self, other) is not None:
+                    raise ParameterError("terrain", f"sets the roughness and fractal dimension "
+                                         f"of the expansion: give `terrain` or `{other}`, "
+                                         f"not both")
         with about("input"):
             if self.input is not None and (not isinstance(self.input, str) or not self.input):
                 raise ParameterTypeError("input", f"must be a file name; got {self.input!r}")

@@ -4,10 +4,15 @@ r"""Multi-resolution enhancement of a DEM around a site (Martin, Parkes & Dunsta
 2^n + 1 pixels, described by a :class:`dem.EnhanceConfig`: layer 0 is the
 ``size``-square window of the base DEM around the target, and layer k is
 :func:`dem.expand` (one RMD doubling) of the ``(size + 1) / 2``-square footprint of layer
-k - 1 centred on the target, so each layer is 2x finer than the last. Where the layers
-lie and which craters and boulders each takes (one population for the whole area,
-drawn band by band in diameter) is planned first (:mod:`dem.planning`); then the layers
-are made one after the other. It writes nothing: :meth:`dem.Stack.write` does.
+k - 1 centred on the target, so each layer is 2x finer than the last. Every layer's RMD
+detail continues the relief of layer 0 (the source DEM; the median over
+:data:`dem.expansion.RELIEF_MEDIAN_PX` pixels of its local relief, scaled by ``2^(-H)``
+per level), not the relief re-estimated on the layer above: that reads the slopes of
+crater walls as roughness and fed it back layer after layer (issue 36: steep ground had
+4.8x the fine detail of flat ground). With ``terrain`` (:mod:`dem.terrains`) the detail
+instead follows that terrain's LOLA deviogram (Rosenburg et al. 2011), the same
+everywhere, each layer filling what its parent lacks (:func:`terrain_relief_m`). Without
+a ``target`` the site is landing-like (:func:`dem.planning.landing_site`).
 
 Consistency (exact)
 -------------------
@@ -56,13 +61,16 @@ from .boulders import place_boulders
 from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
 from .craterdensity import CraterDensity, crater_density
-from .expansion import expand
+from .expansion import RELIEF_MEDIAN_PX, expand, local_relief, midpoint_factor
+from .terrains import MEDIAN_ABS_GAUSSIAN, TerrainRoughness, terrain_roughness
 from .fractal import expansion_fit
 from .frame import LocalFrame, crater_target, grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .planning import (
     STREAM_STAMP,
     StackGeometry,
+    LANDING_SLOPE_LIMIT_DEG,
+    landing_site,
     layer_windows,
     plan_boulders,
     plan_craters,
@@ -247,6 +255,13 @@ class Run(NamedTuple):
     source_density: CraterDensity | None
     fd: float
     fd_estimated: float | None
+    relief: Dem | None
+    """Layer 0's local relief (the median over :data:`RELIEF_MEDIAN_PX` pixels), which
+    every layer's expansion continues (None with a uniform ``roughness``)."""
+    terrain: TerrainRoughness | None
+    """The terrain whose deviogram the layers follow (:func:`terrain_relief_m`)."""
+    site_choice: str
+    """How the site was chosen (the manifest's ``target.chosen``)."""
 
 
 def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -> Run:
@@ -298,12 +313,73 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
                                    if cfg.boulder_layers else ([None] * cfg.layers, None))
     fd = cfg.fractal_dimension
     fd_estimated = None
-    if fd is None:
+    terrain = None if cfg.terrain is None else terrain_roughness(cfg.terrain)
+    if terrain is not None:
+        fd = 3.0 - terrain.hurst
+    elif fd is None:
         fd_estimated = expansion_fit(layer0).fractal_dimension
         fd = min(3.0, max(2.0, fd_estimated))
+    relief = (local_relief(layer0, median_px=RELIEF_MEDIAN_PX) if cfg.roughness is None
+              else None)
     return Run(cfg, seed, layer0, win0, windows, t0, t_base, frame, a0, p0, geometry, target,
                plans, accounting, rock_plans, rock_accounting, source_density, fd,
-               fd_estimated)
+               fd_estimated, relief, terrain, _site_choice(base, cfg))
+
+
+def terrain_target_m(terrain, pixel_m: float, source_pixel_m: float,
+                     source_relief_m: float) -> float:
+    """RMS height difference a stack on ``terrain`` should have at lag ``pixel_m``: the
+    deviogram ``nu`` below the breakover; between the source's pixel and the breakover
+    (where the real deviogram flattens) the log-linear interpolation from the source's
+    own median relief to ``nu(breakover)``."""
+    b = terrain.breakover_m
+    if pixel_m <= b or source_pixel_m <= b or source_relief_m <= 0.0:
+        return terrain.relief_m(pixel_m)
+    t = math.log(pixel_m / source_pixel_m) / math.log(b / source_pixel_m)
+    return math.exp((1.0 - t) * math.log(source_relief_m) + t * math.log(terrain.relief_m(b)))
+
+
+def robust_relief_m(z: np.ndarray, diagonal: bool = False) -> float:
+    """RMS height difference of neighbouring pixels (axis or diagonal) from the median
+    ``|dz|`` (Gaussian: median = 0.6745 RMS), robust to the walls of resolved craters."""
+    if diagonal:
+        d = np.concatenate([(z[1:, 1:] - z[:-1, :-1]).ravel(), (z[1:, :-1] - z[:-1, 1:]).ravel()])
+    else:
+        d = np.concatenate([(z[:, 1:] - z[:, :-1]).ravel(), (z[1:] - z[:-1]).ravel()])
+    d = np.abs(d[np.isfinite(d)])
+    return float(np.median(d)) / MEDIAN_ABS_GAUSSIAN if d.size else 0.0
+
+
+def terrain_relief_m(run: Run, k: int, parent: Dem) -> float:
+    """The uniform relief (metres on layer 0's grid) that makes layer k's RMD bring the
+    stack to its ``terrain``'s deviogram (:mod:`dem.terrains`).
+
+    A square-phase pixel at distance ``rho = d / sqrt 2`` from four parent pixels (``d``
+    the parent's pixel) differs from one of them by ``sum w z + D`` whose variance is
+    ``gamma(d) / 4 + gamma(d sqrt 2) / 8 + s^2`` (:mod:`dem.expansion`). With the parent's
+    *measured* ``gamma`` (robust, over the part being expanded: one number, so the detail
+    does not follow local slopes) the displacement fills the deficit to the target,
+    ``s^2 = nu(rho)^2 - gamma(d) / 4 - gamma(d sqrt 2) / 8`` (at least a tenth of the fBm
+    value ``k(H) nu(rho)^2``): a parent smoother than the terrain at its scale (the LOLA
+    gridded source is) gets the difference at once, a rougher one little more. The
+    terrain type is what the user claims for the site, so its detail is the same
+    everywhere (the source's own relief map, kept without ``terrain``, made the site's
+    560 m slopes 28 % lower: the site is a smooth spot of the source).
+    """
+    terrain, relief = run.terrain, run.relief
+    assert terrain is not None and relief is not None  # a terrain run's (prepare)
+    rr, cc, w = run.windows[k - 1]
+    d = parent.resolution_m
+    target = terrain_target_m(terrain, d / math.sqrt(2.0), relief.resolution_m,
+                              float(np.median(relief.heights)))
+    z = parent.heights[rr:rr + w, cc:cc + w]
+    g_axis = robust_relief_m(z) ** 2
+    g_diag = robust_relief_m(z, diagonal=True) ** 2
+    k_h = midpoint_factor(terrain.hurst)
+    s2 = max(target**2 - g_axis / 4.0 - g_diag / 8.0, 0.1 * k_h * target**2)
+    # the square phase's scale per metre of relief on layer 0's grid (dem.expand)
+    unit = math.sqrt(k_h) * 2.0 ** (-(k - 0.5) * terrain.hurst)
+    return math.sqrt(s2) / unit
 
 
 def layers_of(run: Run, *, progress: bool = False):
@@ -322,8 +398,13 @@ def layers_of(run: Run, *, progress: bool = False):
             rr, cc, w = run.windows[k - 1]
             assert prev is not None  # k > 0: the previous layer's
             parent = prev[0].replace(heights=prev[1])
+            relief = run.relief
+            if relief is not None and run.terrain is not None:
+                relief = relief.replace(heights=np.full(relief.shape,
+                                                        terrain_relief_m(run, k, parent)))
             prev = meta = z = None  # the caller may drop them too: only the copy is held
-            meta = expand(parent, 1, run.fd, cfg.roughness, Window(cc, rr, w, w), rng=run.seed)
+            meta = expand(parent, 1, run.fd, cfg.roughness, Window(cc, rr, w, w), rng=run.seed,
+                          relief=relief)
             del parent
         z, cat = _stamp_layer(np.array(meta.heights), run.plans[k], run.geometry, k,
                               roughness=not cfg.smooth_craters, seed=run.seed, progress=False,
@@ -371,6 +452,7 @@ def stack_info(run: Run, stamped, rocks) -> dict:
         "seed": run.seed,
         "parameters": params,
         "target": {"world": None if cfg.target is None else list(cfg.target),
+                   "chosen": run.site_choice,
                    "pixel_in_base": list(run.t_base), "pixel_in_layer0": list(run.t0),
                    "world_pixel_centre": [float(v) for v in run.layer0.xy(*run.t0)]},
         "layer0_window_in_base": [int(win0.row_off), int(win0.col_off), cfg.size],
@@ -385,6 +467,19 @@ def stack_info(run: Run, stamped, rocks) -> dict:
                       "(4, layer) for stamping; the RMD key is default_rng(seed)'s first "
                       "draw",
     }
+
+
+def _site_choice(base: Dem, cfg: EnhanceConfig) -> str:
+    """How the site was chosen (given, or :func:`dem.planning.landing_site`)."""
+    if cfg.target is not None:
+        return "given"
+    _, worst = landing_site(base, cfg.size)
+    if worst <= LANDING_SLOPE_LIMIT_DEG:
+        return (f"landing-like: nearest the base's centre with 3 x 3 Horn slopes <= "
+                f"{LANDING_SLOPE_LIMIT_DEG:g} deg at the base's pixels (steepest there "
+                f"{worst:.2f} deg)")
+    return (f"landing-like: no pixel near the base's centre has 3 x 3 Horn slopes <= "
+            f"{LANDING_SLOPE_LIMIT_DEG:g} deg; the gentlest (steepest there {worst:.2f} deg)")
 
 
 def finish(run: Run, layers, stamped, rocks, info) -> Stack:

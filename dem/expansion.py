@@ -51,7 +51,9 @@ to each new pixel: the terrain model of :mod:`dem.fractal` (one ``H``, amplitude
 space). Smooth mare then gets smooth detail and crater walls rough detail, which is
 what keeps the slope distribution of a real DEM (a single amplitude makes the median
 slope of smooth areas several times too large). An explicit ``roughness`` gives the
-paper's uniform scale.
+paper's uniform scale. ``relief`` carries a coarser ancestor's relief instead (layer 0's
+in :func:`dem.enhance`), with the scale continued from that level: expanding one level
+at a time with it gives exactly the pixels of one multi-level expansion (tests).
 
 Randomness and tiles
 --------------------
@@ -79,6 +81,7 @@ from typing import NamedTuple
 
 import numpy as np
 from affine import Affine
+from scipy.ndimage import median_filter
 
 from craters._shared import (
     ParameterError,
@@ -96,11 +99,14 @@ from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import MAX_ROUGHNESS, expansion_fit, local_msd
 
-__all__ = ["CONTEXT_PX", "TILE_PX", "ExpandedFile", "displacement_scales", "expand",
-           "expand_to_file", "expansion_sizes", "midpoint_factor"]
+__all__ = ["CONTEXT_PX", "RELIEF_MEDIAN_PX", "TILE_PX", "ExpandedFile", "displacement_scales", "expand",
+           "expand_to_file", "expansion_sizes", "local_relief", "midpoint_factor"]
 
 logger = logging.getLogger(__name__)
 
+#: The window (pixels of layer 0) of the median local relief :func:`dem.enhance`
+#: continues in every layer (:func:`local_relief`).
+RELIEF_MEDIAN_PX = 5
 #: Context pixels a separately cut tile needs around its region to expand exactly like
 #: the same region of the whole DEM (level-1 halo plus the amplitude's neighbours).
 CONTEXT_PX = 3
@@ -172,7 +178,7 @@ def _region(dem: Dem, region) -> tuple[int, int, int]:
 
 def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
            roughness: float | None = None, region=None, rng=None, *,
-           progress: bool = False) -> Dem:
+           relief: Dem | None = None, progress: bool = False) -> Dem:
     """Double the resolution of a square region ``levels`` times by RMD (diamond-square).
 
     A region of ``W = 2^n + 1`` pixels becomes ``(W - 1) 2^levels + 1`` pixels; its
@@ -207,6 +213,16 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     rng : int, numpy.random.Generator or None
         Seed of the counter-based randomness. Give the same *int* to get the same pixels
         from separate calls (tiles).
+    relief : Dem, optional
+        The local relief to continue instead of the input's own (metres, RMS height
+        difference of neighbouring pixels of ``relief``, :func:`local_relief`): a
+        coarser ancestor of ``dem`` on the same lattice (its :attr:`Dem.level` at most
+        ``dem``'s, covering the region), scaled down by ``2^(-H)`` per level between
+        them as fBm continues. :func:`dem.enhance` passes layer 0's, so every layer
+        continues the *source* DEM's roughness: re-estimating it on each expanded
+        layer reads the large-scale slope of crater walls as relief and feeds it back
+        (steep ground got 4.8x the fine detail of flat ground, issue 36). Not with
+        ``roughness``.
     progress : bool
         Show a progress bar over the levels.
 
@@ -222,7 +238,7 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     >>> e.shape, e.pixel_size_m, bool((e.heights[::4, ::4] == d.heights).all())
     ((17, 17), (2.0, 2.0), True)
     """
-    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
+    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng, relief)
     need = (plan.side + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
     have = physical_memory_bytes()
     if need > 0.85 * have:
@@ -365,6 +381,8 @@ class _Plan(NamedTuple):
     params: dict
     uniform_m: float | None
     """The uniform amplitude (roughness x resolution), None for the local one."""
+    relief: Dem | None
+    """The carried local relief (metres at its own level), None for the input's own."""
     fallback_m: float
     """The local amplitude where a pixel has no known neighbour."""
     transform: Affine
@@ -372,7 +390,8 @@ class _Plan(NamedTuple):
     origin: tuple[int, int]
 
 
-def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
+def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng,
+          relief: Dem | None = None) -> _Plan:
     """Check the arguments and make the estimates of the whole DEM (expand's parameters)."""
     dem = _check_dem(dem)
     with about("levels"):
@@ -400,6 +419,9 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
         fractal_dimension = min(3.0, max(2.0, fit.fractal_dimension))
         params["fractal_dimension_estimated"] = fit.fractal_dimension
     params["fractal_dimension"] = fractal_dimension
+    if relief is not None:
+        relief = _check_relief(relief, dem, roughness, (r0, c0, width))
+        params["relief_level"] = relief.level
     resolution = dem.resolution_m
     if roughness is None:
         assert fit is not None  # fitted above
@@ -419,7 +441,62 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng) -> _Plan:
     px = None if dem.crs is not None else tuple(v * scale for v in dem.pixel_size_m)
     origin = ((dem.origin[0] + r0) * 2**levels, (dem.origin[1] + c0) * 2**levels)
     return _Plan(r0, c0, width, levels, side, fractal_dimension, key, seed, params, uniform,
-                 fallback, transform, px, origin)
+                 relief, fallback, transform, px, origin)
+
+
+def _check_relief(relief, dem: Dem, roughness, region) -> Dem:
+    """``relief`` checked against ``dem`` and its region (see :func:`expand`)."""
+    if not isinstance(relief, Dem):
+        raise TypeError(f"`relief` must be a dem.Dem; got {type(relief).__name__}")
+    if roughness is not None:
+        raise ValueError("give `relief` or `roughness`, not both")
+    if relief.level > dem.level:
+        raise ValueError(f"`relief` must be at the level of the DEM or coarser (<= "
+                         f"{dem.level}); got level {relief.level}")
+    if not np.isfinite(relief.heights).all() or (relief.heights < 0).any():
+        raise ValueError("`relief` must be finite and >= 0 metres everywhere")
+    step = 2 ** (dem.level - relief.level)
+    r0, c0, width = region
+    lo = [(dem.origin[i] + (r0, c0)[i]) / step - relief.origin[i] for i in (0, 1)]
+    hi = [v + (width - 1) / step for v in lo]
+    if min(lo) < 0 or hi[0] > relief.shape[0] - 1 or hi[1] > relief.shape[1] - 1:
+        raise ValueError("`relief` does not cover the region to expand (it must be an "
+                         "ancestor of the DEM on the same lattice: dem.local_relief of a "
+                         "coarser layer it was expanded from)")
+    return relief
+
+
+def local_relief(dem: Dem, *, median_px: int = 1) -> Dem:
+    """The local relief of each pixel (metres): RMS height difference to its known axis
+    neighbours, what :func:`expand` scales its displacements by (``local_roughness``
+    times the resolution; a pixel with no known neighbour gets the DEM's RMS value).
+
+    ``median_px`` > 1 (odd) takes the median of that value over a ``median_px`` square
+    around each pixel instead: the relief of the *terrain* there, robust to the few
+    pixels of a resolved landform in the window. A crater wall a few pixels wide reads
+    as relief because of its slope, not its roughness; :func:`dem.enhance` uses
+    :data:`RELIEF_MEDIAN_PX` so the detail below the pixel does not follow the
+    resolved slopes (issue 36; ``tests/benchmarks/measure_rmd_roughness.py``).
+
+    Examples
+    --------
+    >>> d = Dem(np.array([[0.0, 1.0, 2.0], [0.0, 1.0, 2.0]]), pixel_size_m=1.0)
+    >>> local_relief(d).heights.round(3).tolist()
+    [[0.707, 0.816, 0.707], [0.707, 0.816, 0.707]]
+    """
+    dem = _check_dem(dem)
+    with about("median_px"):
+        median_px = check_int("median_px", median_px, 1)
+    if median_px % 2 == 0:
+        raise ValueError(f"`median_px` must be odd; got {median_px}")
+    rows, cols = dem.shape
+    amp, _, _ = _local_amplitude(dem, 0, 0, max(rows, cols), math.nan)
+    amp = amp[:rows, :cols]
+    finite = np.isfinite(amp)
+    amp[~finite] = float(np.sqrt(np.mean(amp[finite] ** 2))) if finite.any() else 0.0
+    if median_px > 1:
+        amp = median_filter(amp, median_px, mode="nearest")
+    return dem.replace(heights=amp)
 
 
 def _tile_task(shared: tuple[Dem, _Plan], corner: tuple[int, int, int]) -> np.ndarray:
@@ -431,14 +508,19 @@ def _expand_tile(dem: Dem, plan: _Plan, r0: int, c0: int, width: int, *,
                  progress: bool = False) -> np.ndarray:
     """The expansion of the square ``(r0, c0, width)`` of ``dem`` with ``plan``'s settings
     (the same pixels as that part of the whole region's expansion)."""
-    if plan.uniform_m is None:
+    coarser = 0
+    if plan.relief is not None:
+        coarser = dem.level - plan.relief.level
+        amp = np.ascontiguousarray(plan.relief.heights)
+        amp_r0, amp_c0 = plan.relief.origin
+    elif plan.uniform_m is None:
         amp, amp_r0, amp_c0 = _local_amplitude(dem, r0, c0, width, plan.fallback_m)
     else:
         amp = np.full((1, 1), plan.uniform_m)
         amp_r0, amp_c0 = dem.origin[0] + r0, dem.origin[1] + c0
     return _expand_region(dem.heights, (r0, c0, width), dem.origin, dem.level, plan.levels,
                           plan.key, plan.fractal_dimension, amp, (amp_r0, amp_c0),
-                          progress=progress)
+                          amp_coarser=coarser, progress=progress)
 
 
 def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
@@ -463,13 +545,13 @@ def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
 
 def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key: int,
                    fractal_dimension: float, amp: np.ndarray, amp_origin, *,
-                   progress: bool = False) -> np.ndarray:
+                   amp_coarser: int = 0, progress: bool = False) -> np.ndarray:
     """Expand ``z[region]`` ``levels`` times with ``_HALO`` context pixels per level.
 
     ``region`` is (row_off, col_off, width) in ``z``; ``origin`` the lattice index of
     ``z[0, 0]`` at ``level0``; ``amp`` the displacement amplitude in metres on the
-    ``level0`` grid, its pixel (0, 0) at lattice index ``amp_origin``. Returns the
-    expanded region only.
+    grid ``amp_coarser`` levels above ``level0``, its pixel (0, 0) at lattice index
+    ``amp_origin`` there. Returns the expanded region only.
     """
     r0, c0, width = region
     rows, cols = z.shape
@@ -479,11 +561,12 @@ def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key:
     org = (origin[0] + a_r, origin[1] + a_c)
     reg = (r0 - a_r, c0 - a_c, width)
     for lev in progress_bar(range(1, levels + 1), enabled=progress, desc="expand"):
-        sd_sq, sd_dia = displacement_scales(lev, fractal_dimension, 1.0)
+        # levels from the amplitude's grid: the scale carries 2^(-H) per level from there
+        sd_sq, sd_dia = displacement_scales(lev + amp_coarser, fractal_dimension, 1.0)
         out = np.empty((2 * arr.shape[0] - 1, 2 * arr.shape[1] - 1), dtype=np.float64)
         org = (2 * org[0], 2 * org[1])
         _expand_kernel(arr, key, level0 + lev, org[0], org[1], sd_sq, sd_dia, amp,
-                       float(amp_origin[0]), float(amp_origin[1]), 0.5**lev, out)
+                       float(amp_origin[0]), float(amp_origin[1]), 0.5**(lev + amp_coarser), out)
         reg = (2 * reg[0], 2 * reg[1], 2 * reg[2] - 1)
         if lev == levels:
             return np.ascontiguousarray(out[reg[0]:reg[0] + reg[2], reg[1]:reg[1] + reg[2]])

@@ -119,16 +119,57 @@ class StackGeometry:
         return (self.size * self.pixel_m(k)) ** 2
 
 
+#: A default site is landing-like: the pixel nearest the base DEM's centre (within a
+#: quarter of the layer size) whose 3 x 3 neighbourhood has Horn slopes at most this many
+#: degrees at the base's pixel scale (else the one with the gentlest such neighbourhood).
+LANDING_SLOPE_LIMIT_DEG = 5.0
+
+
+def landing_site(base: Dem, size: int) -> tuple[tuple[int, int], float]:
+    """The default site (:data:`LANDING_SLOPE_LIMIT_DEG`): its base pixel (row, col) and
+    the steepest Horn slope of its 3 x 3 neighbourhood, degrees.
+
+    The user's ``target`` pins a site; without one the stack should not land on a crater
+    wall (issue 36: the README site's target did, and 16 % of its 59 m layer was steeper
+    than 35 deg). Slopes at the base's scale are all this can see; the layers below
+    inherit them.
+    """
+    from scipy.ndimage import maximum_filter
+
+    from .terrain import slope
+
+    rows, cols = base.shape
+    r_c, c_c = rows // 2, cols // 2
+    reach = max((size - 1) // 4, 1)
+    # two pixels of margin: the Horn slope of every neighbour sees its own neighbours
+    r0, r1 = max(r_c - reach, 2), min(r_c + reach + 1, rows - 2)
+    c0, c1 = max(c_c - reach, 2), min(c_c + reach + 1, cols - 2)
+    if r1 <= r0 or c1 <= c0:
+        return (r_c, c_c), math.nan
+    s = slope(base.crop(Window(c0 - 2, r0 - 2, c1 - c0 + 4, r1 - r0 + 4)))
+    worst = maximum_filter(np.where(np.isfinite(s), s, 90.0), size=3)[2:-2, 2:-2]
+    rr, cc = np.mgrid[r0:r1, c0:c1]
+    dist2 = (rr - r_c) ** 2 + (cc - c_c) ** 2
+    ok = worst <= LANDING_SLOPE_LIMIT_DEG
+    if ok.any():
+        pick = np.flatnonzero(ok.ravel())[np.argmin(dist2[ok])]
+    else:
+        pick = int(np.lexsort((dist2.ravel(), worst.ravel()))[0])
+    i, j = np.unravel_index(pick, worst.shape)
+    return (int(rr[i, j]), int(cc[i, j])), float(worst[i, j])
+
+
 def layer_windows(base: Dem, target, size: int, n_layers: int):
     """Where the layers lie: ``(window of layer 0 in the base, footprints (row_off,
     col_off, width) of layers 1.. in their parents, target pixel in layer 0, target pixel
-    in the base)``; ``target`` is (X, Y) in world coordinates or None (the centre)."""
+    in the base)``; ``target`` is (X, Y) in world coordinates or None (a landing-like
+    site near the centre, :func:`landing_site`)."""
     rows, cols = base.shape
     if rows < size or cols < size:
         raise ParameterError("size", f"{size} needs a base DEM of at least {size} x {size} "
                              f"pixels; it has {rows} x {cols}")
     if target is None:
-        r_t, c_t = rows // 2, cols // 2
+        (r_t, c_t), _ = landing_site(base, size)
         row_f, col_f = r_t + 0.5, c_t + 0.5
     else:
         col_f, row_f = ~base.transform @ target

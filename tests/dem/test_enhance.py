@@ -49,8 +49,10 @@ def test_every_pair_of_layers_is_exactly_consistent(stack):
 def test_layers_are_nested_and_2x_finer(stack, base):
     sizes = stack.pixel_sizes_m()
     assert sizes == [50.0 / 2**k for k in range(6)]
-    # the target (default: the base's centre pixel) is the centre pixel of every layer
-    centre = base.xy(64, 64)
+    # the target (default: a landing-like pixel near the base's centre) is the centre
+    # pixel of every layer
+    assert stack.info["target"]["chosen"].startswith("landing-like")
+    centre = base.xy(*stack.info["target"]["pixel_in_base"])
     for d in stack.layers:
         assert d.xy(32, 32) == pytest.approx(centre, abs=1e-6)
         assert d.crs == base.crs
@@ -60,6 +62,26 @@ def test_layers_are_nested_and_2x_finer(stack, base):
         assert np.allclose(np.stack(coarse.xy(rows + r0, cols + c0)),
                            np.stack(fine.xy(2 * rows, 2 * cols)), rtol=0, atol=1e-6)
         assert fine.level == coarse.level + 1
+
+
+def test_default_site_is_landing_like_and_a_given_one_is_kept():
+    # a 45 deg ramp through the centre, flat from column 38: the site is the nearest pixel
+    # whose 3 x 3 Horn slopes stay under the limit (column 40: column 38's Horn slope
+    # still sees the ramp) (issue 36)
+    from dem.planning import LANDING_SLOPE_LIMIT_DEG, landing_site
+
+    x = np.arange(65.0)
+    z = np.tile(np.where(x < 38, 50.0 * (x - 38), 0.0), (65, 1))
+    base = dem.Dem(z, pixel_size_m=50.0)
+    (r, c), worst = landing_site(base, 65)
+    assert (r, c) == (32, 40) and worst <= LANDING_SLOPE_LIMIT_DEG
+    s = dem.enhance({"layers": 2, "size": 33, "seed": 1}, dem=base)
+    assert s.info["target"]["pixel_in_base"] == [32, 40]
+    assert "landing-like" in s.info["target"]["chosen"]
+    given = dem.enhance({"layers": 2, "size": 33, "seed": 1, "target": list(base.xy(32, 32))},
+                        dem=base)
+    assert given.info["target"]["pixel_in_base"] == [32, 32]
+    assert given.info["target"]["chosen"] == "given"
 
 
 def test_the_finest_layer_holds_a_target_on_a_coarse_pixel_corner(base):
@@ -359,10 +381,34 @@ def test_geographic_base_from_lola(lola_crop):
     ({"source_crater_px": 0.5}, ValueError, "source_crater_px"),
     ({"fractal_dimension": 3.5}, ValueError, "fractal_dimension"),
     ({"smooth_craters": "yes"}, TypeError, "smooth_craters"),
+    ({"terrain": "mountains"}, ValueError, "terrain.*highlands, maria"),
+    ({"terrain": "maria", "roughness": 0.1}, ValueError, "`terrain` or `roughness`"),
+    ({"terrain": "maria", "fractal_dimension": 2.2}, ValueError, "`terrain` or `fractal_dim"),
 ])
 def test_bad_config(base, config, error, match):
     with pytest.raises(error, match=match):
         dem.enhance({"layers": 2, "size": 65, "seed": 1, **config}, dem=base)
+
+
+@pytest.mark.parametrize("terrain,flatten", [("highlands", 1.0), ("maria", 0.1)])
+def test_terrain_stack_follows_the_lola_deviogram(lola_crop, terrain, flatten):
+    # Rosenburg et al. 2011 (dem.terrains): below the breakover, the median
+    # point-to-point slope of every layer at one pixel follows the terrain's deviogram
+    # (within 20 %, the issue 36 acceptance). A source rougher than the terrain cannot be
+    # made smoother: maria get the LOLA highland crop flattened 10x
+    from dem.terrains import MEDIAN_ABS_GAUSSIAN, TERRAINS
+
+    t = TERRAINS[terrain]
+    source = lola_crop.replace(heights=lola_crop.heights * flatten)
+    s = dem.enhance({"layers": 10, "size": 33, "seed": 5, "terrain": terrain}, dem=source)
+    assert s.info["parameters"]["fractal_dimension"] == pytest.approx(3.0 - t.hurst)
+    below = [layer for layer in s.layers if layer.resolution_m <= t.breakover_m]
+    assert len(below) >= 6
+    for layer in below:
+        z, p = layer.heights, layer.resolution_m
+        dz = np.abs(np.concatenate([np.diff(z, axis=0).ravel(), np.diff(z, axis=1).ravel()]))
+        ratio = np.median(dz) / (MEDIAN_ABS_GAUSSIAN * t.relief_m(p))
+        assert 0.8 <= ratio <= 1.2, (terrain, p, ratio)
 
 
 def test_synthetic_craters_stay_below_the_source_resolution(base, stack):

@@ -132,6 +132,58 @@ def test_zero_roughness_keeps_a_plane():
                                atol=1e-12)
 
 
+def test_relief_of_the_input_itself_is_the_default():
+    d = Dem(np.random.default_rng(3).normal(0, 5, (17, 17)), pixel_size_m=8.0)
+    a = dem.expand(d, 2, 2.3, rng=4)
+    b = dem.expand(d, 2, 2.3, rng=4, relief=dem.local_relief(d))
+    assert np.array_equal(a.heights, b.heights)
+
+
+@pytest.mark.parametrize("region,then", [(None, None), ((4, 4, 9), (8, 8, 17))])
+def test_carried_relief_makes_one_level_at_a_time_the_multilevel_expansion(region, then):
+    # layer after layer with the source's relief (dem.enhance) is exactly expanding the
+    # source two levels at once: the displacement scale 2^(-H) per level is carried
+    d = Dem(np.random.default_rng(5).normal(0, 5, (17, 17)), pixel_size_m=8.0)
+    relief = dem.local_relief(d, median_px=3)
+    two = dem.expand(d, 2, 2.3, rng=6, relief=relief, region=region)
+    one = dem.expand(d, 1, 2.3, rng=6, relief=relief)
+    assert not np.array_equal(one.heights, dem.expand(d, 1, 2.3, rng=6).heights)
+    again = dem.expand(one, 1, 2.3, rng=6, relief=relief, region=then)
+    assert (again.level, again.origin) == (two.level, two.origin)
+    assert np.array_equal(again.heights, two.heights)
+
+
+def test_local_relief_median_window():
+    z = np.zeros((9, 9))
+    z[:, 5:] = 100.0  # a cliff: relief only beside it, robustly removed by the median
+    d = Dem(z, pixel_size_m=1.0)
+    pointwise = dem.local_relief(d).heights
+    assert pointwise[4, 4] == pytest.approx(50.0) and pointwise[4, 0] == 0.0
+    assert dem.local_relief(d, median_px=5).heights[4, 4] == 0.0
+    assert dem.local_relief(d, median_px=5).heights.shape == (9, 9)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    ({"relief": np.ones((9, 9))}, "`relief` must be a dem.Dem"),
+    ({"relief": "coarser", "roughness": 0.1}, "`relief` or `roughness`"),
+    ({"relief": "finer"}, "level of the DEM or coarser"),
+    ({"relief": "negative"}, ">= 0 metres"),
+    ({"relief": "small"}, "does not cover"),
+])
+def test_bad_relief(kwargs, match):
+    d = Dem(np.random.default_rng(1).normal(0, 5, (9, 9)), pixel_size_m=8.0)
+    fine = dem.expand(d, 1, 2.3, rng=1)
+    made = {"coarser": dem.local_relief(d), "finer": dem.local_relief(fine),
+            "negative": d.replace(heights=-np.ones((9, 9))),
+            "small": dem.local_relief(d.crop(Window(0, 0, 4, 4)))}
+    value = kwargs["relief"]
+    kwargs = {**kwargs, "relief": made.get(value, value) if isinstance(value, str) else value}
+    with pytest.raises((ValueError, TypeError), match=match):
+        dem.expand(d, 1, 2.3, **kwargs)
+    with pytest.raises(ValueError, match="median_px"):
+        dem.local_relief(d, median_px=4)
+
+
 @pytest.mark.parametrize("kwargs,match", [
     ({}, r"is 257 x 256 pixels.*2\^n \+ 1.*3, 5, 9, 17"),
     ({"region": Window(0, 0, 10, 10)}, r"10 x 10 pixels.*2\^n \+ 1"),
