@@ -205,11 +205,10 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
     from .craterdensity import CraterDensity, crater_density, detect_craters, resolved_diameter_m
     from .craterfill import fill_crater_gaps, replace_crater
     from .enhance import enhance
+    from .expandfile import ExpandedFile, expand_to_file
     from .expansion import (
-        ExpandedFile,
         displacement_scales,
         expand,
-        expand_to_file,
         expansion_sizes,
         local_relief,
     )

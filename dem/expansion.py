@@ -68,15 +68,15 @@ around the region and is given the whole DEM's ``fractal_dimension`` (the defaul
 estimate is per DEM); with a uniform ``roughness`` and a geographic CRS the amplitude
 ``roughness * resolution_m`` also depends on the crop's centre latitude. A finer layer's even
 pixels equal the coarser layer (the layer-stack consistency ``enhance`` relies on).
-:func:`expand_to_file` uses this to write results bigger than memory: tiles of the
-region, each expanded with its halo, each written into its window of the output file.
+:func:`dem.expand_to_file` (:mod:`dem.expandfile`) uses this to write results bigger than
+memory: tiles of the region, each expanded with its halo, each written into its window of
+the output file.
 """
 
 from __future__ import annotations
 
 import logging
 import math
-from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
@@ -99,8 +99,8 @@ from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import MAX_ROUGHNESS, expansion_fit, local_msd
 
-__all__ = ["CONTEXT_PX", "RELIEF_MEDIAN_PX", "TILE_PX", "ExpandedFile", "displacement_scales", "expand",
-           "expand_to_file", "expansion_sizes", "local_relief", "midpoint_factor"]
+__all__ = ["CONTEXT_PX", "RELIEF_MEDIAN_PX", "displacement_scales", "expand", "expansion_sizes",
+           "local_relief", "midpoint_factor"]
 
 logger = logging.getLogger(__name__)
 
@@ -112,9 +112,9 @@ RELIEF_MEDIAN_PX = 5
 CONTEXT_PX = 3
 # context pixels kept around the region at every level: enough for the border diamond
 # pixels of every level to see the same neighbours as in the whole-DEM expansion
-_HALO = 2
+HALO_PX = 2
 # bytes per output pixel: the output, the previous level, the final crop
-_BYTES_PER_PIXEL = 8 * 2.3
+BYTES_PER_PIXEL = 8 * 2.3
 
 
 def expansion_sizes(n_max: int = 12) -> list[int]:
@@ -238,137 +238,22 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     >>> e.shape, e.pixel_size_m, bool((e.heights[::4, ::4] == d.heights).all())
     ((17, 17), (2.0, 2.0), True)
     """
-    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng, relief)
-    need = (plan.side + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
+    plan = plan_expansion(dem, levels, fractal_dimension, roughness, region, rng, relief)
+    need = (plan.side + 4 * HALO_PX) ** 2 * BYTES_PER_PIXEL
     have = physical_memory_bytes()
     if need > 0.85 * have:
         raise ValueError(f"expanding {plan.width} x {plan.width} pixels {levels} levels gives "
                          f"{plan.side} x {plan.side} pixels and needs about {human_bytes(need)} "
                          f"of memory; this machine has {human_bytes(have)} (dem.expand_to_file "
                          f"writes it tile by tile)")
-    heights = _expand_tile(dem, plan, plan.r0, plan.c0, plan.width, progress=progress)
+    heights = expand_tile(dem, plan, plan.r0, plan.c0, plan.width, progress=progress)
     return dem.with_step(heights, "dem.expand", plan.seed, plan.params,
                          transform=plan.transform, pixel_size_m=plan.pixel_size_m,
                          level=dem.level + plan.levels, origin=plan.origin)
 
 
-class ExpandedFile(NamedTuple):
-    """What :func:`expand_to_file` wrote."""
-
-    path: Path
-    """The cloud-optimised GeoTIFF."""
-    shape: tuple[int, int]
-    """Its rows and columns."""
-    seed: int | None
-    """The seed recorded (``rng`` when it is an int)."""
-    parameters: dict
-    """The step's parameters (``CRATERFORM_PARAMETERS``), as ``expand`` records them."""
-    tiles: int
-    """How many tiles were expanded."""
-
-
-#: Default largest output tile side of :func:`expand_to_file`, pixels (about 80 MB).
-TILE_PX = 2049
-
-
-def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | None = None,
-                   roughness: float | None = None, region=None, rng=None, *,
-                   tile_px: int | None = None, backend: str | None = None,
-                   scheduler: str | None = None, workers: int | None = None,
-                   progress: bool = False) -> ExpandedFile:
-    """:func:`expand` written tile by tile into a GeoTIFF: results bigger than memory.
-
-    The region is expanded as square tiles of ``2^k + 1`` input pixels sharing their
-    edge pixels, each at most ``tile_px`` pixels a side once expanded (a tile of 3 input
-    pixels when even that is larger), each with its context halo at every level; the
-    counter-based randomness is keyed by global pixel index and every estimate (the
-    fractal dimension, the fallback roughness) is made once on the whole input DEM, so
-    every tile holds exactly the pixels of the whole expansion. Each tile goes into its
-    window of the output (:class:`dem.io.WindowWriter`): the file has the same bytes as
-    ``dem.write(expand(...), path)`` while the memory holds one tile (about 18 bytes an
-    output pixel of a tile) plus GDAL's block cache.
-
-    Parameters are those of :func:`expand`, plus:
-
-    path : str or Path
-        The ``.tif`` to write (atomically; an existing file is replaced).
-    tile_px : int, optional
-        Largest output tile side in pixels (>= 3); default :data:`TILE_PX` (2049, about
-        80 MB a tile).
-    backend, scheduler, workers : optional
-        Expand the tiles as dask.distributed tasks (:mod:`latlong.parallel.backends`): on
-        the scheduler at an address such as ``tcp://127.0.0.1:8786``, or on a local
-        cluster of ``workers`` processes (``backend="dask"`` alone: one per core); each
-        tile is written as it arrives (the same bytes; the input DEM is sent to each
-        worker once). None of them (or ``backend="serial"``): tile after tile in this
-        process.
-
-    Returns
-    -------
-    ExpandedFile
-
-    Examples
-    --------
-    >>> import tempfile
-    >>> from dem.io import write
-    >>> d = Dem(np.random.default_rng(0).normal(0, 5, (17, 17)), pixel_size_m=8.0)
-    >>> with tempfile.TemporaryDirectory() as tmp:
-    ...     info = expand_to_file(d, f"{tmp}/t.tif", 2, 2.3, rng=1, tile_px=17)
-    ...     whole = write(expand(d, 2, 2.3, rng=1), f"{tmp}/w.tif")
-    ...     same = info.path.read_bytes() == whole.read_bytes()
-    >>> info.shape, info.tiles, same
-    ((65, 65), 16, True)
-    """
-    from latlong.parallel.backends import choose_backend
-    from latlong.parallel.tiles import map_tiles
-
-    from .io import WindowWriter
-
-    with about("tile_px"):
-        tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
-    choose_backend(backend, scheduler, workers)  # before any work (map_tiles checks later)
-    plan = _plan(dem, levels, fractal_dimension, roughness, region, rng)
-    t_in, t_out = _tile_sides(plan, tile_px)
-    n = (plan.width - 1) // (t_in - 1)
-    tags = dem.step_tags("dem.expand", plan.seed, plan.params, level=dem.level + plan.levels,
-                         origin=plan.origin)
-    with WindowWriter(path, (plan.side, plan.side), transform=plan.transform, crs=dem.crs,
-                      tags=tags, body_radius_m=dem.body_radius_m,
-                      pixel_size_m=plan.pixel_size_m) as out:
-        tiles = [(i, j) for i in range(n) for j in range(n)]
-        corners = [(plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1), t_in) for i, j in tiles]
-        made = map_tiles(_tile_task, (dem, plan), corners, backend=backend, scheduler=scheduler,
-                         workers=workers)
-        for k, z in progress_bar(made, enabled=progress, total=len(tiles), desc="expand tiles"):
-            i, j = tiles[k]
-            # tiles share their edge pixels: each writes all but its last row / column,
-            # the last ones all (windows aligned to the output's blocks when large)
-            rows = t_out if i == n - 1 else t_out - 1
-            cols = t_out if j == n - 1 else t_out - 1
-            out.write(z[:rows, :cols], i * (t_out - 1), j * (t_out - 1))
-    return ExpandedFile(out.path, (plan.side, plan.side), plan.seed, plan.params, len(tiles))
-
-
-def _tile_sides(plan: _Plan, tile_px: int) -> tuple[int, int]:
-    """Input and output side of :func:`expand_to_file`'s tiles: ``2^k + 1`` input pixels,
-    the largest whose expansion fits ``tile_px`` (at least 3); a tile too large for this
-    machine's memory is refused."""
-    step = 2**plan.levels
-    k = max(1, min((plan.width - 1).bit_length() - 1,
-                   ((tile_px - 1) // step).bit_length() - 1))
-    t_in = 2**k + 1
-    t_out = (t_in - 1) * step + 1
-    need = (t_out + 4 * _HALO) ** 2 * _BYTES_PER_PIXEL
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
-        raise ValueError(f"one tile of {t_in} x {t_in} pixels expanded {plan.levels} levels "
-                         f"is {t_out} x {t_out} pixels and needs about {human_bytes(need)} of "
-                         f"memory; this machine has {human_bytes(have)}")
-    return t_in, t_out
-
-
-class _Plan(NamedTuple):
-    """An expansion's settings, made once for the whole region (:func:`_plan`)."""
+class ExpansionPlan(NamedTuple):
+    """An expansion's settings, made once for the whole region (:func:`plan_expansion`)."""
 
     r0: int
     c0: int
@@ -390,8 +275,8 @@ class _Plan(NamedTuple):
     origin: tuple[int, int]
 
 
-def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng,
-          relief: Dem | None = None) -> _Plan:
+def plan_expansion(dem: Dem, levels, fractal_dimension, roughness, region, rng,
+          relief: Dem | None = None) -> ExpansionPlan:
     """Check the arguments and make the estimates of the whole DEM (expand's parameters)."""
     dem = _check_dem(dem)
     with about("levels"):
@@ -440,7 +325,7 @@ def _plan(dem: Dem, levels, fractal_dimension, roughness, region, rng,
                  @ Affine.scale(scale))
     px = None if dem.crs is not None else tuple(v * scale for v in dem.pixel_size_m)
     origin = ((dem.origin[0] + r0) * 2**levels, (dem.origin[1] + c0) * 2**levels)
-    return _Plan(r0, c0, width, levels, side, fractal_dimension, key, seed, params, uniform,
+    return ExpansionPlan(r0, c0, width, levels, side, fractal_dimension, key, seed, params, uniform,
                  relief, fallback, transform, px, origin)
 
 
@@ -499,12 +384,7 @@ def local_relief(dem: Dem, *, median_px: int = 1) -> Dem:
     return dem.replace(heights=amp)
 
 
-def _tile_task(shared: tuple[Dem, _Plan], corner: tuple[int, int, int]) -> np.ndarray:
-    """One tile of :func:`expand_to_file` (a task: ``shared`` is sent once a worker)."""
-    return _expand_tile(*shared, *corner)
-
-
-def _expand_tile(dem: Dem, plan: _Plan, r0: int, c0: int, width: int, *,
+def expand_tile(dem: Dem, plan: ExpansionPlan, r0: int, c0: int, width: int, *,
                  progress: bool = False) -> np.ndarray:
     """The expansion of the square ``(r0, c0, width)`` of ``dem`` with ``plan``'s settings
     (the same pixels as that part of the whole region's expansion)."""
@@ -532,7 +412,7 @@ def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
     pixel of the DEM so that every value equals the whole-DEM value (tiles agree).
     """
     rows, cols = dem.shape
-    m = _HALO + 1
+    m = HALO_PX + 1
     a_r, a_c = max(r0 - m, 0), max(c0 - m, 0)
     b_r, b_c = min(r0 + width + m, rows), min(c0 + width + m, cols)
     e_r, e_c = max(a_r - 1, 0), max(a_c - 1, 0)
@@ -546,7 +426,7 @@ def _local_amplitude(dem: Dem, r0: int, c0: int, width: int, fallback: float):
 def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key: int,
                    fractal_dimension: float, amp: np.ndarray, amp_origin, *,
                    amp_coarser: int = 0, progress: bool = False) -> np.ndarray:
-    """Expand ``z[region]`` ``levels`` times with ``_HALO`` context pixels per level.
+    """Expand ``z[region]`` ``levels`` times with ``HALO_PX`` context pixels per level.
 
     ``region`` is (row_off, col_off, width) in ``z``; ``origin`` the lattice index of
     ``z[0, 0]`` at ``level0``; ``amp`` the displacement amplitude in metres on the
@@ -555,8 +435,8 @@ def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key:
     """
     r0, c0, width = region
     rows, cols = z.shape
-    a_r, a_c = max(r0 - _HALO, 0), max(c0 - _HALO, 0)
-    b_r, b_c = min(r0 + width + _HALO, rows), min(c0 + width + _HALO, cols)
+    a_r, a_c = max(r0 - HALO_PX, 0), max(c0 - HALO_PX, 0)
+    b_r, b_c = min(r0 + width + HALO_PX, rows), min(c0 + width + HALO_PX, cols)
     arr = np.ascontiguousarray(z[a_r:b_r, a_c:b_c], dtype=np.float64)
     org = (origin[0] + a_r, origin[1] + a_c)
     reg = (r0 - a_r, c0 - a_c, width)
@@ -570,9 +450,9 @@ def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key:
         reg = (2 * reg[0], 2 * reg[1], 2 * reg[2] - 1)
         if lev == levels:
             return np.ascontiguousarray(out[reg[0]:reg[0] + reg[2], reg[1]:reg[1] + reg[2]])
-        a_r, a_c = max(reg[0] - _HALO, 0), max(reg[1] - _HALO, 0)
-        b_r = min(reg[0] + reg[2] + _HALO, out.shape[0])
-        b_c = min(reg[1] + reg[2] + _HALO, out.shape[1])
+        a_r, a_c = max(reg[0] - HALO_PX, 0), max(reg[1] - HALO_PX, 0)
+        b_r = min(reg[0] + reg[2] + HALO_PX, out.shape[0])
+        b_c = min(reg[1] + reg[2] + HALO_PX, out.shape[1])
         arr = out[a_r:b_r, a_c:b_c]
         if a_r or a_c or b_r < out.shape[0] or b_c < out.shape[1]:
             arr = np.ascontiguousarray(arr)

@@ -471,10 +471,8 @@ def _fit_result(shape, resolution_m: float, lag_px, roughness: float, lags, gam,
             f"explicitly")
     keep = [i for i, g in enumerate(gam) if g > 0.0]  # a direction without relief (a ramp)
     if len({lags[i] for i in keep}) < 2:
-        return FractalFit(2.0, 1.0, roughness, resolution_m, tuple(lags), tuple(gam), span,
-                          2.0)
-    slope = float(np.polyfit(np.log([lags[i] for i in keep]), np.log([gam[i] for i in keep]),
-                             1)[0])
+        return FractalFit(2.0, 1.0, roughness, resolution_m, tuple(lags), tuple(gam), span, 2.0)
+    slope = float(np.polyfit(np.log(np.take(lags, keep)), np.log(np.take(gam, keep)), 1)[0])
     hurst = slope / 2.0
     return FractalFit(3.0 - hurst, hurst, roughness, resolution_m,
                       tuple(float(v) for v in lags), tuple(gam), span, 3.0 - hurst)

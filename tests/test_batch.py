@@ -429,7 +429,7 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
 def test_expand_tiles_as_tasks_give_the_same_bytes(tmp_path, scheduler):
     """``dem.expand_to_file`` with its tiles as dask tasks (this module's cluster, and a
     local cluster of its own through ``dem expand --workers``) = tile after tile here."""
-    from dem.expansion import expand_to_file
+    from dem.expandfile import expand_to_file
 
     base = dem.read(LOLA)
     here = expand_to_file(base, tmp_path / "here.tif", 3, rng=9, tile_px=513)
@@ -459,7 +459,7 @@ def test_expand_task_options_are_one_line_errors(tmp_path, capsys, args, message
 
 
 def test_expand_checks_its_backend_before_any_work(tmp_path):
-    from dem.expansion import expand_to_file
+    from dem.expandfile import expand_to_file
 
     for how, message in (({"backend": "serial", "workers": 2}, "`workers` applies to the dask"),
                          ({"backend": "spark"}, "`backend` must be one of serial, dask")):

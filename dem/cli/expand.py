@@ -7,7 +7,7 @@ from __future__ import annotations
 from craters.cli.options import Setting, Values, default_of
 
 from ..core import parse_region
-from ..expansion import TILE_PX, expand_to_file
+from ..expandfile import TILE_PX, expand_to_file
 from .options import DEM, DEM_OUTPUT, INPUT, READ, RUN, begin, dem_command, read_input, summary
 
 __all__ = ["register"]

@@ -336,12 +336,12 @@ def test_tiled_file_without_crs_and_its_errors(tmp_path):
 
 
 def test_cli_expand_goes_tile_by_tile(tmp_path, lola_crop, monkeypatch, capsys):
-    import dem.expansion
+    import dem.expandfile
     from dem.cli import main
 
     src = dem.write(lola_crop, tmp_path / "in.tif")
     want = dem.write(dem.expand(lola_crop, 2, region=(0, 0, 129), rng=3), tmp_path / "w.tif")
-    monkeypatch.setattr(dem.expansion, "TILE_PX", 65)  # 16 tiles of 17 input pixels
+    monkeypatch.setattr(dem.expandfile, "TILE_PX", 65)  # 16 tiles of 17 input pixels
     assert main(["expand", str(src), "-o", str(tmp_path / "t.tif"), "--levels", "2",
                  "--region", "0,0,129", "--seed", "3", "-q"]) == 0
     assert (tmp_path / "t.tif").read_bytes() == want.read_bytes()

@@ -16,7 +16,8 @@ import pytest
 
 import dem
 from dem import Dem
-from dem.expansion import expand, expand_to_file
+from dem.expandfile import expand_to_file
+from dem.expansion import expand
 from dem.io import WindowWriter
 from dem.tiledfill import fill_to_file
 
