@@ -28,6 +28,7 @@ from ._local_kernels import (  # noqa: F401 - re-exported for the mesh kernels a
     _quadric,
     _stretched,
 )
+from ._tilt_kernels import _TILT_MAX_COS, TILT_MIN_DEG, _tilted_change, _tilted_frame
 
 
 @njit(cache=True)
@@ -264,14 +265,24 @@ def _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert):
 @njit(cache=True)
 def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
                  rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves, gain,
-                 dh_out):
+                 fr, dh_out):
     """New radii for gathered vertices lo..hi-1 (each vertex written once): the radial
-    vector rescaled by the height change."""
+    vector rescaled by the height change (in the tilted base's frame ``fr`` when its
+    ``fr[9]`` > 0, :func:`_tilted_change`)."""
     far = _far(radius, rim_tab, xe)
+    tilted = fr[9] > 0.0
     for q in range(lo, hi):
-        inside, dh = _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
-                                    rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed,
-                                    wavelength, octaves, gain, far)
+        if tilted:
+            if dist[q] > far:
+                inside, dh = False, 0.0
+            else:
+                inside, dh = _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe,
+                                            rim_tab, delta, p0, qa, qb, qc, rough, seed,
+                                            wavelength, octaves, gain, fr)
+        else:
+            inside, dh = _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth,
+                                        xe, rim_tab, delta, p0, gx, gy, qa, qb, qc, rough,
+                                        seed, wavelength, octaves, gain, far)
         if inside:
             i = idx[q]
             radii[i] = radii[i] * (pmag[q] + dh) / pmag[q]
@@ -281,14 +292,14 @@ def _write_range(lo, hi, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, s
 @njit(cache=True, parallel=True)
 def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe,
                     rim_tab, delta, p0, gx, gy, qa, qb, qc, rough, seed, wavelength, octaves,
-                    gain, dh_out):
+                    gain, fr, dh_out):
     """:func:`_write_range` over blocks of vertices in parallel (blocks are disjoint)."""
     n = idx.shape[0]
     block = 4096
     for b in prange((n + block - 1) // block):
         _write_range(b * block, min(n, (b + 1) * block), radii, idx, pmag, dist, az, xl, yl,
                      hgt, radius, tab, scale, depth, xe, rim_tab, delta, p0, gx, gy, qa, qb,
-                     qc, rough, seed, wavelength, octaves, gain, dh_out)
+                     qc, rough, seed, wavelength, octaves, gain, fr, dh_out)
 
 
 @njit(cache=True)
@@ -388,16 +399,21 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     # delta = plane - terrain at the rim = -(residual grid) there
     rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
     octaves = roughness_octaves(radius, sp)
+    # on steep ground the crater is made in its base's frame (issue 36)
+    fr = np.zeros(10)
+    tilt = _tilted_frame(gx, gy, fr)
+    if tilt < TILT_MIN_DEG or fr[9] < _TILT_MAX_COS:
+        fr[9] = 0.0
     dh = np.empty(keep)
     if inner_parallel and keep >= PARALLEL_MIN:
         _write_parallel(radii, idx[:keep], pmag[:keep], dist[:keep], az[:keep], xl[:keep],
                         yl[:keep], hgt[:keep], radius, tabs[c], scale, depths[c], xe,
                         rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
-                        radius, octaves, gain, dh)
+                        radius, octaves, gain, fr, dh)
     else:
         _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
                      scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
-                     rough, seeds[c], radius, octaves, gain, dh)
+                     rough, seeds[c], radius, octaves, gain, fr, dh)
     _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)
     return True
 

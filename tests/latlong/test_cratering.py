@@ -116,6 +116,7 @@ def test_stretched_body_no_spikes_or_holes():
     rng = np.random.default_rng(5)
     lat, lon, _ = surface_positions(body, 60, rng=rng)
     diam = np.exp(rng.uniform(np.log(3.0), np.log(20.0), 60))
+    verts, normals = body.vertices(), body.vertex_normals()
     for k in range(60):  # each crater alone: its own change, not its neighbours'
         cat = craters.make_catalog(lat_deg=lat[k:k + 1], lon_deg=lon[k:k + 1],
                                    diameter_m=diam[k:k + 1])
@@ -123,10 +124,15 @@ def test_stretched_body_no_spikes_or_holes():
             stamped = stamp_craters(body, cat, rng=k, slope_erosion=erosion).craters
             for row in stamped:  # with erosion, craters on >= 45 deg ground are erased
                 # an eroded crater still flattens the terrain inside its rim to the
-                # fitted plane: bound the change by the fresh crater's relief
+                # fitted plane: bound the change by the fresh crater's relief, along the
+                # surface normal; a vertex moves radially, so by up to 1 / cos(tilt)
+                # of that on ground tilted from the radial (the base's frame, issue 36)
                 fresh = craters.fresh_morphometry(row["diameter_m"], "moon")
                 relief = float(fresh["depth_m"] + fresh["rim_height_m"])
-                assert row["max_change_m"] <= 1.5 * relief
+                centre = np.array([row["centre_x_m"], row["centre_y_m"], row["centre_z_m"]])
+                near = np.argmin(np.linalg.norm(verts - centre, axis=1))
+                cos_tilt = abs(normals[near] @ verts[near]) / np.linalg.norm(verts[near])
+                assert row["max_change_m"] <= 1.5 * relief / max(cos_tilt, 0.2)
 
 
 def test_age_order_and_catalog_columns(sphere):
@@ -315,3 +321,69 @@ def test_local_coordinates_match_numpy(rng, lat, lon, stretch):
     assert np.allclose(xl, d[sel] * np.cos(az[sel]), rtol=0, atol=1e-9)
     assert np.allclose(yl, d[sel] * np.sin(az[sel]), rtol=0, atol=1e-9)
     assert np.allclose(hgt, pm[sel] - rloc, rtol=0, atol=1e-9)
+
+
+def _rim_and_floor(body, new, lon_deg, diameter_m):
+    """Rim radius / R along the dip and across it, and the floor depth / D along the
+    surface normal, of a crater at (0 N, ``lon_deg``) on a 3:1:1 spheroid."""
+    lam = np.radians(lon_deg)
+    s = np.asarray(body.stretch)
+    c = body.radius_m * s * np.array([np.cos(lam), np.sin(lam), 0.0])
+    nrm = c / s**2
+    nrm /= np.linalg.norm(nrm)
+    e1 = np.cross([0.0, 0.0, 1.0], nrm)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(nrm, e1)
+    r_c = 0.5 * diameter_m
+
+    def local(p):
+        rel = p - c
+        return rel @ e1, rel @ e2, rel @ nrm
+
+    x0, y0, h0 = local(body.vertices())
+    x, y, h = local(new.vertices())
+    q = lambda a, b: np.c_[np.ones(len(a)), a, b, a * a, a * b, b * b]  # noqa: E731
+    s0 = (np.hypot(x0, y0) < 2.5 * r_c) & (np.abs(h0) < r_c)
+    coef = np.linalg.lstsq(q(x0[s0], y0[s0]), h0[s0], rcond=None)[0]
+    r, az = np.hypot(x, y), np.arctan2(y, x)
+    near = (r < 2 * r_c) & (np.abs(h) < r_c)
+    rims = []
+    for a0 in (0.0, np.pi, 0.5 * np.pi, -0.5 * np.pi):  # dip (e1 = along x) and across
+        sel = near & (np.abs(np.angle(np.exp(1j * (az - a0)))) < np.pi / 12) & (r > 0.4 * r_c)
+        rims.append(r[sel][np.argmax(h[sel])] / r_c)
+    cen = near & (r < 0.3 * r_c)
+    floor = -(h[cen] - q(x[cen], y[cen]) @ coef).min() / diameter_m
+    return 0.5 * (rims[0] + rims[1]), 0.5 * (rims[2] + rims[3]), floor
+
+
+def test_craters_on_steep_ground_are_made_in_the_base_frame():
+    # issue 36: on the flank of a 3:1:1 spheroid, 53 deg from the radial, the radial
+    # frame stretched a crater 1.64x along the dip and made it 40 % shallower (a streak);
+    # in its base's frame it has the rim and depth of the same crater where the ground
+    # faces the radial (the tip, 0 deg)
+    body = Body.sphere(LatLongGrid(150), 1000.0, stretch=(3.0, 1.0, 1.0))
+    got = {}
+    for lon in (40.0, 90.0):
+        cat = craters.make_catalog(lat_deg=np.array([0.0]), lon_deg=np.array([lon]),
+                                   diameter_m=np.array([160.0]))
+        new = stamp_craters(body, cat, roughness=False, rng=1, slope_erosion=False)
+        got[lon] = _rim_and_floor(body, new, lon, 160.0)
+    dip, across, floor = got[40.0]
+    assert dip / across == pytest.approx(1.0, abs=0.06), got
+    assert floor == pytest.approx(got[90.0][2], rel=0.1), got
+
+
+def test_tilted_frame_is_orthonormal_with_the_base_normal():
+    from latlong._tilt_kernels import _tilted_frame
+
+    for gx, gy in ((0.0, 0.0), (0.7, 0.0), (-0.3, 1.2)):
+        fr = np.zeros(10)
+        tilt = _tilted_frame(gx, gy, fr)
+        e, m, n = fr[0:3], fr[3:6], fr[6:9]
+        want_n = np.array([-gx, -gy, 1.0]) / np.sqrt(1 + gx * gx + gy * gy)
+        assert np.allclose(n, want_n) and fr[9] == pytest.approx(want_n[2])
+        assert np.allclose(np.array([e, m, n]) @ np.array([e, m, n]).T, np.eye(3), atol=1e-12)
+        # E' is east projected on the base: in the plane of east and N, on east's side
+        assert np.allclose(np.cross(n, e), m) and e[0] > 0
+        assert np.cross(n, [1.0, 0.0, 0.0]) @ e == pytest.approx(0.0, abs=1e-12)
+        assert tilt == pytest.approx(np.degrees(np.arccos(want_n[2])))

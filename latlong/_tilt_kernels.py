@@ -1,0 +1,149 @@
+"""Numba kernels of a crater stamped in the frame of its tilted base on the lat/long body
+(split from :mod:`latlong._crater_kernels`; issue 36: on steep ground the radial frame
+squeezed craters along the dip into streaks)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from craters.kernels import (
+    fbm2,
+    outer_weight,
+    roughness_amp,
+    table,
+    table_value,
+)
+
+
+#: Tilt (degrees) of a crater's fitted base from the centre's radial above which it is
+#: stamped in the base's own frame (:func:`_tilted_change`); below it the radial frame
+#: differs from it by less than 1.5 % in distance.
+TILT_MIN_DEG = 10.0
+#: Cosine of the steepest tilt stamped in the base's frame: beyond ~78 deg a radial
+#: height cannot follow the surface (the crater is stamped as on gentler ground).
+_TILT_MAX_COS = 0.2
+_TILT_ITERATIONS = 40
+
+
+@njit(cache=True)
+def _tilted_frame(gx, gy, out):
+    """The frame of a base of slopes (gx, gy) in the developed local frame (x east, y
+    north, z the centre's radial): ``out`` = (E' (3), N' (3), N (3), N_z): N the base's
+    unit normal, E' east projected on the base and N' = N x E'. Returns the tilt
+    (degrees) from the radial."""
+    ln = np.sqrt(1.0 + gx * gx + gy * gy)
+    nx, ny, nz = -gx / ln, -gy / ln, 1.0 / ln
+    ex, ey, ez = 1.0 - nx * nx, -nx * ny, -nx * nz  # east minus its normal part
+    le = np.sqrt(ex * ex + ey * ey + ez * ez)
+    ex, ey, ez = ex / le, ey / le, ez / le
+    out[0], out[1], out[2] = ex, ey, ez
+    out[3], out[4], out[5] = ny * ez - nz * ey, nz * ex - nx * ez, nx * ey - ny * ex
+    out[6], out[7], out[8] = nx, ny, nz
+    out[9] = nz
+    return np.degrees(np.arccos(min(nz, 1.0)))
+
+
+@njit(cache=True, inline="always")
+def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta, p0, qa, qb,
+                   qc, rough, seed, wavelength, octaves, gain, fr):
+    """(inside the ejecta edge?, radial height change) of point ``q`` for a crater stamped
+    in the frame ``fr`` of its tilted base (:func:`_tilted_frame`; issue 36: on steep
+    ground the radial frame squeezes a crater along the dip into a streak).
+
+    The point, relative to the base point over the centre, has in-plane coordinates u
+    and a height w along the base normal N. The crater is the same function of (u, w) as
+    :func:`_height_change` is of (x, y, h): inside the rim the base (the quadric's
+    curvature, along N) plus the profile and roughness; outside the terrain plus the
+    profile, the rim offset (a radial residual: times N_z along N) fading to the edge and
+    roughness. The vertex can only move radially (the lat/long mesh), which also moves
+    it along the base by ``t (E'_z, N'_z)``: inside the rim the radial change t solves
+    ``w + t N_z = W(u(t))`` (bracketed, then false position); outside it is the normal
+    change over N_z (the ejecta are thin)."""
+    ex, ey, ez, mx, my, mz, nx, ny, nz, cz = (fr[0], fr[1], fr[2], fr[3], fr[4], fr[5],
+                                              fr[6], fr[7], fr[8], fr[9])
+    r0, r1, r2 = xl[q], yl[q], hgt[q] - p0
+    u1 = r0 * ex + r1 * ey + r2 * ez
+    u2 = r0 * mx + r1 * my + r2 * mz
+    w0 = r0 * nx + r1 * ny + r2 * nz
+    rho = np.sqrt(u1 * u1 + u2 * u2)
+    az = np.arctan2(u2, u1)
+    x = rho / (radius * (1.0 + table(rim_tab, az)))
+    if not x < xe:
+        return False, 0.0
+    has_rough = rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0
+    if x > 1.0:
+        add = scale * table_value(tab, x, xe)
+        if has_rough:
+            add += (roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
+                    * fbm2(seed, u1, u2, wavelength, octaves, gain))
+        return True, add / cz + table(delta, az) * outer_weight(x, xe)
+    # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z: g is bounded (the crater's
+    # relief), so stepping from t = 0 against f's sign brackets it; then Illinois false
+    # position (a plain fixed point diverges where |grad W| tan(tilt) > 1)
+    ta = 0.0
+    fa = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, ta, radius, tab, scale, depth,
+                        xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves,
+                        gain) - ta
+    if fa == 0.0:
+        return True, 0.0
+    step = fa
+    tb = ta + step
+    fb = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, tb, radius, tab, scale, depth,
+                        xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves,
+                        gain) - tb
+    k = 0
+    while fa * fb > 0.0 and k < 30:
+        ta, fa = tb, fb
+        step *= 2.0
+        tb = ta + step
+        fb = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, tb, radius, tab, scale,
+                            depth, xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength,
+                            octaves, gain) - tb
+        k += 1
+    if fa * fb > 0.0:
+        return True, 0.0  # no sign change (not reached: g is bounded)
+    side = 0
+    tol = 1e-9 * radius
+    for _ in range(_TILT_ITERATIONS):
+        t = (ta * fb - tb * fa) / (fb - fa)
+        ft = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale,
+                            depth, xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength,
+                            octaves, gain) - t
+        if abs(ft) <= tol or abs(tb - ta) <= tol:
+            return True, t
+        if ft * fb > 0.0:
+            tb, fb = t, ft
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:
+            ta, fa = t, ft
+            if side == 1:
+                fb *= 0.5
+            side = 1
+    return True, (ta * fb - tb * fa) / (fb - fa)
+
+
+@njit(cache=True, inline="always")
+def _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale, depth, xe,
+                   rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves, gain):
+    """g(t) of :func:`_tilted_change`: the radial change that would put the point moved
+    radially by t on the crater's surface inside the rim."""
+    v1 = u1 + t * ez
+    v2 = u2 + t * mz
+    xv = (np.sqrt(v1 * v1 + v2 * v2)
+          / (radius * (1.0 + table(rim_tab, np.arctan2(v2, v1)))))
+    if xv > 1.0:  # beyond the rim: W as at the rim (bounded in t, so a root is bracketed)
+        v1 /= xv
+        v2 /= xv
+        xv = 1.0
+    # the base's curvature (the quadric's quadratic part, vertical) along the normal
+    hx = v1 * ex + v2 * mx
+    hy = v1 * ey + v2 * my
+    target = (qa * hx * hx + qb * hx * hy + qc * hy * hy) * cz
+    target += scale * table_value(tab, xv, xe)
+    if has_rough:
+        target += (roughness_amp(xv, xe, rough[0], rough[1], rough[2]) * depth * scale
+                   * fbm2(seed, v1, v2, wavelength, octaves, gain))
+    return (target - w0) / cz
