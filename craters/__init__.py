@@ -122,7 +122,9 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         BoulderShape,
         boulder,
         boulder_meshes,
+        golombek_layers,
         parse_boulder_spec,
+        parse_boulder_specs,
     )
     from .catalog import (
         CATALOG_COLUMNS,
@@ -227,7 +229,9 @@ __all__ = [
     "fit_power_law_exponent",
     "fresh_morphometry",
     "fresh_profile",
+    "golombek_layers",
     "parse_boulder_spec",
+    "parse_boulder_specs",
     "parse_layer_spec",
     "formation_ages",
     "get_chronology_system",

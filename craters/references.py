@@ -30,6 +30,7 @@ The entries, by topic (keys of :data:`REFERENCES`):
   ``michel2009`` ``michikami2008`` ``fujiwara2006``; Bennu ``nolan2013`` ``bierhaus2022``
   ``walsh2019`` ``dellagiustina2019`` ``scheeres2019``.
 * Gravity: ``werner1997`` ``tsoulis2012`` ``schuhmacher2024`` ``tiesinga2021``.
+* Rocks: ``golombek1997`` ``golombek2003``.
 * Terrain: ``horn1981`` ``zevenbergen1987`` ``peitgen1988`` ``rosenburg2011``
   ``perlin2002`` ``steele2014``.
 * Implicit surfaces and meshes: ``wyvill1986`` ``weller2010`` ``zorin1996``
@@ -302,6 +303,14 @@ REFERENCES = _entries(
     _R("michel2009", ("Michel, P.", "et al."), 2009,
        "Itokawa's cratering record as observed by Hayabusa: Implications for its age and "
        "collisional history", "Icarus 200(2), 503-513", "10.1016/j.icarus.2008.04.002"),
+    _R("golombek1997", ("Golombek, M.", "Rapp, D."), 1997,
+       "Size-frequency distributions of rocks on Mars and Earth analog sites: Implications "
+       "for future landed missions", "Journal of Geophysical Research 102(E2), 4117-4129",
+       "10.1029/96JE03319"),
+    _R("golombek2003", ("Golombek, M. P.", "Matijevic, J. R.", "DiMaggio, E. N.",
+                        "Schroeder, R. D."), 2003,
+       "(title not confirmed; cited by venue)",
+       "Lunar and Planetary Science XXXIV, abstract, NASA NTRS 20030111177"),
     _R("michikami2008", ("Michikami, T.", "et al."), 2008,
        "Size-frequency statistics of boulders on global surface of asteroid 25143 Itokawa",
        "Earth, Planets and Space 60, 13-20", "10.1186/BF03352757"),

@@ -55,7 +55,8 @@ BOULDER_REACH = 0.87
 def _layers(layers) -> list[BoulderLayer]:
     if isinstance(layers, BoulderLayer | str):
         layers = [layers]
-    out = [craters.parse_boulder_spec(la) if isinstance(la, str) else la for la in layers]
+    out = [got for la in layers
+           for got in (craters.parse_boulder_specs(la) if isinstance(la, str) else (la,))]
     if not out or not all(isinstance(la, BoulderLayer) for la in out):
         raise TypeError("`layers` must be BoulderLayer(s) or specs like "
                         "'c=0.01,k=-3,d_min_m=0.5,d_max_m=5'")

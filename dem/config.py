@@ -20,7 +20,7 @@ from craters import (
     BoulderLayer,
     CraterLayer,
     ModelAgeLayer,
-    parse_boulder_spec,
+    parse_boulder_specs,
     parse_layer_spec,
 )
 from craters._shared import (
@@ -178,11 +178,13 @@ class EnhanceConfig:
     synthetic or smoothed base)."""
     boulders: tuple[str | BoulderLayer, ...] = setting(
         (), "boulder layer c=..,k=..,d_min_m=..,d_max_m=..[,burial_max=..] (N_cum = c D^k per "
-        "m^2, D in metres; burial_max = largest buried fraction of the height); stamped as a "
-        "heightfield maximum in the finest layer holding each; repeat for several",
-        many="append", metavar="SPEC")
+        "m^2, D in metres; burial_max = largest buried fraction of the height) or Golombek & "
+        "Rapp's rock abundance golombek,k=..,d_min_m=..,d_max_m=.. (k = total rock area "
+        "fraction); stamped as a heightfield maximum in the finest layer holding each; "
+        "repeat for several", many="append", metavar="SPEC")
     """Boulder layers: specs ``c=..,k=..,d_min_m=..,d_max_m=..[,burial,near]`` (metres; ``near``
-    is ignored on DEMs) or :class:`craters.BoulderLayer` objects."""
+    is ignored on DEMs), ``golombek,k=..,d_min_m=..,d_max_m=..`` (several power-law layers,
+    :func:`craters.golombek_layers`) or :class:`craters.BoulderLayer` objects."""
     min_boulder_px: float = setting(2.0, "smallest boulder a layer takes, in its pixels",
                                     unit="px", range=(1.0, 1e6), metavar="PX")
     """Smallest boulder a layer takes, in its pixels (>= 1)."""
@@ -274,7 +276,7 @@ class EnhanceConfig:
         for name, parse, kind, example in (
                 ("craters", _parse_crater_spec, (*LAYER_TYPES, SourceCraterLayer),
                  "c=0.05,k=-2,d_min_m=1,d_max_m=500"),
-                ("boulders", parse_boulder_spec, (BoulderLayer,),
+                ("boulders", parse_boulder_specs, (BoulderLayer,),
                  "c=0.01,k=-3,d_min_m=0.5,d_max_m=5")):
             with about(name):
                 specs = getattr(self, name)
@@ -289,7 +291,8 @@ class EnhanceConfig:
                         raise ParameterTypeError(name, f"must hold {name[:-1]} layer specs "
                                                  f"like '{example}' or {records}; got "
                                                  f"{spec!r}")
-                    parsed.append(spec if isinstance(spec, kind) else parse(spec))
+                    got = spec if isinstance(spec, kind) else parse(spec)
+                    parsed.extend(got if isinstance(got, tuple) else (got,))
                 put(name, tuple(specs))
                 put(f"{name[:-1]}_layers", tuple(parsed))
 

@@ -253,9 +253,10 @@ def _layers(value, kind, parse, name: str, *, table=None) -> tuple:
             out.append(item)
         elif isinstance(item, str):
             try:
-                out.append(parse(item))
+                got = parse(item)
             except ValueError as exc:
                 raise ParameterError(name, f": {exc}") from None
+            out.extend(got if isinstance(got, tuple) else (got,))  # a spec of several
         elif isinstance(item, dict):
             if table is None:
                 allowed = {f.name for f in dataclasses.fields(kinds[0])}
@@ -328,15 +329,17 @@ class BoulderSettings:
     layers: tuple[_craters.BoulderLayer, ...] = setting(
         (), "boulder layer c=0.05,k=-3,d_min_m=0.5,d_max_m=10[,burial_max=0.5,near=0.3] (the "
         "fields of craters.BoulderLayer): N_cum = c D^k per m^2, D in metres; burial_max = "
-        "largest buried fraction of the height (<= 0.9); near = share around crater rims "
-        "(repeatable)", key="boulders", many="append", metavar="SPEC")
+        "largest buried fraction of the height (<= 0.9); near = share around crater rims; or "
+        "Golombek & Rapp's rock abundance golombek,k=..,d_min_m=..,d_max_m=..[,burial_max,near] "
+        "(k = total rock area fraction) (repeatable)", key="boulders", many="append",
+        metavar="SPEC")
     """Power-law layers (:class:`craters.BoulderLayer`, spec strings or tables)."""
     shape: _craters.BoulderShape = dataclasses.field(default_factory=_craters.BoulderShape)
     """Flattening, elongation and roughness of the procedural rocks."""
 
     def __post_init__(self):
         _set(self, "layers", _layers(self.layers, _craters.BoulderLayer,
-                                     _craters.parse_boulder_spec, "layers"))
+                                     _craters.parse_boulder_specs, "layers"))
         if not isinstance(self.shape, _craters.BoulderShape):
             raise ParameterTypeError("shape", f"must be a craters.BoulderShape; got "
                                      f"{type(self.shape).__name__}")

@@ -459,14 +459,14 @@ def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_pa
         monkeypatch.setattr(module, name, call)
 
     counted(dem.config, "parse_layer_spec")
-    counted(dem.config, "parse_boulder_spec")
+    counted(dem.config, "parse_boulder_specs")
     counted(craters._shared.settings, "check_int", only=lambda name, *_: name == "seed")
     counted(dem.cli.enhance, "check_stack_folder")
     scene = write_scene(tmp_path / "scene.toml", **scene_keys(tmp_path, lola_tif, layers=2))
     proc = InProcess(capsys)("dem", "enhance", "--config", str(scene), "--seed", "3", "-q",
                              "--boulders", "c=0.00001,k=-3,d_min_m=300,d_max_m=2000")
     assert proc.returncode == 0, proc.stderr
-    assert calls == {"parse_layer_spec": 2, "parse_boulder_spec": 1, "check_int": 1,
+    assert calls == {"parse_layer_spec": 2, "parse_boulder_specs": 1, "check_int": 1,
                      "check_stack_folder": 1}
     # the input as the argument overrides the file's, the other options come from the file
     copy = tmp_path / "copy.tif"
