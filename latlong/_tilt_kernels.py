@@ -44,7 +44,7 @@ def _tilted_frame(gx, gy, out):
     return np.degrees(np.arccos(min(nz, 1.0)))
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta, p0, qa, qb,
                    qc, rough, seed, wavelength, octaves, gain, fr):
     """(inside the ejecta edge?, radial height change) of point ``q`` for a crater stamped
@@ -125,7 +125,7 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
     return True, (ta * fb - tb * fa) / (fb - fa)
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale, depth, xe,
                    rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves, gain):
     """g(t) of :func:`_tilted_change`: the radial change that would put the point moved
