@@ -62,14 +62,13 @@ from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
 from .craterdensity import CraterDensity, crater_density
 from .expansion import RELIEF_MEDIAN_PX, expand, local_relief, midpoint_factor
-from .terrains import MEDIAN_ABS_GAUSSIAN, TerrainRoughness, terrain_roughness
 from .fractal import expansion_fit
 from .frame import LocalFrame, crater_target, grid_pixel_size, local_frame, pixel_affine
 from .io import read
 from .planning import (
+    LANDING_SLOPE_LIMIT_DEG,
     STREAM_STAMP,
     StackGeometry,
-    LANDING_SLOPE_LIMIT_DEG,
     landing_site,
     layer_windows,
     plan_boulders,
@@ -78,6 +77,7 @@ from .planning import (
     stack_geometry,
 )
 from .stack import Stack, propagate_up
+from .terrains import MEDIAN_ABS_GAUSSIAN, TerrainRoughness, terrain_roughness
 
 __all__ = ["Run", "enhance", "finish", "layer_step", "layers_of", "prepare", "stack_info"]
 
@@ -290,7 +290,9 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
         entropy = np.random.SeedSequence().entropy
         assert isinstance(entropy, int)  # a fresh SeedSequence's own
         seed = int(entropy % 2**63)
-    win0, windows, t0, t_base = layer_windows(base, cfg.target, cfg.size, cfg.layers)
+    site = None if cfg.target is not None else landing_site(base, cfg.size)
+    win0, windows, t0, t_base = layer_windows(base, cfg.target, cfg.size, cfg.layers,
+                                              site_px=None if site is None else site[0])
     layer0 = base.crop(win0)
     unknown = int((~layer0.known).sum())
     if unknown:
@@ -323,7 +325,7 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
               else None)
     return Run(cfg, seed, layer0, win0, windows, t0, t_base, frame, a0, p0, geometry, target,
                plans, accounting, rock_plans, rock_accounting, source_density, fd,
-               fd_estimated, relief, terrain, _site_choice(base, cfg))
+               fd_estimated, relief, terrain, _site_choice(site))
 
 
 def terrain_target_m(terrain, pixel_m: float, source_pixel_m: float,
@@ -469,11 +471,12 @@ def stack_info(run: Run, stamped, rocks) -> dict:
     }
 
 
-def _site_choice(base: Dem, cfg: EnhanceConfig) -> str:
-    """How the site was chosen (given, or :func:`dem.planning.landing_site`)."""
-    if cfg.target is not None:
+def _site_choice(site) -> str:
+    """How the site was chosen: given, or :func:`dem.planning.landing_site`'s ``site``
+    (its pixel and the steepest slope around it)."""
+    if site is None:
         return "given"
-    _, worst = landing_site(base, cfg.size)
+    worst = site[1]
     if worst <= LANDING_SLOPE_LIMIT_DEG:
         return (f"landing-like: nearest the base's centre with 3 x 3 Horn slopes <= "
                 f"{LANDING_SLOPE_LIMIT_DEG:g} deg at the base's pixels (steepest there "

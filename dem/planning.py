@@ -130,8 +130,8 @@ def landing_site(base: Dem, size: int) -> tuple[tuple[int, int], float]:
     the steepest Horn slope of its 3 x 3 neighbourhood, degrees.
 
     The user's ``target`` pins a site; without one the stack should not land on a crater
-    wall (issue 36: the README site's target did, and 16 % of its 59 m layer was steeper
-    than 35 deg). Slopes at the base's scale are all this can see; the layers below
+    wall (issue 36: a target on one left 16 % of a stack's 59 m layer steeper than
+    35 deg). Slopes at the base's scale are all this can see; the layers below
     inherit them.
     """
     from scipy.ndimage import maximum_filter
@@ -159,17 +159,18 @@ def landing_site(base: Dem, size: int) -> tuple[tuple[int, int], float]:
     return (int(rr[i, j]), int(cc[i, j])), float(worst[i, j])
 
 
-def layer_windows(base: Dem, target, size: int, n_layers: int):
+def layer_windows(base: Dem, target, size: int, n_layers: int, *, site_px=None):
     """Where the layers lie: ``(window of layer 0 in the base, footprints (row_off,
     col_off, width) of layers 1.. in their parents, target pixel in layer 0, target pixel
     in the base)``; ``target`` is (X, Y) in world coordinates or None (a landing-like
-    site near the centre, :func:`landing_site`)."""
+    site near the centre: the base pixel ``site_px`` when the caller has it already,
+    else :func:`landing_site`'s)."""
     rows, cols = base.shape
     if rows < size or cols < size:
         raise ParameterError("size", f"{size} needs a base DEM of at least {size} x {size} "
                              f"pixels; it has {rows} x {cols}")
     if target is None:
-        (r_t, c_t), _ = landing_site(base, size)
+        r_t, c_t = site_px if site_px is not None else landing_site(base, size)[0]
         row_f, col_f = r_t + 0.5, c_t + 0.5
     else:
         col_f, row_f = ~base.transform @ target

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from .._shared import ParameterError, check_int, check_positive, check_range, parse_spec
-from .placement import BoulderLayer
+from .placement import BoulderLayer, parse_boulder_spec
 
 __all__ = ["golombek_cumulative_area", "golombek_cumulative_number", "golombek_layers",
            "golombek_q", "parse_boulder_specs", "parse_golombek_spec"]
@@ -112,8 +112,6 @@ def parse_golombek_spec(spec: str) -> tuple[BoulderLayer, ...]:
 def parse_boulder_specs(spec: str) -> tuple[BoulderLayer, ...]:
     """One boulder spec as layers: ``golombek,...`` (:func:`parse_golombek_spec`) or a
     power law ``c=..,k=..,d_min_m=..,d_max_m=..`` (one layer)."""
-    from .placement import parse_boulder_spec
-
     if str(spec).strip().startswith("golombek"):
         return parse_golombek_spec(spec)
     return (parse_boulder_spec(spec),)
