@@ -3,7 +3,9 @@
 Builds ``examples/site.toml`` for each seed given (default 2014) and prints the height
 range of all layers, layer 0's median Horn slope against the LOLA input on the same window,
 every layer's median slope, the same-footprint comparison (layer k over the window layer
-k + 1 covers, then layer k + 1) and the share of each layer steeper than 30 degrees.
+k + 1 covers, then layer k + 1), the share of each layer steeper than 30 degrees and
+(issue 36) how many craters of all layers are older than a larger crater whose rim holds
+their centre (brute force over the catalogues in the stack's frame; acceptance: 0).
 Usage, from the repository's top folder: ``python tests/benchmarks/measure_site_stack.py
 [SEED ...]``.
 """
@@ -12,8 +14,20 @@ import sys
 import tomllib
 
 import numpy as np
+from scipy.spatial import cKDTree
 
 import dem
+
+
+def older_inside(stack) -> tuple[int, int]:
+    """(craters older than a larger crater whose rim holds their centre, all craters)."""
+    cats = [c for c in stack.catalogs if c is not None and len(c)]
+    x, y, d, age = (np.concatenate([c[k] for c in cats])
+                    for k in ("x_m", "y_m", "diameter_m", "age_gyr"))
+    tree = cKDTree(np.c_[x, y])
+    bad = {i for j in range(len(d)) for i in tree.query_ball_point([x[j], y[j]], d[j] / 2)
+           if d[i] < d[j] and age[i] > age[j]}
+    return len(bad), len(d)
 
 
 def main() -> None:
@@ -44,6 +58,8 @@ def main() -> None:
         print("  same footprint (coarse -> fine):",
               " ".join(f"{a:.2f}->{b:.2f}" for a, b in same))
         print("  % > 30 deg:", " ".join(f"{s:.2f}" for s in steep))
+        bad, n = older_inside(st)
+        print(f"  craters older than a larger one whose rim holds them: {bad} of {n}")
 
 
 if __name__ == "__main__":

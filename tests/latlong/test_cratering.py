@@ -323,37 +323,16 @@ def test_local_coordinates_match_numpy(rng, lat, lon, stretch):
     assert np.allclose(hgt, pm[sel] - rloc, rtol=0, atol=1e-9)
 
 
-def _rim_and_floor(body, new, lon_deg, diameter_m):
-    """Rim radius / R along the dip and across it, and the floor depth / D along the
-    surface normal, of a crater at (0 N, ``lon_deg``) on a 3:1:1 spheroid."""
-    lam = np.radians(lon_deg)
-    s = np.asarray(body.stretch)
-    c = body.radius_m * s * np.array([np.cos(lam), np.sin(lam), 0.0])
-    nrm = c / s**2
-    nrm /= np.linalg.norm(nrm)
-    e1 = np.cross([0.0, 0.0, 1.0], nrm)
-    e1 /= np.linalg.norm(e1)
-    e2 = np.cross(nrm, e1)
-    r_c = 0.5 * diameter_m
+def _steep_craters_measure():
+    """``measure`` of tests/benchmarks/measure_steep_craters.py (one home for it)."""
+    import importlib.util
+    from pathlib import Path
 
-    def local(p):
-        rel = p - c
-        return rel @ e1, rel @ e2, rel @ nrm
-
-    x0, y0, h0 = local(body.vertices())
-    x, y, h = local(new.vertices())
-    q = lambda a, b: np.c_[np.ones(len(a)), a, b, a * a, a * b, b * b]  # noqa: E731
-    s0 = (np.hypot(x0, y0) < 2.5 * r_c) & (np.abs(h0) < r_c)
-    coef = np.linalg.lstsq(q(x0[s0], y0[s0]), h0[s0], rcond=None)[0]
-    r, az = np.hypot(x, y), np.arctan2(y, x)
-    near = (r < 2 * r_c) & (np.abs(h) < r_c)
-    rims = []
-    for a0 in (0.0, np.pi, 0.5 * np.pi, -0.5 * np.pi):  # dip (e1 = along x) and across
-        sel = near & (np.abs(np.angle(np.exp(1j * (az - a0)))) < np.pi / 12) & (r > 0.4 * r_c)
-        rims.append(r[sel][np.argmax(h[sel])] / r_c)
-    cen = near & (r < 0.3 * r_c)
-    floor = -(h[cen] - q(x[cen], y[cen]) @ coef).min() / diameter_m
-    return 0.5 * (rims[0] + rims[1]), 0.5 * (rims[2] + rims[3]), floor
+    path = Path(__file__).parents[1] / "benchmarks" / "measure_steep_craters.py"
+    spec = importlib.util.spec_from_file_location("measure_steep_craters", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module.measure
 
 
 def test_craters_on_steep_ground_are_made_in_the_base_frame():
@@ -361,16 +340,12 @@ def test_craters_on_steep_ground_are_made_in_the_base_frame():
     # frame stretched a crater 1.64x along the dip and made it 40 % shallower (a streak);
     # in its base's frame it has the rim and depth of the same crater where the ground
     # faces the radial (the tip, 0 deg)
+    measure = _steep_craters_measure()
     body = Body.sphere(LatLongGrid(150), 1000.0, stretch=(3.0, 1.0, 1.0))
-    got = {}
-    for lon in (40.0, 90.0):
-        cat = craters.make_catalog(lat_deg=np.array([0.0]), lon_deg=np.array([lon]),
-                                   diameter_m=np.array([160.0]))
-        new = stamp_craters(body, cat, roughness=False, rng=1, slope_erosion=False)
-        got[lon] = _rim_and_floor(body, new, lon, 160.0)
-    dip, across, floor = got[40.0]
+    got = {lon: measure(body, lon) for lon in (40.0, 90.0)}
+    _, dip, across, floor, _ = got[40.0]
     assert dip / across == pytest.approx(1.0, abs=0.06), got
-    assert floor == pytest.approx(got[90.0][2], rel=0.1), got
+    assert floor == pytest.approx(got[90.0][3], rel=0.1), got
 
 
 def test_tilted_frame_is_orthonormal_with_the_base_normal():
