@@ -112,6 +112,52 @@ def _fbm2(seed, x, y, wavelength, octaves, gain):
     return total / norm
 
 
+# --------------------------------------------------------------------------- walls
+# Irregular complex-crater interiors (issue 36; real terraces are scalloped, discontinuous
+# slump blocks and central peaks are clusters of massifs: Pike 1977; Melosh 1989, ch. 8.3):
+# inside the rim the radial coordinate x of the profile lookup is displaced by fBm noise of
+# the position, so terraces wander, merge and split and the central peak breaks up. The
+# displacement is ``warp`` (0 simple .. 1 complex, :func:`craters.stamp.stamping_profiles`)
+# times WALL_WARP radii over the wall (fading to 0 at the rim, which keeps the rim where
+# the rim perturbation puts it, and keeps x < 1 inside it) plus PEAK_WARP radii inside
+# PEAK_ZONE. A pure function of the crater's seed and the position in its plane.
+WALL_WARP = 0.25
+WALL_WAVELENGTH = 0.8      # radii
+PEAK_WARP = 0.2
+PEAK_WAVELENGTH = 0.12     # radii
+PEAK_ZONE = 0.3            # radii
+_WARP_SALT = np.uint64(0xA24BAED4963EE407)
+
+
+@njit(cache=True)
+def _warp_x(x, u, v, radius, warp, seed):
+    """The profile coordinate of a point at ``x`` radii (< 1, inside the rim) and (u, v)
+    metres from the centre in the crater's plane, for a crater of ``warp`` in [0, 1]
+    (module notes); ``x`` itself when ``warp`` is 0. The result stays in [0, 1)."""
+    if warp <= 0.0 or x >= 1.0:
+        return x
+    s = seed ^ _WARP_SALT
+    d = WALL_WARP * min(1.0, 4.0 * (1.0 - x)) * _fbm2(s, u, v, WALL_WAVELENGTH * radius, 2,
+                                                        0.5)
+    if x < PEAK_ZONE:
+        t = 1.0 - x / PEAK_ZONE
+        d += PEAK_WARP * t * t * _fbm2(s + np.uint64(1), u, v, PEAK_WAVELENGTH * radius, 2,
+                                       0.5)
+    return abs(x + warp * d)
+
+
+@njit(cache=True, inline="always")
+def _crater_rough(rough, warp):
+    """A crater's overlay settings for the writers: the bowl, wall and ejecta roughness
+    amplitudes of ``rough`` and its wall ``warp`` (:func:`_warp_x`)."""
+    out = np.empty(4)
+    out[0] = rough[0]
+    out[1] = rough[1]
+    out[2] = rough[2]
+    out[3] = warp
+    return out
+
+
 # --------------------------------------------------------------------------- helpers
 @njit(cache=True)
 def _fit_plane(h, cy, cx, r_px, pixel):
@@ -231,8 +277,9 @@ def _write_crater(h, cy, cx, pixel, radius, tab, scale, depth, xe, rim_tab, delt
 def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, tab, scale, depth, xe,
                 rim_tab, delta_tab, p0, gx, gy, rough, seed, wavelength, octaves, gain):
     """Write rows r_lo..r_hi-1 (columns j_lo..j_hi) of a crater into ``h`` in place:
-    inside the rim the plane plus ``scale`` x the profile table, outside the terrain plus
-    it (and the plane-to-terrain offset at the rim, carried out to the ejecta edge)."""
+    inside the rim the plane plus ``scale`` x the profile table (at the warped radius,
+    :func:`_warp_x`), outside the terrain plus it (and the plane-to-terrain offset at the
+    rim, carried out to the ejecta edge); ``rough``: :func:`_crater_rough`."""
     for i in range(r_lo, r_hi):
         dy = (i - cy) * pixel
         for j in range(j_lo, j_hi + 1):
@@ -244,7 +291,8 @@ def _write_rows(r_lo, r_hi, j_lo, j_hi, h, cy, cx, pixel, radius, tab, scale, de
             if x >= xe:
                 continue
             if x <= 1.0:
-                v = p0 + gx * dx + gy * dy + scale * _table_value(tab, x, xe)
+                v = p0 + gx * dx + gy * dy + scale * _table_value(
+                    tab, _warp_x(x, dx, dy, radius, rough[3], seed), xe)
             else:
                 v = (h[i, j] + scale * _table_value(tab, x, xe)
                      + _table(delta_tab, theta) * _outer_weight(x, xe))
@@ -268,12 +316,13 @@ def _rim_offsets(h, cy, cx, pixel, radius, rim_tab, p0, gx, gy, out):
 
 
 @njit(cache=True)
-def _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion,
-               onset_deg, full_deg, rough, gain, out_scale, out_slope, out_erased, delta,
-               inner_parallel):
+def _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds, xe,
+               slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope, out_erased,
+               delta, inner_parallel):
     """Stamp crater ``c`` into ``h`` in place (one step of :func:`_stamp_many_kernel`;
     ``delta``: scratch of N_RIM). Its rows are written in parallel when it is large and
     ``inner_parallel`` (False inside a parallel loop: numba does not nest them)."""
+    rough = _crater_rough(rough, warps[c])
     radius = 0.5 * diam[c]
     r_px = radius / pixel
     p0, gx, gy, _ = _fit_plane(h, cy[c], cx[c], r_px, pixel)
@@ -299,7 +348,7 @@ def _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe, slo
 
 
 @njit(cache=True)
-def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe,
+def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds, xe,
                        slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
                        out_erased):
     """Stamp craters in the given order (the caller sorts oldest first), in place.
@@ -308,11 +357,12 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe
     erode on steep ground (ground at or above ``full_deg`` erases the crater: it is not
     written and ``out_erased`` is set; below, the relief is scaled by
     :func:`_slope_factor`, recorded in ``out_scale``), sample the rim offsets, write the
-    profile table ``tabs[c]`` (``depths[c]``: its depth, for the roughness amplitude).
+    profile table ``tabs[c]`` (``depths[c]``: its depth, for the roughness amplitude;
+    ``warps[c]``: its wall warp, :func:`_warp_x`).
     The serial reference of :func:`craters._wave_kernels._stamp_waves_kernel`.
     """
     delta = np.empty(rim_tabs.shape[1])
     for c in range(cx.shape[0]):
-        _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion,
-                   onset_deg, full_deg, rough, gain, out_scale, out_slope, out_erased, delta,
-                   True)
+        _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds, xe,
+                   slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
+                   out_erased, delta, True)

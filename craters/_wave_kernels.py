@@ -65,8 +65,8 @@ def _wave_schedule_kernel(ny, nx, cy, cx, reach, cell, out_wave):
 
 @njit(cache=True, parallel=True)
 def _stamp_waves_kernel(order, starts, alone, n_threads, h, pixel, cx, cy, diam, tabs, depths,
-                        rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
-                        out_scale, out_slope, out_erased):
+                        warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
+                        gain, out_scale, out_slope, out_erased):
     """Stamp the waves ``order[starts[w]:starts[w + 1]]`` one after the other (arguments
     from ``h`` on: :func:`craters._stamp_kernels._stamp_many_kernel`'s, full arrays).
 
@@ -81,14 +81,14 @@ def _stamp_waves_kernel(order, starts, alone, n_threads, h, pixel, cx, cy, diam,
         s = starts[w]
         e = starts[w + 1]
         while s < e and (alone[order[s]] or e - s == 1):
-            _stamp_one(h, order[s], pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe,
-                       slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
+            _stamp_one(h, order[s], pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds,
+                       xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
                        out_erased, delta, True)
             s += 1
         nt = min(n_threads, e - s)
         for t in prange(nt):  # thread t takes every nt-th crater (costliest first)
             scratch = np.empty(n_rim)
             for k in range(s + t, e, nt):
-                _stamp_one(h, order[k], pixel, cx, cy, diam, tabs, depths, rim_tabs, seeds, xe,
-                           slope_erosion, onset_deg, full_deg, rough, gain, out_scale,
+                _stamp_one(h, order[k], pixel, cx, cy, diam, tabs, depths, warps, rim_tabs,
+                           seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale,
                            out_slope, out_erased, scratch, False)

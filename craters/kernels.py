@@ -17,6 +17,9 @@ Crater profile and stamping:
 * ``slope_factor(slope, onset_deg, full_deg)``: the share of the relief kept on a slope
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
   spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
+* ``crater_rough(rough, warp)``: a crater's overlay settings (roughness amplitudes and its
+  wall warp) for the writers; ``warp_x(x, u, v, R, warp, seed)``: the warped profile
+  coordinate inside the rim (irregular terraces and central peaks)
 * ``lcsn_height(kind, r2, kappa, beta, gamma, a, b)``: LCSN crater kernel ``kind`` at
   squared distance r2 (the formulas of :func:`craters.lcsn_kernel`)
 * ``N_RIM``: samples per azimuth table
@@ -63,8 +66,11 @@ from ._stamp_kernels import _roughness_octaves as roughness_octaves
 from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
 from ._stamp_kernels import _table_value as table_value
+from ._stamp_kernels import _warp_x as warp_x
+from ._stamp_kernels import _crater_rough as crater_rough
 
-__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "face_point",
-           "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height", "mix64",
+__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
+           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height", "mix64",
            "outer_weight", "plane_solve", "plane_sums_add", "rim_offsets", "roughness_amp",
-           "roughness_octaves", "slope_factor", "splitmix64", "table", "table_value"]
+           "roughness_octaves", "slope_factor", "splitmix64", "table", "table_value",
+           "warp_x"]

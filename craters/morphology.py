@@ -14,7 +14,8 @@ rim crest at x = 1), for a fresh crater of rim-crest diameter D on a
   rescaled to the depth and rim height; complex: a flat floor out to the floor radius
   (Pike 1977: D_f = 0.187 D^1.249 km, self-similar in D / D_t on other bodies), a wall
   steepest under the rim (``u^1.6`` of the wall coordinate) broken into 1-5 terraces
-  (benches and scarps; more on larger craters), a central peak of height
+  (benches and scarps; more on larger craters; stamping makes them and the peak
+  irregular: :func:`craters.kernels.warp_x`), a central peak of height
   0.032 D^0.9 km (Hale & Head 1979 as tabulated by cratermaker) and base diameter
   0.22 D (Hale & Head 1979; Pike 1985), which becomes a ring of peaks at half the rim
   diameter above the peak-ring onset (Baker et al. 2011: ring / rim ~ 0.5).

@@ -94,14 +94,18 @@ class Roughness:
     """Amplitude just outside the rim (x = 1.1), fading linearly to 0 at the edge."""
     fractal_dimension: float = 2.2
     """Fractal dimension of the overlay (octave gain 2^(F - 3))."""
+    terraces: float = 1.0
+    """Irregularity of complex craters' terraces and central peaks, a factor of the
+    default wall warp (:func:`craters._stamp_kernels._warp_x`; 0: concentric terraces)."""
 
     def __post_init__(self):
         for name in ("bowl", "wall", "ejecta"):
             check_range(name, getattr(self, name), 0.0, 1.0)
         check_range("fractal_dimension", self.fractal_dimension, 2.0, 3.0)
+        check_range("terraces", self.terraces, 0.0, 2.0)
 
 
-_NO_ROUGHNESS = Roughness(0.0, 0.0, 0.0)
+_NO_ROUGHNESS = Roughness(0.0, 0.0, 0.0, terraces=0.0)
 
 
 def rim_perturbations(n: int, irregularity, *, rng=None) -> np.ndarray:
@@ -181,6 +185,11 @@ class StampRequest:
         """Bowl, wall and ejecta amplitudes: the kernels' ``rough``."""
         return np.array([self.roughness.bowl, self.roughness.wall, self.roughness.ejecta])
 
+    def warps(self, prof: StampingProfiles) -> np.ndarray:
+        """Each crater's wall warp (the kernels' ``warps``): its complexity times the
+        ``terraces`` factor of the roughness (0 without roughness: ideal craters)."""
+        return np.ascontiguousarray(prof.complexity * self.roughness.terraces)
+
     @property
     def gain(self) -> float:
         """The overlay's octave gain, 2^(F - 3)."""
@@ -233,6 +242,9 @@ class StampingProfiles:
     """The fresh crater's depth."""
     tau: np.ndarray
     """Dimensionless diffusion time kappa t / R^2."""
+    complexity: np.ndarray
+    """0 simple .. 1 complex (:func:`craters.fresh_morphometry`'s ``complex``): the
+    share of the wall warp a crater gets (:meth:`StampRequest.warps`)."""
     extra: dict
     """Catalog columns: morphology, floor_diameter_m, peak_height_m, kappa_t_m2."""
 
@@ -270,8 +282,8 @@ def stamping_profiles(catalog, target: str | Target = "moon", *,
     kappa_t = tau * (0.5 * d) ** 2
     extra = {"morphology": morphology_class(d, t), "floor_diameter_m": fresh["floor_diameter_m"],
              "peak_height_m": peak, "kappa_t_m2": kappa_t}
-    return StampingProfiles(tabs, rim - floor, rim,
-                            fresh["depth_m"], tau, extra)
+    return StampingProfiles(tabs, rim - floor, rim, fresh["depth_m"], tau,
+                            np.ascontiguousarray(fresh["complex"], dtype=np.float64), extra)
 
 
 def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
@@ -334,9 +346,9 @@ def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
     scale, slope = np.ones(n), np.zeros(n)
     erased = np.zeros(n, dtype=np.bool_)
     rough_arr, gain = req.rough_array, req.gain
-    _stamp_all((h, pixel, cx, cy, diam, prof.tables, prof.depth_m, rim_tabs, seeds,
-                ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain, scale, slope,
-                erased), progress)
+    _stamp_all((h, pixel, cx, cy, diam, prof.tables, prof.depth_m, req.warps(prof), rim_tabs,
+                seeds, ejecta_edge, bool(slope_erosion), onset, full, rough_arr, gain, scale,
+                slope, erased), progress)
     if erased.any():
         logger.info("%d of %d craters fell on ground steeper than %g deg and were erased",
                     int(erased.sum()), n, full)
@@ -351,8 +363,8 @@ def _stamp_all(args: tuple, progress: bool) -> None:
     """Run the stamping kernel on ``args`` (its arguments, full arrays): in parallel waves
     when there are threads and enough craters and pixels to pay for them, else the
     serial kernel (in batches of :data:`_BATCH` craters behind a progress bar)."""
-    (h, pixel, cx, cy, diam, tables, depth, rim_tabs, seeds, ejecta_edge, erosion, onset, full,
-     rough, gain, scale, slope, erased) = args
+    (h, pixel, cx, cy, diam, tables, depth, warps, rim_tabs, seeds, ejecta_edge, erosion, onset,
+     full, rough, gain, scale, slope, erased) = args
     n = len(cx)
     if numba.get_num_threads() > 1 and n >= WAVE_MIN:
         reach = _crater_reach_px(pixel, diam, rim_tabs, ejecta_edge)
@@ -364,7 +376,7 @@ def _stamp_all(args: tuple, progress: bool) -> None:
     for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
         e = min(s + step, n)
         _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], tables[s:e], depth[s:e],
-                           rim_tabs[s:e], seeds[s:e], ejecta_edge, erosion, onset, full, rough,
+                           warps[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge, erosion, onset, full, rough,
                            gain, scale[s:e], slope[s:e], erased[s:e])
 
 

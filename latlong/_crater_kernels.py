@@ -8,6 +8,7 @@ from numba import njit, prange
 from craters.kernels import (
     DC8,
     DR8,
+    crater_rough,
     fbm2,
     idw8,
     outer_weight,
@@ -17,6 +18,7 @@ from craters.kernels import (
     slope_factor,
     table,
     table_value,
+    warp_x,
 )
 
 from ._grid_kernels import _interpolate_one, _ring_size
@@ -187,7 +189,7 @@ def _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe, rim_
         return False, 0.0
     if x <= 1.0:
         new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-               + scale * table_value(tab, x, xe))
+               + scale * table_value(tab, warp_x(x, xl[q], yl[q], radius, rough[3], seed), xe))
     else:
         new = (hgt[q] + scale * table_value(tab, x, xe)
                + table(delta, az[q]) * outer_weight(x, xe))
@@ -303,8 +305,8 @@ def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale,
 
 
 @njit(cache=True)
-def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths, rim_tabs,
-               seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
+def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths, warps,
+               rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
                out_centre, out_maxdh, out_nvert, out_spacing, out_erased, up, naive, stop_after,
                inner_parallel, ang_bound):
     """Stamp crater ``c`` (see :func:`_stamp_body_kernel`); False, with nothing written,
@@ -399,6 +401,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     # delta = plane - terrain at the rim = -(residual grid) there
     rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
     octaves = roughness_octaves(radius, sp)
+    rough = crater_rough(rough, warps[c])
     # on steep ground the crater is made in its base's frame (issue 36)
     fr = np.zeros(10)
     tilt = _tilted_frame(gx, gy, fr)
@@ -420,7 +423,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
 
 @njit(cache=True, nogil=True)
 def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
-                       rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
+                       warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                        out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
                        out_erased, up, naive=False, stop_after=0):
     """Stamp craters on the body in the given order (oldest first), updating ``radii``.
@@ -431,7 +434,8 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
     at the local vertex spacing (vertices binned, holes filled) for the plane fit and
     the rim offsets; the crater evaluated at every vertex with its true distance and
     azimuth (its profile table ``tabs[c]``, scaled by the slope erosion, recorded in
-    ``out_scale``; ``depths[c]`` sets the roughness amplitude); radii rescaled by the
+    ``out_scale``; ``depths[c]`` sets the roughness amplitude, ``warps[c]`` the wall warp of
+    :func:`craters.kernels.warp_x`); radii rescaled by the
     height change. The slope for slope erosion is measured against ``up[c]`` when ``up``
     has rows (one per crater), otherwise against the reference body's normal.
 
@@ -443,6 +447,6 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
     """
     for c in range(lat.shape[0]):
         _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
-                   rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
+                   warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                    out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
                    out_erased, up, naive, stop_after, True, np.inf)

@@ -13,6 +13,7 @@ from craters.kernels import (
     roughness_amp,
     table,
     table_value,
+    warp_x,
 )
 
 
@@ -142,7 +143,7 @@ def _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale
     hx = v1 * ex + v2 * mx
     hy = v1 * ey + v2 * my
     target = (qa * hx * hx + qb * hx * hy + qc * hy * hy) * cz
-    target += scale * table_value(tab, xv, xe)
+    target += scale * table_value(tab, warp_x(xv, v1, v2, radius, rough[3], seed), xe)
     if has_rough:
         target += (roughness_amp(xv, xe, rough[0], rough[1], rough[2]) * depth * scale
                    * fbm2(seed, v1, v2, wavelength, octaves, gain))

@@ -103,7 +103,7 @@ def _balance_waves_kernel(order, starts, cost, n_threads, out_order, out_bounds)
 
 @njit(cache=True, parallel=True, nogil=True)
 def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon, diam, tabs,
-                        depths, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
+                        depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
                         gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,
                         out_spacing, out_erased, up, ang_bound, ok):
     """Stamp the waves one after the other, the craters of a wave in parallel: thread t
@@ -118,7 +118,7 @@ def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon
         if e - s == 1:
             c = order[s]
             ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs,
-                               depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,
+                               depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg,
                                full_deg, rough, gain, out_scale, out_slope, out_centre,
                                out_maxdh, out_nvert, out_spacing, out_erased, up, False, 0,
                                True, ang_bound[c])
@@ -127,7 +127,8 @@ def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon
             for k in range(bounds[w, t], bounds[w, t + 1]):
                 c = order[k]
                 ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam,
-                                   tabs, depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,
+                                   tabs, depths, warps, rim_tabs, seeds, xe, slope_erosion,
+                                   onset_deg,
                                    full_deg, rough, gain, out_scale, out_slope, out_centre,
                                    out_maxdh, out_nvert, out_spacing, out_erased, up, False, 0,
                                    False, ang_bound[c])

@@ -284,7 +284,7 @@ class _BodyStamp:
         stretch = np.array(body.stretch, dtype=np.float64)
         grid = (body.grid.magnitude, np.array(body.grid.ring_offsets()), radii, stretch)
         inputs = (lat, lon, np.ascontiguousarray(cat["diameter_m"], dtype=np.float64),
-                  prof.tables, prof.depth_m, rim_tabs, seeds)
+                  prof.tables, prof.depth_m, req.warps(prof), rim_tabs, seeds)
         options = (req.ejecta_edge, req.slope_erosion, req.onset_deg, req.full_deg,
                    req.rough_array, req.gain)
         outputs = (np.ones(n), np.zeros(n), np.zeros((n, 3)), np.zeros(n), np.zeros(n),
@@ -317,7 +317,7 @@ def _stamp(run: _BodyStamp, body: Body, cat, overwritten: bool, progress: bool) 
     n = len(cat)
     radii = run.grid[2]
     if numba.get_num_threads() > 1 and n > 1:
-        if _stamp_in_waves(body, cat, run.inputs[5], run.options[0], (*run.grid, *run.args()),
+        if _stamp_in_waves(body, cat, run.inputs[6], run.options[0], (*run.grid, *run.args()),
                            progress):
             return
         if overwritten:

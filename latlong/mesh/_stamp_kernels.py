@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import rim_offsets, roughness_octaves, slope_factor
+from craters.kernels import crater_rough, rim_offsets, roughness_octaves, slope_factor
 
 from .._crater_kernels import (
     PARALLEL_MIN,
@@ -92,7 +92,7 @@ def _frame(n0, n1, n2):
 
 @njit(cache=True)
 def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv, vertical,
-                       diam, tabs, depths, rim_tabs, seeds, xe, slope_erosion, onset_deg,
+                       diam, tabs, depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg,
                        full_deg, rough, gain, cos_tilt, mark, gdist, epoch, out_scale,
                        out_slope, out_centre, out_normal, out_maxdh, out_nvert, out_spacing,
                        out_state):
@@ -233,14 +233,15 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
         scale = slope_factor(slope, onset_deg, full_deg) if slope_erosion else 1.0
         rim_offsets(local, float(nh), float(nh), sp, radius, rim_tabs[c], 0.0, 0.0, 0.0, delta)
         octaves = roughness_octaves(radius, sp)
+        rc = crater_rough(rough, warps[c])
         dh = np.empty(keep)
         if keep >= PARALLEL_MIN:
             _write_parallel(pos, heights, idx[:keep], dist[:keep], az[:keep], xl[:keep],
                             yl[:keep], hgt[:keep], up, radius, tabs[c], scale, depths[c], xe,
-                            rim_tabs[c], delta, quad, rough, seeds[c], radius, octaves, gain, dh)
+                            rim_tabs[c], delta, quad, rc, seeds[c], radius, octaves, gain, dh)
         else:
             _write_range(0, keep, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tabs[c],
-                         scale, depths[c], xe, rim_tabs[c], delta, quad, rough, seeds[c],
+                         scale, depths[c], xe, rim_tabs[c], delta, quad, rc, seeds[c],
                          radius, octaves, gain, dh)
         _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)
 

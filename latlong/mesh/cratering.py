@@ -210,7 +210,7 @@ class _MeshStamp:
         mesh = (pos, np.array(surface.heights_m, dtype=np.float64, copy=True), faces,
                 *adjacency(faces, len(pos)))
         inputs = (face_of, uv, vertical, np.ascontiguousarray(cat["diameter_m"], dtype=np.float64),
-                  prof.tables, prof.depth_m, rim_tabs, seeds)
+                  prof.tables, prof.depth_m, req.warps(prof), rim_tabs, seeds)
         options = (req.ejecta_edge, req.slope_erosion, req.onset_deg, req.full_deg,
                    req.rough_array, req.gain)
         work = (np.zeros(len(pos), dtype=np.int64), np.zeros(len(pos)),

@@ -10,7 +10,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import face_point, fbm2, roughness_amp, slope_factor, table, table_value
+from craters.kernels import (
+    face_point,
+    fbm2,
+    roughness_amp,
+    slope_factor,
+    table,
+    table_value,
+    warp_x,
+)
 
 # crater record columns (float64 array "fc", one row per crater)
 C0, C1, C2 = 0, 1, 2          # centre direction (unit)
@@ -25,7 +33,8 @@ DEPTH = 19                    # rim crest to floor of the table (m)
 ACTIVE = 20                   # 1 when stamped (0: erased by slope erosion, or no params yet)
 FAR = 21                      # the widest ejecta edge's angle (radians)
 CHORD2 = 22                   # squared chord of that angle, (2 sin(FAR / 2))^2
-N_COLS = 23
+WARP = 23                     # wall warp (craters.kernels.warp_x): 0 simple .. 1 complex
+N_COLS = 24
 
 
 @njit(cache=True, inline="always")
@@ -81,7 +90,8 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
-    prof = scale * table_value(tabs[k], xr, xe)
+    xw = warp_x(xr, x, y, radius, fc[k, WARP], seeds[k]) if xr < 1.0 else xr
+    prof = scale * table_value(tabs[k], xw, xe)
     if octaves > 0 and (rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0):
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
         # below a millionth of the radius (a crater diffused flat) the overlay is left out:

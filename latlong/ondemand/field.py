@@ -145,6 +145,7 @@ class CraterField:
         self.target = scene.target()
         rough, irregular = resolve_roughness(scene.craters.roughness)
         self.rough = np.array([rough.bowl, rough.wall, rough.ejecta])
+        self.terraces = rough.terraces
         self.gain = 2.0 ** (rough.fractal_dimension - 3.0)
         self.irregularity = IRREGULARITY if irregular else 0.0
         self.xe = float(EJECTA_EDGE)
@@ -361,6 +362,7 @@ class CraterField:
         rims = np.ascontiguousarray(rim_perturbations_from_phases(cr.rim_phases,
                                                                   self.irregularity))
         fc[:, K.DEPTH] = prof.depth_m
+        fc[:, K.WARP] = prof.complexity * self.terraces
         seeds = np.ascontiguousarray(cr.seed)
         up = np.ascontiguousarray(self.base.up(fc[:, K.C0:K.C2 + 1]))
         # dependencies per owner, youngest first

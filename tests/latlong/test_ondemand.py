@@ -8,7 +8,7 @@ import pytest
 
 from craters import CraterLayer
 from craters.cells import cell_ids, cell_of, cell_solid_angle
-from craters.kernels import fbm2, roughness_amp, table, table_value
+from craters.kernels import fbm2, roughness_amp, table, table_value, warp_x
 from craters.local import bins, draw_cells
 from latlong import LatLongGrid, Scene, build
 from latlong.ondemand import _field_kernels as K
@@ -106,7 +106,8 @@ def _step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, p):
     xr = dist / (fc[k, K.RAD] * (1.0 + table.py_func(rims[k], az)))
     if not xr < xe:
         return False, 1.0, 0.0
-    prof = fc[k, K.SCALE] * table_value.py_func(tabs[k], xr, xe)
+    xw = warp_x.py_func(xr, x, y, fc[k, K.RAD], fc[k, K.WARP], seeds[k]) if xr < 1.0 else xr
+    prof = fc[k, K.SCALE] * table_value.py_func(tabs[k], xw, xe)
     amp = roughness_amp.py_func(xr, xe, *rough) * fc[k, K.DEPTH] * fc[k, K.SCALE]
     if amp > 1e-6 * fc[k, K.RAD]:
         prof += amp * fbm2.py_func(seeds[k], x, y, fc[k, K.RAD], ROUGHNESS_OCTAVES, gain)
