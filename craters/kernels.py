@@ -70,7 +70,7 @@ from ._stamp_kernels import _warp_x as warp_x
 from ._stamp_kernels import _crater_rough as crater_rough
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
-           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height", "mix64",
-           "outer_weight", "plane_solve", "plane_sums_add", "rim_offsets", "roughness_amp",
+           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height",
+           "mix64", "outer_weight", "plane_solve", "plane_sums_add", "rim_offsets", "roughness_amp",
            "roughness_octaves", "slope_factor", "splitmix64", "table", "table_value",
            "warp_x"]

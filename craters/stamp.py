@@ -376,8 +376,8 @@ def _stamp_all(args: tuple, progress: bool) -> None:
     for s in progress_bar(range(0, n, step), enabled=progress, desc="craters"):
         e = min(s + step, n)
         _stamp_many_kernel(h, pixel, cx[s:e], cy[s:e], diam[s:e], tables[s:e], depth[s:e],
-                           warps[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge, erosion, onset, full, rough,
-                           gain, scale[s:e], slope[s:e], erased[s:e])
+                           warps[s:e], rim_tabs[s:e], seeds[s:e], ejecta_edge, erosion, onset,
+                           full, rough, gain, scale[s:e], slope[s:e], erased[s:e])
 
 
 def _crater_reach_px(pixel_size_m: float, diameter_m, rim_tabs, ejecta_edge: float) -> np.ndarray:

@@ -159,6 +159,10 @@ def _fill_rim_cells(grid, known, cy, cx, pixel, radius, rim_tab):
     return out
 
 
+#: the first point of a serial write, typed int64 like the parallel blocks' bounds: a
+#: literal 0 made numba compile the writer a second time (for the type Literal[int](0))
+_FIRST = np.int64(0)
+
 # vertices above which a crater is written in parallel: a parallel region costs tens of
 # microseconds, far more when the other core is busy, so small craters stay serial
 PARALLEL_MIN = 20_000
@@ -188,8 +192,8 @@ def _height_change(q, dist, az, xl, yl, hgt, radius, tab, scale, depth, xe, rim_
     if not x < xe:
         return False, 0.0
     if x <= 1.0:
-        new = (_quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q])
-               + scale * table_value(tab, warp_x(x, xl[q], yl[q], radius, rough[3], seed), xe))
+        xw = warp_x(x, xl[q], yl[q], radius, rough[3], seed)
+        new = _quadric(p0, gx, gy, qa, qb, qc, xl[q], yl[q]) + scale * table_value(tab, xw, xe)
     else:
         new = (hgt[q] + scale * table_value(tab, x, xe)
                + table(delta, az[q]) * outer_weight(x, xe))
@@ -306,9 +310,9 @@ def _write_parallel(radii, idx, pmag, dist, az, xl, yl, hgt, radius, tab, scale,
 
 @njit(cache=True)
 def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths, warps,
-               rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
-               out_centre, out_maxdh, out_nvert, out_spacing, out_erased, up, naive, stop_after,
-               inner_parallel, ang_bound):
+               rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale,
+               out_slope, out_centre, out_maxdh, out_nvert, out_spacing, out_erased, up, naive,
+               stop_after, inner_parallel, ang_bound):
     """Stamp crater ``c`` (see :func:`_stamp_body_kernel`); False, with nothing written,
     when its gather cap would exceed ``ang_bound`` (radians: the wave schedule's bound)."""
     smax = max(stretch[0], max(stretch[1], stretch[2]))
@@ -414,7 +418,7 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
                         rim_tabs[c], delta, p0, gx, gy, qa, qb, qc, rough, seeds[c],
                         radius, octaves, gain, fr, dh)
     else:
-        _write_range(0, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
+        _write_range(_FIRST, keep, radii, idx, pmag, dist, az, xl, yl, hgt, radius, tabs[c],
                      scale, depths[c], xe, rim_tabs[c], delta, p0, gx, gy, qa, qb, qc,
                      rough, seeds[c], radius, octaves, gain, fr, dh)
     _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)

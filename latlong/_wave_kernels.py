@@ -103,8 +103,8 @@ def _balance_waves_kernel(order, starts, cost, n_threads, out_order, out_bounds)
 
 @njit(cache=True, parallel=True, nogil=True)
 def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon, diam, tabs,
-                        depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
-                        gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,
+                        depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg,
+                        rough, gain, out_scale, out_slope, out_centre, out_maxdh, out_nvert,
                         out_spacing, out_erased, up, ang_bound, ok):
     """Stamp the waves one after the other, the craters of a wave in parallel: thread t
     takes ``order[bounds[w, t]:bounds[w, t + 1]]`` of wave w (:func:`_balance_waves_kernel`;

@@ -10,6 +10,36 @@ import numpy as np
 import pytest
 
 
+#: Test files that take longest on a cold CI run (seconds, 2 xdist workers, 2026-12-05), run
+#: first: pytest-xdist hands out whole files (``--dist loadfile``, so the two workers
+#: rarely need the same numba kernels at once and compile them twice) in this order, the
+#: longest first so that neither worker is left with a long file at the end. Only the
+#: order of the run depends on it.
+LONGEST_FIRST = (
+    "tests/test_readme_commands.py",     # 262 s
+    "tests/latlong/test_cli.py",         # 134
+    "tests/dem/test_ondemand.py",        # 114
+    "tests/latlong/test_boulders.py",    # 113
+    "tests/latlong/test_gravity.py",     # 75
+    "tests/latlong/test_gabor.py",       # 71
+    "tests/latlong/test_big_bodies.py",  # 69
+    "tests/test_examples.py",            # 62
+    "tests/latlong/test_mesh.py",        # 60
+    "tests/test_batch.py",               # 58
+    "tests/latlong/test_implicit_cli.py",  # 52
+    "tests/dem/test_surface.py",         # 51
+)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Run the files of :data:`LONGEST_FIRST` first, in its order (stable otherwise)."""
+    rank = {name: i for i, name in enumerate(LONGEST_FIRST)}
+    root = config.rootpath
+    items.sort(key=lambda item: rank.get(item.path.relative_to(root).as_posix()
+                                         if item.path.is_relative_to(root) else "",
+                                         len(rank)))
+
+
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(12345)

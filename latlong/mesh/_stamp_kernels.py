@@ -17,6 +17,7 @@ from numba import njit, prange
 from craters.kernels import crater_rough, rim_offsets, roughness_octaves, slope_factor
 
 from .._crater_kernels import (
+    _FIRST,
     PARALLEL_MIN,
     _far,
     _fill_holes,
@@ -240,8 +241,8 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
                             yl[:keep], hgt[:keep], up, radius, tabs[c], scale, depths[c], xe,
                             rim_tabs[c], delta, quad, rc, seeds[c], radius, octaves, gain, dh)
         else:
-            _write_range(0, keep, pos, heights, idx, dist, az, xl, yl, hgt, up, radius, tabs[c],
-                         scale, depths[c], xe, rim_tabs[c], delta, quad, rc, seeds[c],
+            _write_range(_FIRST, keep, pos, heights, idx, dist, az, xl, yl, hgt, up, radius,
+                         tabs[c], scale, depths[c], xe, rim_tabs[c], delta, quad, rc, seeds[c],
                          radius, octaves, gain, dh)
         _record(c, scale, dh, keep, out_scale, out_maxdh, out_nvert)
 
