@@ -77,16 +77,18 @@ def _corner(seed, ix, iy, fx, fy):
 
 
 @njit(cache=True, inline="always")
+def _lattice_coord(x):
+    """(lattice index, fraction, the fraction's quintic fade) of the coordinate ``x``."""
+    x0 = np.floor(x)
+    f = x - x0
+    return np.int64(x0), f, f * f * f * (f * (f * 6.0 - 15.0) + 10.0)
+
+
+@njit(cache=True, inline="always")
 def _noise2(seed, x, y):
     """2-D gradient noise in about [-0.8, 0.8], zero at integer lattice points."""
-    x0 = np.floor(x)
-    y0 = np.floor(y)
-    ix = np.int64(x0)
-    iy = np.int64(y0)
-    fx = x - x0
-    fy = y - y0
-    u = fx * fx * fx * (fx * (fx * 6.0 - 15.0) + 10.0)
-    v = fy * fy * fy * (fy * (fy * 6.0 - 15.0) + 10.0)
+    ix, fx, u = _lattice_coord(x)
+    iy, fy, v = _lattice_coord(y)
     n00 = _corner(seed, ix, iy, fx, fy)
     n10 = _corner(seed, ix + 1, iy, fx - 1.0, fy)
     n01 = _corner(seed, ix, iy + 1, fx, fy - 1.0)

@@ -17,6 +17,7 @@ Crater profile and stamping:
 * ``slope_factor(slope, onset_deg, full_deg)``: the share of the relief kept on a slope
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
   spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
+* ``lattice_coord(x)`` -> (index, fraction, quintic fade): a noise lattice coordinate
 * ``crater_rough(rough, warp)``: a crater's overlay settings (roughness amplitudes and its
   wall warp) for the writers; ``warp_x(x, u, v, R, warp, seed)``: the warped profile
   coordinate inside the rim (irregular terraces and central peaks)
@@ -59,6 +60,7 @@ from ._rng_kernels import _splitmix64 as splitmix64
 from ._stamp_kernels import N_RIM
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
+from ._stamp_kernels import _lattice_coord as lattice_coord
 from ._stamp_kernels import _outer_weight as outer_weight
 from ._stamp_kernels import _rim_offsets as rim_offsets
 from ._stamp_kernels import _roughness_amp as roughness_amp
@@ -70,7 +72,7 @@ from ._stamp_kernels import _warp_x as warp_x
 from ._stamp_kernels import _crater_rough as crater_rough
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
-           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lcsn_height",
-           "mix64", "outer_weight", "plane_solve", "plane_sums_add", "rim_offsets", "roughness_amp",
-           "roughness_octaves", "slope_factor", "splitmix64", "table", "table_value",
-           "warp_x"]
+           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",
+           "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
+           "rim_offsets", "roughness_amp", "roughness_octaves", "slope_factor", "splitmix64",
+           "table", "table_value", "warp_x"]

@@ -3,7 +3,8 @@ diffusion, and the same crater on different targets.
 
 Top row: fresh lunar craters stamped on flat ground - a simple bowl, a flat-floored
 transitional crater, complex craters with central peaks and terraced walls, and a
-peak-ring basin (Pike 1977; Baker et al. 2011). Middle row: one 1 km crater at model
+peak-ring basin (Pike 1977; Baker et al. 2011) - with their roughness: irregular rims,
+scalloped terraces that wander, merge and split, and central peaks broken into massifs. Middle row: one 1 km crater at model
 ages from 0 to 3.8 Gyr, degraded by topographic diffusion (Fassett & Thomson 2014).
 Bottom: radial profiles with their depth/diameter, and the same 20 km crater on the
 Moon, Mars, Mercury and Ceres (Pike 1977/1988, Garvin & Frawley 1998; 1/g scaling).
@@ -30,14 +31,14 @@ n = 129 if small else 401
 light = LightSource(azdeg=270, altdeg=25)
 
 
-def single(diameter_m, *, age_gyr=0.0, degradation=0.0, target="moon"):
+def single(diameter_m, *, age_gyr=0.0, degradation=0.0, target="moon", roughness=False):
     """One crater at the centre of flat ground 3.4 diameters across: heights, pixel."""
     pixel = 3.4 * diameter_m / (n - 1)
     c = (n - 1) / 2 * pixel
     cat = craters.make_catalog(x_m=[c], y_m=[c], diameter_m=[diameter_m], age_gyr=[age_gyr],
                                degradation=[degradation])
-    h, stamped = craters.stamp_many(np.zeros((n, n)), pixel, cat, roughness=False,
-                                    target=target, return_catalog=True)
+    h, stamped = craters.stamp_many(np.zeros((n, n)), pixel, cat, roughness=roughness,
+                                    target=target, return_catalog=True, rng=1)
     return h, pixel, stamped[0]
 
 
@@ -57,7 +58,7 @@ grid = fig.add_gridspec(3, 5, height_ratios=[1, 1, 1.15])
 x = np.linspace(0.0, 1.6, 801)
 ax_fresh = fig.add_subplot(grid[2, 0:2])
 for j, d_km in enumerate(fresh_km):
-    h, pixel, row = single(d_km * 1000.0)
+    h, pixel, row = single(d_km * 1000.0, roughness=True)
     m = craters.crater_morphometry(d_km * 1000.0)
     shade(fig.add_subplot(grid[0, j]), h, pixel,
           f"D = {d_km:g} km: {row['morphology']}\nd/D = {m['depth_diameter']:.3f}")

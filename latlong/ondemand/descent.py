@@ -14,6 +14,12 @@ Shadows are cast by what the window holds. With a LIDAR (``lidar``: its
 over the same terrain (:func:`latlong.sensors.lidar_frame`): returns labelled with the
 frame's craters, range noise keyed by (``lidar_seed``, frame), its beams inside the
 frame's terrain window.
+
+Albedo (issue 36): each frame's terrain carries the brighter ejecta of its fresh craters
+(``bright_ejecta``, :func:`latlong.sensors.ejecta_albedo`: fresh ejecta brighter than the
+matured terrain, darkening with degradation) times the regolith's mottling (``mottling``,
+:func:`latlong.sensors.regolith_albedo`: a function of position, octaves from 2 m down
+to the frame's pixels, keyed by the scene's seed), both 0 to leave the albedo uniform.
 """
 
 from __future__ import annotations
@@ -99,13 +105,23 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
             fov_deg: float = 30.0, width_px: int = 512, sun_azimuth_deg: float = 90.0,
             sun_elevation_deg: float = 25.0, reflectance=None,
-            lidar: LidarSettings | None = None, lidar_seed: int = 0) -> Iterator[DescentFrame]:
+            lidar: LidarSettings | None = None, lidar_seed: int = 0,
+            bright_ejecta: float = 0.5, mottling: float = 0.1) -> Iterator[DescentFrame]:
     """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes) of a
     scene, or of a crater field (any base, e.g. a DEM's), square pictures ``width_px``
     wide, the sun at ``sun_azimuth_deg`` (clockwise from north) and ``sun_elevation_deg``
     above the site's horizon; with ``lidar`` also that LIDAR's returns per frame, range
-    noise keyed by (``lidar_seed``, frame)."""
-    from ..sensors import Camera, LidarSettings, Pose, lidar_frame, render
+    noise keyed by (``lidar_seed``, frame); ``bright_ejecta`` and ``mottling`` the albedo's
+    contrasts (module notes)."""
+    from ..sensors import (
+        Camera,
+        LidarSettings,
+        Pose,
+        ejecta_albedo,
+        lidar_frame,
+        regolith_albedo,
+        render,
+    )
     from ..sensors.engine import RayMesh
     from ..sensors.scene_geometry import SceneGeometry
 
@@ -118,6 +134,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
                         f"{type(scene).__name__}")
     check_range("fov_deg", fov_deg, 1.0, 120.0)
     width_px = check_int("width_px", width_px, 16, 8192)
+    bright_ejecta = check_range("bright_ejecta", bright_ejecta, 0.0, 10.0)
+    mottling = check_range("mottling", mottling, 0.0, 2.0)
     alts = np.asarray(altitudes_m, dtype=np.float64).ravel()
     if not len(alts) or not (np.isfinite(alts).all() and (alts > 0).all()):
         raise ParameterError("altitudes_m", "must be positive numbers")
@@ -149,7 +167,10 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         mesh = RayMesh(verts, faces, build_quality="low")
         truth = SceneGeometry(verts, faces, np.full(len(faces), -1, dtype=np.int32),
                               craters=catalog, source="terrain on demand")
-        frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth)
+        albedo = ejecta_albedo(truth, contrast=bright_ejecta) * regolith_albedo(
+            verts, seed=field.base.seed, contrast=mottling, pixel_m=pixel)
+        frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth,
+                       vertex_albedo=albedo)
         returns = None if lidar is None else lidar_frame(
             mesh, lidar, pose.position_m, pose.quaternion_wxyz,
             rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)

@@ -83,7 +83,7 @@ the same engine and cast shadows. ``python examples/plot_descent_strip.py`` and
 ``plot_lidar_sweep.py`` draw frames and scans.
 """
 
-from .albedo import ejecta_albedo
+from .albedo import ejecta_albedo, regolith_albedo
 from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
 from .camera_files import CameraSettings, camera_run
 from .engine import BUILD_QUALITIES, Hits, RayMesh
@@ -118,5 +118,5 @@ __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "Sensor", "Sun", "beam_pattern", "boulder_labels", "camera_inside", "camera_run",
            "crater_labels", "drape_catalog", "ejecta_albedo", "expose", "lidar_frame",
            "lidar_run", "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
-           "ray_scene", "read_poses", "reflectance_model", "render", "rim_curves",
-           "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]
+           "ray_scene", "read_poses", "reflectance_model", "regolith_albedo", "render",
+           "rim_curves", "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]

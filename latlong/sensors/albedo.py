@@ -13,17 +13,36 @@ the bright, less weathered units). :func:`ejecta_albedo` gives each vertex the f
 the largest over the craters that reach the vertex; craters at or above
 ``fresh_degradation`` leave the terrain as it is. Pass it to
 :func:`latlong.render` as ``vertex_albedo``.
+
+:func:`regolith_albedo` is the regolith's own mottling below the craters: a factor
+``exp(contrast * f / MOTTLE_RMS)`` from a non-repeating 3-D fBm ``f`` of the body-fixed
+position (value noise hashed from the lattice, octaves from ``wavelength_max_m`` halving
+down to two pixels, amplitudes 0.7^k: a frame shows the same coarse mottling as a coarser
+frame, plus finer detail), so ``contrast`` is the RMS of the log albedo at full detail.
+Its default, 0.1 (about +-10 %), is a choice for close-range pictures, not a published
+measurement: lunar surface photographs show bright rock fragments and dark patches on
+the soil at this level, and no small-scale albedo spectrum of the regolith is used here.
+Multiply the two factors for a frame's albedo.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from craters._shared import ParameterError, check_positive, check_range
+from craters._shared import ParameterError, check_int, check_positive, check_range
 
+from ._albedo_kernels import _mottle_kernel
 from .scene_geometry import SceneGeometry
 
-__all__ = ["ejecta_albedo"]
+__all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "ejecta_albedo", "regolith_albedo"]
+
+#: Octave gain of the regolith mottling (amplitude ratio of successive octaves).
+MOTTLE_GAIN = 0.7
+#: RMS of the mottling fBm with all octaves (0.1681-0.1684 over three sets of 10^6
+#: random points, 24 octaves; tests/latlong/test_albedo.py checks it), so that
+#: ``contrast`` is the RMS of the log albedo.
+MOTTLE_RMS = 0.168
+_MOTTLE_SALT = 0x5DEECE66D2545F49
 
 
 def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
@@ -88,3 +107,48 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
         g = np.where(rho <= 1.0, 1.0, np.maximum(rho, 1.0) ** -3)
         out[near] = np.maximum(out[near], 1.0 + contrast * weight[i] * g)  # unique rows
     return out
+
+
+def regolith_albedo(points_m, *, seed: int, contrast: float = 0.1, pixel_m: float,
+                    wavelength_max_m: float = 2.0) -> np.ndarray:
+    """(n,) float64 albedo factor of the regolith's mottling at ``points_m`` (n, 3),
+    body-fixed metres (module notes), for a picture whose pixels are ``pixel_m`` on the
+    ground.
+
+    Parameters
+    ----------
+    points_m : (n, 3) array_like
+        Positions, metres (finite).
+    seed : int
+        The texture's seed, [0, 2^63).
+    contrast : float
+        RMS of the log albedo with all octaves, [0, 2] (0: a factor of 1 everywhere).
+    pixel_m : float
+        Ground pixel of the picture (> 0): octaves end at two pixels.
+    wavelength_max_m : float
+        Wavelength of the coarsest octave, metres (> 0). The default, 2 m, keeps the
+        mottling to close range: at 20 m a frame from 1 km looked cloudy, topography (the
+        small craters) is what orbital pictures show.
+
+    Examples
+    --------
+    >>> f = regolith_albedo([[0.0, 0.0, 1737e3], [0.5, 0.0, 1737e3]], seed=1, pixel_m=0.01)
+    >>> f.shape, bool(((f > 0.5) & (f < 2.0)).all())
+    ((2,), True)
+    """
+    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
+        raise ParameterError("points_m", f"must be finite (n, 3) positions; got shape "
+                                         f"{pts.shape}")
+    seed = check_int("seed", seed, 0, 2**63 - 1)
+    contrast = check_range("contrast", contrast, 0.0, 2.0)
+    pixel = check_positive("pixel_m", pixel_m)
+    top = check_positive("wavelength_max_m", wavelength_max_m)
+    out = np.ones(len(pts))
+    octaves = 0
+    while octaves < 48 and top / 2.0**octaves >= 2.0 * pixel:
+        octaves += 1
+    if contrast == 0.0 or octaves == 0 or not len(pts):
+        return out
+    _mottle_kernel(pts, np.uint64(seed ^ _MOTTLE_SALT), top, octaves, MOTTLE_GAIN, out)
+    return np.exp((contrast / MOTTLE_RMS) * out)

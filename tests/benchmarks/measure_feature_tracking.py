@@ -169,6 +169,8 @@ def track_pair(a, b, max_corners=4000):
 
     p0 = cv2.goodFeaturesToTrack(a, maxCorners=max_corners, qualityLevel=0.003,
                                  minDistance=8, blockSize=7)
+    if p0 is None:  # a featureless picture (e.g. all in shadow): no tracks
+        return np.zeros((0, 2), np.float32), np.zeros((0, 2), np.float32), 0
     p0 = cv2.cornerSubPix(a, p0.astype(np.float32), (5, 5), (-1, -1),
                           (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 40, 0.01))
     lk = {"winSize": (21, 21), "maxLevel": 4,

@@ -41,7 +41,9 @@ stand for the regolith's texture (the equilibrium law carried on: with craters e
 3. A 6-frame strip (100 km, 10 km, 1 km, 100 m, 10 m, 1 m) for the README.
 
 Usage: ``python tests/benchmarks/measure_ondemand.py [--frames 100] [--size 1024]
-[--strip examples/images/descent_ondemand.png] [--json out/ondemand.json]``
+[--strip examples/images/descent_ondemand.png] [--json out/ondemand.json]``. The README's
+strip: ``--frames 6 --skip-tiles --site 0.01,0.01 --strip ...`` (at the default site,
+(0, 0), a crater's shadow fills the frames from 100 m down at the 25 deg sun).
 """
 
 from __future__ import annotations

@@ -1,0 +1,60 @@
+"""Numba kernel of the regolith's albedo texture (:func:`latlong.sensors.albedo.
+regolith_albedo`): 3-D value noise hashed from the integer lattice of body-fixed
+coordinates (counter-based: no table, so nothing repeats; a point's value depends only on
+its position and the seed). Reference in numpy: ``tests/latlong/test_albedo.py``."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit, prange
+
+from craters.kernels import lattice_coord, mix64
+
+_KX = np.uint64(0x9E3779B97F4A7C15)
+_KY = np.uint64(0xC2B2AE3D27D4EB4F)
+_KZ = np.uint64(0x165667B19E3779F9)
+_OCTAVE = np.uint64(0x632BE59BD9B4E019)
+
+
+@njit(cache=True)
+def _lattice(seed, ix, iy, iz):
+    """A value in [-1, 1) at lattice point (ix, iy, iz)."""
+    k = (np.uint64(ix) * _KX) ^ (np.uint64(iy) * _KY) ^ (np.uint64(iz) * _KZ)
+    return (mix64(seed ^ mix64(k)) >> np.uint64(11)) * (2.0 / 9007199254740992.0) - 1.0
+
+
+@njit(cache=True)
+def _value3(seed, x, y, z):
+    """Trilinear value noise with quintic fades at (x, y, z) lattice units."""
+    ix, _, u = lattice_coord(x)
+    iy, _, v = lattice_coord(y)
+    iz, _, w = lattice_coord(z)
+    c = np.empty(8)
+    for k in range(8):
+        c[k] = _lattice(seed, ix + (k & 1), iy + ((k >> 1) & 1), iz + (k >> 2))
+    a0 = c[0] + u * (c[1] - c[0])
+    a1 = c[2] + u * (c[3] - c[2])
+    a2 = c[4] + u * (c[5] - c[4])
+    a3 = c[6] + u * (c[7] - c[6])
+    b0 = a0 + v * (a1 - a0)
+    b1 = a2 + v * (a3 - a2)
+    return b0 + w * (b1 - b0)
+
+
+@njit(cache=True, parallel=True)
+def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
+    """fBm of ``octaves`` octaves of :func:`_value3` from ``wavelength_m`` halving each
+    octave, amplitudes ``gain``^k times (1 - gain) (the infinite series' sum is 1: a
+    picture with fewer octaves, the finer ones below its pixels, shows the same coarser
+    octaves) at each row of ``points`` (metres), into ``out``."""
+    for i in prange(points.shape[0]):
+        total = 0.0
+        amp = 1.0 - gain
+        inv = 1.0 / wavelength_m
+        for o in range(octaves):
+            s = seed + np.uint64(o) * _OCTAVE
+            total += amp * _value3(s, points[i, 0] * inv, points[i, 1] * inv,
+                                   points[i, 2] * inv)
+            amp *= gain
+            inv *= 2.0
+        out[i] = total
