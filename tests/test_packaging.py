@@ -33,3 +33,17 @@ def test_the_readme_architecture_names_every_subpackage():
     missing = sorted(s for s in subpackages
                      if not re.search(rf"[`/]{re.escape(s.split('/', 1)[1])}/`", section))
     assert not missing, missing
+
+
+def test_the_longest_first_files_exist():
+    """tests/conftest.py's run order names real test files (a renamed file would silently
+    fall back to the collection order and leave a long file to the end of a CI run)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("_conftest", ROOT / "tests" / "conftest.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    LONGEST_FIRST = module.LONGEST_FIRST
+    missing = [f for f in LONGEST_FIRST if not (ROOT / f).is_file()]
+    assert not missing and len(set(LONGEST_FIRST)) == len(LONGEST_FIRST), missing
