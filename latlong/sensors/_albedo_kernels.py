@@ -58,3 +58,56 @@ def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
             amp *= gain
             inv *= 2.0
         out[i] = total
+
+
+@njit(cache=True, parallel=True)
+def _ejecta_kernel(verts, order, keys, lo, cell, dims, centres, radii, gains, reach, n_threads,
+                   out):
+    """Brighten ``out`` (one factor per row of ``verts``, in place) by every crater c:
+    ``max(out, 1 + gains[c] * g)``, g = 1 within ``radii[c]`` of ``centres[c]``, (d / R)^-3
+    out to ``reach`` radii, nothing beyond. Vertices are found through a uniform grid of
+    cubes ``cell`` metres wide from ``lo``, ``dims`` cubes along each axis: ``keys`` the
+    sorted cube keys (i + dims0 (j + dims1 k)) of the vertices ``order``. Thread t of
+    ``n_threads`` takes every n-th crater into its own copy of ``out``; the copies are
+    merged by their maximum, which does not depend on who took which crater."""
+    copies = np.empty((n_threads, out.shape[0]))
+    for t in prange(n_threads):
+        mine = copies[t]
+        mine[:] = out
+        for c in range(t, centres.shape[0], n_threads):
+            _brighten(verts, order, keys, lo, cell, dims, centres[c], radii[c], gains[c],
+                      reach, mine)
+    for t in range(n_threads):
+        for v in range(out.shape[0]):
+            if copies[t, v] > out[v]:
+                out[v] = copies[t, v]
+
+
+@njit(cache=True)
+def _brighten(verts, order, keys, lo, cell, dims, centre, radius, gain, reach, out):
+    """One crater of :func:`_ejecta_kernel` into ``out``."""
+    big = reach * radius
+    a = np.empty(3, np.int64)
+    b = np.empty(3, np.int64)
+    for ax in range(3):
+        a[ax] = max(np.int64(np.floor((centre[ax] - big - lo[ax]) / cell)), 0)
+        b[ax] = min(np.int64(np.floor((centre[ax] + big - lo[ax]) / cell)), dims[ax] - 1)
+    for k in range(a[2], b[2] + 1):
+        for j in range(a[1], b[1] + 1):
+            for i in range(a[0], b[0] + 1):
+                key = i + dims[0] * (j + dims[1] * k)
+                s = np.searchsorted(keys, key)
+                e = np.searchsorted(keys, key, side="right")
+                for p in range(s, e):
+                    v = order[p]
+                    dx = verts[v, 0] - centre[0]
+                    dy = verts[v, 1] - centre[1]
+                    dz = verts[v, 2] - centre[2]
+                    d = np.sqrt(dx * dx + dy * dy + dz * dz)
+                    if d > big:
+                        continue
+                    rho = d / radius
+                    g = 1.0 if rho <= 1.0 else 1.0 / (rho * rho * rho)
+                    f = 1.0 + gain * g
+                    if f > out[v]:
+                        out[v] = f

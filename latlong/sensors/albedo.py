@@ -27,11 +27,12 @@ Multiply the two factors for a frame's albedo.
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
-from ._albedo_kernels import _mottle_kernel
+from ._albedo_kernels import _ejecta_kernel, _mottle_kernel
 from .scene_geometry import SceneGeometry
 
 __all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "ejecta_albedo", "regolith_albedo"]
@@ -95,17 +96,23 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     rows = np.flatnonzero((weight > 0) & (radii > 0) & np.isfinite(centres).all(axis=1))
     if not len(rows):
         return out
-    from scipy.spatial import cKDTree  # scipy.spatial loads argparse: only when used
-
-    tree = cKDTree(verts)
-    for i, near in zip(rows, tree.query_ball_point(centres[rows], reach * radii[rows]),
-                       strict=True):
-        near = np.asarray(near, dtype=np.int64)
-        if not len(near):
-            continue
-        rho = np.linalg.norm(verts[near] - centres[i], axis=1) / radii[i]
-        g = np.where(rho <= 1.0, 1.0, np.maximum(rho, 1.0) ** -3)
-        out[near] = np.maximum(out[near], 1.0 + contrast * weight[i] * g)  # unique rows
+    # a uniform grid of cubes as wide as the median crater's reach finds each crater's
+    # vertices (a k-d tree of the vertices took ~4 s a 1024^2 descent frame)
+    cell = max(float(np.median(reach * radii[rows])), 1e-9)
+    lo = verts.min(axis=0)
+    ijk = np.floor((verts - lo) / cell).astype(np.int64)
+    dims = ijk.max(axis=0) + 1
+    if float(dims[0]) * float(dims[1]) * float(dims[2]) > 2.0**62:  # a key would overflow
+        cell *= (float(dims.prod()) / 2.0**62) ** (1 / 3) * 2.0
+        ijk = np.floor((verts - lo) / cell).astype(np.int64)
+        dims = ijk.max(axis=0) + 1
+    keys = ijk[:, 0] + dims[0] * (ijk[:, 1] + dims[1] * ijk[:, 2])
+    order = np.argsort(keys, kind="stable")
+    _ejecta_kernel(np.ascontiguousarray(verts, dtype=np.float64), order,
+                   np.ascontiguousarray(keys[order]), lo, cell, dims,
+                   np.ascontiguousarray(centres[rows]), np.ascontiguousarray(radii[rows]),
+                   contrast * weight[rows], float(reach),
+                   min(numba.get_num_threads(), len(rows)), out)
     return out
 
 
