@@ -51,6 +51,10 @@ __all__ = ["Crater", "Roughness", "StampRequest", "StampingProfiles", "resolve_r
            "stamp_request", "stamped_after", "stamping_profiles"]
 
 _HARMONICS = np.arange(2, 17)
+#: Share of the wall warp a peak-ring basin loses: with the full warp (0.25 R) its ring at
+#: half the rim radius came out a lumpy rounded triangle; real rings are near-circular
+#: chains of massifs (Baker et al. 2011: ring / rim ~ 0.5 with little scatter).
+RING_WARP_CUT = 0.7
 _BATCH = 512  # craters per kernel call when a progress bar is shown
 # the serial kernel for fewer craters or crater-box pixels than these (or one thread): a
 # few ms of work per wave does not pay for its barrier, least of all on a busy machine
@@ -243,8 +247,9 @@ class StampingProfiles:
     tau: np.ndarray
     """Dimensionless diffusion time kappa t / R^2."""
     complexity: np.ndarray
-    """0 simple .. 1 complex (:func:`craters.fresh_morphometry`'s ``complex``): the
-    share of the wall warp a crater gets (:meth:`StampRequest.warps`)."""
+    """The share of the wall warp a crater gets (:meth:`StampRequest.warps`): 0 simple ..
+    1 complex (:func:`craters.fresh_morphometry`'s ``complex``), less on peak-ring basins
+    (``complex - RING_WARP_CUT * ring``: their ring stays a ring)."""
     extra: dict
     """Catalog columns: morphology, floor_diameter_m, peak_height_m, kappa_t_m2."""
 
@@ -282,8 +287,9 @@ def stamping_profiles(catalog, target: str | Target = "moon", *,
     kappa_t = tau * (0.5 * d) ** 2
     extra = {"morphology": morphology_class(d, t), "floor_diameter_m": fresh["floor_diameter_m"],
              "peak_height_m": peak, "kappa_t_m2": kappa_t}
+    warp = fresh["complex"] - RING_WARP_CUT * fresh["ring"]
     return StampingProfiles(tabs, rim - floor, rim, fresh["depth_m"], tau,
-                            np.ascontiguousarray(fresh["complex"], dtype=np.float64), extra)
+                            np.ascontiguousarray(warp, dtype=np.float64), extra)
 
 
 def stamp_many(heights, pixel_size_m: float, catalog, *, roughness=True,
