@@ -131,13 +131,20 @@ PEAK_ZONE = 0.3            # radii
 _WARP_SALT = np.uint64(0xA24BAED4963EE407)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _warp_x(x, u, v, radius, warp, seed):
-    """The profile coordinate of a point at ``x`` radii (< 1, inside the rim) and (u, v)
-    metres from the centre in the crater's plane, for a crater of ``warp`` in [0, 1]
-    (module notes); ``x`` itself when ``warp`` is 0. The result stays in [0, 1)."""
+    """The profile coordinate of a point at ``x`` radii and (u, v) metres from the centre
+    in the crater's plane, for a crater of ``warp`` in [0, 1] (module notes): ``x`` itself
+    outside the rim or when ``warp`` is 0 (a compare inlined into the writers' loops, not a
+    call: most craters are simple), else :func:`_warped_x`, in [0, 1)."""
     if warp <= 0.0 or x >= 1.0:
         return x
+    return _warped_x(x, u, v, radius, warp, seed)
+
+
+@njit(cache=True)
+def _warped_x(x, u, v, radius, warp, seed):
+    """:func:`_warp_x` inside the rim of a crater with a warp."""
     s = seed ^ _WARP_SALT
     d = WALL_WARP * min(1.0, 4.0 * (1.0 - x)) * _fbm2(s, u, v, WALL_WAVELENGTH * radius, 2,
                                                         0.5)

@@ -58,6 +58,7 @@ from ._rng_kernels import _hash_normal as hash_normal
 from ._rng_kernels import _mix64 as mix64
 from ._rng_kernels import _splitmix64 as splitmix64
 from ._stamp_kernels import N_RIM
+from ._stamp_kernels import _crater_rough as crater_rough
 from ._stamp_kernels import _fbm2 as fbm2
 from ._stamp_kernels import _fit_plane as fit_plane
 from ._stamp_kernels import _lattice_coord as lattice_coord
@@ -69,7 +70,6 @@ from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
 from ._stamp_kernels import _table_value as table_value
 from ._stamp_kernels import _warp_x as warp_x
-from ._stamp_kernels import _crater_rough as crater_rough
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
            "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",

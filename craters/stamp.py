@@ -190,9 +190,9 @@ class StampRequest:
         return np.array([self.roughness.bowl, self.roughness.wall, self.roughness.ejecta])
 
     def warps(self, prof: StampingProfiles) -> np.ndarray:
-        """Each crater's wall warp (the kernels' ``warps``): its complexity times the
-        ``terraces`` factor of the roughness (0 without roughness: ideal craters)."""
-        return np.ascontiguousarray(prof.complexity * self.roughness.terraces)
+        """Each crater's wall warp (the kernels' ``warps``) with this request's roughness
+        (0 without roughness: ideal craters)."""
+        return prof.warps(self.roughness.terraces)
 
     @property
     def gain(self) -> float:
@@ -246,12 +246,17 @@ class StampingProfiles:
     """The fresh crater's depth."""
     tau: np.ndarray
     """Dimensionless diffusion time kappa t / R^2."""
-    complexity: np.ndarray
-    """The share of the wall warp a crater gets (:meth:`StampRequest.warps`): 0 simple ..
-    1 complex (:func:`craters.fresh_morphometry`'s ``complex``), less on peak-ring basins
+    warp_share: np.ndarray
+    """The share of the wall warp a crater gets (:meth:`warps`): 0 simple .. 1 complex
+    (:func:`craters.fresh_morphometry`'s ``complex``), less on peak-ring basins
     (``complex - RING_WARP_CUT * ring``: their ring stays a ring)."""
     extra: dict
     """Catalog columns: morphology, floor_diameter_m, peak_height_m, kappa_t_m2."""
+
+    def warps(self, terraces: float) -> np.ndarray:
+        """Each crater's wall warp (the kernels' ``warps``, :func:`craters.kernels.warp_x`)
+        for the ``terraces`` factor of a :class:`Roughness`."""
+        return np.ascontiguousarray(self.warp_share * terraces)
 
 
 def stamping_profiles(catalog, target: str | Target = "moon", *,

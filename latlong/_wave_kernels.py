@@ -128,7 +128,6 @@ def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon
                 c = order[k]
                 ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam,
                                    tabs, depths, warps, rim_tabs, seeds, xe, slope_erosion,
-                                   onset_deg,
-                                   full_deg, rough, gain, out_scale, out_slope, out_centre,
-                                   out_maxdh, out_nvert, out_spacing, out_erased, up, False, 0,
-                                   False, ang_bound[c])
+                                   onset_deg, full_deg, rough, gain, out_scale, out_slope,
+                                   out_centre, out_maxdh, out_nvert, out_spacing, out_erased,
+                                   up, False, 0, False, ang_bound[c])

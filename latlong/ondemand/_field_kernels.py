@@ -90,8 +90,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
-    xw = warp_x(xr, x, y, radius, fc[k, WARP], seeds[k]) if xr < 1.0 else xr
-    prof = scale * table_value(tabs[k], xw, xe)
+    prof = scale * table_value(tabs[k], warp_x(xr, x, y, radius, fc[k, WARP], seeds[k]), xe)
     if octaves > 0 and (rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0):
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
         # below a millionth of the radius (a crater diffused flat) the overlay is left out:

@@ -362,7 +362,7 @@ class CraterField:
         rims = np.ascontiguousarray(rim_perturbations_from_phases(cr.rim_phases,
                                                                   self.irregularity))
         fc[:, K.DEPTH] = prof.depth_m
-        fc[:, K.WARP] = prof.complexity * self.terraces
+        fc[:, K.WARP] = prof.warps(self.terraces)
         seeds = np.ascontiguousarray(cr.seed)
         up = np.ascontiguousarray(self.base.up(fc[:, K.C0:K.C2 + 1]))
         # dependencies per owner, youngest first

@@ -97,15 +97,14 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     if not len(rows):
         return out
     # a uniform grid of cubes as wide as the median crater's reach finds each crater's
-    # vertices (a k-d tree of the vertices took ~4 s a 1024^2 descent frame)
-    cell = max(float(np.median(reach * radii[rows])), 1e-9)
+    # vertices (a k-d tree of the vertices took ~4 s a 1024^2 descent frame); at most 2^20
+    # cubes along an axis, so that a cube's key fits an int64 (the cube size changes the
+    # time, not the result)
     lo = verts.min(axis=0)
+    cell = max(float(np.median(reach * radii[rows])), float((verts.max(axis=0) - lo).max())
+               / 2.0**20, 1e-9)
     ijk = np.floor((verts - lo) / cell).astype(np.int64)
     dims = ijk.max(axis=0) + 1
-    if float(dims[0]) * float(dims[1]) * float(dims[2]) > 2.0**62:  # a key would overflow
-        cell *= (float(dims.prod()) / 2.0**62) ** (1 / 3) * 2.0
-        ijk = np.floor((verts - lo) / cell).astype(np.int64)
-        dims = ijk.max(axis=0) + 1
     keys = ijk[:, 0] + dims[0] * (ijk[:, 1] + dims[1] * ijk[:, 2])
     order = np.argsort(keys, kind="stable")
     _ejecta_kernel(np.ascontiguousarray(verts, dtype=np.float64), order,

@@ -42,7 +42,7 @@ def run_kernel(body, cat, prof, rng, **switches):
     _stamp_body_kernel(g.magnitude, g.ring_offsets(), unit, radii,
                        np.asarray(body.stretch), cat["lat_deg"].copy(), cat["lon_deg"].copy(),
                        cat["diameter_m"].copy(), prof.tables[:n], prof.depth_m[:n],
-                       prof.complexity[:n].copy(), rim, seeds,
+                       prof.warps(1.0)[:n].copy(), rim, seeds,
                        3.0, True, 20.0, 45.0, np.array([0.03, 0.06, 0.05]), 2.0**-0.8, *outs,
                        np.empty((0, 3)), **switches)
     return time.perf_counter() - t0
