@@ -204,8 +204,11 @@ def _table(tab, theta):
     t = (theta + np.pi) * (n / (2.0 * np.pi))
     k0 = int(np.floor(t))
     w = t - k0
-    k0 = k0 % n
-    k1 = (k0 + 1) % n
+    if k0 < 0 or k0 >= n:  # an angle outside [-pi, pi): an integer division, rarely
+        k0 = k0 % n
+    k1 = k0 + 1
+    if k1 == n:
+        k1 = 0
     return tab[k0] + w * (tab[k1] - tab[k0])
 
 

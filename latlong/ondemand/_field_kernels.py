@@ -220,26 +220,17 @@ def _points_kernel(points, block_of, blk_start, blk_list, base, fc, tabs, rims, 
 
 
 @njit(cache=True, inline="always")
-def _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam, out_owner,
-              out_dep, at, write):
+def _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, out_owner, out_dep, at,
+              write):
     """The pairs of owner ``owners[s]`` (:func:`_dep_kernel`), written from ``at`` when
     ``write``; returns how many."""
     n = 0
     o = owners[s]
+    c = owner_cell[s]
     own = fc[o, RAD] / fc[o, RHO] * (1.0 + 1e-9)  # the owner's angular radius, widened
     chord_own = 2.0 * np.sin(0.5 * own)
     for t in range(9):
-        cell = own_cell9[s, t]
-        dup = False
-        for t2 in range(t):
-            if own_cell9[s, t2] == cell:
-                dup = True
-        if dup:
-            continue
-        pos = np.searchsorted(cand_cells, cell)
-        if pos >= cand_cells.shape[0] or cand_cells[pos] != cell:
-            continue
-        for q in range(cand_start[pos], cand_start[pos + 1]):
+        for q in range(lo[c, t], hi[c, t]):
             k = cand_sorted[q]
             if not diam[k] > diam[o]:
                 continue
@@ -258,24 +249,25 @@ def _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, dia
 
 
 @njit(cache=True, parallel=True)
-def _dep_kernel(owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam):
-    """Pairs (owner, candidate) where a candidate crater of the bin (``cand_sorted``,
-    grouped by cell ``cand_cells`` with ranges ``cand_start``) is larger than the owner
-    and its ejecta reach the owner's rim disc (centres within the candidate's widest
+def _dep_kernel(owners, owner_cell, lo, hi, cand_sorted, fc, diam):
+    """Pairs (owner, candidate) where a candidate crater of the bin is larger than the
+    owner and its ejecta reach the owner's rim disc (centres within the candidate's widest
     ejecta edge plus the owner's radius), owner by owner in the order given: (owners,
-    deps). Owners in parallel, counted first, then written at their offsets."""
+    deps). The candidates of the cells around owner ``s``'s cell ``c = owner_cell[s]``
+    are ``cand_sorted[lo[c, t]:hi[c, t]]``, t = 0..8 (each cell once). Owners in
+    parallel, counted first, then written at their offsets."""
     n_own = owners.shape[0]
     counts = np.zeros(n_own + 1, dtype=np.int64)
     none = np.empty(0, dtype=np.int64)
     for s in prange(n_own):
-        counts[s + 1] = _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted,
-                                  fc, diam, none, none, 0, False)
+        counts[s + 1] = _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, none,
+                                  none, 0, False)
     offsets = np.cumsum(counts)
     out_owner = np.empty(offsets[n_own], dtype=np.int64)
     out_dep = np.empty(offsets[n_own], dtype=np.int64)
     for s in prange(n_own):
-        _dep_scan(s, owners, own_cell9, cand_cells, cand_start, cand_sorted, fc, diam,
-                  out_owner, out_dep, offsets[s], True)
+        _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, out_owner, out_dep,
+                  offsets[s], True)
     return out_owner, out_dep
 
 

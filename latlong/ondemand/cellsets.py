@@ -13,7 +13,7 @@ from . import _cell_kernels as C
 from . import _field_kernels as K
 
 __all__ = ["block_level", "block_pairs", "cell_areas", "cells_of", "coarser", "in_sorted",
-           "neighbours", "reaching", "unique_inverse", "unique_sorted"]
+           "neighbour_set", "neighbours", "reaching", "unique_inverse", "unique_sorted"]
 
 
 def cells_of(units: np.ndarray, level: int) -> np.ndarray:
@@ -37,7 +37,9 @@ def unique_sorted(x: np.ndarray) -> np.ndarray:
     a = np.asarray(x).ravel()
     if not len(a):
         return np.sort(a)
-    a = np.sort(a[_run_starts(a)])
+    # timsort (``stable``): cells of points row by row, or of neighbourhoods column by
+    # column, come in long sorted runs, which it merges instead of sorting
+    a = np.sort(a[_run_starts(a)], kind="stable")
     return a[np.concatenate([[True], a[1:] != a[:-1]])]
 
 
@@ -84,6 +86,14 @@ def neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
     if len(cells):
         C._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
     return out if keep_shape else out.ravel()
+
+
+def neighbour_set(cells: np.ndarray) -> np.ndarray:
+    """Sorted distinct cells around ``cells`` (themselves included): the union of their
+    :func:`neighbours`, from the distinct cells first (many craters share a cell, so this
+    sorts some ten times fewer ids than the neighbourhoods of all of them)."""
+    around = neighbours(unique_sorted(cells), keep_shape=True)
+    return unique_sorted(around.T.ravel())  # by column: nine sorted runs
 
 
 def block_level(n: int, units: np.ndarray) -> int:

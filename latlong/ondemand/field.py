@@ -68,6 +68,7 @@ from .cellsets import (
     cells_of,
     coarser,
     in_sorted,
+    neighbour_set,
     neighbours,
     reaching,
     unique_inverse,
@@ -234,23 +235,24 @@ class CraterField:
             cand_cells = unique_sorted(neighbours(at_level[level]))
             q_cells = cand_cells
             # the cells around the centres of the needed smaller craters
-            own_cells9 = neighbours(cells_of(fc_have[:, K.C0:K.C2 + 1], level), keep_shape=True)
-            cand_cells = unique_sorted(np.concatenate([cand_cells, own_cells9.ravel()]))
+            own_cells = cells_of(fc_have[:, K.C0:K.C2 + 1], level)
+            set9 = neighbour_set(own_cells)  # the cells around them, distinct
+            cand_cells = unique_sorted(np.concatenate([cand_cells, set9]))
             cand = self._draw(b, cand_cells, d_min)
             needed_mask = in_sorted(cand.cell, q_cells)
             needed_mask[needed_mask] = reaching(cand.fc[needed_mask], *blocks)
             owners = np.arange(n_have, dtype=np.int64)
-            cells9 = own_cells9
+            owner_cells = own_cells
             # the query-rule craters are owners within this bin too
             first = np.flatnonzero(needed_mask)
             while True:
                 fc_all = np.concatenate([fc_have, cand.fc])
                 d_all = np.concatenate([d_have, cand.diameter_m])
                 owners = np.concatenate([owners, first + n_have])
-                cells9 = np.concatenate([cells9, neighbours(
-                    cells_of(cand.fc[first, K.C0:K.C2 + 1], level), keep_shape=True)])
-                extra = unique_sorted(cells9.ravel())
-                extra = extra[~in_sorted(extra, cand_cells)]
+                first_cells = cells_of(cand.fc[first, K.C0:K.C2 + 1], level)
+                owner_cells = np.concatenate([owner_cells, first_cells])
+                set9 = unique_sorted(np.concatenate([set9, neighbour_set(first_cells)]))
+                extra = set9[~in_sorted(set9, cand_cells)]
                 if len(extra):  # cells around same-bin owners not drawn yet
                     more = self._draw(b, extra, d_min)
                     cand = _Craters.concat([cand, more])
@@ -258,7 +260,7 @@ class CraterField:
                     cand_cells = unique_sorted(np.concatenate([cand_cells, extra]))
                     fc_all = np.concatenate([fc_have, cand.fc])
                     d_all = np.concatenate([d_have, cand.diameter_m])
-                o, d = _dep_pairs(owners, cells9, cand, n_have, fc_all, d_all)
+                o, d = _dep_pairs(owners, owner_cells, cand, n_have, fc_all, d_all)
                 owners_all.append(o)
                 deps_all.append(d)
                 hit = np.zeros(len(cand), bool)
@@ -268,7 +270,8 @@ class CraterField:
                 if not len(first):
                     break
                 owners = np.zeros(0, dtype=np.int64)
-                cells9 = np.zeros((0, 9), dtype=np.uint64)
+                owner_cells = np.zeros(0, dtype=np.uint64)
+                set9 = np.zeros(0, dtype=np.uint64)
             keep = np.flatnonzero(needed_mask)
             remap = np.full(len(cand), -1, dtype=np.int64)
             remap[keep] = np.arange(len(keep)) + n_have
@@ -414,18 +417,29 @@ class CraterField:
         return out
 
 
-def _dep_pairs(owners, cells9, cand: _Craters, n_have: int, fc_all, d_all):
-    """(owner, dep) pairs of ``owners`` (indices into ``fc_all``) and the candidates of
-    the bin (indices ``n_have + i``) (:func:`_field_kernels._dep_kernel`)."""
+def _dep_pairs(owners, owner_cells, cand: _Craters, n_have: int, fc_all, d_all):
+    """(owner, dep) pairs of ``owners`` (indices into ``fc_all``, their centres in
+    ``owner_cells``) and the candidates of the bin (indices ``n_have + i``)
+    (:func:`_field_kernels._dep_kernel`). Owners of one cell share the candidates of the
+    cells around it, found once a cell."""
     if not len(owners) or not len(cand):
         return np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
     order = np.argsort(cand.cell, kind="stable")
     srt = cand.cell[order]
-    first = np.concatenate([[True], srt[1:] != srt[:-1]]) if len(srt) else np.zeros(0, bool)
+    first = np.concatenate([[True], srt[1:] != srt[:-1]])
     ucells, starts = srt[first], np.flatnonzero(first)
-    starts = np.append(starts, len(order)).astype(np.int64)
+    ends = np.append(starts[1:], len(order))
+    cells, owner_cell = unique_inverse(owner_cells)
+    around = neighbours(cells, keep_shape=True)
+    pos = np.minimum(np.searchsorted(ucells, around), len(ucells) - 1)
+    found = ucells[pos] == around
+    # each distinct neighbour once (the neighbourhood of a cube corner repeats cells)
+    earlier = np.tril(np.ones((9, 9), dtype=bool), -1)
+    found &= ~((around[:, :, None] == around[:, None, :]) & earlier).any(axis=2)
+    lo = np.where(found, starts[pos], 0).astype(np.int64)
+    hi = np.where(found, ends[pos], 0).astype(np.int64)
     cand_idx = (order + n_have).astype(np.int64)
-    return K._dep_kernel(owners.astype(np.int64), np.ascontiguousarray(cells9), ucells, starts,
+    return K._dep_kernel(owners.astype(np.int64), owner_cell.astype(np.int64), lo, hi,
                          cand_idx, fc_all, d_all)
 
 

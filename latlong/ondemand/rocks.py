@@ -28,7 +28,7 @@ from craters.local import ROCK_FACETS, bin_bounds, bin_level, bins, draw_rock_ce
 from ..scene import Scene
 from . import _rock_kernels as R
 from .base import BaseField, tangent_frame
-from .cellsets import block_pairs, cell_areas, cells_of, coarser, neighbours, unique_sorted
+from .cellsets import block_pairs, cell_areas, cells_of, coarser, neighbour_set, unique_sorted
 
 __all__ = ["RockField"]
 
@@ -72,7 +72,7 @@ class RockField:
                 continue
             # the points' cells once, at the finest level drawn; coarser ones by shifts
             fine = (level, unique_sorted(cells_of(units, level))) if fine is None else fine
-            cells = unique_sorted(neighbours(coarser(fine[1], fine[0], level)))
+            cells = neighbour_set(coarser(fine[1], fine[0], level))
             area = cell_areas(self.base, level, cells)
             for idx in drawn:
                 la = self.layers[idx]

@@ -207,3 +207,17 @@ def test_roughness_octaves(wavelength, spacing):
         want += 1
     assert K.roughness_octaves(wavelength, spacing) == want
     assert 1 <= want <= 10
+
+
+def test_azimuth_table_is_periodic_linear_interpolation_at_any_angle(rng):
+    """``table`` (the rim and offset tables) against numpy's periodic ``interp``, over
+    [-pi, pi) where no integer division is taken, at its ends, and outside it."""
+    tab = rng.normal(size=K.N_RIM)
+    samples = -np.pi + 2.0 * np.pi * np.arange(K.N_RIM) / K.N_RIM
+    inside = np.concatenate([rng.uniform(-np.pi, np.pi, 400), samples,
+                             [-np.pi, np.nextafter(np.pi, 0.0), np.pi]])
+    outside = np.concatenate([rng.uniform(-9.0, -np.pi, 50), rng.uniform(np.pi, 9.0, 50)])
+    for theta in np.concatenate([inside, outside]):
+        want = np.interp(theta, samples, tab, period=2.0 * np.pi)
+        assert K.table(tab, theta) == pytest.approx(want, abs=1e-12)
+    assert K.table(tab, -np.pi) == tab[0]

@@ -357,6 +357,22 @@ def test_distinct_cells_and_their_inverse_match_numpy_with_runs_and_without():
         assert got.dtype == x.dtype and np.array_equal(got_inv, want_inv.ravel())
 
 
+def test_a_neighbour_set_is_the_union_of_the_neighbourhoods():
+    """``neighbour_set`` (distinct cells first, nine runs merged) against numpy's unique
+    of every neighbourhood, with cells on a cube corner and edge and repeated cells."""
+    from latlong.ondemand.cellsets import cells_of, neighbour_set, neighbours
+
+    rng = np.random.default_rng(5)
+    u = rng.normal(size=(3000, 3))
+    corner = np.array([[1.0, 1.0, 1.0], [1.0, -1.0, 1e-9], [-1.0, 1e-9, 1e-9]])
+    u = np.concatenate([u, corner, u[:500]])
+    u /= np.linalg.norm(u, axis=1, keepdims=True)
+    for level in (0, 2, 7, 20):
+        cells = cells_of(u, level)
+        assert np.array_equal(neighbour_set(cells), np.unique(neighbours(cells)))
+    assert len(neighbour_set(np.zeros(0, dtype=np.uint64))) == 0
+
+
 def test_a_centimetre_crater_on_the_moon_reaches_its_whole_ejecta_blanket():
     # at 1e-8 rad (2 cm on the Moon) a cosine test cannot tell points apart: the reach
     # tests go by chords
