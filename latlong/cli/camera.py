@@ -53,7 +53,14 @@ def _detector(key: str, help: str, **kw) -> Setting:
 
 #: The detector's settings (:class:`~latlong.sensors.Sensor`, whose defaults they take).
 SENSOR = {
-    "exposure_s": _detector("exposure_s", "exposure time", unit="s"),
+    "exposure_s": _detector("exposure_s", "exposure time (auto: the lit pixels' "
+                            "--exposure-percentile at --exposure-target of full scale)",
+                            unit="s", kind=float, default_text="auto"),
+    "exposure_percentile": _detector("exposure_percentile", "auto-exposure: percentile of "
+                                     "the lit pixels' I/F put at the target",
+                                     range=(50.0, 100.0)),
+    "exposure_target": _detector("exposure_target", "auto-exposure: where that percentile "
+                                 "lands, share of full scale", range=(0.0, 1.0)),
     "flux_e_per_s": _detector("flux_e_per_s", "photo-electrons per second of a pixel seeing "
                               "I/F = 1", unit="e/s"),
     "full_well_e": _detector("full_well_e", "full well", unit="electrons"),

@@ -72,8 +72,10 @@ spaced geometrically, ``--frames``, ``--path-angle-deg``, ``--path-azimuth-deg``
 ``--size WxH``, Brown-Conrady ``--distortion`` as OpenCV defines it, ``--reflectance
 lambert|lommel-seeliger|lunar-lambert|hapke`` (``--hapke-preset moon|s-type|c-type``),
 cast shadows always (soft with ``--sun-angular-radius-deg`` and
-``--soft-shadow-samples``), and a sensor model (exposure, gain, 8/16-bit PNG or float
-TIFF, photon and read noise, PSF). In Python, the same for any surface (a
+``--soft-shadow-samples``), and a sensor model (auto-exposure by default, or
+``--exposure-s``; gain, linear 8/16-bit PNG or float TIFF plus an 8-bit sRGB
+``display_NNNN.png`` for people, photon and read noise, PSF; ground truth as TIFF, NPY or
+OpenEXR with ``--depth-format``). In Python, the same for any surface (a
 :class:`latlong.Body`, a mesh surface, ``latlong.load_surface(path)``, a
 ``dem.DemSurface``): :func:`camera_run` (a :class:`CameraSettings`) and :func:`lidar_run`
 write a run, :func:`render` and :func:`lidar_frame` make one frame; for many frames of
@@ -109,14 +111,15 @@ from .scene_geometry import (
     scene_geometry,
     scene_mesh,
 )
-from .sensor import Sensor, expose
+from .sensor import Sensor, display_image, expose, exposure_for
 
 __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "CameraSettings",
            "Frame", "Hapke", "Hits", "Lambert", "LidarFrame", "LidarSettings",
            "LommelSeeliger", "LunarLambert", "Pose", "Poses", "RayMesh", "SceneGeometry",
            "Sensor", "Sun", "beam_pattern", "boulder_labels", "camera_inside", "camera_run",
-           "crater_labels", "drape_catalog", "ejecta_albedo", "expose", "lidar_frame",
+           "crater_labels", "display_image", "drape_catalog", "ejecta_albedo", "expose",
+           "exposure_for", "lidar_frame",
            "lidar_run", "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
            "ray_scene", "read_poses", "reflectance_model", "regolith_albedo", "render",
            "rim_curves", "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]

@@ -4,11 +4,18 @@ frames and the ``frames.json`` manifest (issue 17's interface) into a run folder
 and how its frames are written is one :class:`CameraSettings` record.
 
 * :func:`write_frame`: one frame's files, each written atomically: the image (16- or
-  8-bit PNG, or float32 TIFF for a float sensor), depth and range (float32 ``.tif`` or
-  ``.npy``), normals (float32 (H, W, 3) ``.npy``) and, on request, the other ground
-  truth (incidence / emission / phase angles, position, face id, lit fraction, as .npy);
-  the crater-id and boulder-id label images (int32, -1 = none, in the depth format) when
-  the frame has them.
+  8-bit PNG of linear DN, or float32 TIFF of I/F for a float sensor), an 8-bit sRGB
+  ``display`` PNG of it for people (:func:`~latlong.sensors.sensor.display_image`),
+  depth and range (float32 ``.tif``, ``.npy`` or ``.exr``), normals (float32 (H, W, 3)
+  ``.npy``, or ``.exr``) and, on request, the other ground truth (incidence / emission /
+  phase angles, position, face id, lit fraction, albedo, as .npy); the crater-id and
+  boulder-id label images (int32, -1 = none, in the depth format) when the frame has
+  them.
+* OpenEXR (``depth_format="exr"``, for ML pipelines; the `OpenEXR` package, the
+  Academy Software Foundation's own binding, ZIP-compressed scanlines): depth and range
+  in a float32 channel ``Z`` (metres, NaN on the sky), normals in float32 ``X``, ``Y``,
+  ``Z``, the albedo seen in float32 ``Y`` (``albedo_NNNN.exr``, always with exr), label
+  images in a uint32 channel ``id`` (4294967295, the bits of -1, where none).
 * :func:`manifest`: the ``frames.json`` document: ``{"intrinsics": {fx, fy, cx, cy, width,
   height}, "frames": [{"time_s", "position_m", "quaternion_wxyz", "sun_direction",
   "files": {"image", "depth", "range", "normals", "crater_id", "boulder_id", ...}}]}``,
@@ -41,13 +48,13 @@ from .poses import Poses
 from .render import Frame, Sun, render
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
-from .sensor import Sensor
+from .sensor import Sensor, display_image
 
 __all__ = ["DEPTH_FORMATS", "CameraSettings", "camera_run", "frame_entry", "manifest",
            "write_frame", "write_manifest"]
 
 #: Formats of the float32 depth and range images (and the label images).
-DEPTH_FORMATS = ("tif", "npy")
+DEPTH_FORMATS = ("tif", "npy", "exr")
 _NAMES = {model: name for name, model in REFLECTANCES.items()}
 
 CONVENTIONS = ("OpenCV camera frame (x right, y down, z forward); quaternion_wxyz rotates "
@@ -64,6 +71,8 @@ def _save(path: Path, array: np.ndarray) -> None:
         if path.suffix == ".npy":
             with open(tmp, "wb") as fh:
                 np.save(fh, array, allow_pickle=False)
+        elif path.suffix == ".exr":
+            _save_exr(tmp, array)
         elif path.suffix == ".tif":
             kind = np.int32 if array.dtype == np.int32 else np.float32
             Image.fromarray(np.ascontiguousarray(array, dtype=kind)).save(tmp, format="TIFF")
@@ -71,18 +80,41 @@ def _save(path: Path, array: np.ndarray) -> None:
             Image.fromarray(np.ascontiguousarray(array)).save(tmp, format="PNG")
 
 
+def _save_exr(path: Path, array: np.ndarray, channel: str = "Z") -> None:
+    """One OpenEXR image (module notes): (H, W, 3) as X, Y, Z; int32 labels as uint32
+    ``id``; else float32 ``channel``."""
+    import OpenEXR
+
+    if array.ndim == 3:
+        channels = {c: np.ascontiguousarray(array[:, :, i], dtype=np.float32)
+                    for i, c in enumerate("XYZ")}
+    elif array.dtype == np.int32:
+        channels = {"id": np.ascontiguousarray(array).view(np.uint32)}
+    else:
+        channels = {channel: np.ascontiguousarray(array, dtype=np.float32)}
+    header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+    with OpenEXR.File(header, channels) as exr:
+        exr.write(str(path))
+
+
 def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
                 extra: bool = False) -> dict:
     """Write frame ``index``'s files into ``folder``; their names (relative)."""
     if depth_format not in DEPTH_FORMATS:
-        raise ParameterError("depth_format", f"must be tif or npy; got {depth_format!r}")
+        raise ParameterError("depth_format", f"must be one of {', '.join(DEPTH_FORMATS)}; "
+                             f"got {depth_format!r}")
     folder = Path(folder)
     tag = f"{index:04d}"
     image_name = f"image_{tag}.tif" if frame.image.dtype == np.float32 else f"image_{tag}.png"
-    files = {"image": image_name, "depth": f"depth_{tag}.{depth_format}",
-             "range": f"range_{tag}.{depth_format}", "normals": f"normals_{tag}.npy"}
-    arrays = {"image": frame.image, "depth": frame.depth_m, "range": frame.range_m,
-              "normals": frame.normals}
+    exr = depth_format == "exr"
+    files = {"image": image_name, "display": f"display_{tag}.png",
+             "depth": f"depth_{tag}.{depth_format}", "range": f"range_{tag}.{depth_format}",
+             "normals": f"normals_{tag}.{'exr' if exr else 'npy'}"}
+    arrays = {"image": frame.image, "display": display_image(frame.image),
+              "depth": frame.depth_m, "range": frame.range_m, "normals": frame.normals}
+    if (exr or extra) and frame.albedo is not None:
+        files["albedo"] = f"albedo_{tag}.{'exr' if exr else 'npy'}"
+        arrays["albedo"] = frame.albedo
     if extra:
         for key, arr in (("incidence", frame.incidence_deg), ("emission", frame.emission_deg),
                          ("phase", frame.phase_deg), ("position", frame.position_m),
@@ -94,7 +126,11 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
             files[key] = f"{key}_{tag}.{depth_format}"
             arrays[key] = ids
     for key, name in files.items():
-        _save(folder / name, arrays[key])
+        if key == "albedo" and exr:
+            with atomic_path(folder / name) as tmp:
+                _save_exr(tmp, arrays[key], "Y")
+        else:
+            _save(folder / name, arrays[key])
     return {"crater_id": None, "boulder_id": None, **files}
 
 
@@ -103,7 +139,7 @@ def frame_entry(frame: Frame, files: dict, *, craters=None, rims=None) -> dict:
     ellipses (pinhole, pixels) of the craters whose id is in the frame's label image,
     their rims from ``rims`` (a :class:`~latlong.sensors.labels.FittedRims` shared by
     the frames) when given, else the catalog rule."""
-    entry = {"time_s": frame.pose.time_s,
+    entry = {"time_s": frame.pose.time_s, "exposure_s": frame.exposure_s,
              "position_m": [float(v) for v in frame.pose.position_m],
              "quaternion_wxyz": [float(v) for v in frame.pose.quaternion_wxyz],
              "sun_direction": [float(v) for v in frame.sun.direction],
@@ -159,7 +195,8 @@ class CameraSettings:
     ejecta_albedo`), [0, 10] (0: off)."""
     depth_format: str = setting("tif", "files of the float32 depth and range images and of "
                                 "the label images", choices=DEPTH_FORMATS)
-    """Files of the float32 depth and range images and of the label images: tif or npy."""
+    """Files of the float32 depth and range images and of the label images: tif, npy or
+    exr (OpenEXR, with the normals and the albedo seen: module notes)."""
     all_ground_truth: bool = setting(False, "also write incidence, emission, phase, position, "
                                      "face and lit fraction per frame (.npy)")
     """Also write incidence, emission, phase, position, face and lit fraction (.npy)."""

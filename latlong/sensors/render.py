@@ -24,7 +24,7 @@ Ground truth per pixel (NaN / -1 where the ray misses): ``depth_m`` (camera z) a
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -41,7 +41,7 @@ from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
 from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
 from .scene_geometry import SceneGeometry, traced_model
-from .sensor import Sensor, expose
+from .sensor import Sensor, expose, exposure_for
 
 __all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render"]
 
@@ -127,6 +127,11 @@ class Frame:
     boulder_id: np.ndarray | None = None
     """int32 boulder catalog row of the boulder seen, -1 for none; None without
     ``ground_truth``."""
+    exposure_s: float = float("nan")
+    """The exposure the sensor took, seconds (auto-exposure's choice, or its own)."""
+    albedo: np.ndarray | None = None
+    """float32 albedo seen: the reflectance model's normal albedo (1 for Hapke) times the
+    per-vertex factor; NaN on the sky."""
 
 
 def camera_inside(mesh: RayMesh, position_m) -> bool:
@@ -262,7 +267,11 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))
     _ground_truth_kernel(hits.t_m, face, dirs, pose.rotation[:, 2], cosines, ns, lit, depth,
                          rng_m, angles, normals32, sunlit)
-    return Frame(image=expose(refl, sensor, seed=seed), reflectance=refl,
+    exposure = exposure_for(refl, sensor)
+    seen = np.where(face >= 0, albedo * getattr(photometry, "albedo", 1.0), np.nan)
+    return Frame(image=expose(refl, replace(sensor, exposure_s=exposure), seed=seed),
+                 reflectance=refl, exposure_s=exposure,
+                 albedo=seen.astype(np.float32).reshape(h, w),
                  depth_m=depth.reshape(h, w), range_m=rng_m.reshape(h, w),
                  position_m=pos.reshape(h, w, 3), normals=normals32.reshape(h, w, 3),
                  incidence_deg=angles[:, 0].reshape(h, w),
