@@ -115,6 +115,7 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
         "seed": dataclasses.replace(own["seed"], group="sensor", parse=parse_seed),
         "depth_format": into("output", own["depth_format"]),
         "all_ground_truth": into("output", own["all_ground_truth"]),
+        "datasets": into("output", own["datasets"]),
         **{k: into("output", s) for k, s in RUN.items()},
     }
 

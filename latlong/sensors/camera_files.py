@@ -41,6 +41,7 @@ from craters._shared.settings import check_declared, setting
 
 from .albedo import ejecta_albedo
 from .camera import Camera
+from .datasets import parse_datasets, write_datasets
 from .engine import RayMesh
 from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry
@@ -200,6 +201,11 @@ class CameraSettings:
     all_ground_truth: bool = setting(False, "also write incidence, emission, phase, position, "
                                      "face and lit fraction per frame (.npy)")
     """Also write incidence, emission, phase, position, face and lit fraction (.npy)."""
+    datasets: str = setting("", "dataset files to write into the run: comma-separated coco "
+                            "(instance masks), colmap (text model), nerf (transforms.json)",
+                            default_text="none")
+    """Dataset files written into the run (:mod:`~latlong.sensors.datasets`): any of coco,
+    colmap, nerf, comma-separated ("" for none)."""
 
     def __post_init__(self):
         for name, kind in (("camera", Camera), ("reflectance", Photometry),
@@ -208,6 +214,7 @@ class CameraSettings:
                 raise TypeError(f"`{name}` must be a {name} model of latlong.sensors; got "
                                 f"{type(getattr(self, name)).__name__}")
         object.__setattr__(self, "all_ground_truth", bool(self.all_ground_truth))
+        object.__setattr__(self, "datasets", ",".join(parse_datasets(self.datasets)))
         check_declared(self)  # every declared range and choice, named by the field
 
     def record(self, sun: Sun) -> dict:
@@ -260,5 +267,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
             entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
         doc = manifest(settings.camera, entries, model=model_name or geometry.source,
                        **settings.record(sun))
+        if settings.datasets:
+            write_datasets(tmp, settings.datasets, manifest=doc)
         write_manifest(tmp, doc)
     return doc
