@@ -41,7 +41,7 @@ from craters._shared.settings import check_declared, setting
 
 from .albedo import ejecta_albedo
 from .camera import Camera
-from .datasets import parse_datasets, write_datasets
+from .datasets import optical_flow, parse_datasets, write_datasets, write_flow
 from .engine import RayMesh
 from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry
@@ -202,10 +202,10 @@ class CameraSettings:
                                      "face and lit fraction per frame (.npy)")
     """Also write incidence, emission, phase, position, face and lit fraction (.npy)."""
     datasets: str = setting("", "dataset files to write into the run: comma-separated coco "
-                            "(instance masks), colmap (text model), nerf (transforms.json)",
-                            default_text="none")
+                            "(instance masks), colmap (text model), nerf (transforms.json), "
+                            "flow (optical flow to the next frame)", default_text="none")
     """Dataset files written into the run (:mod:`~latlong.sensors.datasets`): any of coco,
-    colmap, nerf, comma-separated ("" for none)."""
+    colmap, nerf, flow, comma-separated ("" for none)."""
 
     def __post_init__(self):
         for name, kind in (("camera", Camera), ("reflectance", Photometry),
@@ -256,7 +256,9 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     if geometry.craters is not None and len(geometry.craters):
         rims = FittedRims(geometry.craters, geometry)
     with run_folder(folder, "frames.json") as tmp:
-        entries = []
+        entries: list[dict] = []
+        flow = "flow" in settings.datasets.split(",")
+        previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
             frame = render(mesh, settings.camera, poses[k], sun,
                            reflectance=settings.reflectance, sensor=settings.sensor,
@@ -264,6 +266,11 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
                            seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo)
             files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
                                 extra=settings.all_ground_truth)
+            if flow and previous is not None:  # the flow from the frame before to this one
+                name = f"flow_{k - 1:04d}.{'exr' if settings.depth_format == 'exr' else 'flo'}"
+                write_flow(tmp / name, optical_flow(previous, frame))
+                entries[-1]["files"]["flow"] = name
+            previous = frame if flow else None
             entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
         doc = manifest(settings.camera, entries, model=model_name or geometry.source,
                        **settings.record(sun))

@@ -18,9 +18,17 @@ all from the run's own ground truth (``frames.json`` and the label images):
   the 4 x 4 camera-to-world matrix in their OpenGL camera convention (x right, y up,
   z backwards: the OpenCV axes with y and z negated), metres of the body frame, and the
   depth image's name.
+* ``flow_NNNN.flo`` (or ``.exr`` with ``depth_format="exr"``): the optical flow from
+  frame N to frame N + 1 from the known geometry (:func:`optical_flow`): each pixel's
+  surface point projected into the next frame (distortion included), minus the pixel
+  centre, in pixels; unknown (1e10 in ``.flo``, NaN in the EXR channels ``U``, ``V``)
+  where the pixel sees the sky or the point leaves the next frame or is hidden in it.
+  Middlebury ``.flo``: ``PIEH`` (the float 202021.25), width and height as int32, then
+  u, v float32 interleaved row by row (read by OpenCV's ``readOpticalFlow``).
 
-:func:`write_datasets` writes them into a finished run folder (``latlong camera
---datasets coco,colmap,nerf`` does it before the run is moved into place).
+:func:`write_datasets` writes the first three into a finished run folder (``latlong
+camera --datasets coco,colmap,nerf`` does it before the run is moved into place); the
+flow needs the frames' surface points, so a camera run writes it (``--datasets flow``).
 """
 
 from __future__ import annotations
@@ -34,11 +42,16 @@ from craters._shared import ParameterError, atomic_path
 
 from .camera import quaternion_to_matrix
 
-__all__ = ["DATASETS", "coco_document", "colmap_text", "nerf_transforms", "parse_datasets",
-           "rle_counts", "write_datasets"]
+__all__ = ["DATASETS", "FLOW_UNKNOWN", "coco_document", "colmap_text", "nerf_transforms",
+           "optical_flow", "parse_datasets", "rle_counts", "write_datasets", "write_flow"]
 
-#: The dataset files :func:`write_datasets` knows.
-DATASETS = ("coco", "colmap", "nerf")
+#: The dataset files of a camera run (``flow`` is written by the run itself).
+DATASETS = ("coco", "colmap", "nerf", "flow")
+#: Flow of unknown pixels in ``.flo`` files (Middlebury: above 1e9 is unknown).
+FLOW_UNKNOWN = 1e10
+#: A point is hidden in the next frame when its depth there exceeds the depth that frame
+#: sees at its nearest pixel by more than this share.
+OCCLUSION_TOLERANCE = 0.02
 _CATEGORIES = (("crater_id", 1, "crater"), ("boulder_id", 2, "boulder"))
 
 
@@ -190,9 +203,53 @@ def nerf_transforms(manifest: dict) -> dict:
             "depth_unit_scale_factor": 1.0, "frames": frames}
 
 
+def optical_flow(frame, following) -> np.ndarray:
+    """(H, W, 2) float32 flow (u, v) in pixels from :class:`~latlong.sensors.render.Frame`
+    ``frame`` to ``following`` (module notes); NaN where unknown."""
+    h, w = frame.depth_m.shape
+    pos = frame.position_m.reshape(-1, 3)
+    seen = np.isfinite(pos[:, 0])
+    flow = np.full((h * w, 2), np.nan)
+    px, z = following.camera.project(pos[seen], following.pose)
+    j, i = np.divmod(np.flatnonzero(seen), w)
+    col, row = np.floor(px[:, 0]), np.floor(px[:, 1])
+    inside = (z > 0) & (col >= 0) & (col < w) & (row >= 0) & (row < h)
+    there = np.full(len(z), np.nan)
+    there[inside] = following.depth_m[row[inside].astype(np.int64),
+                                      col[inside].astype(np.int64)]
+    with np.errstate(invalid="ignore"):
+        ok = inside & (z <= there * (1.0 + OCCLUSION_TOLERANCE))
+    idx = np.flatnonzero(seen)[ok]
+    flow[idx, 0] = px[ok, 0] - (i[ok] + 0.5)
+    flow[idx, 1] = px[ok, 1] - (j[ok] + 0.5)
+    return flow.reshape(h, w, 2).astype(np.float32)
+
+
+def write_flow(path, flow: np.ndarray) -> Path:
+    """Write an (H, W, 2) flow as Middlebury ``.flo`` (NaN -> :data:`FLOW_UNKNOWN`) or
+    OpenEXR ``.exr`` (float32 ``U``, ``V``), atomically."""
+    path = Path(path)
+    flow = np.asarray(flow, dtype=np.float32)
+    with atomic_path(path) as tmp:
+        if path.suffix == ".exr":
+            import OpenEXR
+
+            channels = {c: np.ascontiguousarray(flow[:, :, k]) for k, c in enumerate("UV")}
+            header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
+            with OpenEXR.File(header, channels) as exr:
+                exr.write(str(tmp))
+        else:
+            with open(tmp, "wb") as fh:
+                np.array([202021.25], dtype="<f4").tofile(fh)
+                np.array([flow.shape[1], flow.shape[0]], dtype="<i4").tofile(fh)
+                np.nan_to_num(flow, nan=FLOW_UNKNOWN).astype("<f4").tofile(fh)
+    return path
+
+
 def write_datasets(folder, datasets=DATASETS, manifest: dict | None = None) -> list[Path]:
-    """Write the ``datasets`` (names of :data:`DATASETS`) of the run in ``folder`` (its
-    ``frames.json``, or ``manifest``), each file atomically; the paths written."""
+    """Write the ``datasets`` (names of :data:`DATASETS`; ``flow`` is left to the run) of
+    the run in ``folder`` (its ``frames.json``, or ``manifest``), each file atomically;
+    the paths written."""
     folder = Path(folder)
     names = parse_datasets(datasets)
     if manifest is None:

@@ -130,3 +130,51 @@ def test_dataset_names_and_folders_are_checked(tmp_path):
         CameraSettings(Camera.from_fov(40.0, 8, 8), datasets="bop")
     with pytest.raises(FileNotFoundError, match="frames.json"):
         write_datasets(tmp_path)
+
+
+def read_flo(path) -> np.ndarray:
+    """Middlebury .flo, as its specification reads."""
+    raw = np.fromfile(path, dtype="<f4")
+    assert raw[0] == np.float32(202021.25)
+    w, h = np.frombuffer(raw[1:3].tobytes(), dtype="<i4")
+    return raw[3:].reshape(h, w, 2)
+
+
+@pytest.mark.parametrize("fmt", ["npy", "exr"])
+def test_optical_flow_carries_each_surface_point_to_where_the_next_frame_sees_it(
+        tmp_path, fmt):
+    body = latlong.Body.sphere(latlong.LatLongGrid(96), 500.0)
+    target = [500.0, 20.0, -10.0]
+    poses = Poses.of([Pose.look_at([800.0, 0.0, 0.0], target),
+                      Pose.look_at([780.0, -60.0, 40.0], target, time_s=1.0)])
+    cam = Camera.from_fov(30.0, 96, 80, k1=-0.03)
+    settings = CameraSettings(cam, datasets="flow", depth_format=fmt, all_ground_truth=True)
+    doc = camera_run(body, settings, poses, [1.0, 0.3, 0.2], tmp_path / "run")
+    name = doc["frames"][0]["files"]["flow"]
+    assert "flow" not in doc["frames"][1]["files"]
+    if fmt == "exr":
+        import OpenEXR
+
+        with OpenEXR.File(str(tmp_path / "run" / name)) as f:
+            ch = f.channels()
+            flow = np.stack([ch["U"].pixels, ch["V"].pixels], axis=-1)
+        known = np.isfinite(flow[:, :, 0])
+    else:
+        flow = read_flo(tmp_path / "run" / name)
+        known = flow[:, :, 0] < 1e9
+    pos_a = np.load(tmp_path / "run" / doc["frames"][0]["files"]["position"])
+    pos_b = np.load(tmp_path / "run" / doc["frames"][1]["files"]["position"])
+    # unknown only on the sky and off the next frame: most of the seen sphere is known
+    assert known.sum() >= 0.8 * np.isfinite(pos_a[:, :, 0]).sum() > 1000
+    assert not known[~np.isfinite(pos_a[:, :, 0])].any()
+    j, i = np.nonzero(known)
+    x = i + 0.5 + flow[j, i, 0]
+    y = j + 0.5 + flow[j, i, 1]
+    # the next frame sees the same surface point at the pixel the flow points to: within
+    # a pixel's footprint (range x pixel angle) of its own point there
+    col = np.clip(np.floor(x).astype(int), 0, cam.width - 1)
+    row = np.clip(np.floor(y).astype(int), 0, cam.height - 1)
+    miss = np.linalg.norm(pos_b[row, col] - pos_a[j, i], axis=1)
+    footprint = np.linalg.norm(pos_a[j, i] - poses[1].position_m, axis=1) / cam.fx
+    assert np.all(miss <= 1.5 * footprint)
+    assert np.abs(flow[known]).max() > 3.0  # the camera moved: the flow is not zero
