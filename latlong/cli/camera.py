@@ -35,6 +35,7 @@ from .sensor_options import (
     poses_of,
     refuse_inside,
     sensor_command,
+    spice_of,
     wxh,
 )
 
@@ -95,8 +96,8 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
                               parse=numbers(5, "k1,k2,p1,p2,k3"), metavar="K1,K2,P1,P2,K3",
                               also=_DISTORTION, group="intrinsics"),
         "sun_direction": Setting(help="direction towards the sun X,Y,Z, body frame",
-                                 parse=numbers(3, "X,Y,Z"), metavar="X,Y,Z", required=True,
-                                 group="light"),
+                                 parse=numbers(3, "X,Y,Z"), metavar="X,Y,Z", group="light",
+                                 default_text="required; with --spice: from the kernels"),
         "sun_angular_radius_deg": Setting(default_of(Sun, "angular_radius_deg"),
                                           "angular radius of the sun (0.2666 at 1 au)",
                                           unit="deg", also=("angular_radius_deg",),
@@ -152,13 +153,19 @@ def run_camera(v: Values, load) -> int:
 
     out = output_folder(v)
     settings = camera_settings(v)
-    poses = poses_of(v)
-    sun = Sun(v.sun_direction, v.sun_angular_radius_deg)
+    if (v.sun_direction is None) == (v.spice is None):
+        raise CliError("give --sun-direction X,Y,Z, or --spice (the sun from the kernels)"
+                       if v.spice is None else "give --sun-direction or --spice, not both")
+    seq = spice_of(v)
+    poses = seq.poses if seq is not None else poses_of(v)
+    sun = Sun(v.sun_direction, v.sun_angular_radius_deg) if seq is None else \
+        [Sun(d, v.sun_angular_radius_deg) for d in seq.sun_directions]
     geometry, mesh = model_scene(v, load)
     poses = poses if poses is not None else poses_of(v, mesh)
     refuse_inside(mesh, poses, v, "camera")
     camera_run(geometry, settings, poses, sun, out, force=v.force, progress=not v.quiet,
-               mesh=mesh, model_name=str(v.model))
+               mesh=mesh, model_name=str(v.model),
+               frame_info=None if seq is None else seq.frame_info())
     if not v.quiet:
         print(f"wrote {len(poses)} frame(s) and {out / 'frames.json'}")
     return 0

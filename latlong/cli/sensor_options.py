@@ -125,7 +125,45 @@ def pose_options(sensor: str, *, vertical=None) -> dict[str, Setting]:
         "duration_s": of_approach("duration_s", "time from the first to the last generated "
                                   "frame", unit="s", kind=float,
                                   default_text="one second per frame"),
+        "spice": pose(help="SPICE kernels for the poses (and the camera's sun): a "
+                      "meta-kernel .tm or kernel files, comma-separated; with --utc, "
+                      "--target, --observer, --frame, --instrument-frame", metavar="FILES",
+                      run=True),
+        "utc": pose(help="SPICE times START,STOP,STEP_S (UTC, UTC, seconds)",
+                    metavar="START,STOP,STEP_S"),
+        "target": pose(help="SPICE name or id of the body the model is", metavar="BODY"),
+        "observer": pose(help="SPICE name or id of the spacecraft", metavar="SC"),
+        "frame": pose(help="SPICE body-fixed frame of the model (e.g. IAU_MOON)",
+                      metavar="FRAME"),
+        "instrument_frame": pose(help=f"SPICE frame of the {sensor} (+Z boresight, +X right, "
+                                 "+Y down)", metavar="FRAME"),
+        "abcorr": pose("NONE", "SPICE aberration correction",
+                       choices=("NONE", "LT", "LT+S", "CN", "CN+S")),
     }
+
+
+_SPICE_KEYS = ("utc", "target", "observer", "frame", "instrument_frame")
+
+
+def spice_of(v: Values):
+    """The :class:`~latlong.sensors.spice.SpiceSequence` that ``--spice`` asks for, or
+    None without it."""
+    if v.spice is None:
+        if any(v[k] is not None for k in _SPICE_KEYS):
+            raise CliError("--utc, --target, --observer, --frame and --instrument-frame go "
+                           "with --spice")
+        return None
+    missing = [k for k in _SPICE_KEYS if v[k] is None]
+    if missing:
+        raise CliError(f"--spice needs {', '.join('--' + k.replace('_', '-') for k in missing)}")
+    from latlong.sensors.spice import spice_sequence
+
+    try:
+        return spice_sequence(v.spice, utc=v.utc, target=v.target, observer=v.observer,
+                              frame=v.frame, camera_frame=v.instrument_frame,
+                              abcorr=v.abcorr)
+    except (ValueError, FileNotFoundError) as exc:
+        raise CliError(str(exc)) from None
 
 
 def sensor_command(sub, name: str, help: str, options: dict[str, Setting], run: Callable,
@@ -150,10 +188,12 @@ def poses_of(v: Values, mesh=None):
 
     single = v.position_m is not None or v.quaternion is not None
     generated = v.target_lat_lon is not None or v.target_m is not None
-    if sum((single, v.poses is not None, generated)) != 1 or (
+    if sum((single, v.poses is not None, generated, v.spice is not None)) != 1 or (
             v.target_lat_lon is not None and v.target_m is not None):
-        raise CliError("give one of: --position-m with --quaternion, --poses FILE, or "
-                       "--target-lat-lon / --target-m (with --range-m)")
+        raise CliError("give one of: --position-m with --quaternion, --poses FILE, "
+                       "--target-lat-lon / --target-m (with --range-m), or --spice")
+    if v.spice is not None:
+        return spice_of(v).poses
     if v.poses is not None:
         try:
             return read_poses(v.poses)

@@ -68,14 +68,16 @@ one ``--position-m X,Y,Z --quaternion W,X,Y,Z``, a trajectory file ``--poses FIL
 with the header ``time_s,x_m,y_m,z_m,qw,qx,qy,qz``, or TOML ``[[frame]]`` tables), or a
 generated approach (``--target-lat-lon`` or ``--target-m``, ``--range-m START,END``
 spaced geometrically, ``--frames``, ``--path-angle-deg``, ``--path-azimuth-deg``,
-``--duration-s``). The camera takes ``--fov-deg`` or ``--intrinsics fx,fy,cx,cy`` with
-``--size WxH``, Brown-Conrady ``--distortion`` as OpenCV defines it, ``--reflectance
-lambert|lommel-seeliger|lunar-lambert|hapke`` (``--hapke-preset moon|s-type|c-type``),
-cast shadows always (soft with ``--sun-angular-radius-deg`` and
-``--soft-shadow-samples``), and a sensor model (auto-exposure by default, or
-``--exposure-s``; gain, linear 8/16-bit PNG or float TIFF plus an 8-bit sRGB
-``display_NNNN.png`` for people, photon and read noise, PSF; ground truth as TIFF, NPY or
-OpenEXR with ``--depth-format``). In Python, the same for any surface (a
+``--duration-s``), or SPICE kernels (``--spice``, :mod:`.spice`: poses, the sun and the
+UTC of each frame, as missions deliver them). The camera takes ``--fov-deg`` or
+``--intrinsics fx,fy,cx,cy`` with ``--size WxH``, Brown-Conrady ``--distortion`` as
+OpenCV defines it, ``--reflectance lambert|lommel-seeliger|lunar-lambert|hapke``
+(``--hapke-preset moon|s-type|c-type``), cast shadows always (soft with
+``--sun-angular-radius-deg`` and ``--soft-shadow-samples``), and a sensor model
+(auto-exposure by default, or ``--exposure-s``; gain, linear 8/16-bit PNG or float TIFF
+plus an 8-bit sRGB ``display_NNNN.png`` for people, photon and read noise, PSF; ground
+truth as TIFF, NPY or OpenEXR with ``--depth-format``; ``--datasets`` for COCO, COLMAP,
+nerfstudio and optical flow, :mod:`.datasets`). In Python, the same for any surface (a
 :class:`latlong.Body`, a mesh surface, ``latlong.load_surface(path)``, a
 ``dem.DemSurface``): :func:`camera_run` (a :class:`CameraSettings`) and :func:`lidar_run`
 write a run, :func:`render` and :func:`lidar_frame` make one frame; for many frames of

@@ -231,23 +231,31 @@ class CameraSettings:
 
 def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, craters=None,
                force: bool = False, progress: bool = False, mesh: RayMesh | None = None,
-               model_name: str = "") -> dict:
+               model_name: str = "", frame_info: list[dict] | None = None) -> dict:
     """Render every frame of ``poses`` and write the run folder (module notes); the
     ``frames.json`` document.
 
     ``model`` is any surface (a body, a mesh surface or file, a DEM site) or its
     :class:`~latlong.sensors.scene_geometry.SceneGeometry`; ``sun`` a :class:`Sun` or a
-    direction towards it; ``craters`` a catalog (or CSV) to label the frames instead of
-    the surface's own (:func:`~latlong.sensors.scene_geometry.scene_geometry`); ``mesh``
-    its :class:`RayMesh` if built already; ``model_name`` names the model in the manifest
-    (default: the surface's source). The same shape as
+    direction towards it (or a list of :class:`Sun`, one per pose); ``craters`` a catalog
+    (or CSV) to label the frames instead of the surface's own
+    (:func:`~latlong.sensors.scene_geometry.scene_geometry`); ``mesh`` its
+    :class:`RayMesh` if built already; ``model_name`` names the model in the manifest
+    (default: the surface's source); ``frame_info`` a dict per frame added to its
+    manifest entry (e.g. SPICE's ``et_s`` and ``utc``). The same shape as
     :func:`~latlong.sensors.lidar_files.lidar_run`.
     """
     if not isinstance(settings, CameraSettings):
         raise TypeError(f"`settings` must be CameraSettings; got {type(settings).__name__}")
     if not isinstance(poses, Poses):
         raise TypeError(f"`poses` must be Poses; got {type(poses).__name__}")
-    sun = sun if isinstance(sun, Sun) else Sun(sun)
+    suns = list(sun) if isinstance(sun, list | tuple) and sun and isinstance(sun[0], Sun) \
+        else [sun if isinstance(sun, Sun) else Sun(sun)] * len(poses)
+    if len(suns) != len(poses) or not all(isinstance(s, Sun) for s in suns):
+        raise ParameterError("sun", f"must be a Sun, a direction, or {len(poses)} Sun, one "
+                             f"per pose; got {len(suns)}")
+    if frame_info is not None and len(frame_info) != len(poses):
+        raise ParameterError("frame_info", f"must hold {len(poses)} dicts, one per pose")
     folder = check_output_folder(folder, force=force)
     geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
     albedo = ejecta_albedo(geometry, contrast=settings.bright_ejecta) \
@@ -260,7 +268,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         flow = "flow" in settings.datasets.split(",")
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
-            frame = render(mesh, settings.camera, poses[k], sun,
+            frame = render(mesh, settings.camera, poses[k], suns[k],
                            reflectance=settings.reflectance, sensor=settings.sensor,
                            soft_shadow_samples=settings.soft_shadow_samples,
                            seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo)
@@ -272,8 +280,10 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
                 entries[-1]["files"]["flow"] = name
             previous = frame if flow else None
             entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
+            if frame_info is not None:
+                entries[-1].update(frame_info[k])
         doc = manifest(settings.camera, entries, model=model_name or geometry.source,
-                       **settings.record(sun))
+                       **settings.record(suns[0]))
         if settings.datasets:
             write_datasets(tmp, settings.datasets, manifest=doc)
         write_manifest(tmp, doc)

@@ -1,0 +1,162 @@
+"""Sensor poses and the sun from SPICE kernels (NASA NAIF's toolkit, through spiceypy), as
+mission teams get their trajectories, attitudes and ephemerides.
+
+For each time of a sequence (UTC ``START,STOP,STEP_S``, or ephemeris times):
+
+* the sensor's position: the observer (the spacecraft) relative to the target body, in
+  the target's body-fixed ``frame`` (the frame the model is in, e.g. ``IAU_MOON``), km
+  -> metres (:func:`spiceypy.spkpos`);
+* its orientation: the rotation from the ``camera_frame`` to ``frame``
+  (:func:`spiceypy.pxform`), the camera frame taken in the OpenCV convention (+Z the
+  boresight, +X right and +Y down in the image, as most instrument kernels define it);
+* the sun: the unit direction from the target's centre to the sun in ``frame``.
+
+``abcorr`` is SPICE's aberration correction (``NONE``: geometric). Kernels are a
+meta-kernel (``.tm``) or kernel files; each is checked before it is loaded, and every
+SPICE error becomes a one-line ``ValueError`` naming the kernel or the body. The kernels
+are unloaded afterwards: SPICE's kernel pool is global to the process.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from pathlib import Path
+
+import numpy as np
+
+from craters._shared import ParameterError
+
+from .camera import quaternion_from_matrix
+from .poses import Poses
+
+__all__ = ["MAX_SPICE_FRAMES", "SpiceSequence", "parse_utc_range", "spice_sequence"]
+
+#: Most frames a SPICE sequence gives (a typo in STEP_S should not start a million).
+MAX_SPICE_FRAMES = 100_000
+
+
+@dataclasses.dataclass(frozen=True)
+class SpiceSequence:
+    """Poses and sun directions of a SPICE time sequence (module notes)."""
+
+    poses: Poses
+    """Sensor poses; ``time_s`` is the ephemeris time (TDB seconds past J2000)."""
+    sun_directions: np.ndarray
+    """(n, 3) unit directions towards the sun, body-fixed frame."""
+    utc: tuple[str, ...]
+    """ISO UTC of each frame (``YYYY-MM-DDTHH:MM:SS.ffffff``)."""
+
+    def frame_info(self) -> list[dict]:
+        """Per frame ``{"et_s", "utc"}`` for the run's manifest."""
+        return [{"et_s": float(t), "utc": u} for t, u in zip(self.poses.time_s, self.utc,
+                                                              strict=True)]
+
+
+def parse_utc_range(spec) -> tuple[str, str, float]:
+    """``"START,STOP,STEP_S"`` -> (start, stop, step in seconds > 0)."""
+    parts = [p.strip() for p in str(spec).split(",")]
+    if len(parts) != 3 or not all(parts):
+        raise ParameterError("utc", f"must be START,STOP,STEP_S (UTC, UTC, seconds); got "
+                             f"{spec!r}")
+    try:
+        step = float(parts[2])
+    except ValueError:
+        raise ParameterError("utc", f"STEP_S must be a number of seconds; got "
+                             f"{parts[2]!r}") from None
+    if not 0.0 < step < np.inf:
+        raise ParameterError("utc", f"STEP_S must be > 0 seconds; got {parts[2]}")
+    return parts[0], parts[1], step
+
+
+def _short(exc) -> str:
+    """One line of a SpiceyError: its short code and the first sentence of its text."""
+    text = " ".join(str(getattr(exc, "long", "") or exc).split())
+    return f"{getattr(exc, 'short', '') or 'SPICE error'}: {text.split('. ')[0][:300]}"
+
+
+def _kernel_files(kernels) -> list[Path]:
+    paths = [kernels] if isinstance(kernels, str | Path) else list(kernels)
+    if isinstance(kernels, str) and "," in kernels:
+        paths = [p.strip() for p in kernels.split(",") if p.strip()]
+    if not paths:
+        raise ParameterError("spice", "needs at least one kernel or meta-kernel")
+    out = []
+    for p in map(Path, paths):
+        if not p.is_file():
+            raise FileNotFoundError(f"SPICE kernel {str(p)!r} does not exist")
+        out.append(p)
+    return out
+
+
+def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_frame: str,
+                   utc=None, et: Sequence[float] | None = None,
+                   abcorr: str = "NONE") -> SpiceSequence:
+    """The poses and sun directions of the times ``utc`` (``"START,STOP,STEP_S"``) or
+    ``et`` (ephemeris seconds) from SPICE ``kernels`` (module notes)."""
+    import spiceypy as sp
+    from spiceypy.utils.exceptions import SpiceyError
+
+    files = _kernel_files(kernels)
+    if (utc is None) == (et is None):
+        raise ParameterError("utc", "give the times as utc START,STOP,STEP_S or as et")
+    loaded: list[str] = []
+    try:
+        for path in files:
+            try:
+                if sp.getfat(str(path))[0] == "?":  # SPICE would load it as an empty text
+                    raise ValueError(f"SPICE kernel {str(path)!r} is not a SPICE kernel (no "
+                                     f"KPL/ identification word, not a DAF or DAS file)")
+                sp.furnsh(str(path))
+            except SpiceyError as exc:
+                sp.unload(str(path))  # a meta-kernel stays loaded when a kernel it lists fails
+                raise ValueError(f"SPICE kernel {str(path)!r}: {_short(exc)}") from None
+            loaded.append(str(path))
+        times = _times(sp, SpiceyError, utc, et)
+        pos, rot, sun = _geometry(sp, SpiceyError, times, target=target, observer=observer,
+                                  frame=frame, camera_frame=camera_frame, abcorr=abcorr)
+        stamps = tuple(sp.et2utc(float(t), "ISOC", 6) for t in times)
+    finally:
+        for path_s in reversed(loaded):
+            sp.unload(path_s)
+    poses = Poses(times, pos, np.array([quaternion_from_matrix(r) for r in rot]))
+    return SpiceSequence(poses, sun, stamps)
+
+
+def _times(sp, error, utc, et) -> np.ndarray:
+    if et is not None:
+        times = np.asarray(et, dtype=np.float64).reshape(-1)
+        if not len(times) or not np.isfinite(times).all():
+            raise ParameterError("et", "must be one or more finite ephemeris times")
+        return times
+    start, stop, step = parse_utc_range(utc)
+    try:
+        t0, t1 = sp.str2et(start), sp.str2et(stop)
+    except error as exc:
+        raise ValueError(f"utc {start!r} / {stop!r}: {_short(exc)} (a leapseconds "
+                         f"kernel must be among the kernels)") from None
+    if t1 < t0:
+        raise ParameterError("utc", f"STOP {stop!r} is before START {start!r}")
+    n = int(np.floor((t1 - t0) / step + 1e-9)) + 1
+    if n > MAX_SPICE_FRAMES:
+        raise ParameterError("utc", f"gives {n} frames; at most {MAX_SPICE_FRAMES} (raise "
+                             f"STEP_S)")
+    return t0 + step * np.arange(n)
+
+
+def _geometry(sp, error, times, *, target, observer, frame, camera_frame, abcorr):
+    n = len(times)
+    pos, sun, rot = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3))
+    for k, t in enumerate(times):
+        what = f"observer {observer!r} relative to target {target!r} in frame {frame!r}"
+        try:
+            pos[k] = np.asarray(sp.spkpos(observer, t, frame, abcorr, target)[0]) * 1000.0
+            what = f"the sun relative to target {target!r}"
+            s = np.asarray(sp.spkpos("SUN", t, frame, abcorr, target)[0])
+            what = f"the rotation from camera frame {camera_frame!r} to {frame!r}"
+            rot[k] = np.asarray(sp.pxform(camera_frame, frame, t))
+        except error as exc:
+            raise ValueError(f"SPICE has no {what} at {sp.et2utc(float(t), 'ISOC', 3)} UTC "
+                             f"in the kernels loaded: {_short(exc)}") from None
+        sun[k] = s / np.linalg.norm(s)
+    return pos, rot, sun

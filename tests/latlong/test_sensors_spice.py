@@ -1,0 +1,140 @@
+"""SPICE-driven sequences (latlong.sensors.spice) against spiceypy's own answers, from
+kernels the tests write (tests/latlong/spice_kernels.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from craters._shared import ParameterError
+from latlong.sensors import quaternion_to_matrix
+
+sp = pytest.importorskip("spiceypy")
+
+from latlong.sensors.spice import spice_sequence  # noqa: E402
+
+from .spice_kernels import CAM_FRAME, START_UTC, write_kernels  # noqa: E402
+
+ARGS = {"target": "MOON", "observer": "TESTCRAFT", "frame": "IAU_MOON",
+        "camera_frame": CAM_FRAME}
+
+
+@pytest.fixture(scope="module")
+def kernels(tmp_path_factory):
+    return write_kernels(tmp_path_factory.mktemp("spice"))
+
+
+def angle(a, b) -> float:
+    return float(np.arccos(np.clip(np.dot(a, b) / np.linalg.norm(a) / np.linalg.norm(b),
+                                   -1.0, 1.0)))
+
+
+def test_a_sequence_is_what_spiceypy_gives(kernels):
+    seq = spice_sequence(kernels, utc=f"{START_UTC},2025-03-01T12:05:00,30", **ARGS)
+    assert len(seq.poses) == 11 and seq.utc[0] == "2025-03-01T12:00:00.000000"
+    assert seq.utc[-1] == "2025-03-01T12:05:00.000000"
+    sp.furnsh(str(kernels))
+    try:
+        for k, t in enumerate(seq.poses.time_s):
+            assert t == sp.str2et(seq.utc[k])
+            pos = np.asarray(sp.spkpos("TESTCRAFT", t, "IAU_MOON", "NONE", "MOON")[0]) * 1e3
+            assert np.abs(seq.poses.position_m[k] - pos).max() <= 1e-9 * np.linalg.norm(pos)
+            rot = np.asarray(sp.pxform(CAM_FRAME, "IAU_MOON", t))
+            mine = quaternion_to_matrix(seq.poses.quaternion_wxyz[k])
+            # the angle of the rotation between the two (|R - I|_F / sqrt 2 for small
+            # angles: arccos of the trace loses 1e-8 to rounding): within 1e-9 rad
+            assert np.linalg.norm(mine.T @ rot - np.eye(3)) / np.sqrt(2) <= 1e-9
+            sun = np.asarray(sp.spkpos("SUN", t, "IAU_MOON", "NONE", "MOON")[0])
+            assert angle(seq.sun_directions[k], sun) <= 1e-9
+            # the camera looks at the Moon's centre (the CK was written so)
+            assert angle(mine[:, 2], -seq.poses.position_m[k]) <= 1e-6
+    finally:
+        sp.kclear()
+    info = seq.frame_info()
+    assert info[3] == {"et_s": float(seq.poses.time_s[3]), "utc": seq.utc[3]}
+    # the kernels were unloaded again
+    assert sp.ktotal("ALL") == 0
+
+
+def test_kernels_listed_one_by_one_and_ephemeris_times(kernels):
+    files = [str(kernels.parent / n) for n in ("test.tls", "moon.tpc", "craft.tsc",
+                                               "craft.tf", "craft.bsp", "craft.bc")]
+    a = spice_sequence(",".join(files), utc=f"{START_UTC},2025-03-01T12:00:20,10", **ARGS)
+    b = spice_sequence(files, et=a.poses.time_s, **ARGS)
+    np.testing.assert_array_equal(a.poses.position_m, b.poses.position_m)
+    np.testing.assert_array_equal(a.sun_directions, b.sun_directions)
+
+
+def test_bad_kernels_and_times_give_one_line_naming_them(kernels, tmp_path):
+    with pytest.raises(FileNotFoundError, match="SPICE kernel '.*nope.bsp' does not exist"):
+        spice_sequence(str(tmp_path / "nope.bsp"), et=[0.0], **ARGS)
+    junk = tmp_path / "junk.bsp"
+    junk.write_bytes(b"\x00not a kernel" * 20)
+    with pytest.raises(ValueError, match="SPICE kernel '.*junk.bsp' is not a SPICE") as err:
+        spice_sequence([str(kernels), str(junk)], et=[0.0], **ARGS)
+    assert "\n" not in str(err.value)
+    broken = tmp_path / "broken.tm"
+    broken.write_text("KPL/MK\n\\begindata\nKERNELS_TO_LOAD = ( 'gone.bsp' )\n"
+                      "\\begintext\n")
+    with pytest.raises(ValueError, match="SPICE kernel '.*broken.tm'.*gone.bsp") as err:
+        spice_sequence(broken, et=[0.0], **ARGS)
+    assert "\n" not in str(err.value)
+    with pytest.raises(ValueError, match="no observer 'TESTCRAFT'.*2030") as err:
+        spice_sequence(kernels, utc="2030-01-01,2030-01-01T00:00:10,5", **ARGS)
+    assert "\n" not in str(err.value)
+    with pytest.raises(ValueError, match="camera frame 'NO_SUCH_FRAME'"):
+        spice_sequence(kernels, utc=f"{START_UTC},{START_UTC},1",
+                       **{**ARGS, "camera_frame": "NO_SUCH_FRAME"})
+    lsk_less = [str(kernels.parent / n) for n in ("moon.tpc", "craft.bsp")]
+    with pytest.raises(ValueError, match="leapseconds"):
+        spice_sequence(lsk_less, utc=f"{START_UTC},{START_UTC},1", **ARGS)
+    for utc in ("2025-03-01", "a,b,-1", "a,b,x"):
+        with pytest.raises(ParameterError, match="utc"):
+            spice_sequence(kernels, utc=utc, **ARGS)
+    with pytest.raises(ParameterError, match="at most"):
+        spice_sequence(kernels, utc=f"{START_UTC},2025-03-02T12:00:00,0.01", **ARGS)
+    assert sp.ktotal("ALL") == 0
+
+
+def test_the_camera_command_flies_a_spice_sequence(kernels, run_cli, tmp_path):
+    from latlong import Body, LatLongGrid
+
+    model = tmp_path / "moon.npz"
+    Body.sphere(LatLongGrid(40), 1737400.0).save(model)
+    spice = ["--spice", str(kernels), "--utc", f"{START_UTC},2025-03-01T12:01:00,20",
+             "--target", "MOON", "--observer", "TESTCRAFT", "--frame", "IAU_MOON",
+             "--instrument-frame", CAM_FRAME]
+    out = tmp_path / "frames"
+    proc = run_cli("latlong", "camera", str(model), "-o", str(out), "--fov-deg", "20",
+                   "--size", "40x30", *spice, "-q")
+    assert proc.returncode == 0, proc.stderr
+    import json
+
+    doc = json.loads((out / "frames.json").read_text())
+    seq = spice_sequence(kernels, utc=f"{START_UTC},2025-03-01T12:01:00,20", **ARGS)
+    assert len(doc["frames"]) == 4
+    depth = np.load(out / doc["frames"][0]["files"]["depth"]) if str(
+        doc["frames"][0]["files"]["depth"]).endswith(".npy") else None
+    if depth is None:
+        from PIL import Image
+
+        depth = np.asarray(Image.open(out / doc["frames"][0]["files"]["depth"]))
+    # the camera looks down at the Moon from 100 km: the surface fills the frame
+    assert np.isfinite(depth).all() and np.nanmax(depth) < 2e5
+    for k, frame in enumerate(doc["frames"]):
+        assert frame["utc"] == seq.utc[k] and frame["et_s"] == frame["time_s"]
+        assert frame["time_s"] == seq.poses.time_s[k]
+        assert frame["position_m"] == seq.poses.position_m[k].tolist()
+        assert angle(frame["sun_direction"], seq.sun_directions[k]) <= 1e-9
+    # one-line errors, exit 2: a missing option, a missing kernel, both suns
+    for extra, message in (([], "--instrument-frame"),
+                           (["--spice", str(tmp_path / "gone.tm")], "gone.tm"),
+                           (["--sun-direction", "1,0,0"], "not both")):
+        args = spice[:-2] if message == "--instrument-frame" else spice
+        if extra[:1] == ["--spice"]:
+            args = extra + spice[2:]
+            extra = []
+        proc = run_cli("latlong", "camera", str(model), "-o", str(tmp_path / "x"),
+                       "--fov-deg", "20", "--size", "40x30", *args, *extra, "-q")
+        assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+        assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
