@@ -217,15 +217,7 @@ class CraterField:
         n_have = 0
         fc_have = np.zeros((0, K.N_COLS))
         d_have = np.zeros(0)
-        # the points' cells at the finest level asked, once: coarser ones by shifts
-        at_level: dict[int, np.ndarray] = {}
-        drawn = {lv for b, lv in self.levels.items() if self._bin_top(b) > d_min}
-        level_now = max(drawn, default=0)
-        cells_now = unique_sorted(cells_of(units, level_now))
-        for lv in sorted(drawn, reverse=True):
-            cells_now = coarser(cells_now, level_now, lv)
-            level_now = lv
-            at_level[lv] = cells_now
+        at_level = self._cells_by_level(units, d_min)
         for b in sorted(self.levels):
             if self._bin_top(b) <= d_min:
                 continue
@@ -273,19 +265,10 @@ class CraterField:
                 owner_cells = np.zeros(0, dtype=np.uint64)
                 set9 = np.zeros(0, dtype=np.uint64)
             keep = np.flatnonzero(needed_mask)
-            remap = np.full(len(cand), -1, dtype=np.int64)
-            remap[keep] = np.arange(len(keep)) + n_have
-
-            def fix(x, n_have=n_have, remap=remap):
-                y = x.copy()
-                hi = x >= n_have
-                y[hi] = remap[x[hi] - n_have]
-                return y
-
             # this bin's pairs point at its candidates: renumber them (earlier bins' pairs
             # hold kept indices below n_have already)
-            owners_all[first_pair:] = [fix(x) for x in owners_all[first_pair:]]
-            deps_all[first_pair:] = [fix(x) for x in deps_all[first_pair:]]
+            for pairs in (owners_all, deps_all):
+                pairs[first_pair:] = _renumbered(pairs[first_pair:], keep, len(cand), n_have)
             kept = cand.take(keep)
             parts.append(kept)
             fc_have = np.concatenate([fc_have, kept.fc])
@@ -298,6 +281,19 @@ class CraterField:
             ok = (owner >= 0) & (dep >= 0)
             return craters, owner[ok], dep[ok]
         return craters, np.zeros(0, dtype=np.int64), np.zeros(0, dtype=np.int64)
+
+    def _cells_by_level(self, units: np.ndarray, d_min: float) -> dict[int, np.ndarray]:
+        """{level: the sorted distinct cells of the points} at every level a bin with
+        craters >= ``d_min`` is drawn at: the finest once, the coarser ones by shifts."""
+        at_level: dict[int, np.ndarray] = {}
+        drawn = {lv for b, lv in self.levels.items() if self._bin_top(b) > d_min}
+        level_now = max(drawn, default=0)
+        cells_now = unique_sorted(cells_of(units, level_now))
+        for lv in sorted(drawn, reverse=True):
+            cells_now = coarser(cells_now, level_now, lv)
+            level_now = lv
+            at_level[lv] = cells_now
+        return at_level
 
     def _bin_top(self, b: int) -> float:
         return self._tops[b]
@@ -415,6 +411,21 @@ class CraterField:
         self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key),
                      "fresh_depth_m": prof.fresh_depth_m}
         return out
+
+
+def _renumbered(pairs: list[np.ndarray], keep: np.ndarray, n_cand: int,
+                n_have: int) -> list[np.ndarray]:
+    """Indices ``n_have + i`` of a bin's candidates become those of the kept ones
+    (``n_have + position in keep``; -1 for a candidate left out); lower ones stay."""
+    remap = np.full(n_cand, -1, dtype=np.int64)
+    remap[keep] = np.arange(len(keep)) + n_have
+    out = []
+    for x in pairs:
+        y = x.copy()
+        hi = x >= n_have
+        y[hi] = remap[x[hi] - n_have]
+        out.append(y)
+    return out
 
 
 def _dep_pairs(owners, owner_cells, cand: _Craters, n_have: int, fc_all, d_all):
