@@ -103,6 +103,8 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
                                           unit="deg", also=("angular_radius_deg",),
                                           group="light"),
         "soft_shadow_samples": into("light", own["soft_shadow_samples"]),
+        "bounces": into("light", own["bounces"]),
+        "bounce_samples": into("light", own["bounce_samples"]),
         "reflectance": Setting(next(k for k, m in REFLECTANCES.items()
                                     if type(reflectance) is m), "reflectance model",
                                choices=tuple(REFLECTANCES), group="light"),

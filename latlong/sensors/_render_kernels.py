@@ -145,13 +145,20 @@ def _shadow_rays_kernel(pos, ng, offset, centre, floor, sun, radius_rad, seed, s
             dy = ct * sun[1] + cp * e1y + sp * e2y
             dz = ct * sun[2] + cp * e1z + sp * e2z
         out_d[i, 0], out_d[i, 1], out_d[i, 2] = dx, dy, dz
-        rx = pos[i, 0] - centre[0]
-        ry = pos[i, 1] - centre[1]
-        rz = pos[i, 2] - centre[2]
-        eps = max(offset * math.sqrt(rx * rx + ry * ry + rz * rz), floor)
-        for k in range(3):
-            out_o[i, k] = pos[i, k] + eps * ng[i, k]
+        _lift(pos, ng, offset, centre, floor, i, out_o)
         facing[i] = ng[i, 0] * dx + ng[i, 1] * dy + ng[i, 2] * dz > 0.0
+
+
+@njit(cache=True, inline="always")
+def _lift(pos, ng, offset, centre, floor, i, out_o):
+    """Origin of a secondary ray from point i: lifted along the geometric normal by
+    ``offset`` times its distance from ``centre``, at least ``floor``."""
+    rx = pos[i, 0] - centre[0]
+    ry = pos[i, 1] - centre[1]
+    rz = pos[i, 2] - centre[2]
+    eps = max(offset * math.sqrt(rx * rx + ry * ry + rz * rz), floor)
+    for k in range(3):
+        out_o[i, k] = pos[i, k] + eps * ng[i, k]
 
 
 @njit(cache=True, parallel=True)

@@ -186,6 +186,12 @@ class CameraSettings:
     soft_shadow_samples: int = setting(0, "shadow rays per pixel over the solar disk (0: hard "
                                        "shadows)", range=(0, 1024))
     """Shadow rays per pixel over the solar disk, [0, 1024] (0: hard shadows)."""
+    bounces: int = setting(0, "bounces of light between surfaces (1: crater floors in shadow "
+                           "lit by the sunlit walls; 0: direct sunlight only)", range=(0, 1))
+    """Bounces of light between surfaces, 0 or 1 (:func:`~latlong.sensors.render.render`)."""
+    bounce_samples: int = setting(16, "rays a pixel for the bounced light (its noise falls as "
+                                  "1 / sqrt of this)", range=(1, 4096))
+    """Cosine-weighted rays a pixel for the bounced light, [1, 4096]."""
     seed: int = setting(0, "seed of the noise and of the sun-disk samples", range=(0, 2**63 - 1))
     """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
     bright_ejecta: float = setting(0.0, "albedo contrast of fresh craters' ejecta (0.5 = 50 % "
@@ -225,6 +231,7 @@ class CameraSettings:
                                            for f in fields(model)},
                 "sun_angular_radius_deg": sun.angular_radius_deg,
                 "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
+                "bounces": self.bounces, "bounce_samples": self.bounce_samples,
                 "sensor": {f.name: getattr(self.sensor, f.name)
                            for f in fields(self.sensor)}}
 
@@ -271,7 +278,8 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
             frame = render(mesh, settings.camera, poses[k], suns[k],
                            reflectance=settings.reflectance, sensor=settings.sensor,
                            soft_shadow_samples=settings.soft_shadow_samples,
-                           seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo)
+                           seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo,
+                           bounces=settings.bounces, bounce_samples=settings.bounce_samples)
             files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
                                 extra=settings.all_ground_truth)
             if flow and previous is not None:  # the flow from the frame before to this one
