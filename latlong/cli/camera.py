@@ -105,6 +105,8 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
         "soft_shadow_samples": into("light", own["soft_shadow_samples"]),
         "bounces": into("light", own["bounces"]),
         "bounce_samples": into("light", own["bounce_samples"]),
+        "blur_samples": into("sensor", own["blur_samples"]),
+        "line_time_s": into("sensor", own["line_time_s"]),
         "reflectance": Setting(next(k for k, m in REFLECTANCES.items()
                                     if type(reflectance) is m), "reflectance model",
                                choices=tuple(REFLECTANCES), group="light"),

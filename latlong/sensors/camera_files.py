@@ -44,6 +44,7 @@ from .camera import Camera
 from .datasets import optical_flow, parse_datasets, write_datasets, write_flow
 from .engine import RayMesh
 from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
+from .motion import timed_frame
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry
 from .poses import Poses
 from .render import Frame, Sun, render
@@ -192,6 +193,13 @@ class CameraSettings:
     bounce_samples: int = setting(16, "rays a pixel for the bounced light (its noise falls as "
                                   "1 / sqrt of this)", range=(1, 4096))
     """Cosine-weighted rays a pixel for the bounced light, [1, 4096]."""
+    blur_samples: int = setting(0, "motion blur: instants sampled over each frame's exposure "
+                                "along the trajectory (0: a sharp frame)", range=(0, 256))
+    """Motion blur: instants over the exposure, [0, 256] (:mod:`~latlong.sensors.motion`;
+    0 or 1: none)."""
+    line_time_s: float = setting(0.0, "rolling shutter: delay of each image row after the "
+                                 "one above (0: a global shutter)", range=(0.0, 1.0))
+    """Rolling shutter: each row's delay after the row above, seconds, [0, 1]."""
     seed: int = setting(0, "seed of the noise and of the sun-disk samples", range=(0, 2**63 - 1))
     """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
     bright_ejecta: float = setting(0.0, "albedo contrast of fresh craters' ejecta (0.5 = 50 % "
@@ -232,6 +240,7 @@ class CameraSettings:
                 "sun_angular_radius_deg": sun.angular_radius_deg,
                 "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
                 "bounces": self.bounces, "bounce_samples": self.bounce_samples,
+                "blur_samples": self.blur_samples, "line_time_s": self.line_time_s,
                 "sensor": {f.name: getattr(self.sensor, f.name)
                            for f in fields(self.sensor)}}
 
@@ -275,11 +284,17 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         flow = "flow" in settings.datasets.split(",")
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
-            frame = render(mesh, settings.camera, poses[k], suns[k],
-                           reflectance=settings.reflectance, sensor=settings.sensor,
-                           soft_shadow_samples=settings.soft_shadow_samples,
-                           seed=settings.seed, ground_truth=geometry, vertex_albedo=albedo,
-                           bounces=settings.bounces, bounce_samples=settings.bounce_samples)
+            def render_at(camera, pose, sun=suns[k]):
+                return render(mesh, camera, pose, sun, reflectance=settings.reflectance,
+                              sensor=settings.sensor,
+                              soft_shadow_samples=settings.soft_shadow_samples,
+                              seed=settings.seed, ground_truth=geometry,
+                              vertex_albedo=albedo, bounces=settings.bounces,
+                              bounce_samples=settings.bounce_samples)
+
+            frame = timed_frame(render_at, poses, k, settings.camera, settings.sensor,
+                                blur_samples=settings.blur_samples,
+                                line_time_s=settings.line_time_s, seed=settings.seed)
             files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
                                 extra=settings.all_ground_truth)
             if flow and previous is not None:  # the flow from the frame before to this one
