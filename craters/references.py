@@ -37,10 +37,10 @@ The entries, by topic (keys of :data:`REFERENCES`):
   ``baerentzen2005`` ``lagae2009`` ``galerne2012`` ``ericson2005`` ``max1999``.
 * Randomness of terrain on demand: ``salmon2011`` (counter-based Philox).
 * Sensors: ``moller1997`` ``wald2014`` ``shepperd1978`` ``brown1966`` ``conrady1919``
-  ``hofle2007``; photometry ``lommel1887`` ``seeliger1888`` ``mcewen1991`` ``mcewen1996``
-  ``hapke1984`` ``hapke1986`` ``hapke2002`` ``hapke2008`` ``hapke2012``
-  ``helfenstein1987`` ``helfenstein1989`` ``ishiguro2014`` ``li2004``; albedo
-  ``grier2001``.
+  ``hofle2007`` ``frisvad2012`` ``duff2017``; stars ``hoffleit1991`` ``willmer2018``;
+  photometry ``lommel1887`` ``seeliger1888`` ``mcewen1991`` ``mcewen1996`` ``hapke1984``
+  ``hapke1986`` ``hapke2002`` ``hapke2008`` ``hapke2012`` ``helfenstein1987``
+  ``helfenstein1989`` ``ishiguro2014`` ``li2004``; albedo ``grier2001``.
 
 Examples
 --------
@@ -403,6 +403,18 @@ REFERENCES = _entries(
     _R("wald2014", ("Wald, I.", "Woop, S.", "Benthin, C.", "Johnson, G. S.", "Ernst, M."),
        2014, "Embree: A kernel framework for efficient CPU ray tracing",
        "ACM Transactions on Graphics 33(4), 143", "10.1145/2601097.2601199"),
+    _R("frisvad2012", ("Frisvad, J. R.",), 2012,
+       "Building an orthonormal basis from a 3D unit vector without normalization",
+       "Journal of Graphics Tools 16(3), 151-159 (DOI not confirmed)"),
+    _R("duff2017", ("Duff, T.", "Burgess, J.", "Christensen, P.", "et al."), 2017,
+       "Building an orthonormal basis, revisited",
+       "Journal of Computer Graphics Techniques 6(1), 1-8"),
+    _R("hoffleit1991", ("Hoffleit, D.", "Warren, W. H., Jr."), 1991,
+       "The Bright Star Catalogue, 5th Revised Ed. (Preliminary Version)",
+       "NSSDC/ADC catalogue V/50; ADS 1991bsc..book.....H"),
+    _R("willmer2018", ("Willmer, C. N. A.",), 2018,
+       "The absolute magnitude of the Sun in several filters",
+       "The Astrophysical Journal Supplement Series 236(2), 47", "10.3847/1538-4365/aabfdf"),
     _R("shepperd1978", ("Shepperd, S. W.",), 1978, "Quaternion from rotation matrix",
        "Journal of Guidance and Control 1(3), 223-224", "10.2514/3.55767b"),
     _R("brown1966", ("Brown, D. C.",), 1966, "Decentering distortion of lenses",
