@@ -107,6 +107,7 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
         "bounce_samples": into("light", own["bounce_samples"]),
         "blur_samples": into("sensor", own["blur_samples"]),
         "line_time_s": into("sensor", own["line_time_s"]),
+        "stars": into("light", own["stars"]),
         "reflectance": Setting(next(k for k, m in REFLECTANCES.items()
                                     if type(reflectance) is m), "reflectance model",
                                choices=tuple(REFLECTANCES), group="light"),
@@ -169,7 +170,8 @@ def run_camera(v: Values, load) -> int:
     refuse_inside(mesh, poses, v, "camera")
     camera_run(geometry, settings, poses, sun, out, force=v.force, progress=not v.quiet,
                mesh=mesh, model_name=str(v.model),
-               frame_info=None if seq is None else seq.frame_info())
+               frame_info=None if seq is None else seq.frame_info(),
+               body_to_j2000=None if seq is None else seq.body_to_j2000)
     if not v.quiet:
         print(f"wrote {len(poses)} frame(s) and {out / 'frames.json'}")
     return 0

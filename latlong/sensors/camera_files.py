@@ -51,6 +51,7 @@ from .render import Frame, Sun, render
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
 from .sensor import Sensor, display_image
+from .stars import with_stars
 
 __all__ = ["DEPTH_FORMATS", "CameraSettings", "camera_run", "frame_entry", "manifest",
            "write_frame", "write_manifest"]
@@ -200,6 +201,9 @@ class CameraSettings:
     line_time_s: float = setting(0.0, "rolling shutter: delay of each image row after the "
                                  "one above (0: a global shutter)", range=(0.0, 1.0))
     """Rolling shutter: each row's delay after the row above, seconds, [0, 1]."""
+    stars: bool = setting(False, "stars (Yale Bright Star Catalogue, V <= 6) where no "
+                          "surface is seen; J2000 = the body frame unless SPICE says")
+    """Stars where no surface is seen (:mod:`~latlong.sensors.stars`)."""
     seed: int = setting(0, "seed of the noise and of the sun-disk samples", range=(0, 2**63 - 1))
     """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
     bright_ejecta: float = setting(0.0, "albedo contrast of fresh craters' ejecta (0.5 = 50 % "
@@ -241,13 +245,15 @@ class CameraSettings:
                 "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
                 "bounces": self.bounces, "bounce_samples": self.bounce_samples,
                 "blur_samples": self.blur_samples, "line_time_s": self.line_time_s,
+                "stars": self.stars,
                 "sensor": {f.name: getattr(self.sensor, f.name)
                            for f in fields(self.sensor)}}
 
 
 def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, craters=None,
                force: bool = False, progress: bool = False, mesh: RayMesh | None = None,
-               model_name: str = "", frame_info: list[dict] | None = None) -> dict:
+               model_name: str = "", frame_info: list[dict] | None = None,
+               body_to_j2000: np.ndarray | None = None) -> dict:
     """Render every frame of ``poses`` and write the run folder (module notes); the
     ``frames.json`` document.
 
@@ -258,7 +264,8 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     (:func:`~latlong.sensors.scene_geometry.scene_geometry`); ``mesh`` its
     :class:`RayMesh` if built already; ``model_name`` names the model in the manifest
     (default: the surface's source); ``frame_info`` a dict per frame added to its
-    manifest entry (e.g. SPICE's ``et_s`` and ``utc``). The same shape as
+    manifest entry (e.g. SPICE's ``et_s`` and ``utc``); ``body_to_j2000`` (n, 3, 3) the
+    body frame's orientation per frame for the stars (default: J2000). The same shape as
     :func:`~latlong.sensors.lidar_files.lidar_run`.
     """
     if not isinstance(settings, CameraSettings):
@@ -295,6 +302,10 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
             frame = timed_frame(render_at, poses, k, settings.camera, settings.sensor,
                                 blur_samples=settings.blur_samples,
                                 line_time_s=settings.line_time_s, seed=settings.seed)
+            if settings.stars:
+                frame = with_stars(frame, settings.sensor, seed=settings.seed,
+                                   body_to_j2000=None if body_to_j2000 is None
+                                   else body_to_j2000[k])
             files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
                                 extra=settings.all_ground_truth)
             if flow and previous is not None:  # the flow from the frame before to this one

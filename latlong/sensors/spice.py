@@ -46,6 +46,8 @@ class SpiceSequence:
     """(n, 3) unit directions towards the sun, body-fixed frame."""
     utc: tuple[str, ...]
     """ISO UTC of each frame (``YYYY-MM-DDTHH:MM:SS.ffffff``)."""
+    body_to_j2000: np.ndarray
+    """(n, 3, 3) rotations from the body-fixed frame to J2000 (for the stars)."""
 
     def frame_info(self) -> list[dict]:
         """Per frame ``{"et_s", "utc"}`` for the run's manifest."""
@@ -113,14 +115,15 @@ def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_fr
                 raise ValueError(f"SPICE kernel {str(path)!r}: {_short(exc)}") from None
             loaded.append(str(path))
         times = _times(sp, SpiceyError, utc, et)
-        pos, rot, sun = _geometry(sp, SpiceyError, times, target=target, observer=observer,
-                                  frame=frame, camera_frame=camera_frame, abcorr=abcorr)
+        pos, rot, sun, inertial = _geometry(sp, SpiceyError, times, target=target,
+                                            observer=observer, frame=frame,
+                                            camera_frame=camera_frame, abcorr=abcorr)
         stamps = tuple(sp.et2utc(float(t), "ISOC", 6) for t in times)
     finally:
         for path_s in reversed(loaded):
             sp.unload(path_s)
     poses = Poses(times, pos, np.array([quaternion_from_matrix(r) for r in rot]))
-    return SpiceSequence(poses, sun, stamps)
+    return SpiceSequence(poses, sun, stamps, inertial)
 
 
 def _times(sp, error, utc, et) -> np.ndarray:
@@ -147,6 +150,7 @@ def _times(sp, error, utc, et) -> np.ndarray:
 def _geometry(sp, error, times, *, target, observer, frame, camera_frame, abcorr):
     n = len(times)
     pos, sun, rot = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 3, 3))
+    inertial = np.empty((n, 3, 3))
     for k, t in enumerate(times):
         what = f"observer {observer!r} relative to target {target!r} in frame {frame!r}"
         try:
@@ -155,8 +159,10 @@ def _geometry(sp, error, times, *, target, observer, frame, camera_frame, abcorr
             s = np.asarray(sp.spkpos("SUN", t, frame, abcorr, target)[0])
             what = f"the rotation from camera frame {camera_frame!r} to {frame!r}"
             rot[k] = np.asarray(sp.pxform(camera_frame, frame, t))
+            what = f"the rotation from {frame!r} to J2000"
+            inertial[k] = np.asarray(sp.pxform(frame, "J2000", t))
         except error as exc:
             raise ValueError(f"SPICE has no {what} at {sp.et2utc(float(t), 'ISOC', 3)} UTC "
                              f"in the kernels loaded: {_short(exc)}") from None
         sun[k] = s / np.linalg.norm(s)
-    return pos, rot, sun
+    return pos, rot, sun, inertial
