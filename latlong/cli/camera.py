@@ -84,8 +84,11 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
         **model_options("frames", model_help, units=units),
         **pose_options("camera", vertical=vertical),
         "size": Setting(help="image size WxH", unit="px", parse=wxh("in pixels", "1024x768"),
-                        metavar="WxH", required=True, also=("width", "height"),
-                        group="intrinsics"),
+                        metavar="WxH", also=("width", "height"), group="intrinsics",
+                        default_text="required; or --instrument"),
+        "instrument": Setting(help="SPICE instrument whose kernel gives the image size and "
+                              "focal length (with --spice)", metavar="NAME",
+                              group="intrinsics"),
         "fov_deg": Setting(help="horizontal field of view, centred square pixels", unit="deg",
                            kind=float, default_text="none; or --intrinsics",
                            group="intrinsics"),
@@ -129,8 +132,20 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
 def _camera(v: Values):
     from latlong.sensors import Camera
 
-    w, h = v.size
     dist = dict(zip(_DISTORTION, v.distortion or [0.0] * 5, strict=True))
+    if v.instrument is not None:
+        if v.spice is None or v.size or v.fov_deg or v.intrinsics:
+            raise CliError("--instrument takes the camera from the --spice kernels: give it "
+                           "without --size, --fov-deg and --intrinsics")
+        from latlong.sensors.spice import spice_camera
+
+        try:
+            return spice_camera(v.spice, v.instrument, **dist)
+        except (ValueError, FileNotFoundError) as exc:
+            raise CliError(str(exc)) from None
+    if v.size is None:
+        raise CliError("give --size WxH (or --instrument with --spice)")
+    w, h = v.size
     if v.intrinsics is not None:
         if v.fov_deg is not None:
             raise CliError("give --fov-deg or --intrinsics, not both")

@@ -30,7 +30,8 @@ from craters._shared import ParameterError
 from .camera import quaternion_from_matrix
 from .poses import Poses
 
-__all__ = ["MAX_SPICE_FRAMES", "SpiceSequence", "parse_utc_range", "spice_sequence"]
+__all__ = ["MAX_SPICE_FRAMES", "SpiceSequence", "parse_utc_range", "spice_camera",
+           "spice_sequence"]
 
 #: Most frames a SPICE sequence gives (a typo in STEP_S should not start a million).
 MAX_SPICE_FRAMES = 100_000
@@ -124,6 +125,63 @@ def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_fr
             sp.unload(path_s)
     poses = Poses(times, pos, np.array([quaternion_from_matrix(r) for r in rot]))
     return SpiceSequence(poses, sun, stamps, inertial)
+
+
+def spice_camera(kernels, instrument: str, **distortion):
+    """The :class:`~latlong.sensors.camera.Camera` of ``instrument`` (SPICE name or id)
+    from its instrument kernel: ``INS<id>_PIXEL_SAMPLES`` x ``INS<id>_PIXEL_LINES``
+    pixels, the focal length in pixels ``INS<id>_FOCAL_LENGTH / INS<id>_PIXEL_PITCH``
+    (both in mm) or else from the field of view (``getfov``: the widest bound vector's
+    angles from the +Z boresight across x and y), the principal point at the image's
+    centre; ``distortion`` as :class:`Camera`'s."""
+    import spiceypy as sp
+    from spiceypy.utils.exceptions import SpiceyError
+
+    from .camera import Camera
+
+    files = _kernel_files(kernels)
+    loaded: list[str] = []
+    try:
+        for path in files:
+            sp.furnsh(str(path))
+            loaded.append(str(path))
+        try:
+            ident = int(instrument) if str(instrument).lstrip("-").isdigit() \
+                else int(sp.bods2c(str(instrument)))
+        except SpiceyError:
+            raise ValueError(f"SPICE does not know the instrument {instrument!r} (a name "
+                             f"needs NAIF_BODY_NAME/CODE in a kernel, or give its id)") from None
+
+        def number(key: str, required: bool = True):
+            name = f"INS{ident}_{key}"
+            try:
+                return float(sp.gdpool(name, 0, 1)[0])
+            except SpiceyError:
+                if required:
+                    raise ValueError(f"the instrument kernel of {instrument!r} has no "
+                                     f"{name}") from None
+                return None
+
+        width, height = int(number("PIXEL_SAMPLES")), int(number("PIXEL_LINES"))
+        focal, pitch = number("FOCAL_LENGTH", False), number("PIXEL_PITCH", False)
+        if focal and pitch:
+            fx = fy = focal / pitch
+        else:
+            try:
+                _, _, bsight, _, bounds = sp.getfov(ident, 10)
+            except SpiceyError as exc:
+                raise ValueError(f"instrument {instrument!r}: no focal length and pitch, "
+                                 f"and no field of view: {_short(exc)}") from None
+            b = np.asarray(bounds, dtype=float)
+            tx = np.abs(b[:, 0] / b[:, 2]).max()
+            ty = np.abs(b[:, 1] / b[:, 2]).max()
+            fx, fy = 0.5 * width / tx, 0.5 * height / ty
+    except SpiceyError as exc:
+        raise ValueError(f"SPICE kernels {', '.join(map(str, files))}: {_short(exc)}") from None
+    finally:
+        for path_s in reversed(loaded):
+            sp.unload(path_s)
+    return Camera(fx, fy, 0.5 * width, 0.5 * height, width, height, **distortion)
 
 
 def _times(sp, error, utc, et) -> np.ndarray:

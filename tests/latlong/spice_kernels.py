@@ -65,6 +65,29 @@ NAIF_BODY_CODE += ( -9999 )
 \begintext
 """
 
+# two instruments: the camera with focal length and pixel pitch (100 px), and a second
+# whose focal length comes from its field of view (a 10 x 7.5 degree half-angle box)
+IK = r"""KPL/IK
+\begindata
+INS-9999000_PIXEL_SAMPLES = ( 64 )
+INS-9999000_PIXEL_LINES = ( 48 )
+INS-9999000_FOCAL_LENGTH = ( 50.0 )
+INS-9999000_PIXEL_PITCH = ( 0.5 )
+INS-9999001_PIXEL_SAMPLES = ( 80 )
+INS-9999001_PIXEL_LINES = ( 60 )
+INS-9999001_FOV_SHAPE = 'RECTANGLE'
+INS-9999001_FOV_FRAME = 'SC_CAM'
+INS-9999001_BORESIGHT = ( 0.0 0.0 1.0 )
+INS-9999001_FOV_CLASS_SPEC = 'ANGLES'
+INS-9999001_FOV_REF_VECTOR = ( 1.0 0.0 0.0 )
+INS-9999001_FOV_REF_ANGLE = ( 10.0 )
+INS-9999001_FOV_CROSS_ANGLE = ( 7.5 )
+INS-9999001_FOV_ANGLE_UNITS = 'DEGREES'
+NAIF_BODY_NAME += ( 'TESTCAM' 'TESTCAM_WIDE' )
+NAIF_BODY_CODE += ( -9999000 -9999001 )
+\begintext
+"""
+
 START_UTC = "2025-03-01T12:00:00"
 
 
@@ -82,7 +105,8 @@ def write_kernels(folder: Path, *, duration_s: float = 600.0) -> Path:
     import spiceypy as sp
 
     folder.mkdir(parents=True, exist_ok=True)
-    texts = {"test.tls": LSK, "moon.tpc": PCK, "craft.tsc": SCLK, "craft.tf": FK}
+    texts = {"test.tls": LSK, "moon.tpc": PCK, "craft.tsc": SCLK, "craft.tf": FK,
+             "craft.ti": IK}
     for name, text in texts.items():
         (folder / name).write_text(text)
     sp.kclear()

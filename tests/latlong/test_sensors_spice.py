@@ -11,7 +11,7 @@ from latlong.sensors import quaternion_to_matrix
 
 sp = pytest.importorskip("spiceypy")
 
-from latlong.sensors.spice import spice_sequence  # noqa: E402
+from latlong.sensors.spice import spice_camera, spice_sequence  # noqa: E402
 
 from .spice_kernels import CAM_FRAME, START_UTC, write_kernels  # noqa: E402
 
@@ -58,7 +58,7 @@ def test_a_sequence_is_what_spiceypy_gives(kernels):
 
 def test_kernels_listed_one_by_one_and_ephemeris_times(kernels):
     files = [str(kernels.parent / n) for n in ("test.tls", "moon.tpc", "craft.tsc",
-                                               "craft.tf", "craft.bsp", "craft.bc")]
+                                               "craft.tf", "craft.ti", "craft.bsp", "craft.bc")]
     a = spice_sequence(",".join(files), utc=f"{START_UTC},2025-03-01T12:00:20,10", **ARGS)
     b = spice_sequence(files, et=a.poses.time_s, **ARGS)
     np.testing.assert_array_equal(a.poses.position_m, b.poses.position_m)
@@ -105,14 +105,16 @@ def test_the_camera_command_flies_a_spice_sequence(kernels, run_cli, tmp_path):
              "--target", "MOON", "--observer", "TESTCRAFT", "--frame", "IAU_MOON",
              "--instrument-frame", CAM_FRAME]
     out = tmp_path / "frames"
-    proc = run_cli("latlong", "camera", str(model), "-o", str(out), "--fov-deg", "20",
-                   "--size", "40x30", *spice, "-q")
+    proc = run_cli("latlong", "camera", str(model), "-o", str(out), "--instrument", "TESTCAM",
+                   *spice, "-q")
     assert proc.returncode == 0, proc.stderr
     import json
 
     doc = json.loads((out / "frames.json").read_text())
     seq = spice_sequence(kernels, utc=f"{START_UTC},2025-03-01T12:01:00,20", **ARGS)
     assert len(doc["frames"]) == 4
+    assert doc["intrinsics"] == {"fx": 100.0, "fy": 100.0, "cx": 32.0, "cy": 24.0,
+                                 "width": 64, "height": 48}  # from the instrument kernel
     depth = np.load(out / doc["frames"][0]["files"]["depth"]) if str(
         doc["frames"][0]["files"]["depth"]).endswith(".npy") else None
     if depth is None:
@@ -138,3 +140,19 @@ def test_the_camera_command_flies_a_spice_sequence(kernels, run_cli, tmp_path):
                        "--fov-deg", "20", "--size", "40x30", *args, *extra, "-q")
         assert proc.returncode == 2 and message in proc.stderr, proc.stderr
         assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+
+
+def test_the_instrument_kernel_gives_the_camera(kernels):
+    cam = spice_camera(kernels, "TESTCAM")
+    assert (cam.width, cam.height, cam.fx, cam.fy, cam.cx, cam.cy) == (64, 48, 100.0, 100.0,
+                                                                        32.0, 24.0)
+    wide = spice_camera(kernels, "-9999001", k1=-0.01)
+    assert (wide.width, wide.height) == (80, 60) and wide.k1 == -0.01
+    # the field of view's half-angles, 10 and 7.5 degrees, reach the image's edges
+    assert wide.fx == pytest.approx(40.0 / np.tan(np.radians(10.0)), rel=1e-12)
+    assert wide.fy == pytest.approx(30.0 / np.tan(np.radians(7.5)), rel=1e-12)
+    with pytest.raises(ValueError, match="instrument 'NOPE'"):
+        spice_camera(kernels, "NOPE")
+    with pytest.raises(ValueError, match="INS-9999002_PIXEL_SAMPLES"):
+        spice_camera(kernels, "-9999002")
+    assert sp.ktotal("ALL") == 0
