@@ -32,6 +32,7 @@ BAND_ROWS = 8
 
 
 def _slerp(q0: np.ndarray, q1: np.ndarray, s: float) -> np.ndarray:
+    """The geodesic from q0 (s = 0) to q1 (s = 1), continued for s outside [0, 1]."""
     dot = float(np.dot(q0, q1))
     if dot < 0.0:
         q1, dot = -q1, -dot
@@ -54,27 +55,8 @@ def pose_at(poses: Poses, time_s: float) -> Pose:
                              f"needs increasing frame times")
     s = (time_s - t[k]) / span
     pos = poses.position_m[k] + s * (poses.position_m[k + 1] - poses.position_m[k])
-    q = _slerp(poses.quaternion_wxyz[k], poses.quaternion_wxyz[k + 1], s) if 0 <= s <= 1 \
-        else _extrapolated(poses.quaternion_wxyz[k], poses.quaternion_wxyz[k + 1], s)
+    q = _slerp(poses.quaternion_wxyz[k], poses.quaternion_wxyz[k + 1], s)
     return Pose(pos, q / np.linalg.norm(q), float(time_s))
-
-
-def _extrapolated(q0: np.ndarray, q1: np.ndarray, s: float) -> np.ndarray:
-    """q0 turned by s times the rotation from q0 to q1 (any real s)."""
-    from .camera import quaternion_from_matrix, quaternion_to_matrix
-
-    r0, r1 = quaternion_to_matrix(q0), quaternion_to_matrix(q1)
-    rel = r1 @ r0.T
-    angle = np.arccos(np.clip((np.trace(rel) - 1.0) / 2.0, -1.0, 1.0))
-    if angle < 1e-12:
-        return q0
-    axis = np.array([rel[2, 1] - rel[1, 2], rel[0, 2] - rel[2, 0], rel[1, 0] - rel[0, 1]])
-    axis /= 2.0 * np.sin(angle)
-    a = s * angle
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]],
-                  [-axis[1], axis[0], 0.0]])
-    turn = np.eye(3) + np.sin(a) * k + (1.0 - np.cos(a)) * (k @ k)
-    return quaternion_from_matrix(turn @ r0)
 
 
 def timed_frame(render_at, poses: Poses, k: int, camera: Camera, sensor, *,
@@ -86,12 +68,13 @@ def timed_frame(render_at, poses: Poses, k: int, camera: Camera, sensor, *,
     if blur_samples < 2 and not line_time_s > 0.0:
         return sharp
     t0, exposure = float(poses.time_s[k]), sharp.exposure_s
-    instants = (np.arange(max(blur_samples, 1)) + 0.5) / max(blur_samples, 1) * exposure
+    n = max(blur_samples, 1)
+    instants = (np.arange(n) + 0.5) / n * exposure
     h = camera.height
-    bands = range(0, h, BAND_ROWS) if line_time_s > 0.0 else range(0, h, h)
+    rows = BAND_ROWS if line_time_s > 0.0 else h
     refl = np.zeros((h, camera.width))
-    for r0 in bands:
-        r1 = min(h, r0 + (BAND_ROWS if line_time_s > 0.0 else h))
+    for r0 in range(0, h, rows):
+        r1 = min(h, r0 + rows)
         # the band's rows as a camera of their own: same rays, principal point shifted
         sub = dataclasses.replace(camera, cy=camera.cy - r0, height=r1 - r0)
         delay = line_time_s * 0.5 * (r0 + r1 - 1)

@@ -19,8 +19,9 @@ are unloaded afterwards: SPICE's kernel pool is global to the process.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -92,6 +93,32 @@ def _kernel_files(kernels) -> list[Path]:
     return out
 
 
+@contextlib.contextmanager
+def _loaded(kernels) -> Iterator[None]:
+    """The kernels loaded, each checked first (SPICE would take a file that is no kernel
+    as an empty text kernel), and unloaded again afterwards (the pool is the process's);
+    a kernel that fails is named in a one-line ValueError."""
+    import spiceypy as sp
+    from spiceypy.utils.exceptions import SpiceyError
+
+    loaded: list[str] = []
+    try:
+        for path in map(str, _kernel_files(kernels)):
+            try:
+                if sp.getfat(path)[0] == "?":
+                    raise ValueError(f"SPICE kernel {path!r} is not a SPICE kernel (no KPL/ "
+                                     f"identification word, not a DAF or DAS file)")
+                sp.furnsh(path)
+            except SpiceyError as exc:
+                sp.unload(path)  # a meta-kernel stays loaded when a kernel it lists fails
+                raise ValueError(f"SPICE kernel {path!r}: {_short(exc)}") from None
+            loaded.append(path)
+        yield
+    finally:
+        for path in reversed(loaded):
+            sp.unload(path)
+
+
 def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_frame: str,
                    utc=None, et: Sequence[float] | None = None,
                    abcorr: str = "NONE") -> SpiceSequence:
@@ -100,29 +127,14 @@ def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_fr
     import spiceypy as sp
     from spiceypy.utils.exceptions import SpiceyError
 
-    files = _kernel_files(kernels)
     if (utc is None) == (et is None):
         raise ParameterError("utc", "give the times as utc START,STOP,STEP_S or as et")
-    loaded: list[str] = []
-    try:
-        for path in files:
-            try:
-                if sp.getfat(str(path))[0] == "?":  # SPICE would load it as an empty text
-                    raise ValueError(f"SPICE kernel {str(path)!r} is not a SPICE kernel (no "
-                                     f"KPL/ identification word, not a DAF or DAS file)")
-                sp.furnsh(str(path))
-            except SpiceyError as exc:
-                sp.unload(str(path))  # a meta-kernel stays loaded when a kernel it lists fails
-                raise ValueError(f"SPICE kernel {str(path)!r}: {_short(exc)}") from None
-            loaded.append(str(path))
+    with _loaded(kernels):
         times = _times(sp, SpiceyError, utc, et)
         pos, rot, sun, inertial = _geometry(sp, SpiceyError, times, target=target,
                                             observer=observer, frame=frame,
                                             camera_frame=camera_frame, abcorr=abcorr)
         stamps = tuple(sp.et2utc(float(t), "ISOC", 6) for t in times)
-    finally:
-        for path_s in reversed(loaded):
-            sp.unload(path_s)
     poses = Poses(times, pos, np.array([quaternion_from_matrix(r) for r in rot]))
     return SpiceSequence(poses, sun, stamps, inertial)
 
@@ -139,12 +151,7 @@ def spice_camera(kernels, instrument: str, **distortion):
 
     from .camera import Camera
 
-    files = _kernel_files(kernels)
-    loaded: list[str] = []
-    try:
-        for path in files:
-            sp.furnsh(str(path))
-            loaded.append(str(path))
+    with _loaded(kernels):
         try:
             ident = int(instrument) if str(instrument).lstrip("-").isdigit() \
                 else int(sp.bods2c(str(instrument)))
@@ -168,7 +175,7 @@ def spice_camera(kernels, instrument: str, **distortion):
             fx = fy = focal / pitch
         else:
             try:
-                _, _, bsight, _, bounds = sp.getfov(ident, 10)
+                bounds = sp.getfov(ident, 10)[4]
             except SpiceyError as exc:
                 raise ValueError(f"instrument {instrument!r}: no focal length and pitch, "
                                  f"and no field of view: {_short(exc)}") from None
@@ -176,11 +183,6 @@ def spice_camera(kernels, instrument: str, **distortion):
             tx = np.abs(b[:, 0] / b[:, 2]).max()
             ty = np.abs(b[:, 1] / b[:, 2]).max()
             fx, fy = 0.5 * width / tx, 0.5 * height / ty
-    except SpiceyError as exc:
-        raise ValueError(f"SPICE kernels {', '.join(map(str, files))}: {_short(exc)}") from None
-    finally:
-        for path_s in reversed(loaded):
-            sp.unload(path_s)
     return Camera(fx, fy, 0.5 * width, 0.5 * height, width, height, **distortion)
 
 

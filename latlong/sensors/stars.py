@@ -75,6 +75,6 @@ def with_stars(frame, sensor, *, body_to_j2000: np.ndarray | None = None, seed: 
     sees no surface, exposed again (auto-exposure sees them too)."""
     stars = star_reflectance(frame.camera, frame.pose, body_to_j2000=body_to_j2000)
     refl = np.where(frame.face < 0, frame.reflectance + stars, frame.reflectance)
-    exposure = exposure_for(refl, sensor) if sensor.exposure_s is None else sensor.exposure_s
+    exposure = exposure_for(refl, sensor)
     image = expose(refl, dataclasses.replace(sensor, exposure_s=exposure), seed=seed)
     return dataclasses.replace(frame, image=image, reflectance=refl, exposure_s=exposure)
