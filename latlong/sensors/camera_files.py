@@ -67,7 +67,7 @@ CONVENTIONS = ("OpenCV camera frame (x right, y down, z forward); quaternion_wxy
                "where no surface; normals = unit shading normals in the body frame.")
 
 
-def _save(path: Path, array: np.ndarray) -> None:
+def _save(path: Path, array: np.ndarray, channel: str = "Z") -> None:
     from PIL import Image
 
     with atomic_path(path) as tmp:
@@ -75,7 +75,7 @@ def _save(path: Path, array: np.ndarray) -> None:
             with open(tmp, "wb") as fh:
                 np.save(fh, array, allow_pickle=False)
         elif path.suffix == ".exr":
-            _save_exr(tmp, array)
+            _save_exr(tmp, array, channel)
         elif path.suffix == ".tif":
             kind = np.int32 if array.dtype == np.int32 else np.float32
             Image.fromarray(np.ascontiguousarray(array, dtype=kind)).save(tmp, format="TIFF")
@@ -129,11 +129,7 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
             files[key] = f"{key}_{tag}.{depth_format}"
             arrays[key] = ids
     for key, name in files.items():
-        if key == "albedo" and exr:
-            with atomic_path(folder / name) as tmp:
-                _save_exr(tmp, arrays[key], "Y")
-        else:
-            _save(folder / name, arrays[key])
+        _save(folder / name, arrays[key], "Y" if key == "albedo" else "Z")
     return {"crater_id": None, "boulder_id": None, **files}
 
 
