@@ -20,6 +20,7 @@ from latlong.sensors import (
     REFLECTANCES,
     CameraSettings,
     LommelSeeliger,
+    Planet,
     Sensor,
     Sun,
 )
@@ -105,6 +106,20 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
                                           "angular radius of the sun (0.2666 at 1 au)",
                                           unit="deg", also=("angular_radius_deg",),
                                           group="light"),
+        "planet_direction": Setting(help="planetshine: direction towards a planet X,Y,Z, body "
+                                    "frame (the Earth for the Moon's night side)",
+                                    parse=numbers(3, "X,Y,Z"), metavar="X,Y,Z", group="light",
+                                    default_text="none"),
+        "planet": Setting(help="planetshine from SPICE: the planet's name or id (with --spice; "
+                          "direction and size from the kernels)", metavar="NAME",
+                          group="light"),
+        "planet_radius_deg": Setting(default_of(Planet, "angular_radius_deg"), "planetshine: "
+                                     "the planet's angular radius (the Earth from the Moon)",
+                                     unit="deg", group="light", range=(0.0, 60.0)),
+        "planet_albedo": Setting(default_of(Planet, "geometric_albedo"), "planetshine: the "
+                                 "planet's geometric albedo (the Earth as a Lambert sphere of Bond "
+                                 "albedo 0.30)", group="light",
+                                 range=(0.0, 1.0)),
         "soft_shadow_samples": into("light", own["soft_shadow_samples"]),
         "bounces": into("light", own["bounces"]),
         "bounce_samples": into("light", own["bounce_samples"]),
@@ -186,10 +201,25 @@ def run_camera(v: Values, load) -> int:
     camera_run(geometry, settings, poses, sun, out, force=v.force, progress=not v.quiet,
                mesh=mesh, model_name=str(v.model),
                frame_info=None if seq is None else seq.frame_info(),
-               body_to_j2000=None if seq is None else seq.body_to_j2000)
+               body_to_j2000=None if seq is None else seq.body_to_j2000,
+               planet=_planet(v, seq))
     if not v.quiet:
         print(f"wrote {len(poses)} frame(s) and {out / 'frames.json'}")
     return 0
+
+
+def _planet(v: Values, seq):
+    """The planet of ``--planet-direction`` (or each frame's from ``--planet`` with
+    ``--spice``), or None."""
+    if v.planet is not None and v.planet_direction is not None:
+        raise CliError("give --planet-direction or --planet (with --spice), not both")
+    if v.planet is None:
+        return None if v.planet_direction is None else \
+            Planet(v.planet_direction, v.planet_radius_deg, v.planet_albedo)
+    if seq is None:
+        raise CliError("--planet NAME takes the planet from the --spice kernels; without "
+                       "them give --planet-direction X,Y,Z")
+    return seq.planets(v.planet_albedo)
 
 
 def register(sub) -> None:

@@ -161,7 +161,7 @@ def spice_of(v: Values):
     try:
         return spice_sequence(v.spice, utc=v.utc, target=v.target, observer=v.observer,
                               frame=v.frame, camera_frame=v.instrument_frame,
-                              abcorr=v.abcorr)
+                              abcorr=v.abcorr, planet=v.get("planet"))
     except (ValueError, FileNotFoundError) as exc:
         raise CliError(str(exc)) from None
 

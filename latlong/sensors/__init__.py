@@ -104,6 +104,7 @@ from .photometry import (
     radiance_factor,
     reflectance_model,
 )
+from .planetshine import Planet
 from .poses import Poses, read_poses
 from .render import SUN_RADIUS_1AU_DEG, Frame, Sun, camera_inside, render
 from .scene_geometry import (
@@ -118,7 +119,7 @@ from .sensor import Sensor, display_image, expose, exposure_for
 __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "CameraSettings",
            "Frame", "Hapke", "Hits", "Lambert", "LidarFrame", "LidarSettings",
-           "LommelSeeliger", "LunarLambert", "Pose", "Poses", "RayMesh", "SceneGeometry",
+           "LommelSeeliger", "LunarLambert", "Planet", "Pose", "Poses", "RayMesh", "SceneGeometry",
            "Sensor", "Sun", "beam_pattern", "boulder_labels", "camera_inside", "camera_run",
            "crater_labels", "display_image", "drape_catalog", "ejecta_albedo", "expose",
            "exposure_for", "lidar_frame",

@@ -14,6 +14,8 @@ from ._render_kernels import _key, _lift, _uniform
 
 # the counter stream of the bounce directions (the sun-disk samples use 1 + sample)
 BOUNCE_STREAM = 1 << 40
+#: added to the sample index for the rays on from the first bounce's hits
+SECOND_BOUNCE = 1 << 32
 
 
 @njit(cache=True, parallel=True)

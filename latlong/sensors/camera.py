@@ -42,8 +42,26 @@ from craters._shared import ParameterError, check_finite, check_int, check_posit
 
 from ._camera_kernels import _distort, _pixel_rays_kernel, _undistort_kernel
 
-__all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix",
+__all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix", "unit_direction",
            "unit_quaternions"]
+
+
+def unit_direction(parameter: str, value) -> np.ndarray:
+    """``value`` as a read-only unit (3,) float64 vector; ValueError naming ``parameter``
+    unless it is 3 finite numbers, not all zero."""
+    try:
+        d = np.array(value, dtype=np.float64).reshape(-1)
+    except (TypeError, ValueError):
+        raise ParameterError(parameter, f"must be 3 numbers; got {value!r}") from None
+    if d.shape != (3,) or not np.isfinite(d).all():
+        raise ParameterError(parameter, f"must be 3 finite numbers; got {value!r}")
+    big = float(np.abs(d).max())
+    if not big > 0:
+        raise ParameterError(parameter, "must not be the zero vector")
+    d = d / big  # 1e308 components do not overflow the norm
+    d = d / np.linalg.norm(d)
+    d.flags.writeable = False
+    return d
 
 #: How far a quaternion's norm may be from 1 (CSV files round to ~1e-7).
 QUATERNION_TOLERANCE = 1e-6

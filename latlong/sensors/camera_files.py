@@ -21,7 +21,9 @@ and how its frames are written is one :class:`CameraSettings` record.
   "files": {"image", "depth", "range", "normals", "crater_id", "boulder_id", ...}}]}``,
   file names relative to the folder (``crater_id`` / ``boulder_id`` null when the model
   has no catalogs), and per frame the projected rim ellipses of the craters seen, plus
-  the distortion, the conventions and the settings used.
+  the distortion, the conventions and the settings used; with planetshine, per frame
+  its ``planet``: direction, angular radius, geometric albedo, phase and irradiance
+  ratio.
 
 The run is written into a hidden temporary folder next to the target, each file
 atomically, and moved into place at the end with ``frames.json`` last
@@ -46,6 +48,7 @@ from .engine import RayMesh
 from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
 from .motion import timed_frame
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry
+from .planetshine import Planet
 from .poses import Poses
 from .render import Frame, Sun, render
 from .runs import check_output_folder, run_folder
@@ -185,8 +188,9 @@ class CameraSettings:
                                        "shadows)", range=(0, 1024))
     """Shadow rays per pixel over the solar disk, [0, 1024] (0: hard shadows)."""
     bounces: int = setting(0, "bounces of light between surfaces (1: crater floors in shadow "
-                           "lit by the sunlit walls; 0: direct sunlight only)", range=(0, 1))
-    """Bounces of light between surfaces, 0 or 1 (:func:`~latlong.sensors.render.render`)."""
+                           "lit by the sunlit walls; 2: and by what those walls received; "
+                           "0: direct sunlight only)", range=(0, 2))
+    """Bounces of light between surfaces, 0, 1 or 2 (:func:`~latlong.sensors.render.render`)."""
     bounce_samples: int = setting(16, "rays a pixel for the bounced light (its noise falls as "
                                   "1 / sqrt of this)", range=(1, 4096))
     """Cosine-weighted rays a pixel for the bounced light, [1, 4096]."""
@@ -246,10 +250,29 @@ class CameraSettings:
                            for f in fields(self.sensor)}}
 
 
+def _per_pose(planet, n: int) -> list[Planet | None]:
+    """One :class:`Planet` (or None) per pose."""
+    if planet is None or isinstance(planet, Planet):
+        return [planet] * n
+    planets = list(planet)
+    if len(planets) != n or not all(isinstance(p, Planet) for p in planets):
+        raise ParameterError("planet", f"must be a Planet or {n} Planet, one per pose")
+    return planets
+
+
+def _planet_entry(planet: Planet, sun: Sun) -> dict:
+    """The planet of a frame in its manifest entry."""
+    return {"direction": planet.direction.tolist(),
+            "angular_radius_deg": planet.angular_radius_deg,
+            "geometric_albedo": planet.geometric_albedo,
+            "phase_deg": planet.phase_deg(sun.direction),
+            "irradiance_ratio": planet.irradiance_ratio(sun.direction)}
+
+
 def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, craters=None,
                force: bool = False, progress: bool = False, mesh: RayMesh | None = None,
                model_name: str = "", frame_info: list[dict] | None = None,
-               body_to_j2000: np.ndarray | None = None) -> dict:
+               body_to_j2000: np.ndarray | None = None, planet=None) -> dict:
     """Render every frame of ``poses`` and write the run folder (module notes); the
     ``frames.json`` document.
 
@@ -261,8 +284,9 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     :class:`RayMesh` if built already; ``model_name`` names the model in the manifest
     (default: the surface's source); ``frame_info`` a dict per frame added to its
     manifest entry (e.g. SPICE's ``et_s`` and ``utc``); ``body_to_j2000`` (n, 3, 3) the
-    body frame's orientation per frame for the stars (default: J2000). The same shape as
-    :func:`~latlong.sensors.lidar_files.lidar_run`.
+    body frame's orientation per frame for the stars (default: J2000); ``planet`` a
+    :class:`~latlong.sensors.planetshine.Planet` (or one per pose) whose light is added
+    (planetshine). The same shape as :func:`~latlong.sensors.lidar_files.lidar_run`.
     """
     if not isinstance(settings, CameraSettings):
         raise TypeError(f"`settings` must be CameraSettings; got {type(settings).__name__}")
@@ -273,6 +297,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     if len(suns) != len(poses) or not all(isinstance(s, Sun) for s in suns):
         raise ParameterError("sun", f"must be a Sun, a direction, or {len(poses)} Sun, one "
                              f"per pose; got {len(suns)}")
+    planets = _per_pose(planet, len(poses))
     if frame_info is not None and len(frame_info) != len(poses):
         raise ParameterError("frame_info", f"must hold {len(poses)} dicts, one per pose")
     folder = check_output_folder(folder, force=force)
@@ -287,13 +312,13 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         flow = "flow" in settings.datasets.split(",")
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
-            def render_at(camera, pose, sun=suns[k]):
+            def render_at(camera, pose, sun=suns[k], planet=planets[k]):
                 return render(mesh, camera, pose, sun, reflectance=settings.reflectance,
                               sensor=settings.sensor,
                               soft_shadow_samples=settings.soft_shadow_samples,
                               seed=settings.seed, ground_truth=geometry,
                               vertex_albedo=albedo, bounces=settings.bounces,
-                              bounce_samples=settings.bounce_samples)
+                              bounce_samples=settings.bounce_samples, planet=planet)
 
             frame = timed_frame(render_at, poses, k, settings.camera, settings.sensor,
                                 blur_samples=settings.blur_samples,
@@ -312,6 +337,8 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
             entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
             if frame_info is not None:
                 entries[-1].update(frame_info[k])
+            if planets[k] is not None:
+                entries[-1]["planet"] = _planet_entry(planets[k], suns[k])
         doc = manifest(settings.camera, entries, model=model_name or geometry.source,
                        **settings.record(suns[0]))
         if settings.datasets:

@@ -20,9 +20,16 @@ With ``bounces=1`` each seen point also gets the light the surface sends it once
 pixel and sample), the I/F of the sunlit facet each ray hits seen back along the ray
 (the model at that facet, its albedo factor and cast shadow), averaged and times the
 point's normal albedo, as a Lambertian surface receives it (exact for Lambert; an
-approximation of the second scattering for the other models). A spherical bowl gets its
-closed form within 3 % and a crater's shadowed floor Mitsuba 3's path tracer within
-3.5 % (``tests/benchmarks/compare_bounce_mitsuba.py``). The sky sends nothing.
+approximation of the second scattering for the other models). With ``bounces=2`` each
+of those rays goes on once from the facet it hit (a cosine-weighted ray about the
+facet's normal, a second counter stream): the light that facet received once, times
+its albedo as a Lambertian surface, is added to what it sends back. A spherical bowl
+gets its closed form (every further bounce is the last times albedo x the bowl's share
+of the sphere: Ingersoll, Svitek & Murray 1992) within 3 % for one bounce and 4 % for
+the second; a crater's shadowed floor Mitsuba 3's path tracer within 3.5 % for one
+bounce (``tests/benchmarks/compare_bounce_mitsuba.py``). The sky sends nothing but,
+with ``planet``, a planet's light (:mod:`.planetshine`): shaded and shadowed as the
+sun's, scaled by its irradiance ratio.
 
 Ground truth per pixel (NaN / -1 where the ray misses): ``depth_m`` (camera z) and
 ``range_m`` (distance) as float32, ``position_m`` (body frame, float64), ``normals``
@@ -39,17 +46,18 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_range
 
-from ._bounce_kernels import _bounce_light_kernel, _bounce_rays_kernel
+from ._bounce_kernels import SECOND_BOUNCE, _bounce_light_kernel, _bounce_rays_kernel
 from ._render_kernels import (
     _ground_truth_kernel,
     _shade_kernel,
     _shadow_rays_kernel,
     _surface_kernel,
 )
-from .camera import Camera, Pose
+from .camera import Camera, Pose, unit_direction
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
 from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert, radiance_factor
+from .planetshine import Planet
 from .scene_geometry import SceneGeometry, traced_model
 from .sensor import Sensor, expose, exposure_for
 
@@ -62,6 +70,8 @@ SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
 #: least 1e-3 of that times the bounding radius: a 700 km DEM mesh lifts points near its
 #: centre by millimetres, not by 2e-6 of its radius (1.4 m, shortening low-sun shadows).
 SHADOW_OFFSET = 2e-6
+#: The counter streams of the samples over the planet's disk (the sun's: 1 + sample).
+PLANET_STREAM = 1 << 36
 
 
 @dataclass(frozen=True, slots=True)
@@ -75,19 +85,7 @@ class Sun:
     """Angular radius of the solar disk, degrees (0: a point; 0.2666 at 1 au), [0, 5]."""
 
     def __post_init__(self):
-        try:
-            d = np.array(self.direction, dtype=np.float64).reshape(-1)
-        except (TypeError, ValueError):
-            raise ParameterError("sun_direction", f"must be 3 numbers; got "
-                                 f"{self.direction!r}") from None
-        norm = float(np.linalg.norm(d)) if d.shape == (3,) else 0.0
-        if d.shape != (3,) or not np.isfinite(d).all():
-            raise ParameterError("sun_direction", f"must be 3 finite numbers; got "
-                                 f"{self.direction!r}")
-        if not norm > 0:
-            raise ParameterError("sun_direction", "must not be the zero vector")
-        d = d / norm
-        d.flags.writeable = False
+        d = unit_direction("sun_direction", self.direction)
         object.__setattr__(self, "direction", d)
         object.__setattr__(self, "angular_radius_deg", check_range(
             "angular_radius_deg", self.angular_radius_deg, 0.0, 5.0))
@@ -195,8 +193,10 @@ def _vertex_normals(mesh: RayMesh, normals):
     return n
 
 
-def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndarray:
-    """Lit fraction per hit: facet faces the sun and the shadow ray is free."""
+def _sunlit(mesh, pos, ng, facing, sun: Sun | Planet, samples: int, seed: int,
+            stream: int = 0) -> np.ndarray:
+    """Lit fraction per hit: facet faces the light and the shadow ray is free (samples
+    over the light's disk from the counter streams ``stream`` + sample)."""
     lit = np.zeros(len(pos))
     cand = np.flatnonzero(facing)
     if not len(cand):
@@ -210,7 +210,7 @@ def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndar
     total = np.zeros(len(cand))
     for k in range(max(samples, 1)):
         _shadow_rays_kernel(p, n, SHADOW_OFFSET, centre, floor, sun.direction, radius, seed,
-                            k, o, d, face_ok)
+                            stream + k, o, d, face_ok)
         free = face_ok & ~mesh.occluded(o, d, np.inf)
         total += free
     lit[cand] = total / max(samples, 1)
@@ -218,9 +218,10 @@ def _sunlit(mesh, pos, ng, facing, sun: Sun, samples: int, seed: int) -> np.ndar
 
 
 def _indirect(mesh: RayMesh, photometry, pos, ng, ns, albedo, vertex_albedo, sun: Sun,
-              samples: int, seed: int) -> np.ndarray:
-    """One bounce of light (module notes): I/F added at each point ``pos`` (n, 3) by the
-    sunlit surface it sees, sampled with ``samples`` cosine-weighted rays a point."""
+              samples: int, seed: int, bounces: int = 1) -> np.ndarray:
+    """Bounced light (module notes): I/F added at each point ``pos`` (n, 3) by the sunlit
+    surface it sees (``samples`` cosine-weighted rays a point) and, with ``bounces`` 2,
+    by the light that surface received once from the rest (one ray on from each hit)."""
     centre, radius_m = mesh.bounding_sphere
     floor = 1e-3 * SHADOW_OFFSET * radius_m
     n = len(pos)
@@ -228,24 +229,69 @@ def _indirect(mesh: RayMesh, photometry, pos, ng, ns, albedo, vertex_albedo, sun
     o, d = np.empty((n, 3)), np.empty((n, 3))
     above = np.empty(n, dtype=np.bool_)
     total = np.zeros(n)
-    light = np.empty(n)
+    # the receiving points as Lambertian surfaces of the model's normal albedo
+    normal_albedo = float(radiance_factor(photometry, 1.0, 1.0, 1.0)[0])
     for k in range(samples):
         _bounce_rays_kernel(p, g, h, SHADOW_OFFSET, centre, floor, seed, k, o, d, above)
-        hits = mesh.intersect(o, d)
-        face = np.where(above, hits.face, -1)
-        seen = face >= 0
-        q = hits.points(o, d)
-        nq = np.zeros((n, 3))
-        nq[seen] = mesh.face_normals[face[seen]]
-        facing = seen & (nq @ sun.direction > 0.0)
-        lit = _sunlit(mesh, q, nq, facing, sun, 0, seed)
-        _bounce_light_kernel(photometry.code, photometry.vector(), d, face,
-                             mesh.face_normals, _vertex_albedo(mesh, vertex_albedo, hits),
-                             sun.direction, lit, light)
-        total += light
-    # the receiving point as a Lambertian surface of the model's normal albedo
-    normal_albedo = float(radiance_factor(photometry, 1.0, 1.0, 1.0)[0])
+        face, q, nq, hits = _secondary_hits(mesh, o, d, above)
+        total += _seen_light(mesh, photometry, d, face, q, nq, hits, vertex_albedo, sun,
+                             seed)
+        front = np.flatnonzero((face >= 0) & (np.einsum("ij,ij->i", nq, d) < 0.0))
+        if bounces < 2 or not len(front):
+            continue
+        # one ray on from each front-facing hit: its own once-bounced light, received as
+        # a Lambertian surface of its albedo (the second counter stream of the sample)
+        q2, n2 = np.ascontiguousarray(q[front]), np.ascontiguousarray(nq[front])
+        o2, d2 = np.empty_like(q2), np.empty_like(q2)
+        above2 = np.empty(len(front), dtype=np.bool_)
+        _bounce_rays_kernel(q2, n2, n2, SHADOW_OFFSET, centre, floor, seed,
+                            SECOND_BOUNCE + k, o2, d2, above2)
+        face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
+        rho = normal_albedo * _vertex_albedo(mesh, vertex_albedo, hits)[front]
+        total[front] += rho * _seen_light(mesh, photometry, d2, face2, r2, nr2, hits2,
+                                          vertex_albedo, sun, seed)
     return normal_albedo * albedo * total / samples
+
+
+def _secondary_hits(mesh: RayMesh, o, d, above):
+    """(face or -1, hit points, their facet normals (0 on a miss), hits) of rays that
+    leave their facet (``above``)."""
+    hits = mesh.intersect(o, d)
+    face = np.where(above, hits.face, -1)
+    seen = face >= 0
+    q = hits.points(o, d)
+    nq = np.zeros((len(face), 3))
+    nq[seen] = mesh.face_normals[face[seen]]
+    return face, q, nq, hits
+
+
+def _seen_light(mesh: RayMesh, photometry, d, face, q, nq, hits, vertex_albedo, sun: Sun,
+                seed: int) -> np.ndarray:
+    """The direct I/F of each secondary hit seen back along its ray (0 for a miss)."""
+    facing = (face >= 0) & (nq @ sun.direction > 0.0)
+    lit = _sunlit(mesh, q, nq, facing, sun, 0, seed)
+    light = np.empty(len(face))
+    _bounce_light_kernel(photometry.code, photometry.vector(), d, face, mesh.face_normals,
+                         _vertex_albedo(mesh, vertex_albedo, hits), sun.direction, lit,
+                         light)
+    return light
+
+
+def _planetshine(mesh: RayMesh, photometry, origin, dirs, hits, vnormals, planet: Planet,
+                 sun: Sun, albedo, samples: int, seed: int) -> np.ndarray:
+    """I/F the planet's light adds at each pixel (:mod:`.planetshine`): the reflectance
+    model lit from the planet, its cast shadows, times its irradiance ratio."""
+    n = len(hits.face)
+    pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
+    facing = np.empty(n, dtype=np.bool_)
+    smooth = vnormals is not None
+    _surface_kernel(origin, dirs, hits.t_m, hits.face, hits.u, hits.v, mesh.vertices,
+                    mesh.faces, vnormals if smooth else np.zeros((1, 3)), smooth,
+                    planet.direction, pos, ng, ns, cosines, facing)
+    lit = _sunlit(mesh, pos, ng, facing, planet, samples, seed, PLANET_STREAM)
+    out = np.empty(n)
+    _shade_kernel(photometry.code, photometry.vector(), cosines, lit, albedo, out)
+    return planet.irradiance_ratio(sun.direction) * out
 
 
 def _primary(mesh: RayMesh, camera: Camera, pose: Pose):
@@ -267,7 +313,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
            soft_shadow_samples: int = 0, seed: int = 0,
            ground_truth: SceneGeometry | None = None, bounces: int = 0,
-           bounce_samples: int = 16) -> Frame:
+           bounce_samples: int = 16, planet: Planet | None = None) -> Frame:
     """Render one frame of ``model`` seen by ``camera`` at ``pose``, lit by ``sun`` (a
     :class:`Sun` or a direction towards it). See the module notes.
 
@@ -281,8 +327,10 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     (e.g. a sphere's exact radial directions); ``vertex_albedo`` an optional (n,) factor
     per vertex; ``seed`` keys the sun-disk samples and the sensor noise. With ground
     truth the frame has the crater-id and boulder-id label images. ``bounces`` 1 adds
-    the light the surface sends to itself once (``bounce_samples`` rays a pixel; 0: the
-    sun's direct light only).
+    the light the surface sends to itself once (``bounce_samples`` rays a pixel), 2 that
+    light bounced once more (0: the sun's direct light only). ``planet`` adds a
+    :class:`~latlong.sensors.planetshine.Planet`'s light (its disk sampled like the sun's
+    with ``soft_shadow_samples``).
     """
     if not isinstance(camera, Camera):
         raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
@@ -294,9 +342,12 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     if not isinstance(sensor, Sensor):
         raise TypeError(f"`sensor` must be a Sensor; got {type(sensor).__name__}")
     samples = check_int("soft_shadow_samples", soft_shadow_samples, 0, 1024)
-    bounces = check_int("bounces", bounces, 0, 1)
+    bounces = check_int("bounces", bounces, 0, 2)
     bounce_samples = check_int("bounce_samples", bounce_samples, 1, 4096)
     seed = check_int("seed", seed, 0, 2**63 - 1)
+    if planet is not None and not isinstance(planet, Planet):
+        raise TypeError(f"`planet` must be a Planet; got {type(planet).__name__}")
+    planet_samples = samples
     if sun.angular_radius_deg == 0.0:
         samples = 0
     mesh, ground_truth = traced_model(model, ground_truth)
@@ -318,7 +369,11 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     if bounces:
         seen = face >= 0
         refl[seen] += _indirect(mesh, photometry, pos[seen], ng[seen], ns[seen],
-                                albedo[seen], vertex_albedo, sun, bounce_samples, seed)
+                                albedo[seen], vertex_albedo, sun, bounce_samples, seed,
+                                bounces)
+    if planet is not None:
+        refl += _planetshine(mesh, photometry, origin, dirs, hits, vnormals, planet, sun,
+                             albedo, planet_samples, seed)
     refl = refl.reshape(h, w)
     depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))
     angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))

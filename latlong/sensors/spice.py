@@ -9,7 +9,9 @@ For each time of a sequence (UTC ``START,STOP,STEP_S``, or ephemeris times):
 * its orientation: the rotation from the ``camera_frame`` to ``frame``
   (:func:`spiceypy.pxform`), the camera frame taken in the OpenCV convention (+Z the
   boresight, +X right and +Y down in the image, as most instrument kernels define it);
-* the sun: the unit direction from the target's centre to the sun in ``frame``.
+* the sun: the unit direction from the target's centre to the sun in ``frame``;
+* with ``planet`` (planetshine, :mod:`.planetshine`): its direction the same way and its
+  angular radius from its mean radius (``BODYnnn_RADII``) and distance.
 
 ``abcorr`` is SPICE's aberration correction (``NONE``: geometric). Kernels are a
 meta-kernel (``.tm``) or kernel files; each is checked before it is loaded, and every
@@ -29,6 +31,7 @@ import numpy as np
 from craters._shared import ParameterError
 
 from .camera import quaternion_from_matrix
+from .planetshine import Planet
 from .poses import Poses
 
 __all__ = ["MAX_SPICE_FRAMES", "SpiceSequence", "parse_utc_range", "spice_camera",
@@ -50,6 +53,19 @@ class SpiceSequence:
     """ISO UTC of each frame (``YYYY-MM-DDTHH:MM:SS.ffffff``)."""
     body_to_j2000: np.ndarray
     """(n, 3, 3) rotations from the body-fixed frame to J2000 (for the stars)."""
+    planet_directions: np.ndarray | None = None
+    """(n, 3) unit directions from the target's centre towards the ``planet``'s, body-fixed
+    frame (None without a planet)."""
+    planet_radii_deg: np.ndarray | None = None
+    """(n,) angular radius of the planet seen from the target's centre, degrees (its mean
+    radius from the kernels' ``BODYnnn_RADII``)."""
+
+    def planets(self, geometric_albedo: float) -> list[Planet] | None:
+        """The :class:`~latlong.sensors.planetshine.Planet` of each frame (None without)."""
+        if self.planet_directions is None or self.planet_radii_deg is None:
+            return None
+        return [Planet(d, float(r), geometric_albedo)
+                for d, r in zip(self.planet_directions, self.planet_radii_deg, strict=True)]
 
     def frame_info(self) -> list[dict]:
         """Per frame ``{"et_s", "utc"}`` for the run's manifest."""
@@ -121,9 +137,10 @@ def _loaded(kernels) -> Iterator[None]:
 
 def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_frame: str,
                    utc=None, et: Sequence[float] | None = None,
-                   abcorr: str = "NONE") -> SpiceSequence:
+                   abcorr: str = "NONE", planet: str | None = None) -> SpiceSequence:
     """The poses and sun directions of the times ``utc`` (``"START,STOP,STEP_S"``) or
-    ``et`` (ephemeris seconds) from SPICE ``kernels`` (module notes)."""
+    ``et`` (ephemeris seconds) from SPICE ``kernels`` (module notes); with ``planet`` (a
+    SPICE body name or id) also its direction and angular radius."""
     import spiceypy as sp
     from spiceypy.utils.exceptions import SpiceyError
 
@@ -135,8 +152,10 @@ def spice_sequence(kernels, *, target: str, observer: str, frame: str, camera_fr
                                             observer=observer, frame=frame,
                                             camera_frame=camera_frame, abcorr=abcorr)
         stamps = tuple(sp.et2utc(float(t), "ISOC", 6) for t in times)
+        shine = {} if planet is None else _planet(sp, SpiceyError, times, planet=planet,
+                                                  target=target, frame=frame, abcorr=abcorr)
     poses = Poses(times, pos, np.array([quaternion_from_matrix(r) for r in rot]))
-    return SpiceSequence(poses, sun, stamps, inertial)
+    return SpiceSequence(poses, sun, stamps, inertial, **shine)
 
 
 def spice_camera(kernels, instrument: str, **distortion):
@@ -226,3 +245,26 @@ def _geometry(sp, error, times, *, target, observer, frame, camera_frame, abcorr
                              f"in the kernels loaded: {_short(exc)}") from None
         sun[k] = s / np.linalg.norm(s)
     return pos, rot, sun, inertial
+
+
+def _planet(sp, error, times, *, planet, target, frame, abcorr) -> dict:
+    """{planet_directions, planet_radii_deg} of ``planet`` seen from ``target``."""
+    try:
+        radius_km = float(np.mean(sp.bodvrd(planet, "RADII", 3)[1]))
+    except error as exc:
+        raise ValueError(f"SPICE has no radii of planet {planet!r} in the kernels loaded "
+                         f"(BODYnnn_RADII of a PCK): {_short(exc)}") from None
+    d = np.empty((len(times), 3))
+    for k, t in enumerate(times):
+        try:
+            d[k] = np.asarray(sp.spkpos(planet, t, frame, abcorr, target)[0])
+        except error as exc:
+            raise ValueError(f"SPICE has no planet {planet!r} relative to target {target!r} "
+                             f"at {sp.et2utc(float(t), 'ISOC', 3)} UTC in the kernels loaded: "
+                             f"{_short(exc)}") from None
+    dist = np.linalg.norm(d, axis=1)
+    if not (dist > radius_km).all():
+        raise ValueError(f"planet {planet!r} is not outside target {target!r}'s centre by "
+                         "more than its radius")
+    return {"planet_directions": d / dist[:, None],
+            "planet_radii_deg": np.degrees(np.arcsin(radius_km / dist))}

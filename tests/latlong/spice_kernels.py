@@ -1,6 +1,7 @@
 """Tiny SPICE kernels written by the tests (no downloads): a leapseconds kernel, the
-Moon's IAU rotation, a spacecraft clock and frame, an SPK of the spacecraft and the sun
-(type 8, relative to the Moon) and a CK of the camera (type 3), plus a meta-kernel."""
+Moon's IAU rotation and the Earth's radii, a spacecraft clock and frame, an SPK of the
+spacecraft, the sun and the Earth (type 8, relative to the Moon) and a CK of the camera
+(type 3), plus a meta-kernel."""
 
 from __future__ import annotations
 
@@ -33,6 +34,7 @@ BODY301_POLE_RA = ( 269.9949 0.0031 0. )
 BODY301_POLE_DEC = ( 66.5392 0.0130 0. )
 BODY301_PM = ( 38.3213 13.17635815 -1.4D-12 )
 BODY301_RADII = ( 1737.4 1737.4 1737.4 )
+BODY399_RADII = ( 6378.1366 6378.1366 6356.7519 )
 \begintext
 """
 
@@ -129,6 +131,11 @@ def write_kernels(folder: Path, *, duration_s: float = 600.0) -> Path:
                   np.hstack([p, v]), t[0], step)
         sp.spkw08(handle, 10, 301, "J2000", t[0], t[-1], "sun", 3, n,
                   np.hstack([sun, np.gradient(sun, step, axis=0)]), t[0], step)
+        # the Earth 384 400 km away, moving slowly
+        earth = np.column_stack([-3.0e5 + 1.0 * (t - t0), 2.4e5 * np.ones(n),
+                                 1.0e4 * np.ones(n)])
+        sp.spkw08(handle, 399, 301, "J2000", t[0], t[-1], "earth", 3, n,
+                  np.hstack([earth, np.gradient(earth, step, axis=0)]), t[0], step)
         sp.spkcls(handle)
         ticks = np.array([sp.sce2c(SC, float(x)) for x in t])
         quats = np.array([sp.m2q(nadir_c_matrix(x)) for x in p])

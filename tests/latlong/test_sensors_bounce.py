@@ -1,6 +1,8 @@
-"""Light bounced between surfaces (latlong.sensors.render, ``bounces=1``): the kernels
-against numpy, and a spherical bowl against its closed form (every point of a sphere's
-inside sees every other with the same form factor, 1 / (4 pi R^2) per unit area)."""
+"""Light bounced between surfaces (latlong.sensors.render, ``bounces`` 1 and 2): the
+kernels against numpy, and a spherical bowl against its closed form (every point of a
+sphere's inside sees every other with the same form factor, 1 / (4 pi R^2) per unit
+area, so each further bounce is the last one times albedo x the bowl's area / 4 pi R^2:
+the uniform scattered light of Ingersoll, Svitek & Murray 1992's spherical bowls)."""
 
 from __future__ import annotations
 
@@ -65,6 +67,24 @@ def test_a_bowl_receives_its_closed_form_bounce(bowl):
     np.testing.assert_array_equal(again.reflectance, bounced.reflectance)
     np.testing.assert_array_equal(render(bowl, CAM, POSE, SUN, bounces=0, **kw).image,
                                   direct.image)
+
+
+def test_a_second_bounce_adds_albedo_times_the_bowls_share_of_the_sphere(bowl):
+    kw = {"reflectance": Lambert(ALBEDO), "bounce_samples": 256, "seed": 3}
+    once = render(bowl, CAM, POSE, SUN, bounces=1, **kw)
+    twice = render(bowl, CAM, POSE, SUN, bounces=2, **kw)
+    seen = once.face >= 0
+    v, f = bowl.vertices, bowl.faces
+    area = 0.5 * np.linalg.norm(np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]]),
+                                axis=1).sum()
+    want = ALBEDO * area / (4.0 * np.pi * R * R) * closed_form(bowl)  # ~0.19 of bounce 1
+    added = (twice.reflectance - once.reflectance)[seen]
+    assert abs(added.mean() / want - 1.0) < 0.04
+    assert (added >= 0).all()  # the first bounce's rays are the same rays
+    np.testing.assert_array_equal(render(bowl, CAM, POSE, SUN, bounces=2, **kw).reflectance,
+                                  twice.reflectance)
+    with pytest.raises(ValueError, match="bounces"):
+        render(bowl, CAM, POSE, SUN, bounces=3)
 
 
 def test_bounce_directions_are_cosine_weighted_about_the_normal():

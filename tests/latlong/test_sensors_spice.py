@@ -56,6 +56,29 @@ def test_a_sequence_is_what_spiceypy_gives(kernels):
     assert sp.ktotal("ALL") == 0
 
 
+def test_the_planet_is_where_spiceypy_puts_it(kernels):
+    seq = spice_sequence(kernels, utc=f"{START_UTC},2025-03-01T12:02:00,60", planet="EARTH",
+                         **ARGS)
+    assert seq.planet_directions is not None and seq.planet_radii_deg is not None
+    sp.furnsh(str(kernels))
+    try:
+        radius = np.mean(sp.bodvrd("EARTH", "RADII", 3)[1])
+        for k, t in enumerate(seq.poses.time_s):
+            e = np.asarray(sp.spkpos("EARTH", t, "IAU_MOON", "NONE", "MOON")[0])
+            assert angle(seq.planet_directions[k], e) <= 1e-9
+            assert seq.planet_radii_deg[k] == pytest.approx(
+                np.degrees(np.arcsin(radius / np.linalg.norm(e))), rel=1e-12)
+    finally:
+        sp.kclear()
+    assert 0.9 < seq.planet_radii_deg[0] < 1.0
+    planets = seq.planets(0.434)
+    assert planets is not None and len(planets) == 3 and planets[1].geometric_albedo == 0.434
+    assert spice_sequence(kernels, utc=f"{START_UTC},{START_UTC},1", **ARGS).planets(0.4) \
+        is None
+    with pytest.raises(ValueError, match="radii of planet 'MARS'"):
+        spice_sequence(kernels, utc=f"{START_UTC},{START_UTC},1", planet="MARS", **ARGS)
+
+
 def test_kernels_listed_one_by_one_and_ephemeris_times(kernels):
     files = [str(kernels.parent / n) for n in ("test.tls", "moon.tpc", "craft.tsc",
                                                "craft.tf", "craft.ti", "craft.bsp", "craft.bc")]
@@ -138,6 +161,39 @@ def test_the_camera_command_flies_a_spice_sequence(kernels, run_cli, tmp_path):
             extra = []
         proc = run_cli("latlong", "camera", str(model), "-o", str(tmp_path / "x"),
                        "--fov-deg", "20", "--size", "40x30", *args, *extra, "-q")
+        assert proc.returncode == 2 and message in proc.stderr, proc.stderr
+        assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
+
+
+def test_the_camera_command_takes_the_planet_from_the_kernels(kernels, run_cli, tmp_path):
+    import json
+
+    from latlong import Body, LatLongGrid
+
+    model = tmp_path / "moon.npz"
+    Body.sphere(LatLongGrid(20), 1737400.0).save(model)
+    utc = f"{START_UTC},2025-03-01T12:00:30,30"
+    spice = ["--spice", str(kernels), "--utc", utc, "--target", "MOON", "--observer",
+             "TESTCRAFT", "--frame", "IAU_MOON", "--instrument-frame", CAM_FRAME]
+    out = tmp_path / "frames"
+    proc = run_cli("latlong", "camera", str(model), "-o", str(out), "--fov-deg", "20",
+                   "--size", "16x12", *spice, "--planet", "EARTH", "-q")
+    assert proc.returncode == 0, proc.stderr
+    doc = json.loads((out / "frames.json").read_text())
+    seq = spice_sequence(kernels, utc=utc, planet="EARTH", **ARGS)
+    for k, frame in enumerate(doc["frames"]):
+        assert angle(frame["planet"]["direction"], seq.planet_directions[k]) <= 1e-12
+        assert frame["planet"]["angular_radius_deg"] == seq.planet_radii_deg[k]
+        assert frame["planet"]["geometric_albedo"] == 0.2
+        assert 0.0 < frame["planet"]["irradiance_ratio"] < 6.0e-5
+    for args, message in ((["--planet", "EARTH", "--fov-deg", "20", "--size", "16x12",
+                            "--sun-direction", "1,0,0"], "--spice"),
+                          ([*spice, "--planet", "EARTH", "--planet-direction", "0,0,1",
+                            "--fov-deg", "20", "--size", "16x12"], "not both")):
+        proc = run_cli("latlong", "camera", str(model), "-o", str(tmp_path / "x"), *args,
+                       "--position-m", "0,0,3000000", "--quaternion", "0,1,0,0", "-q") \
+            if "--spice" not in args else \
+            run_cli("latlong", "camera", str(model), "-o", str(tmp_path / "x"), *args, "-q")
         assert proc.returncode == 2 and message in proc.stderr, proc.stderr
         assert proc.stderr.count("\n") == 1 and "Traceback" not in proc.stderr
 
