@@ -10,37 +10,11 @@ ADS bibcode, PMID) in ``venue``. A title that no record confirmed is kept but ma
 ``(title not confirmed)`` in ``venue``; where no title is known at all the title is
 ``(title not confirmed; cited by venue)``.
 
-The entries, by topic (keys of :data:`REFERENCES`):
-
-* The source papers: ``martin2014asteroid`` (lat/long mesh, faulting, fBm, stamping,
-  boulders, slopes), ``martin2014lunar`` (crater model, DEM gap filling, RMD expansion),
-  ``li2020`` and ``li2022`` (implicit backend, LCSN kernels).
-* Crater shapes and their scaling: ``pike1977`` ``pike1980`` ``pike1985`` ``pike1988``
-  ``hale1979`` ``melosh1989`` ``baker2011`` ``garvin1998`` ``grieve1987`` ``sun2023``
-  ``hiesinger2016`` ``marchi2015`` ``daly2020`` ``mcgetchin1973``.
-* Degradation: ``fassett2014`` ``fassett2015`` ``guizar2004``.
-* Production, chronology, equilibrium, counts: ``neukum1983`` ``neukum2001``
-  ``neukum2001mercury`` ``ivanov2001`` ``hartmann2001`` ``strom1988``
-  ``schmedemann2014vesta`` ``schmedemann2014phobos`` ``trask1966`` ``hartmann1984``
-  ``michael2010`` ``michael2013`` ``kneissl2011`` ``robbins2019``; body radii
-  ``archinal2018`` ``russell2012`` ``park2016`` ``thomas1994`` ``thomas1996``
-  ``sierks2011`` ``willner2014``.
-* Asteroid presets: Eros ``veverka2000`` ``chapman2002`` ``berthoud2001`` ``thomas2001``
-  ``michikami2021`` ``yeomans2000`` ``zuber2000``; Itokawa ``saito2006`` ``hirata2009``
-  ``michel2009`` ``michikami2008`` ``fujiwara2006``; Bennu ``nolan2013`` ``bierhaus2022``
-  ``walsh2019`` ``dellagiustina2019`` ``scheeres2019``.
-* Gravity: ``werner1997`` ``tsoulis2012`` ``schuhmacher2024`` ``tiesinga2021``.
-* Rocks: ``golombek1997`` ``golombek2003``.
-* Terrain: ``horn1981`` ``zevenbergen1987`` ``peitgen1988`` ``rosenburg2011``
-  ``perlin2002`` ``steele2014``.
-* Implicit surfaces and meshes: ``wyvill1986`` ``weller2010`` ``zorin1996``
-  ``baerentzen2005`` ``lagae2009`` ``galerne2012`` ``ericson2005`` ``max1999``.
-* Randomness of terrain on demand: ``salmon2011`` (counter-based Philox).
-* Sensors: ``moller1997`` ``wald2014`` ``shepperd1978`` ``brown1966`` ``conrady1919``
-  ``hofle2007`` ``frisvad2012`` ``duff2017``; stars ``hoffleit1991`` ``willmer2018``;
-  photometry ``lommel1887`` ``seeliger1888`` ``mcewen1991`` ``mcewen1996`` ``hapke1984``
-  ``hapke1986`` ``hapke2002`` ``hapke2008`` ``hapke2012`` ``helfenstein1987``
-  ``helfenstein1989`` ``ishiguro2014`` ``li2004``; albedo ``grier2001``.
+The table :data:`REFERENCES` is grouped by topic: the source papers (Martin et al.'s
+two, Li et al.'s two), crater shapes and their scaling, degradation, production and
+chronology, body radii, the asteroid presets (Eros, Itokawa, Bennu), gravity, terrain,
+implicit surfaces and meshes, randomness, and the sensors (ray tracing, cameras, stars,
+photometry, light between surfaces and from planets).
 
 Examples
 --------

@@ -133,6 +133,7 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
                           kind=float, group="light",
                           default_text=shown_value(default_of(LommelSeeliger, "albedo"))),
         "bright_ejecta": into("light", own["bright_ejecta"]),
+        "bands": into("light", own["bands"]),
         "hapke_preset": Setting(help="Hapke parameters", choices=tuple(HAPKE_PRESETS),
                                 default_text="s-type", also=("preset",), group="light"),
         **SENSOR,

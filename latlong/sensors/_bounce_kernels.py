@@ -1,4 +1,4 @@
-"""Numba kernels of the interreflection (:mod:`latlong.sensors.bounce`). References in
+"""Numba kernels of the interreflection (:mod:`latlong.sensors.light`). References in
 numpy: ``tests/latlong/test_sensors_bounce.py``."""
 
 from __future__ import annotations

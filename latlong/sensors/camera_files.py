@@ -4,8 +4,10 @@ frames and the ``frames.json`` manifest (issue 17's interface) into a run folder
 and how its frames are written is one :class:`CameraSettings` record.
 
 * :func:`write_frame`: one frame's files, each written atomically: the image (16- or
-  8-bit PNG of linear DN, or float32 TIFF of I/F for a float sensor), an 8-bit sRGB
-  ``display`` PNG of it for people (:func:`~latlong.sensors.sensor.display_image`),
+  8-bit PNG of linear DN, or float32 TIFF of I/F for a float sensor; for a multi-band
+  camera one TIFF of all bands, each band's name its description), an 8-bit sRGB
+  ``display`` PNG of it for people (:func:`~latlong.sensors.sensor.display_image`; the
+  first three bands as red, green, blue),
   depth and range (float32 ``.tif``, ``.npy`` or ``.exr``), normals (float32 (H, W, 3)
   ``.npy``, or ``.exr``) and, on request, the other ground truth (incidence / emission /
   phase angles, position, face id, lit fraction, albedo, as .npy); the crater-id and
@@ -47,7 +49,7 @@ from .datasets import optical_flow, parse_datasets, write_datasets, write_flow
 from .engine import RayMesh
 from .labels import ELLIPSE_DTYPE, FittedRims, rim_ellipses
 from .motion import timed_frame
-from .photometry import REFLECTANCES, LommelSeeliger, Photometry
+from .photometry import REFLECTANCES, LommelSeeliger, Photometry, with_albedo
 from .planetshine import Planet
 from .poses import Poses
 from .render import Frame, Sun, render
@@ -70,7 +72,9 @@ CONVENTIONS = ("OpenCV camera frame (x right, y down, z forward); quaternion_wxy
                "where no surface; normals = unit shading normals in the body frame.")
 
 
-def _save(path: Path, array: np.ndarray, channel: str = "Z") -> None:
+def _save(path: Path, array: np.ndarray, channel: str | tuple[str, ...] = "Z") -> None:
+    """One file of a frame by its suffix; ``channel`` names an EXR's float channel, or
+    the bands of an (H, W, bands) image (TIFF band descriptions, EXR channels)."""
     from PIL import Image
 
     with atomic_path(path) as tmp:
@@ -79,6 +83,8 @@ def _save(path: Path, array: np.ndarray, channel: str = "Z") -> None:
                 np.save(fh, array, allow_pickle=False)
         elif path.suffix == ".exr":
             _save_exr(tmp, array, channel)
+        elif path.suffix == ".tif" and isinstance(channel, tuple):
+            _save_bands(tmp, array, channel)
         elif path.suffix == ".tif":
             kind = np.int32 if array.dtype == np.int32 else np.float32
             Image.fromarray(np.ascontiguousarray(array, dtype=kind)).save(tmp, format="TIFF")
@@ -86,21 +92,47 @@ def _save(path: Path, array: np.ndarray, channel: str = "Z") -> None:
             Image.fromarray(np.ascontiguousarray(array)).save(tmp, format="PNG")
 
 
-def _save_exr(path: Path, array: np.ndarray, channel: str = "Z") -> None:
-    """One OpenEXR image (module notes): (H, W, 3) as X, Y, Z; int32 labels as uint32
-    ``id``; else float32 ``channel``."""
+def _save_bands(path: Path, array: np.ndarray, names: tuple[str, ...]) -> None:
+    """An (H, W, bands) image as one TIFF of that many bands (rasterio: any band count
+    and uint8 / uint16 / float32, each band's name as its description)."""
+    import warnings
+
+    import rasterio
+    from rasterio.errors import NotGeoreferencedWarning
+
+    h, w, count = array.shape
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", NotGeoreferencedWarning)
+        with rasterio.open(path, "w", driver="GTiff", width=w, height=h, count=count,
+                           dtype=array.dtype.name, compress="deflate") as out:
+            out.write(np.moveaxis(array, 2, 0))
+            out.descriptions = names
+
+
+def _save_exr(path: Path, array: np.ndarray, channel: str | tuple[str, ...] = "Z") -> None:
+    """One OpenEXR image (module notes): (H, W, 3) as X, Y, Z (or as the ``channel``
+    names given); int32 labels as uint32 ``id``; else float32 ``channel``."""
     import OpenEXR
 
     if array.ndim == 3:
+        names = channel if isinstance(channel, tuple) else tuple("XYZ")
         channels = {c: np.ascontiguousarray(array[:, :, i], dtype=np.float32)
-                    for i, c in enumerate("XYZ")}
+                    for i, c in enumerate(names)}
     elif array.dtype == np.int32:
         channels = {"id": np.ascontiguousarray(array).view(np.uint32)}
     else:
-        channels = {channel: np.ascontiguousarray(array, dtype=np.float32)}
+        channels = {str(channel): np.ascontiguousarray(array, dtype=np.float32)}
     header = {"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage}
     with OpenEXR.File(header, channels) as exr:
         exr.write(str(path))
+
+
+def _display(frame: Frame) -> np.ndarray:
+    """The sRGB picture of a frame: grey, or the first three bands as red, green, blue."""
+    picture = display_image(frame.image)
+    if picture.ndim == 3:
+        return picture[:, :, :3] if picture.shape[2] >= 3 else picture[:, :, 0]
+    return picture
 
 
 def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
@@ -111,12 +143,13 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
                              f"got {depth_format!r}")
     folder = Path(folder)
     tag = f"{index:04d}"
-    image_name = f"image_{tag}.tif" if frame.image.dtype == np.float32 else f"image_{tag}.png"
+    tif = frame.image.dtype == np.float32 or bool(frame.bands)
+    image_name = f"image_{tag}.tif" if tif else f"image_{tag}.png"
     exr = depth_format == "exr"
     files = {"image": image_name, "display": f"display_{tag}.png",
              "depth": f"depth_{tag}.{depth_format}", "range": f"range_{tag}.{depth_format}",
              "normals": f"normals_{tag}.{'exr' if exr else 'npy'}"}
-    arrays = {"image": frame.image, "display": display_image(frame.image),
+    arrays = {"image": frame.image, "display": _display(frame),
               "depth": frame.depth_m, "range": frame.range_m, "normals": frame.normals}
     if (exr or extra) and frame.albedo is not None:
         files["albedo"] = f"albedo_{tag}.{'exr' if exr else 'npy'}"
@@ -132,7 +165,9 @@ def write_frame(folder, index: int, frame: Frame, *, depth_format: str = "tif",
             files[key] = f"{key}_{tag}.{depth_format}"
             arrays[key] = ids
     for key, name in files.items():
-        _save(folder / name, arrays[key], "Y" if key == "albedo" else "Z")
+        channel = frame.bands if frame.bands and key in ("image", "albedo") else \
+            "Y" if key == "albedo" else "Z"
+        _save(folder / name, arrays[key], channel)
     return {"crater_id": None, "boulder_id": None, **files}
 
 
@@ -212,6 +247,13 @@ class CameraSettings:
                                    range=(0.0, 10.0))
     """Albedo contrast of fresh craters' ejecta (:func:`~latlong.sensors.albedo.
     ejecta_albedo`), [0, 10] (0: off)."""
+    bands: str = setting("", "multi-band camera: NAME=ALBEDO,... one band each, in order, "
+                         "with the reflectance model's albedo (w for hapke) of that band; "
+                         "the first three are the display picture's red, green and blue",
+                         default_text="one band")
+    """A multi-band camera (``R=0.14,G=0.12,B=0.10``): each band's albedo for the
+    reflectance model (:func:`~latlong.sensors.photometry.with_albedo`); "" for one band.
+    The image is then one multi-band TIFF a frame (module notes)."""
     depth_format: str = setting("tif", "files of the float32 depth and range images and of "
                                 "the label images", choices=DEPTH_FORMATS)
     """Files of the float32 depth and range images and of the label images: tif, npy or
@@ -233,7 +275,16 @@ class CameraSettings:
                                 f"{type(getattr(self, name)).__name__}")
         object.__setattr__(self, "all_ground_truth", bool(self.all_ground_truth))
         object.__setattr__(self, "datasets", ",".join(parse_datasets(self.datasets)))
+        bands = parse_bands(self.bands)  # checked here, kept as written
+        for name, albedo in bands.items():
+            with_albedo(self.reflectance, albedo)  # in the model's range
+        object.__setattr__(self, "bands", ",".join(f"{k}={v!r}" for k, v in bands.items()))
         check_declared(self)  # every declared range and choice, named by the field
+
+    def band_models(self) -> dict | None:
+        """{band: reflectance model} of a multi-band camera (None for one band)."""
+        bands = parse_bands(self.bands)
+        return {k: with_albedo(self.reflectance, a) for k, a in bands.items()} or None
 
     def record(self, sun: Sun) -> dict:
         """The ``settings`` of the manifest (without ``model``)."""
@@ -245,9 +296,32 @@ class CameraSettings:
                 "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
                 "bounces": self.bounces, "bounce_samples": self.bounce_samples,
                 "blur_samples": self.blur_samples, "line_time_s": self.line_time_s,
-                "stars": self.stars,
+                "stars": self.stars, "bands": parse_bands(self.bands),
                 "sensor": {f.name: getattr(self.sensor, f.name)
                            for f in fields(self.sensor)}}
+
+
+def parse_bands(spec: str) -> dict[str, float]:
+    """{name: albedo} of a ``NAME=ALBEDO,...`` bands spec ("" for one band)."""
+    if not isinstance(spec, str):
+        raise ParameterError("bands", f"must be a NAME=ALBEDO,... string; got {spec!r}")
+    out: dict[str, float] = {}
+    for item in filter(None, (i.strip() for i in spec.split(","))):
+        name, sep, value = item.partition("=")
+        name = name.strip()
+        if not sep or not name or not name.replace("_", "").replace("-", "").isalnum():
+            raise ParameterError("bands", f"items are NAME=ALBEDO (a name of letters, digits, "
+                                 f"- and _); got {item!r}")
+        if name in out:
+            raise ParameterError("bands", f"band {name!r} is given twice")
+        try:
+            out[name] = float(value)
+        except ValueError:
+            raise ParameterError("bands", f"the albedo of band {name!r} must be a number; "
+                                 f"got {value.strip()!r}") from None
+    if len(out) > 64:
+        raise ParameterError("bands", f"at most 64 bands; got {len(out)}")
+    return out
 
 
 def _per_pose(planet, n: int) -> list[Planet | None]:
@@ -313,7 +387,9 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
             def render_at(camera, pose, sun=suns[k], planet=planets[k]):
-                return render(mesh, camera, pose, sun, reflectance=settings.reflectance,
+                bands = settings.band_models()
+                return render(mesh, camera, pose, sun,
+                              reflectance=None if bands else settings.reflectance, bands=bands,
                               sensor=settings.sensor,
                               soft_shadow_samples=settings.soft_shadow_samples,
                               seed=settings.seed, ground_truth=geometry,

@@ -72,7 +72,7 @@ def timed_frame(render_at, poses: Poses, k: int, camera: Camera, sensor, *,
     instants = (np.arange(n) + 0.5) / n * exposure
     h = camera.height
     rows = BAND_ROWS if line_time_s > 0.0 else h
-    refl = np.zeros((h, camera.width))
+    refl = np.zeros(sharp.reflectance.shape)  # (H, W) or (H, W, bands)
     for r0 in range(0, h, rows):
         r1 = min(h, r0 + rows)
         # the band's rows as a camera of their own: same rays, principal point shifted

@@ -44,6 +44,7 @@ True
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 
@@ -60,7 +61,7 @@ from ._photometry_kernels import (
 )
 
 __all__ = ["HAPKE_PRESETS", "REFLECTANCES", "Hapke", "Lambert", "LommelSeeliger",
-           "LunarLambert", "Photometry", "radiance_factor", "reflectance_model"]
+           "LunarLambert", "Photometry", "radiance_factor", "reflectance_model", "with_albedo"]
 
 
 @dataclass(frozen=True, slots=True)
@@ -191,6 +192,16 @@ def reflectance_model(name: str, *, albedo: float | None = None,
     if preset is not None:
         raise ParameterError("preset", f"applies to hapke only, not {name}")
     return REFLECTANCES[name]() if albedo is None else REFLECTANCES[name](albedo)
+
+
+def with_albedo(model: Photometry, albedo: float) -> Photometry:
+    """``model`` with another albedo: the normal albedo of the simple models, the
+    single-scattering albedo ``w`` of Hapke's (a band of a multi-band camera)."""
+    if isinstance(model, Hapke):
+        return dataclasses.replace(model, w=albedo)
+    if not isinstance(model, Lambert | LommelSeeliger | LunarLambert):
+        raise TypeError(f"`model` must be a reflectance model; got {type(model).__name__}")
+    return dataclasses.replace(model, albedo=albedo)
 
 
 def radiance_factor(model: Photometry, cos_i, cos_e, cos_g) -> np.ndarray:

@@ -39,62 +39,33 @@ Ground truth per pixel (NaN / -1 where the ray misses): ``depth_m`` (camera z) a
 
 from __future__ import annotations
 
-import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from craters._shared import ParameterError, check_int, check_range
+from craters._shared import ParameterError, check_int
 
-from ._bounce_kernels import SECOND_BOUNCE, _bounce_light_kernel, _bounce_rays_kernel
-from ._render_kernels import (
-    _ground_truth_kernel,
-    _shade_kernel,
-    _shadow_rays_kernel,
-    _surface_kernel,
-)
-from .camera import Camera, Pose, unit_direction
+from ._render_kernels import _ground_truth_kernel, _surface_kernel
+from .camera import Camera, Pose
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
-from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert, radiance_factor
+from .light import (
+    SUN_RADIUS_1AU_DEG,
+    Sun,
+    indirect,
+    planet_light,
+    shade,
+    sunlit,
+    vertex_albedo_at,
+)
+from .photometry import Hapke, Lambert, LommelSeeliger, LunarLambert
 from .planetshine import Planet
 from .scene_geometry import SceneGeometry, traced_model
 from .sensor import Sensor, expose, exposure_for
 
 __all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render"]
 
-#: Angular radius of the sun seen from 1 au, degrees (696 000 km / 1 au).
-SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
-#: Shadow rays start this fraction of the point's distance from the model's centre (the
-#: centre of its bounding box, where the engine's float32 frame is) above the surface, at
-#: least 1e-3 of that times the bounding radius: a 700 km DEM mesh lifts points near its
-#: centre by millimetres, not by 2e-6 of its radius (1.4 m, shortening low-sun shadows).
-SHADOW_OFFSET = 2e-6
-#: The counter streams of the samples over the planet's disk (the sun's: 1 + sample).
-PLANET_STREAM = 1 << 36
-
-
-@dataclass(frozen=True, slots=True)
-class Sun:
-    """The light: a direction towards the sun and its angular size."""
-
-    direction: np.ndarray
-    """(3,) unit vector from the surface towards the sun, body frame (normalised; a zero
-    vector is an error)."""
-    angular_radius_deg: float = 0.0
-    """Angular radius of the solar disk, degrees (0: a point; 0.2666 at 1 au), [0, 5]."""
-
-    def __post_init__(self):
-        d = unit_direction("sun_direction", self.direction)
-        object.__setattr__(self, "direction", d)
-        object.__setattr__(self, "angular_radius_deg", check_range(
-            "angular_radius_deg", self.angular_radius_deg, 0.0, 5.0))
-
-    @classmethod
-    def at_distance(cls, direction, distance_au: float) -> Sun:
-        """The sun seen from ``distance_au`` au (its angular radius from its size)."""
-        d = check_range("distance_au", distance_au, 0.01, 1000.0)
-        return cls(direction, math.degrees(math.asin(6.957e8 / (d * 1.495978707e11))))
 
 
 @dataclass(frozen=True, slots=True)
@@ -102,9 +73,11 @@ class Frame:
     """One rendered frame and its ground truth (module notes); images are (H, W)."""
 
     image: np.ndarray
-    """The sensor's image: uint16 / uint8 DN or float32 I/F (:class:`Sensor`)."""
+    """The sensor's image: uint16 / uint8 DN or float32 I/F (:class:`Sensor`); (H, W,
+    bands) for a multi-band camera."""
     reflectance: np.ndarray
-    """float64 I/F with shadows, before the sensor (0 in shadow and on the sky)."""
+    """float64 I/F with shadows, before the sensor (0 in shadow and on the sky); (H, W,
+    bands) for a multi-band camera."""
     depth_m: np.ndarray
     """float32 distance along the optical axis (camera z), metres; NaN on the sky."""
     range_m: np.ndarray
@@ -139,7 +112,10 @@ class Frame:
     """The exposure the sensor took, seconds (auto-exposure's choice, or its own)."""
     albedo: np.ndarray | None = None
     """float32 albedo seen: the reflectance model's normal albedo (1 for Hapke) times the
-    per-vertex factor; NaN on the sky."""
+    per-vertex factor; NaN on the sky; (H, W, bands) for a multi-band camera."""
+    bands: tuple[str, ...] = ()
+    """The names of a multi-band camera's bands, in the order of the last axis of
+    ``image``, ``reflectance`` and ``albedo`` (empty: one band, (H, W) images)."""
 
 
 def camera_inside(mesh: RayMesh, position_m) -> bool:
@@ -164,19 +140,19 @@ def _photometry(reflectance):
     return reflectance
 
 
-def _vertex_albedo(mesh: RayMesh, vertex_albedo, hits) -> np.ndarray:
-    if vertex_albedo is None:
-        return np.ones(len(hits.face))
-    a = np.asarray(vertex_albedo, dtype=np.float64)
-    if a.shape != (len(mesh.vertices),) or not np.isfinite(a).all() or (a < 0).any():
-        raise ParameterError("vertex_albedo", f"must be {len(mesh.vertices)} finite factors "
-                             ">= 0, one per vertex")
-    out = np.zeros(len(hits.face))
-    ok = hits.hit
-    tri = mesh.faces[hits.face[ok]]
-    u, v = hits.u[ok], hits.v[ok]
-    out[ok] = (1 - u - v) * a[tri[:, 0]] + u * a[tri[:, 1]] + v * a[tri[:, 2]]
-    return out
+def _models(reflectance, bands) -> tuple[list, tuple[str, ...]]:
+    """(the reflectance model of each band, the band names: () for one band)."""
+    if bands is None:
+        return [_photometry(reflectance)], ()
+    if reflectance is not None:
+        raise ParameterError("bands", "give `reflectance` or `bands` (a model per band), "
+                             "not both")
+    if not isinstance(bands, Mapping) or not 1 <= len(bands) <= 64:
+        raise ParameterError("bands", "must map 1 to 64 band names to reflectance models")
+    names = tuple(str(k) for k in bands)
+    if any(not n or not n.replace("_", "").replace("-", "").isalnum() for n in names):
+        raise ParameterError("bands", f"names must be letters, digits, - and _; got {names}")
+    return [_photometry(m) for m in bands.values()], names
 
 
 def _vertex_normals(mesh: RayMesh, normals):
@@ -191,107 +167,6 @@ def _vertex_normals(mesh: RayMesh, normals):
         raise ParameterError("normals", f"must be 'smooth', 'face' or {mesh.vertices.shape} "
                              "finite vertex normals")
     return n
-
-
-def _sunlit(mesh, pos, ng, facing, sun: Sun | Planet, samples: int, seed: int,
-            stream: int = 0) -> np.ndarray:
-    """Lit fraction per hit: facet faces the light and the shadow ray is free (samples
-    over the light's disk from the counter streams ``stream`` + sample)."""
-    lit = np.zeros(len(pos))
-    cand = np.flatnonzero(facing)
-    if not len(cand):
-        return lit
-    centre, radius_m = mesh.bounding_sphere  # the engine's float32 frame is centred here
-    floor = 1e-3 * SHADOW_OFFSET * radius_m
-    radius = math.radians(sun.angular_radius_deg) if samples else 0.0
-    p, n = np.ascontiguousarray(pos[cand]), np.ascontiguousarray(ng[cand])
-    o, d = np.empty_like(p), np.empty_like(p)
-    face_ok = np.empty(len(cand), dtype=np.bool_)
-    total = np.zeros(len(cand))
-    for k in range(max(samples, 1)):
-        _shadow_rays_kernel(p, n, SHADOW_OFFSET, centre, floor, sun.direction, radius, seed,
-                            stream + k, o, d, face_ok)
-        free = face_ok & ~mesh.occluded(o, d, np.inf)
-        total += free
-    lit[cand] = total / max(samples, 1)
-    return lit
-
-
-def _indirect(mesh: RayMesh, photometry, pos, ng, ns, albedo, vertex_albedo, sun: Sun,
-              samples: int, seed: int, bounces: int = 1) -> np.ndarray:
-    """Bounced light (module notes): I/F added at each point ``pos`` (n, 3) by the sunlit
-    surface it sees (``samples`` cosine-weighted rays a point) and, with ``bounces`` 2,
-    by the light that surface received once from the rest (one ray on from each hit)."""
-    centre, radius_m = mesh.bounding_sphere
-    floor = 1e-3 * SHADOW_OFFSET * radius_m
-    n = len(pos)
-    p, g, h = (np.ascontiguousarray(a) for a in (pos, ng, ns))
-    o, d = np.empty((n, 3)), np.empty((n, 3))
-    above = np.empty(n, dtype=np.bool_)
-    total = np.zeros(n)
-    # the receiving points as Lambertian surfaces of the model's normal albedo
-    normal_albedo = float(radiance_factor(photometry, 1.0, 1.0, 1.0)[0])
-    for k in range(samples):
-        _bounce_rays_kernel(p, g, h, SHADOW_OFFSET, centre, floor, seed, k, o, d, above)
-        face, q, nq, hits = _secondary_hits(mesh, o, d, above)
-        total += _seen_light(mesh, photometry, d, face, q, nq, hits, vertex_albedo, sun,
-                             seed)
-        front = np.flatnonzero((face >= 0) & (np.einsum("ij,ij->i", nq, d) < 0.0))
-        if bounces < 2 or not len(front):
-            continue
-        # one ray on from each front-facing hit: its own once-bounced light, received as
-        # a Lambertian surface of its albedo (the second counter stream of the sample)
-        q2, n2 = np.ascontiguousarray(q[front]), np.ascontiguousarray(nq[front])
-        o2, d2 = np.empty_like(q2), np.empty_like(q2)
-        above2 = np.empty(len(front), dtype=np.bool_)
-        _bounce_rays_kernel(q2, n2, n2, SHADOW_OFFSET, centre, floor, seed,
-                            SECOND_BOUNCE + k, o2, d2, above2)
-        face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
-        rho = normal_albedo * _vertex_albedo(mesh, vertex_albedo, hits)[front]
-        total[front] += rho * _seen_light(mesh, photometry, d2, face2, r2, nr2, hits2,
-                                          vertex_albedo, sun, seed)
-    return normal_albedo * albedo * total / samples
-
-
-def _secondary_hits(mesh: RayMesh, o, d, above):
-    """(face or -1, hit points, their facet normals (0 on a miss), hits) of rays that
-    leave their facet (``above``)."""
-    hits = mesh.intersect(o, d)
-    face = np.where(above, hits.face, -1)
-    seen = face >= 0
-    q = hits.points(o, d)
-    nq = np.zeros((len(face), 3))
-    nq[seen] = mesh.face_normals[face[seen]]
-    return face, q, nq, hits
-
-
-def _seen_light(mesh: RayMesh, photometry, d, face, q, nq, hits, vertex_albedo, sun: Sun,
-                seed: int) -> np.ndarray:
-    """The direct I/F of each secondary hit seen back along its ray (0 for a miss)."""
-    facing = (face >= 0) & (nq @ sun.direction > 0.0)
-    lit = _sunlit(mesh, q, nq, facing, sun, 0, seed)
-    light = np.empty(len(face))
-    _bounce_light_kernel(photometry.code, photometry.vector(), d, face, mesh.face_normals,
-                         _vertex_albedo(mesh, vertex_albedo, hits), sun.direction, lit,
-                         light)
-    return light
-
-
-def _planetshine(mesh: RayMesh, photometry, origin, dirs, hits, vnormals, planet: Planet,
-                 sun: Sun, albedo, samples: int, seed: int) -> np.ndarray:
-    """I/F the planet's light adds at each pixel (:mod:`.planetshine`): the reflectance
-    model lit from the planet, its cast shadows, times its irradiance ratio."""
-    n = len(hits.face)
-    pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
-    facing = np.empty(n, dtype=np.bool_)
-    smooth = vnormals is not None
-    _surface_kernel(origin, dirs, hits.t_m, hits.face, hits.u, hits.v, mesh.vertices,
-                    mesh.faces, vnormals if smooth else np.zeros((1, 3)), smooth,
-                    planet.direction, pos, ng, ns, cosines, facing)
-    lit = _sunlit(mesh, pos, ng, facing, planet, samples, seed, PLANET_STREAM)
-    out = np.empty(n)
-    _shade_kernel(photometry.code, photometry.vector(), cosines, lit, albedo, out)
-    return planet.irradiance_ratio(sun.direction) * out
 
 
 def _primary(mesh: RayMesh, camera: Camera, pose: Pose):
@@ -313,7 +188,8 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
            soft_shadow_samples: int = 0, seed: int = 0,
            ground_truth: SceneGeometry | None = None, bounces: int = 0,
-           bounce_samples: int = 16, planet: Planet | None = None) -> Frame:
+           bounce_samples: int = 16, planet: Planet | None = None,
+           bands: Mapping[str, object] | None = None) -> Frame:
     """Render one frame of ``model`` seen by ``camera`` at ``pose``, lit by ``sun`` (a
     :class:`Sun` or a direction towards it). See the module notes.
 
@@ -330,26 +206,27 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     the light the surface sends to itself once (``bounce_samples`` rays a pixel), 2 that
     light bounced once more (0: the sun's direct light only). ``planet`` adds a
     :class:`~latlong.sensors.planetshine.Planet`'s light (its disk sampled like the sun's
-    with ``soft_shadow_samples``).
+    with ``soft_shadow_samples``). ``bands`` (instead of ``reflectance``) makes a
+    multi-band camera: {name: reflectance model} in band order; the rays are shared, one
+    exposure is taken for all bands (the shutter is one) and the sensor noise differs
+    between them.
     """
     if not isinstance(camera, Camera):
         raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
     if not isinstance(pose, Pose):
         raise TypeError(f"`pose` must be a Pose; got {type(pose).__name__}")
     sun = sun if isinstance(sun, Sun) else Sun(sun)
-    photometry = _photometry(reflectance)
+    models, names = _models(reflectance, bands)
     sensor = Sensor() if sensor is None else sensor
     if not isinstance(sensor, Sensor):
         raise TypeError(f"`sensor` must be a Sensor; got {type(sensor).__name__}")
-    samples = check_int("soft_shadow_samples", soft_shadow_samples, 0, 1024)
-    bounces = check_int("bounces", bounces, 0, 2)
-    bounce_samples = check_int("bounce_samples", bounce_samples, 1, 4096)
-    seed = check_int("seed", seed, 0, 2**63 - 1)
     if planet is not None and not isinstance(planet, Planet):
         raise TypeError(f"`planet` must be a Planet; got {type(planet).__name__}")
-    planet_samples = samples
-    if sun.angular_radius_deg == 0.0:
-        samples = 0
+    samples = check_int("soft_shadow_samples", soft_shadow_samples, 0, 1024)
+    light = {"bounces": check_int("bounces", bounces, 0, 2),
+             "bounce_samples": check_int("bounce_samples", bounce_samples, 1, 4096),
+             "seed": check_int("seed", seed, 0, 2**63 - 1), "planet": planet,
+             "planet_samples": samples, "vertex_albedo": vertex_albedo}
     mesh, ground_truth = traced_model(model, ground_truth)
     h, w = camera.height, camera.width
     origin, dirs, hits = _primary(mesh, camera, pose)
@@ -358,39 +235,50 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
     facing = np.empty(n, dtype=np.bool_)
     vnormals = _vertex_normals(mesh, normals)
-    smooth = vnormals is not None
     _surface_kernel(origin, dirs, hits.t_m, face, hits.u, hits.v, mesh.vertices,
-                    mesh.faces, vnormals if smooth else np.zeros((1, 3)), smooth,
-                    sun.direction, pos, ng, ns, cosines, facing)
-    lit = _sunlit(mesh, pos, ng, facing, sun, samples, seed)
-    albedo = _vertex_albedo(mesh, vertex_albedo, hits)
-    refl: np.ndarray = np.empty(n)
-    _shade_kernel(photometry.code, photometry.vector(), cosines, lit, albedo, refl)
-    if bounces:
-        seen = face >= 0
-        refl[seen] += _indirect(mesh, photometry, pos[seen], ng[seen], ns[seen],
-                                albedo[seen], vertex_albedo, sun, bounce_samples, seed,
-                                bounces)
-    if planet is not None:
-        refl += _planetshine(mesh, photometry, origin, dirs, hits, vnormals, planet, sun,
-                             albedo, planet_samples, seed)
-    refl = refl.reshape(h, w)
-    depth, rng_m, sunlit = (np.empty(n, dtype=np.float32) for _ in range(3))
+                    mesh.faces, np.zeros((1, 3)) if vnormals is None else vnormals,
+                    vnormals is not None, sun.direction, pos, ng, ns, cosines, facing)
+    lit = sunlit(mesh, pos, ng, facing, sun,
+                 samples if sun.angular_radius_deg > 0.0 else 0, light["seed"])
+    albedo = vertex_albedo_at(mesh, vertex_albedo, hits)
+    refl = _reflectance(mesh, models, (origin, dirs, hits, vnormals), (pos, ng, ns, cosines),
+                        lit, albedo, sun, **light)
+    shape = (h, w) if not names else (h, w, len(names))
+    refl = refl[:, 0].reshape(h, w) if not names else refl.reshape(shape)
+    depth, rng_m, lit32 = (np.empty(n, dtype=np.float32) for _ in range(3))
     angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))
     _ground_truth_kernel(hits.t_m, face, dirs, pose.rotation[:, 2], cosines, ns, lit, depth,
-                         rng_m, angles, normals32, sunlit)
+                         rng_m, angles, normals32, lit32)
     exposure = exposure_for(refl, sensor)
-    seen = np.where(face >= 0, albedo * getattr(photometry, "albedo", 1.0), np.nan)
-    return Frame(image=expose(refl, replace(sensor, exposure_s=exposure), seed=seed),
-                 reflectance=refl, exposure_s=exposure,
-                 albedo=seen.astype(np.float32).reshape(h, w),
+    seen = np.stack([np.where(face >= 0, albedo * getattr(m, "albedo", 1.0), np.nan)
+                     for m in models], axis=-1)
+    return Frame(image=expose(refl, replace(sensor, exposure_s=exposure), seed=light["seed"]),
+                 reflectance=refl, exposure_s=exposure, bands=names,
+                 albedo=seen.astype(np.float32).reshape(shape),
                  depth_m=depth.reshape(h, w), range_m=rng_m.reshape(h, w),
                  position_m=pos.reshape(h, w, 3), normals=normals32.reshape(h, w, 3),
                  incidence_deg=angles[:, 0].reshape(h, w),
                  emission_deg=angles[:, 1].reshape(h, w),
                  phase_deg=angles[:, 2].reshape(h, w), face=face.reshape(h, w),
-                 sunlit=sunlit.reshape(h, w), camera=camera, pose=pose, sun=sun,
+                 sunlit=lit32.reshape(h, w), camera=camera, pose=pose, sun=sun,
                  **_labels(ground_truth, pos, face, h, w))
+
+
+def _reflectance(mesh: RayMesh, models, rays, surface, lit, albedo, sun: Sun, *,
+                 bounces: int, bounce_samples: int, seed: int, planet: Planet | None,
+                 planet_samples: int, vertex_albedo) -> np.ndarray:
+    """(n, bands) I/F of the pixels: the sun's light, bounced light and planetshine."""
+    origin, dirs, hits, vnormals = rays
+    pos, ng, ns, cosines = surface
+    refl = shade(models, cosines, lit, albedo)
+    if bounces:
+        seen = hits.face >= 0
+        refl[seen] += indirect(mesh, models, pos[seen], ng[seen], ns[seen], albedo[seen],
+                               vertex_albedo, sun, bounce_samples, seed, bounces)
+    if planet is not None:
+        refl += planet_light(mesh, models, origin, dirs, hits, vnormals, planet, sun, albedo,
+                             planet_samples, seed)
+    return refl
 
 
 def _labels(geometry: SceneGeometry | None, pos, face, h: int, w: int) -> dict:

@@ -106,13 +106,15 @@ def _checked(reflectance, sensor) -> tuple[np.ndarray, Sensor]:
     if not isinstance(sensor, Sensor):
         raise TypeError(f"`sensor` must be a Sensor; got {type(sensor).__name__}")
     img = np.nan_to_num(np.asarray(reflectance, dtype=np.float64), nan=0.0)
-    if img.ndim != 2:
-        raise ParameterError("reflectance", f"must be an (H, W) image; got shape {img.shape}")
+    if img.ndim not in (2, 3):
+        raise ParameterError("reflectance", f"must be an (H, W) or (H, W, bands) image; got "
+                             f"shape {img.shape}")
     return img, sensor
 
 
 def exposure_for(reflectance, sensor: Sensor | None = None) -> float:
-    """The exposure (s) a :class:`Sensor` takes of an (H, W) I/F image: its own
+    """The exposure (s) a :class:`Sensor` takes of an (H, W) I/F image (or (H, W, bands):
+    one exposure for all bands, from all their lit pixels): its own
     ``exposure_s``, or under auto-exposure the one that puts the lit pixels' (I/F > 0)
     ``exposure_percentile`` th percentile at ``exposure_target`` of full scale
     (:data:`DEFAULT_EXPOSURE_S` when nothing is lit). The percentile is taken before the
@@ -150,7 +152,8 @@ def display_image(image: np.ndarray, *, white_percentile: float = 95.0,
 
 def expose(reflectance, sensor: Sensor | None = None, *, seed: int = 0) -> np.ndarray:
     """The image a :class:`Sensor` records of an (H, W) I/F image (NaN counts as 0), at
-    :func:`exposure_for` of it."""
+    :func:`exposure_for` of it; an (H, W, bands) image band by band (the PSF within each
+    band; the noise keyed by the pixel and the band)."""
     img, sensor = _checked(reflectance, sensor)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     if sensor.exposure_s is None:
@@ -158,8 +161,8 @@ def expose(reflectance, sensor: Sensor | None = None, *, seed: int = 0) -> np.nd
     if sensor.psf_sigma_px > 0:
         from scipy.ndimage import gaussian_filter
 
-        img = gaussian_filter(img, sensor.psf_sigma_px, mode="constant", cval=0.0,
-                              truncate=4.0)
+        sigma = sensor.psf_sigma_px if img.ndim == 2 else (sensor.psf_sigma_px,) * 2 + (0.0,)
+        img = gaussian_filter(img, sigma, mode="constant", cval=0.0, truncate=4.0)
     electrons = np.ascontiguousarray(img.ravel() * sensor.electrons_per_reflectance)
     quantize = sensor.bits != 32
     if quantize:

@@ -163,8 +163,12 @@ def spice_camera(kernels, instrument: str, **distortion):
     from its instrument kernel: ``INS<id>_PIXEL_SAMPLES`` x ``INS<id>_PIXEL_LINES``
     pixels, the focal length in pixels ``INS<id>_FOCAL_LENGTH / INS<id>_PIXEL_PITCH``
     (both in mm) or else from the field of view (``getfov``: the widest bound vector's
-    angles from the +Z boresight across x and y), the principal point at the image's
-    centre; ``distortion`` as :class:`Camera`'s."""
+    angles from the +Z boresight across x and y), the principal point from
+    ``INS<id>_CCD_CENTER`` (sample, line) taken as given in this package's convention
+    (pixel centres at integer + 0.5; an IK whose pixel centres are integers needs 0.5
+    added: give ``--intrinsics`` instead), else the image's centre. Distortion keywords
+    differ between missions (their models, units and directions) and are not read:
+    ``distortion`` as :class:`Camera`'s."""
     import spiceypy as sp
     from spiceypy.utils.exceptions import SpiceyError
 
@@ -202,7 +206,14 @@ def spice_camera(kernels, instrument: str, **distortion):
             tx = np.abs(b[:, 0] / b[:, 2]).max()
             ty = np.abs(b[:, 1] / b[:, 2]).max()
             fx, fy = 0.5 * width / tx, 0.5 * height / ty
-    return Camera(fx, fy, 0.5 * width, 0.5 * height, width, height, **distortion)
+        try:
+            cx, cy = (float(c) for c in sp.gdpool(f"INS{ident}_CCD_CENTER", 0, 2))
+        except SpiceyError:
+            cx, cy = 0.5 * width, 0.5 * height
+        except ValueError:
+            raise ValueError(f"the instrument kernel of {instrument!r} has an "
+                             f"INS{ident}_CCD_CENTER without two values") from None
+    return Camera(fx, fy, cx, cy, width, height, **distortion)
 
 
 def _times(sp, error, utc, et) -> np.ndarray:

@@ -74,7 +74,10 @@ def with_stars(frame, sensor, *, body_to_j2000: np.ndarray | None = None, seed: 
     """``frame`` (a :class:`~latlong.sensors.render.Frame`) with the stars added where it
     sees no surface, exposed again (auto-exposure sees them too)."""
     stars = star_reflectance(frame.camera, frame.pose, body_to_j2000=body_to_j2000)
-    refl = np.where(frame.face < 0, frame.reflectance + stars, frame.reflectance)
+    if frame.reflectance.ndim == 3:  # a multi-band camera: the stars in every band
+        stars = stars[:, :, None]
+    sky = frame.face < 0 if frame.reflectance.ndim == 2 else (frame.face < 0)[:, :, None]
+    refl = np.where(sky, frame.reflectance + stars, frame.reflectance)
     exposure = exposure_for(refl, sensor)
     image = expose(refl, dataclasses.replace(sensor, exposure_s=exposure), seed=seed)
     return dataclasses.replace(frame, image=image, reflectance=refl, exposure_s=exposure)

@@ -68,7 +68,8 @@ NAIF_BODY_CODE += ( -9999 )
 """
 
 # two instruments: the camera with focal length and pixel pitch (100 px), and a second
-# whose focal length comes from its field of view (a 10 x 7.5 degree half-angle box)
+# whose focal length comes from its field of view (a 10 x 7.5 degree half-angle box) and
+# whose boresight is off the image's centre (CCD_CENTER)
 IK = r"""KPL/IK
 \begindata
 INS-9999000_PIXEL_SAMPLES = ( 64 )
@@ -77,6 +78,7 @@ INS-9999000_FOCAL_LENGTH = ( 50.0 )
 INS-9999000_PIXEL_PITCH = ( 0.5 )
 INS-9999001_PIXEL_SAMPLES = ( 80 )
 INS-9999001_PIXEL_LINES = ( 60 )
+INS-9999001_CCD_CENTER = ( 41.25 29.5 )
 INS-9999001_FOV_SHAPE = 'RECTANGLE'
 INS-9999001_FOV_FRAME = 'SC_CAM'
 INS-9999001_BORESIGHT = ( 0.0 0.0 1.0 )

@@ -204,6 +204,7 @@ def test_the_instrument_kernel_gives_the_camera(kernels):
                                                                         32.0, 24.0)
     wide = spice_camera(kernels, "-9999001", k1=-0.01)
     assert (wide.width, wide.height) == (80, 60) and wide.k1 == -0.01
+    assert (wide.cx, wide.cy) == (41.25, 29.5)  # INS-9999001_CCD_CENTER
     # the field of view's half-angles, 10 and 7.5 degrees, reach the image's edges
     assert wide.fx == pytest.approx(40.0 / np.tan(np.radians(10.0)), rel=1e-12)
     assert wide.fy == pytest.approx(30.0 / np.tan(np.radians(7.5)), rel=1e-12)
