@@ -1,4 +1,4 @@
-"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON for planar catalogs,
+"""Crater catalogs: structured numpy arrays, CSV with units, GeoJSON (RFC 7946) points,
 craterstats spatial crater counts (``.scc``).
 
 A catalog is the ground truth that users feed to crater-detection and navigation
@@ -240,36 +240,55 @@ def read_catalog(path) -> np.ndarray:
     return validate_catalog(cat)
 
 
-def write_geojson(cat: np.ndarray, path, *, to_world=None, crs: str | None = None) -> Path:
-    """Write a planar catalog as GeoJSON points (atomic).
+def write_geojson(cat: np.ndarray, path, *, lonlat=None, body: str | None = None,
+                  crs: str | None = None, prj: str | None = None) -> Path:
+    """Write a catalog as RFC 7946 GeoJSON points (atomic): each feature's coordinates
+    are its longitude and latitude in degrees, the longitude wrapped to [-180, 180).
 
-    ``to_world(x_m, y_m) -> (X, Y)`` maps catalog coordinates to world coordinates
-    (default identity); ``crs`` is recorded as a top-level ``crs`` name if given.
+    The positions are ``lonlat(x_m, y_m) -> (lon_deg, lat_deg)`` of a planar catalog, or
+    the ``lon_deg``, ``lat_deg`` columns of one on a body. RFC 7946 has no ``crs`` member
+    (its coordinates are WGS 84's on the Earth); on another body they are the body's
+    planetocentric longitude and latitude, and the document says so in a foreign member
+    ``"craterform": {"body", "crs", "coordinates"}`` (``crs``: the geographic CRS's code
+    such as ``IAU_2015:30100``, or its WKT). ``prj`` (a WKT) is also written as the
+    sidecar ``<name>.prj`` for GIS programs. Every column is kept in the properties.
+    Points never cross the antimeridian, so none is split.
     """
     validate_catalog(cat)
     fields = cat.dtype.names
     assert fields is not None  # validate_catalog: a structured array
-    if "x_m" not in fields:
-        raise ValueError("GeoJSON output needs a planar catalog (x_m, y_m)")
-    xs, ys = cat["x_m"], cat["y_m"]
+    if "x_m" in fields:
+        if lonlat is None:
+            raise ValueError("GeoJSON (RFC 7946) needs longitude and latitude: give "
+                             "`lonlat` for a planar catalog")
+        lon, lat = (np.asarray(a, dtype=np.float64) for a in lonlat(cat["x_m"], cat["y_m"]))
+    else:
+        lon, lat = cat["lon_deg"].astype(np.float64), cat["lat_deg"].astype(np.float64)
+    if not (np.isfinite(lon).all() and np.isfinite(lat).all()
+            and (np.abs(lat) <= 90.0).all()):
+        raise ValueError("GeoJSON positions must be finite, latitudes in [-90, 90]")
+    lon = (lon + 180.0) % 360.0 - 180.0
     if is_boulder_catalog(cat):  # as its CSV: no crater-only columns
         cat = cat[[n for n in fields if n not in _CRATER_ONLY]]
         fields = cat.dtype.names
         assert fields is not None
-    if to_world is not None:
-        xs, ys = to_world(xs, ys)
     feats = []
     for k, row in enumerate(cat.tolist()):
         props = {n: (float(v) if isinstance(v, float) else v)
                  for n, v in zip(fields, row, strict=True)}
         props = {n: (int(v) if isinstance(v, np.integer) else v) for n, v in props.items()}
         feats.append({"type": "Feature",
-                      "geometry": {"type": "Point", "coordinates": [float(xs[k]), float(ys[k])]},
+                      "geometry": {"type": "Point",
+                                   "coordinates": [float(lon[k]), float(lat[k])]},
                       "properties": props})
     doc: dict[str, Any] = {"type": "FeatureCollection", "features": feats}
-    if crs:
-        doc["crs"] = {"type": "name", "properties": {"name": crs}}
+    if body or crs:
+        doc["craterform"] = {"body": body, "crs": crs, "coordinates":
+                             "longitude, latitude in degrees (east, planetocentric)"}
     path = Path(path)
+    if prj:
+        with atomic_path(path.with_suffix(".prj")) as tmp:
+            tmp.write_text(prj, encoding="utf-8")
     with atomic_path(path) as tmp:
-        tmp.write_text(json.dumps(doc), encoding="utf-8")
+        tmp.write_text(json.dumps(doc, allow_nan=False), encoding="utf-8")
     return path

@@ -305,6 +305,22 @@ def axis_radius_m(proj: dict, where: str) -> float:
     return radius_m
 
 
+def _sphere_crs(target: str, radius_m: float):
+    """The longitude/latitude CRS of ``target``'s sphere: the IAU_2015 one when PROJ knows
+    that body with that radius (the Moon's 1737.4 km sphere: ``IAU_2015:30100``), else a
+    WKT of its own."""
+    crs = CRS.from_wkt(
+        f'GEOGCS["{target} (sphere, PDS label)",DATUM["D_{target}",'
+        f'SPHEROID["{target}",{radius_m!r},0]],PRIMEM["Reference_Meridian",0],'
+        f'UNIT["degree",0.0174532925199433]]')
+    code = crs.to_authority(confidence_threshold=50)
+    if code and code[0].startswith("IAU"):
+        coded = CRS.from_user_input(":".join(code))
+        if coded.to_wkt().split('"')[1].startswith(target):  # the same body, not a namesake
+            return coded
+    return crs
+
+
 def georeference(proj: dict, label: dict, where: str):
     """Transform (degrees), geographic CRS and radius (m) of a simple-cylindrical map."""
     ptype = " ".join(str(proj.get("MAP_PROJECTION_TYPE", "")).upper().split())
@@ -352,10 +368,6 @@ def georeference(proj: dict, label: dict, where: str):
             if gap > 0.01:
                 logger.warning("%s: label %s = %g but the projection offsets put the edge at "
                                "%g; using the offsets", where, key, stated, value)
-    target = str(label.get("TARGET_NAME", "body")).title()
-    crs = CRS.from_wkt(
-        f'GEOGCS["{target} (sphere, PDS label)",DATUM["D_{target}",'
-        f'SPHEROID["{target}",{radius_m!r},0]],PRIMEM["Reference_Meridian",0],'
-        f'UNIT["degree",0.0174532925199433]]')
+    crs = _sphere_crs(str(label.get("TARGET_NAME", "body")).title(), radius_m)
     transform = Affine(1.0 / res, 0.0, west, 0.0, -1.0 / res, north)
     return transform, crs, radius_m

@@ -39,8 +39,9 @@ from craters._shared import check_finite, check_positive
 
 from .core import Dem, crs_label
 
-__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "crater_target", "grid_affine",
-           "grid_pixel_size", "local_frame", "pixel_affine", "resolve_frame", "world_to_lonlat"]
+__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "crater_target",
+           "body_name", "geographic_crs", "grid_affine", "grid_pixel_size", "local_frame", "pixel_affine",
+           "resolve_frame", "world_to_lonlat"]
 
 #: Largest relative difference of the two pixel sides (and cosine of the angle between
 #: them) accepted for stamping craters into a DEM.
@@ -187,6 +188,33 @@ def grid_affine(a: Affine, pixel_m: float) -> Affine:
 
 # the PROJ parameters that say which body (sphere or ellipsoid) a CRS lives on
 _BODY_KEYS = ("R", "a", "b", "rf", "f", "ellps", "datum", "pm", "towgs84")
+
+
+def geographic_crs(crs):
+    """The longitude/latitude CRS (degrees, east) of the sphere or ellipsoid ``crs`` lives
+    on -- the IAU_2015 (or EPSG) CRS of that body when PROJ identifies one (the Moon's
+    sphere: ``IAU_2015:30100``) -- or None when ``crs`` names no body."""
+    from rasterio.crs import CRS
+    from rasterio.errors import CRSError
+
+    if crs is None:
+        return None
+    body = {k: v for k, v in crs.to_dict().items() if k in _BODY_KEYS}
+    if not body:
+        return None
+    try:
+        geo = CRS.from_dict({"proj": "longlat", **body})
+    except CRSError:
+        return None
+    code = geo.to_authority(confidence_threshold=50)
+    return CRS.from_user_input(":".join(code)) if code else geo
+
+
+def body_name(geo) -> str:
+    """The body of a geographic CRS, from its name (``Moon (2015) - Sphere / Ocentric``:
+    ``Moon``; ``WGS 84``)."""
+    m = re.match(r'\s*\w+\["([^"(]*)', geo.to_wkt())
+    return m.group(1).strip() if m else "unknown"
 
 
 def world_to_lonlat(crs, x, y):

@@ -50,7 +50,15 @@ from craters._shared import (
 from craters._shared.files import check_regular_file
 
 from .core import Dem, crs_label
-from .frame import LocalFrame, body_axes_m, grid_pixel_size, pixel_affine, world_to_lonlat
+from .frame import (
+    LocalFrame,
+    body_axes_m,
+    body_name,
+    geographic_crs,
+    grid_pixel_size,
+    pixel_affine,
+    world_to_lonlat,
+)
 from .io import read, write
 
 __all__ = ["MANIFEST", "STACK_FORMAT", "Stack", "check_stack_folder", "propagate_up", "read_stack",
@@ -249,6 +257,11 @@ class Stack:
         return all(m == 0.0 for m in self.mismatch_m())
 
     # ------------------------------------------------------------------ files
+    def _geojson(self, name: str) -> str | None:
+        """The GeoJSON file of a layer's catalog: written only where the CRS names a
+        body (RFC 7946 positions are longitude, latitude)."""
+        return name if geographic_crs(self._layers[0].crs) is not None else None
+
     def manifest(self) -> dict:
         """The JSON manifest describing this stack (file names relative to the folder)."""
         sizes = self.pixel_sizes_m()
@@ -266,13 +279,13 @@ class Stack:
             cat = self._catalogs[k]
             if cat is not None:
                 csv_name, geojson_name = _catalog_files(k)
-                entry["craters"] = {"csv": csv_name, "geojson": geojson_name,
+                entry["craters"] = {"csv": csv_name, "geojson": self._geojson(geojson_name),
                                     "stamped": int(len(cat)), "scc": _count_file(k),
                                     "counted": int(len(self.crater_count(k)[0]))}
             rocks = self._boulders[k]
             if rocks is not None:
                 csv_name, geojson_name = _boulder_files(k)
-                entry["boulders"] = {"csv": csv_name, "geojson": geojson_name,
+                entry["boulders"] = {"csv": csv_name, "geojson": self._geojson(geojson_name),
                                      "stamped": int(len(rocks))}
             layers.append(entry)
         return {
@@ -356,7 +369,7 @@ def propagate_up(arrays: list[np.ndarray], windows, k: int) -> None:
 #: The names of the files a stack writes (:func:`write_stack`): only a folder holding
 #: nothing else is replaced.
 STACK_FILE = re.compile(r"^(manifest\.json|layer_\d{2,}\.tif|(craters|boulders)_\d{2,}"
-                        r"\.(csv|geojson)|craters_\d{2,}\.scc)$")
+                        r"\.(csv|geojson|prj)|craters_\d{2,}\.scc)$")
 
 
 def check_stack_folder(folder, *, force: bool, inputs=()) -> Path:
@@ -415,8 +428,11 @@ def _write_catalog(stack: Stack, k: int, folder: Path, *, boulders: bool = False
     cat = stack.world_catalog(k, boulders=boulders)
     write_catalog(cat, folder / csv_name)
     crs = stack.layers[0].crs
-    write_geojson(cat, folder / geojson_name, to_world=stack.frame.to_world,
-                  crs=None if crs is None else crs_label(crs))
+    geo = geographic_crs(crs)
+    if geo is not None:  # RFC 7946 GeoJSON is longitude, latitude: only on a known body
+        write_geojson(cat, folder / geojson_name, body=body_name(geo), crs=crs_label(geo),
+                      lonlat=lambda x, y: world_to_lonlat(crs, *stack.frame.to_world(x, y)),
+                      prj=geo.to_wkt(version="WKT1_ESRI"))
     if not boulders:
         _write_count(stack, k, folder)
 

@@ -100,14 +100,26 @@ def test_catalog_csv_roundtrip(tmp_path, big_population):
         assert np.array_equal(back[name], cat[name], equal_nan=floats), name  # lossless
 
 
-def test_geojson(tmp_path):
+def test_geojson_is_rfc_7946(tmp_path):
     cat = craters.make_catalog(x_m=[1.0, 2.0], y_m=[3.0, 4.0], diameter_m=[5.0, 6.0])
     p = craters.write_geojson(cat, tmp_path / "c.geojson",
-                              to_world=lambda x, y: (x + 100, y - 100), crs="EPSG:32633")
+                              lonlat=lambda x, y: (x * 100.0 - 10.0, y - 10.0), body="Moon",
+                              crs="IAU_2015:30100", prj='GEOGCS["Moon"]')
     doc = json.loads(p.read_text())
-    assert doc["features"][1]["geometry"]["coordinates"] == [102.0, -96.0]
+    # longitudes wrapped to [-180, 180): 190 -> -170; no `crs` member (RFC 7946 4.)
+    assert [f["geometry"]["coordinates"] for f in doc["features"]] == [[90.0, -7.0],
+                                                                      [-170.0, -6.0]]
+    assert "crs" not in doc and doc["craterform"]["crs"] == "IAU_2015:30100"
+    assert doc["craterform"]["body"] == "Moon"
     assert doc["features"][0]["properties"]["diameter_m"] == 5.0
-    assert doc["crs"]["properties"]["name"] == "EPSG:32633"
+    assert (tmp_path / "c.prj").read_text() == 'GEOGCS["Moon"]'
+    # a catalog on a body brings its own positions; a planar one needs lonlat
+    body = craters.make_catalog(lat_deg=[10.0], lon_deg=[359.5], diameter_m=[5.0])
+    doc = json.loads(craters.write_geojson(body, tmp_path / "b.geojson").read_text())
+    assert doc["features"][0]["geometry"]["coordinates"] == [-0.5, 10.0]
+    assert "craterform" not in doc and not (tmp_path / "b.prj").exists()
+    with pytest.raises(ValueError, match="lonlat"):
+        craters.write_geojson(cat, tmp_path / "x.geojson")
 
 
 def test_catalog_validation(tmp_path):

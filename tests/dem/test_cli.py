@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import json
 import subprocess
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -334,6 +336,29 @@ def test_enhance_and_mesh_through_the_entry_point(run_cli, tmp_path, lola_tif):
     assert proc.returncode == 0 and proc.stdout == ""
 
 
+def check_geojson_files(folder: Path) -> None:
+    """Every GeoJSON of a stack over the LOLA crop (longitudes 166-194 east) is RFC 7946:
+    no `crs` member (geojson-validator), longitudes in [-180, 180), the body's IAU code
+    in the foreign member and in the sidecar .prj."""
+    import geojson_validator
+    from rasterio.crs import CRS
+
+    files = sorted(folder.glob("*.geojson"))
+    assert files
+    lons = []
+    for path in files:
+        doc = json.loads(path.read_text())
+        assert geojson_validator.validate_structure(doc, check_crs=True) == {}
+        assert doc["craterform"]["crs"] == "IAU_2015:30100"
+        assert doc["craterform"]["body"] == "Moon"
+        prj = CRS.from_wkt(path.with_suffix(".prj").read_text())
+        assert prj.to_authority(confidence_threshold=50) == ("IAU_2015", "30100")
+        lons += [f["geometry"]["coordinates"][0] for f in doc["features"]]
+    lons = np.array(lons)
+    assert len(lons) > 10 and (lons >= -180).all() and (lons < 180).all()
+    assert (lons < -170).any() and (lons > 170).any()  # both sides of the antimeridian
+
+
 def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path, lola_tif):
     scene = write_scene(tmp_path / "scene.toml",
                         **scene_keys(tmp_path, lola_tif, layers=3, output="unused"))
@@ -344,7 +369,9 @@ def test_enhance_same_seed_same_bytes_any_thread_count(run_cli, capsys, tmp_path
                        "-q", env={"NUMBA_NUM_THREADS": threads})
         assert proc.returncode == 0 and proc.stdout == "", proc.stderr
         trees[threads] = {p.name: p.read_bytes() for p in sorted(out.iterdir())}
-    assert len(trees["1"]) == 3 + 3 * 3 + 1 and trees["1"] == trees["2"]  # tif, csv geojson scc
+    # per layer: tif, csv, geojson + its prj, scc; and the manifest
+    assert len(trees["1"]) == 3 + 3 * 4 + 1 and trees["1"] == trees["2"]
+    check_geojson_files(tmp_path / "stack1")
     other = tmp_path / "other"
     assert InProcess(capsys)("dem", "enhance", "--config", str(scene), "-o", str(other),
                              "--seed", "5", "-q").returncode == 0

@@ -288,10 +288,13 @@ def test_write_read_roundtrip_and_files(tmp_path, stack):
         assert np.allclose(cat["world_x"], wx) and np.allclose(cat["world_y"], wy)
         gj = json.loads((out / entry["craters"]["geojson"]).read_text())
         assert len(gj["features"]) == len(cat)
-        if len(cat):
+        if len(cat):  # RFC 7946: longitude, latitude on WGS 84 (EPSG:32633 is UTM 33N)
+            from rasterio.warp import transform
+
+            lon, lat = transform("EPSG:32633", "EPSG:4326", [float(wx[0])], [float(wy[0])])
             assert gj["features"][0]["geometry"]["coordinates"] == pytest.approx(
-                [float(wx[0]), float(wy[0])])
-            assert gj["crs"]["properties"]["name"] == "EPSG:32633"
+                [lon[0], lat[0]], abs=1e-9)
+            assert "crs" not in gj and gj["craterform"]["crs"] == "EPSG:4326"
     # an existing stack is replaced only with force; a foreign folder never
     with pytest.raises(ValueError, match="`force` is needed: output .* exists"):
         stack.write(out)
