@@ -28,6 +28,7 @@ import numpy as np
 
 from latlong.meshio.writers import MeshSource
 
+from .core import crs_label
 from .io import read
 from .mesh import as_stack, mesh_arrays, mesh_source, to_mesh
 from .stack import MANIFEST, Stack, read_stack
@@ -99,9 +100,21 @@ class DemSurface:
     @property
     def metadata(self) -> dict:
         """``source``, the ``frame`` (:meth:`dem.LocalFrame.to_dict`), the ``pixel_sizes_m``
-        of the layers and the stack's ``info`` (seed, parameters, crater counts)."""
+        of the layers, the stack's ``info`` (seed, parameters, crater counts) and
+        ``crs_wkt``: the site's local frame as an OGC WKT engineering CRS naming the DEM's
+        CRS and the origin (what the sensors' point clouds are in)."""
         return {"source": self._name, "frame": self._stack.frame.to_dict(),
-                "pixel_sizes_m": self._stack.pixel_sizes_m(), "info": self._stack.info}
+                "pixel_sizes_m": self._stack.pixel_sizes_m(), "info": self._stack.info,
+                "crs_wkt": self._local_wkt()}
+
+    def _local_wkt(self) -> str:
+        f = self._stack.frame
+        crs = self._stack.layers[0].crs
+        of = "no CRS" if crs is None else crs_label(crs)
+        name = (f"site frame: metres east, north, up from ({f.origin_x!r}, {f.origin_y!r}) "
+                f"of {of}").replace('"', "'")
+        return (f'LOCAL_CS["{name}",LOCAL_DATUM["site",0],UNIT["metre",1],'
+                'AXIS["X",EAST],AXIS["Y",NORTH],AXIS["Z",UP]]')
 
     def mesh(self) -> tuple[np.ndarray, np.ndarray]:
         """``(vertices, faces)`` of the terrain (boulders not included): (V, 3) float64

@@ -4,7 +4,9 @@ manifest of a run (the layout of the camera's ``frames.json``).
 A run folder holds, per frame ``k``, ``lidar_k.las`` (point format 6: x, y, z in the body
 frame, metres; intensity; return number; number of returns; GPS time = the beam's time in
 seconds; point source id = frame index; extra dimensions ``crater_id`` and
-``boulder_id``, int32, -1 = none) and ``range_k.npy`` ((H, W) float32 first-return range,
+``boulder_id``, int32, -1 = none; the WKT bit set and the CRS as a WKT VLR:
+body-fixed Cartesian on the sphere of the model's mean radius, or a DEM site's local
+frame, :func:`las_crs_wkt`) and ``range_k.npy`` ((H, W) float32 first-return range,
 NaN = no return), and ``lidar.json``::
 
     {"format": "craterform.lidar/1", "model": ..., "seed": ..., "settings": {...},
@@ -34,19 +36,46 @@ from .poses import Poses
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
 
-__all__ = ["LIDAR_FORMAT", "lidar_run", "settings_json", "write_las"]
+__all__ = ["LIDAR_FORMAT", "body_fixed_wkt", "las_crs_wkt", "lidar_run", "settings_json",
+           "write_las"]
 
 LIDAR_FORMAT = "craterform.lidar/1"
 _LAS_DATE = datetime.date(2000, 1, 1)  # fixed: the same run gives the same bytes
 _LAS_SCALE_M = 1e-4  # 0.1 mm steps (coarser only for extents beyond +-200 km)
 
 
-def write_las(frame: LidarFrame, path, *, point_source_id: int = 0) -> Path:
-    """Write one frame's returns to a LAS 1.4 file (point format 6), atomically."""
+def body_fixed_wkt(name: str, radius_m: float) -> str:
+    """The OGC WKT (1) of a body-fixed Cartesian CRS, metres, on a sphere of ``radius_m``
+    named ``name`` (a shape model's body, which no authority codes)."""
+    safe = "".join(c for c in str(name) if c not in '"[]') or "body"
+    return (f'GEOCCS["{safe} body-fixed",DATUM["{safe}",SPHEROID["{safe}",{radius_m:.6g},0]],'
+            'PRIMEM["Reference Meridian",0],UNIT["metre",1],AXIS["Geocentric X",OTHER],'
+            'AXIS["Geocentric Y",OTHER],AXIS["Geocentric Z",NORTH]]')
+
+
+def las_crs_wkt(geometry) -> str:
+    """The CRS of a run's points: the surface's own (a DEM site says its local frame)
+    or, for a body or a mesh, body-fixed Cartesian on the sphere of its mean radius."""
+    own = getattr(geometry, "crs_wkt", "")
+    if own:
+        return own
+    radius = float(np.mean(np.linalg.norm(geometry.vertices, axis=1)))
+    return body_fixed_wkt(Path(geometry.source).stem or "body", max(radius, 1e-3))
+
+
+def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
+              crs_wkt: str | None = None) -> Path:
+    """Write one frame's returns to a LAS 1.4 file (point format 6), atomically: the
+    global encoding's WKT bit set (point formats 6-10 require it) and, with ``crs_wkt``,
+    the CRS as an OGC WKT coordinate-system VLR, as PDAL and QGIS read it."""
     import laspy
+    from laspy.vlrs.known import WktCoordinateSystemVlr
 
     path = Path(path)
     header = laspy.LasHeader(point_format=6, version="1.4")
+    header.global_encoding.wkt = True
+    if crs_wkt:
+        header.vlrs.append(WktCoordinateSystemVlr(crs_wkt))
     header.creation_date = _LAS_DATE
     header.system_identifier = "craterform lidar"
     header.generating_software = f"craterform {package_version()}"[:32]
@@ -118,6 +147,7 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
     folder = check_output_folder(folder, force=force)
     seed = _seed_of(rng)
     geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
+    crs_wkt = las_crs_wkt(geometry)
     with run_folder(folder, "lidar.json") as tmp:
         frames = []
         for k in progress_bar(range(len(poses)), enabled=progress, desc="lidar frames"):
@@ -125,7 +155,7 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
                              time_s=float(poses.time_s[k]), rng=np.random.default_rng([seed, k]),
                              ground_truth=geometry)
             names = {"points": f"lidar_{k:04d}.las", "range": f"range_{k:04d}.npy"}
-            write_las(fr, tmp / names["points"], point_source_id=k)
+            write_las(fr, tmp / names["points"], point_source_id=k, crs_wkt=crs_wkt)
             np.save(tmp / names["range"], fr.range_image, allow_pickle=False)
             frames.append({"time_s": fr.frame_time_s, "position_m": fr.pose["position_m"],
                            "quaternion_wxyz": fr.pose["quaternion_wxyz"],
@@ -133,6 +163,7 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
         manifest = {"format": LIDAR_FORMAT, "generator": f"craterform {package_version()}",
                     "model": model_name or geometry.source, "seed": seed,
                     "settings": settings_json(settings), "intrinsics": settings.intrinsics(),
+                    "crs_wkt": crs_wkt,
                     "frames": frames}
         with open(tmp / "lidar.json", "w") as fh:
             json.dump(manifest, fh, indent=1)

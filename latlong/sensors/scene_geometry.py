@@ -58,11 +58,14 @@ class SceneGeometry(TriangleMeshSurface):
     """The boulder catalog as placed or None."""
     source: str = ""
     """Where it came from."""
+    crs_wkt: str = ""
+    """The CRS of the vertices as OGC WKT when the surface says it (a DEM site's local
+    frame), else "" (a body's frame: :func:`~latlong.sensors.lidar_files.las_crs_wkt`)."""
 
     @property
     def metadata(self) -> dict:
-        """``{"source": source}``."""
-        return {"source": self.source}
+        """``{"source": source}`` and, when known, ``{"crs_wkt": crs_wkt}``."""
+        return {"source": self.source, **({"crs_wkt": self.crs_wkt} if self.crs_wkt else {})}
 
     def mesh(self) -> tuple[np.ndarray, np.ndarray]:
         """The vertices and the surface's faces (the boulders' left out)."""
@@ -97,7 +100,7 @@ def _of_surface(model: Surface) -> SceneGeometry:
     vid = np.concatenate(ids)
     source = str(model.metadata.get("source") or "") or repr(model)
     return SceneGeometry(np.concatenate(verts), faces, vid[faces[:, 0]], model.craters,
-                         model.boulders, source)
+                         model.boulders, source, str(model.metadata.get("crs_wkt") or ""))
 
 
 def scene_geometry(model, *, craters=None, mesh: RayMesh | None = None) -> SceneGeometry:

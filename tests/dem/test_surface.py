@@ -164,7 +164,16 @@ def test_dem_camera_and_lidar_commands(run_cli, stack, tmp_path):
                    "0,0,0", "--range-m", "900,900", "--frames", "1", "--beams", "8x8",
                    "--seed", "1", "-q")
     assert proc.returncode == 0, proc.stderr
-    assert json.loads((tmp_path / "lidar" / "lidar.json").read_text())["seed"] == 1
+    doc = json.loads((tmp_path / "lidar" / "lidar.json").read_text())
+    assert doc["seed"] == 1
+    # a site's points are in its local frame: an engineering CRS naming the DEM's CRS
+    import laspy
+    import pyproj
+
+    las = laspy.read(tmp_path / "lidar" / doc["frames"][0]["files"]["points"])
+    crs = las.header.parse_crs()
+    assert las.header.global_encoding.wkt and crs == pyproj.CRS.from_wkt(doc["crs_wkt"])
+    assert crs.type_name == "Engineering CRS" and "metres east, north, up" in crs.name
     bad = run_cli("dem", "camera", str(tif), "-o", str(tmp_path / "x"), "--target-m",
                   "0,0,0", "--range-m", "900,900", "--size", "8x8", "--sun-direction",
                   "0,0,1", "--fov-deg", "30", "--soft-shadow-samples", "5000")

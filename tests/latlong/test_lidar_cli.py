@@ -59,6 +59,14 @@ def test_lidar_command_writes_las_ranges_and_manifest(run_cli, body_file, tmp_pa
     las = laspy.read(out / fr["files"]["points"])
     assert las.header.version == "1.4" and las.header.point_format.id == 6
     assert len(las.points) == fr["n_returns"] > 500
+    # the WKT bit (point formats 6-10 need it) and the CRS VLR PDAL and QGIS read:
+    # body-fixed Cartesian on the sphere of the model's mean radius
+    import pyproj
+
+    assert las.header.global_encoding.wkt
+    crs = las.header.parse_crs()
+    assert crs == pyproj.CRS.from_wkt(man["crs_wkt"]) and crs.is_geocentric
+    assert crs.ellipsoid.semi_major_metre == pytest.approx(400.0, rel=1e-3)
     rng_img = np.load(out / fr["files"]["range"])
     assert rng_img.shape == (30, 40) and rng_img.dtype == np.float32
     # LAS points: body frame, on the 400 m sphere's surface, time = frame time + offsets
