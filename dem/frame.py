@@ -39,8 +39,8 @@ from craters._shared import check_finite, check_positive
 
 from .core import Dem, crs_label
 
-__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "crater_target",
-           "body_name", "geographic_crs", "grid_affine", "grid_pixel_size", "local_frame", "pixel_affine",
+__all__ = ["SQUARE_TOLERANCE", "LocalFrame", "body_axes_m", "body_name", "crater_target",
+           "geographic_crs", "grid_affine", "grid_pixel_size", "local_frame", "pixel_affine",
            "resolve_frame", "world_to_lonlat"]
 
 #: Largest relative difference of the two pixel sides (and cosine of the angle between
