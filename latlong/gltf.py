@@ -1,7 +1,9 @@
 """Renderer export: patched triangle strips as glTF 2.0 binary, VTP strips, a manifest.
 
-``export_glb`` writes one glTF scene per level of detail (scene 0 = the full body,
-scene l = the nested magnitude M / 2^l body); every leaf of the patch tree
+``export_glb`` writes one glTF scene per level of detail (scene 0, the default, = the
+full body, scene l = the nested magnitude M / 2^l body); each scene's one root node
+``lod<l>`` turns the body frame's +Z (north) into glTF's +Y (up: :data:`Y_UP`), so
+viewers show the body upright; every leaf of the patch tree
 (:func:`latlong.strips.patch_tree`) is one node with one mesh whose single primitive is
 a ``TRIANGLE_STRIP`` (mode 5) over the patch's own vertices: float32 ``POSITION`` (with
 min/max) and unit ``NORMAL``, uint32 indices. The patch strips are the band strips cut
@@ -52,10 +54,11 @@ from craters.boulders import boulder_meshes, catalog_shape, mesh_chunk
 
 from .geometry.normals import vertex_normals
 from .grid import LatLongGrid
+from .meshio.writers import Y_UP
 from .patchdata import leaf_metadata, write_leaf_data
 from .strips import patch_tree, triangle_strips
 
-__all__ = ["export_glb", "export_vtp_strips", "unit_vectors_of"]
+__all__ = ["LOD_LAYOUTS", "export_glb", "export_vtp_strips", "level_path", "unit_vectors_of"]
 
 _ARRAY_BUFFER = 34962
 _ELEMENT_ARRAY_BUFFER = 34963
@@ -75,7 +78,7 @@ def _pad4(n: int) -> int:
     return (4 - n % 4) % 4
 
 
-def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
+def export_glb(body, path, *, patch_k: int = 64, lod: int = 0, lods: str = "scenes",
                progress: bool = False) -> dict:
     """Write ``body`` as a patched, multi-LOD glTF binary and a JSON manifest.
 
@@ -89,11 +92,17 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
     lod : int
         Coarsest level of detail: levels 0..lod are written (M must be divisible by
         2^lod); level l is ``body.lod(l)``.
+    lods : str
+        ``"scenes"``: one file, one scene per level (viewers show the default scene,
+        level 0; Blender's importer puts every scene's objects into one scene);
+        ``"separate"``: one file per level, level l > 0 in ``<stem>.lod<l>.glb`` with its
+        own manifest (what Blender users want).
 
     Returns
     -------
     The manifest (also written): per level the magnitude, triangle count and patches
-    with their bounds and byte ranges.
+    with their bounds and byte ranges; with ``separate``, ``files`` lists the files and
+    ``levels`` each file's level.
     """
     if not isinstance(getattr(body, "grid", None), LatLongGrid):
         raise TypeError(f"`body` must be a latlong.Body; got {type(body).__name__}")
@@ -102,9 +111,33 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
         raise ValueError(f"`path` must end in .glb; got {str(path)!r}")
     patch_k = check_int("patch_k", patch_k, 2, 1_000_000)
     lod = check_int("lod", lod, 0, 20)
+    if lods not in LOD_LAYOUTS:
+        raise ValueError(f"`lods` must be one of {', '.join(LOD_LAYOUTS)}; got {lods!r}")
     if body.magnitude % (2**lod):
         raise ValueError(f"`lod` {lod} needs a magnitude divisible by {2**lod}; "
                          f"the body has M = {body.magnitude}")
+    if lods == "scenes":
+        return _export(body, path, patch_k, list(range(lod + 1)), progress)
+    files = [level_path(path, level) for level in range(lod + 1)]
+    with output_group():  # every level's files: together or not at all
+        parts = [_export(body, f, patch_k, [level], progress)
+                 for level, f in enumerate(files)]
+    return {"format": "craterform.patches/1", "files": [f.name for f in files],
+            "patch_k": patch_k, "levels": [m["levels"][0] for m in parts]}
+
+
+#: How the levels of detail are laid out (:func:`export_glb`'s ``lods``).
+LOD_LAYOUTS = ("scenes", "separate")
+
+
+def level_path(path, level: int) -> Path:
+    """The file of level ``level`` when the levels are separate files."""
+    path = Path(path)
+    return path if level == 0 else path.with_name(f"{path.stem}.lod{level}.glb")
+
+
+def _export(body, path: Path, patch_k: int, levels: list[int], progress: bool) -> dict:
+    """One .glb (and its manifest) holding ``levels``, one scene each."""
     gl = {"asset": {"version": "2.0", "generator": f"craterform {package_version()}"},
           "scene": 0, "scenes": [], "nodes": [], "meshes": [], "accessors": [],
           "bufferViews": [], "buffers": []}
@@ -113,18 +146,18 @@ def export_glb(body, path, *, patch_k: int = 64, lod: int = 0,
     temps = []
     try:
         sizes, plans = [], []
-        for level in range(lod + 1):
-            plan = _plan_level(body.lod(level), level, patch_k, gl, manifest)
+        for index, level in enumerate(levels):
+            plan = _plan_level(body.lod(level), index, level, patch_k, gl, manifest)
             size = plan.size
             if body.boulders is not None and len(body.boulders):
-                if level == 0:
+                if index == 0:
                     tmp_bin = str(temp_file(path, ".boulders.bin"))
                     temps.append(tmp_bin)
                     plan.boulders = tmp_bin
                     with open(tmp_bin, "wb") as binf:
                         size, boulder_first = _write_boulder_meshes(body.boulders, gl,
                                                                      manifest, binf, size)
-                _boulder_nodes(body.boulders, level, boulder_first, gl, manifest)
+                _boulder_nodes(body.boulders, index, level, boulder_first, gl, manifest)
             sizes.append(size)
             plans.append(plan)
         with output_group():  # the .glb, its .json and .bin files: together or not at all
@@ -226,7 +259,8 @@ def _leaf_table(grid: LatLongGrid, leaves: list) -> tuple:
     return band_lo, ptr, lo, hi
 
 
-def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _LevelPlan:
+def _plan_level(body, index: int, level: int, patch_k: int, gl: dict,
+                manifest: dict) -> _LevelPlan:
     """First pass over one level's patches: their JSON (buffer = the level; offsets
     within it), manifest entries and where their data goes (positions made ring window
     by ring window: :mod:`latlong.patchdata`)."""
@@ -240,7 +274,7 @@ def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _Le
     offset = 0
     scene_nodes = []
     level_info = {"level": level, "magnitude": grid.magnitude, "n_vertices": grid.n_vertices,
-                  "n_triangles": grid.n_triangles, "scene": level, "patches": []}
+                  "n_triangles": grid.n_triangles, "scene": index, "patches": []}
     for i, leaf in enumerate(leaves):
         length, nv, n_tri = (int(x) for x in meta[i])
         if length < 3:
@@ -251,7 +285,7 @@ def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _Le
         for k, (name, nbyte, target) in enumerate((
                 ("positions", 12 * nv, _ARRAY_BUFFER), ("normals", 12 * nv, _ARRAY_BUFFER),
                 ("indices", 4 * length, _ELEMENT_ARRAY_BUFFER))):
-            gl["bufferViews"].append({"buffer": level, "byteOffset": offset,
+            gl["bufferViews"].append({"buffer": index, "byteOffset": offset,
                                       "byteLength": nbyte, "target": target})
             ranges[name] = [offset, nbyte]
             at[i, k] = offset
@@ -277,11 +311,12 @@ def _plan_level(body, level: int, patch_k: int, gl: dict, manifest: dict) -> _Le
                                        "n_triangles": n_tri}})
         scene_nodes.append(len(gl["nodes"]) - 1)
         level_info["patches"].append(info)
-    gl["nodes"].append({"name": f"lod{level}", "children": scene_nodes,
-                        "extras": {"magnitude": grid.magnitude, "level": level}})
+    gl["nodes"].append({"name": f"lod{level}", "children": scene_nodes, "rotation": Y_UP,
+                        "extras": {"magnitude": grid.magnitude, "level": level,
+                                   "up": "the body frame's +Z is glTF's +Y (rotation)"}})
     gl["scenes"].append({"name": f"lod{level}", "nodes": [len(gl["nodes"]) - 1]})
     manifest["levels"].append(level_info)
-    return _LevelPlan(level, body, leaves_table, at, nbytes, offset)
+    return _LevelPlan(index, body, leaves_table, at, nbytes, offset)
 
 
 def _write_level_data(plan: _LevelPlan, fh, progress: bool) -> None:
@@ -347,8 +382,10 @@ def _write_boulder_meshes(cat, gl: dict, manifest: dict, binf, offset: int):
     return offset, first
 
 
-def _boulder_nodes(cat, level: int, first: dict, gl: dict, manifest: dict) -> None:
-    """One node per boulder in scene ``level`` (its boulder level), under a root node."""
+def _boulder_nodes(cat, index: int, level: int, first: dict, gl: dict,
+                   manifest: dict) -> None:
+    """One node per boulder in scene ``index`` (level ``level``'s boulder level), under
+    a root node."""
     levels = sorted(first)
     blevel = max(levels[-1] - level, levels[0])
     children = []
@@ -362,8 +399,9 @@ def _boulder_nodes(cat, level: int, first: dict, gl: dict, manifest: dict) -> No
         children.append(len(gl["nodes"]) - 1)
     gl["nodes"].append({"name": f"lod{level}/boulders", "children": children,
                         "extras": {"boulder_level": blevel}})
-    gl["scenes"][level]["nodes"].append(len(gl["nodes"]) - 1)
-    manifest["levels"][level]["boulder_level"] = blevel
+    root = gl["scenes"][index]["nodes"][0]  # the level's node: the body's frame, +Y up
+    gl["nodes"][root]["children"].append(len(gl["nodes"]) - 1)
+    manifest["levels"][index]["boulder_level"] = blevel
 
 
 def export_vtp_strips(body, path) -> Path:

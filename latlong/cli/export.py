@@ -10,6 +10,7 @@ from craters._shared import check_output_path, human_bytes
 from craters.cli.kit import CliError, check_not_input
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, default_of
 from latlong import export_glb, export_vtp_strips, load
+from latlong.gltf import LOD_LAYOUTS, level_path
 
 from .inputs import MODEL
 
@@ -23,6 +24,10 @@ OPTIONS = {
                        range=(2, 1_000_000), run=True),
     "lod": Setting(default_of(export_glb, "lod"), "coarsest level of detail (M / 2^lod), 0 = "
                    "the body only", range=(0, 20), run=True),
+    "lods": Setting(default_of(export_glb, "lods"), "levels of detail in one .glb, one "
+                    "scene each (viewers show level 0; Blender imports them all into one "
+                    "scene), or separate: level l in OUT.lod<l>.glb", choices=LOD_LAYOUTS,
+                    run=True),
     "force": FORCE, "quiet": QUIET,
 }
 
@@ -33,18 +38,24 @@ def _export(v: Values) -> int:
     if suffix not in (".glb", ".vtp"):
         raise CliError(f"-o/--output must end in .glb or .vtp; got {str(out)!r}")
     check_output_path(out, force=v["force"], suffixes=(".glb", ".vtp"))
+    written = [out]
     if suffix == ".glb":
-        check_output_path(out.with_suffix(".json"), force=v["force"], suffixes=(".json",))
-        for level in range(v["lod"] + 1):  # external buffers of exports past 4 GiB
-            check_output_path(out.with_name(f"{out.stem}.lod{level}.bin"), force=v["force"])
-    for written in (out, out.with_suffix(".json")):
-        check_not_input(written, [("MODEL", v["model"])])
+        files = [level_path(out, level) for level in range(v["lod"] + 1)] \
+            if v["lods"] == "separate" else [out]
+        for f in files:
+            written += [f, f.with_suffix(".json")]
+            check_output_path(f, force=v["force"], suffixes=(".glb",))
+            check_output_path(f.with_suffix(".json"), force=v["force"], suffixes=(".json",))
+            for level in range(v["lod"] + 1):  # external buffers of exports past 4 GiB
+                check_output_path(f.with_name(f"{f.stem}.lod{level}.bin"), force=v["force"])
+    for f in written:
+        check_not_input(f, [("MODEL", v["model"])])
     body = load(v["model"])
     if body.magnitude % (2 ** v["lod"]):
         raise CliError(f"--lod {v['lod']} needs a magnitude divisible by {2 ** v['lod']}; "
                        f"{v['model']} has M = {body.magnitude}")
     if suffix == ".glb":
-        man = export_glb(body, out, patch_k=v["patch_k"], lod=v["lod"],
+        man = export_glb(body, out, patch_k=v["patch_k"], lod=v["lod"], lods=v["lods"],
                          progress=not v["quiet"])
         summary = ", ".join(f"LOD {lv['level']}: M={lv['magnitude']} "
                             f"{len(lv['patches'])} patches" for lv in man["levels"])

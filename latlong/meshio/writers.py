@@ -17,7 +17,8 @@ Formats
 * ``.vtp``: VTK XML PolyData, raw appended binary (UInt64 headers): float32 points,
   the fields, Int32 (Int64 if needed) connectivity and offsets.
 * ``.vtk``: VTK legacy binary (big-endian), POINTS float, POLYGONS, POINT_DATA fields.
-* ``.glb``: glTF 2.0 binary, one node and mesh: float32 POSITION (with bounds), uint32
+* ``.glb``: glTF 2.0 binary, one node (rotated so the model's +Z is glTF's +Y, up:
+  :data:`Y_UP`) and mesh: float32 POSITION (with bounds), uint32
   triangle indices (fields are not written).
 """
 
@@ -39,6 +40,9 @@ from .chunks import BackgroundWriter
 __all__ = ["MESH_SUFFIXES", "MESH_WRITERS", "MeshSource", "array_source", "pack_faces",
            "pack_vertices", "ply_face_dtype", "ply_vertex_dtype", "write_mesh"]
 
+#: The mesh node's rotation (glTF's x, y, z, w): -90 degrees about x, the model's +Z
+#: (a body's north, a DEM's up) to glTF's +Y (up); the positions stay the model's metres.
+Y_UP = [-0.7071067811865476, 0.0, 0.0, 0.7071067811865476]
 _PLY_TYPES = {"f4": "float", "f8": "double", "i4": "int", "u1": "uchar", "u4": "uint",
               "i2": "short", "u2": "ushort", "i1": "char"}
 _VTK_XML_TYPES = {"f4": "Float32", "f8": "Float64", "i4": "Int32", "u1": "UInt8",
@@ -334,7 +338,7 @@ def write_glb(src: MeshSource, fh, progress: bool = False) -> None:
         lo, hi = np.minimum(lo, p.min(axis=0)), np.maximum(hi, p.max(axis=0))
     gl = {"asset": {"version": "2.0", "generator": "craterform"},
           "extras": {"title": src.title}, "scene": 0, "scenes": [{"nodes": [0]}],
-          "nodes": [{"mesh": 0}],
+          "nodes": [{"mesh": 0, "rotation": Y_UP}],
           "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1,
                                       "mode": 4}]}],
           "buffers": [{"byteLength": pos_bytes + idx_bytes}],

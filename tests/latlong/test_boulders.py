@@ -374,7 +374,8 @@ def test_glb_boulder_nodes(body_with_boulders, tmp_path):
     gl = pygltflib.GLTF2().load(str(path))
     blob = gl.binary_blob()
     for level in range(3):
-        roots = [gl.nodes[i] for i in gl.scenes[level].nodes]
+        (top,) = gl.scenes[level].nodes  # the level's node, +Y up; boulders under it
+        roots = [gl.nodes[i] for i in gl.nodes[top].children]
         rocks = [r for r in roots if r.name == f"lod{level}/boulders"]
         assert len(rocks) == 1 and len(rocks[0].children) == nb
         blevel = man["levels"][level]["boulder_level"]

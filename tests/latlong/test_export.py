@@ -111,6 +111,12 @@ def test_glb_loads_in_three_readers(body, tmp_path):
     scene = trimesh.load(path, process=False)
     faces = [scene.geometry[scene.graph[n][1]].faces for n in scene.graph.nodes_geometry]
     assert sum(non_degenerate(f) for f in faces) == expected[0]
+    # upright: the body's north pole (+Z) is glTF's +Y, its +Y glTF's -Z
+    world = scene.to_geometry().vertices
+    v = body.vertices()
+    assert world[:, 1].max() == pytest.approx(v[:, 2].max(), rel=1e-6)
+    assert world[:, 2].min() == pytest.approx(-v[:, 1].max(), rel=1e-6)
+    assert world[:, 0].max() == pytest.approx(v[:, 0].max(), rel=1e-6)
     import vtk
 
     for level in range(3):
@@ -136,6 +142,33 @@ def test_glb_loads_in_three_readers(body, tmp_path):
         pos = np.frombuffer(raw[base + off: base + off + n], dtype="<f4").reshape(-1, 3)
         d = np.linalg.norm(pos - np.asarray(patch["centre_m"]), axis=1)
         assert d.max() <= patch["radius_m"] * (1 + 1e-6) + 1e-6
+
+
+def test_separate_levels_are_one_file_each(body, tmp_path, run_cli):
+    """--lods separate: level l in <stem>.lod<l>.glb, one scene each (what Blender's
+    importer needs: it puts every scene of one file into one Blender scene)."""
+    import pygltflib
+
+    path = tmp_path / "s.glb"
+    man = export_glb(body, path, patch_k=16, lod=2, lods="separate")
+    assert man["files"] == ["s.glb", "s.lod1.glb", "s.lod2.glb"]
+    one = export_glb(body, tmp_path / "one.glb", patch_k=16, lod=2)
+    for level, name in enumerate(man["files"]):
+        gl = pygltflib.GLTF2().load(str(tmp_path / name))
+        assert len(gl.scenes) == 1 and gl.nodes[gl.scenes[0].nodes[0]].name == f"lod{level}"
+        doc = json.loads((tmp_path / name).with_suffix(".json").read_text())
+        assert doc["levels"][0]["n_triangles"] == one["levels"][level]["n_triangles"]
+        assert doc["levels"][0]["level"] == level
+    with pytest.raises(ValueError, match="lods"):
+        export_glb(body, tmp_path / "x.glb", lods="nested")
+    body.save(tmp_path / "b.npz")
+    r = run_cli("latlong", "export", str(tmp_path / "b.npz"), "-o", str(tmp_path / "c.glb"),
+                "--lod", "1", "--lods", "separate", "-q")
+    assert r.returncode == 0, r.stderr
+    assert (tmp_path / "c.lod1.glb").is_file() and (tmp_path / "c.lod1.json").is_file()
+    r = run_cli("latlong", "export", str(tmp_path / "b.npz"), "-o", str(tmp_path / "c.glb"),
+                "--lod", "1", "--lods", "separate", "-q")
+    assert r.returncode == 2 and "exists" in r.stderr
 
 
 def test_export_is_deterministic(body, tmp_path):
