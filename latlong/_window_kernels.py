@@ -20,9 +20,10 @@ from .geometry._normal_kernels import _band_area_vectors
 
 
 @njit(cache=True, parallel=True)
-def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out):
-    """Unit area-weighted normals (float32) of the vertices of rings ``r_lo .. r_hi`` into
-    ``out`` (their count, 3): those of ``grid.vertex_normals``, bit for bit. The bands
+def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out, angle):
+    """Unit area-weighted (``angle``: angle-weighted) normals (float32) of the vertices of
+    rings ``r_lo .. r_hi`` into ``out`` (their count, 3): those of the whole-body kernel,
+    bit for bit. The bands
     touching those rings (``r_lo - 1 .. r_hi``) are streamed as the whole-body kernel
     streams them, even bands first, into an accumulator over rings ``r_lo - 1 .. r_hi + 1``
     (the outer two rings only receive part of their bands and are dropped)."""
@@ -38,7 +39,7 @@ def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out):
         first = band_lo + ((parity - band_lo) % 2)
         for hb in prange((band_hi - first) // 2 + 1 if band_hi >= first else 0):
             _band_area_vectors(m, ring_offsets, radii, stretch, no_table, first + 2 * hb, acc,
-                               base)
+                               base, angle)
     skip = ring_offsets[r_lo] - base
     for i in prange(out.shape[0]):
         x = np.float64(acc[skip + i, 0])

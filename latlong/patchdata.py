@@ -128,7 +128,8 @@ def write_leaf_data(grid, radii, stretch, leaves: tuple, at: np.ndarray, nbytes:
         for r0, r1, a, b in _windows(offs, table):
             pos = _window_positions(grid, radii, stretch, r0, r1)
             nrm = np.empty_like(pos)
-            _window_normals_kernel(grid.magnitude, offs, radii, stretch, r0, r1, nrm)
+            # angle-weighted: the camera's shading normals, and Mitsuba's and Blender's
+            _window_normals_kernel(grid.magnitude, offs, radii, stretch, r0, r1, nrm, True)
             groups = _groups(nb_s, a, b)
             big = max(int(nb_s[g0:g1].sum()) for g0, g1 in groups)
 

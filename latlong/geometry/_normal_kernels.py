@@ -46,6 +46,29 @@ def _add_triangle_normal(pos, a, b, c, out):
     return nx, ny, nz
 
 
+@njit(cache=True, inline="always")
+def _add_triangle_angle_normal(pos, a, b, c, out):
+    """Add triangle (a, b, c)'s unit normal times its angle at each corner to that
+    corner's row of ``out`` (the ``"angle"`` weighting: Mitsuba's and Blender's smooth
+    normals); a degenerate triangle adds nothing."""
+    cx, cy, cz = _triangle_cross(pos, a, b, c)
+    norm = np.sqrt(cx * cx + cy * cy + cz * cz)
+    if not norm > 0.0:
+        return
+    nx, ny, nz = cx / norm, cy / norm, cz / norm
+    for v, p, q in ((a, b, c), (b, c, a), (c, a, b)):
+        ux, uy, uz = pos[p, 0] - pos[v, 0], pos[p, 1] - pos[v, 1], pos[p, 2] - pos[v, 2]
+        wx, wy, wz = pos[q, 0] - pos[v, 0], pos[q, 1] - pos[v, 1], pos[q, 2] - pos[v, 2]
+        lu = np.sqrt(ux * ux + uy * uy + uz * uz)
+        lw = np.sqrt(wx * wx + wy * wy + wz * wz)
+        if lu > 0.0 and lw > 0.0:
+            cosang = (ux * wx + uy * wy + uz * wz) / (lu * lw)
+            ang = np.arccos(min(1.0, max(-1.0, cosang)))
+            out[v, 0] += ang * nx
+            out[v, 1] += ang * ny
+            out[v, 2] += ang * nz
+
+
 @njit(cache=True)
 def _area_normals_kernel(verts, tris, out, area):
     """Area-weighted vertex normal sums, triangle after triangle (the ``"faces"`` order):
@@ -102,15 +125,17 @@ def _scatter_add_kernel(index, values, out):
 
 # --------------------------------------------------------------------------- lat/long body
 @njit(cache=True, inline="always")
-def _band_normals(pos, oa, na, ob, nb, south, out):
-    """Area vectors of a band's triangles, in :func:`_band_triangles_kernel`'s order and
-    winding (the same zipper), added to ``out`` as they are made (no triangle array)."""
+def _band_normals(pos, oa, na, ob, nb, south, out, angle):
+    """Area vectors (``angle``: unit normals times corner angles) of a band's triangles,
+    in :func:`_band_triangles_kernel`'s order and winding (the same zipper), added to
+    ``out`` as they are made (no triangle array)."""
     if na == 1:  # pole fan
         for j in range(nb):
-            if south:
-                _add_triangle_normal(pos, oa, ob + (j + 1) % nb, ob + j, out)
+            b, c = (ob + (j + 1) % nb, ob + j) if south else (ob + j, ob + (j + 1) % nb)
+            if angle:
+                _add_triangle_angle_normal(pos, oa, b, c, out)
             else:
-                _add_triangle_normal(pos, oa, ob + j, ob + (j + 1) % nb, out)
+                _add_triangle_normal(pos, oa, b, c, out)
         return
     i = 0
     j = 0
@@ -122,16 +147,19 @@ def _band_normals(pos, oa, na, ob, nb, south, out):
             p, q, r = oa + i % na, ob + j, ob + (j + 1) % nb
             j += 1
         if south:
-            _add_triangle_normal(pos, p, r, q, out)
+            q, r = r, q
+        if angle:
+            _add_triangle_angle_normal(pos, p, q, r, out)
         else:
             _add_triangle_normal(pos, p, q, r, out)
 
 
 @njit(cache=True, inline="always")
-def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, base):
+def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, base, angle):
     """Band ``band``'s two rings positioned locally (:func:`_ring_positions`; longitudes
     from ``lon_table``, or computed when it is empty) and its triangles' area vectors
-    added to ``acc`` (row ``v - base`` is vertex v's)."""
+    (``angle``: angle-weighted unit normals) added to ``acc`` (row ``v - base`` is vertex
+    v's)."""
     if band < m:
         ra, rb, south = band, band + 1, False
     else:
@@ -146,12 +174,15 @@ def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, ba
     tb = _lon_row(m, rb, ring_offsets) if lon_table.shape[0] else 0
     _ring_positions(m, ra, oa, radii, stretch, lon_table, ta, pos[oa - lo:oa - lo + na])
     _ring_positions(m, rb, ob, radii, stretch, lon_table, tb, pos[ob - lo:ob - lo + nb])
-    _band_normals(pos, oa - lo, na, ob - lo, nb, south, acc[lo - base:lo - base + na + nb])
+    _band_normals(pos, oa - lo, na, ob - lo, nb, south, acc[lo - base:lo - base + na + nb],
+                  angle)
 
 
 @njit(cache=True, parallel=True)
-def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc):
-    """Area-weighted vertex normals of the body into ``acc``, streamed band by band (no
+def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc,
+                               angle):
+    """Area-weighted (``angle``: angle-weighted) vertex normals of the body into ``acc``,
+    streamed band by band (no
     triangle or vertex array of the whole body): each band's two rings (consecutive
     vertex numbers) are positioned locally and its triangles' area vectors added as the
     zipper makes them (:func:`_band_normals`; 40 % less time than triangulating into an
@@ -165,7 +196,8 @@ def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lo
             band = 2 * hb + parity
             if band >= n_bands:
                 continue
-            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, 0)
+            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, 0,
+                               angle)
 
 
 @njit(cache=True, parallel=True)

@@ -5,18 +5,16 @@ A vertex normal sums the normals of the facets around the vertex with a weightin
 (:data:`WEIGHTINGS`), then scales the sum to unit length:
 
 * ``"area"``: each facet's area vector (half its cross product ``(b - a) x (c - a)``),
-  so large facets count more; the body's shading and slopes, the mesh writers' glTF
-  normals, boulder placement, the mesh surfaces and gravity's evaluation points;
+  so large facets count more; the body's slopes, boulder placement, the mesh surfaces
+  and gravity's evaluation points;
 * ``"angle"``: each facet's unit normal times its angle at the vertex (Baerentzen &
-  Aanaes 2005, pseudo-normals; the implicit backend's inside/outside test), left
-  unnormalised there;
+  Aanaes 2005, pseudo-normals; the weighting of Thürmer & Wüthrich 1998, which Mitsuba 3
+  and Blender use for smooth shading): the shading normals of the camera and of the glTF
+  export, so a renderer fed the glTF shades as craterform does; the implicit backend's
+  inside/outside test (left unnormalised there);
 * ``"max"``: each facet's cross product over the product of the squared lengths of the
   two edges at the vertex (Max 1999, "Weights for computing vertex normals from facet
-  normals", J. Graphics Tools 4(2): exact for vertices on a sphere); the sensors'
-  smooth shading.
-
-The weightings differ (the camera's smooth shading and the glTF writer's normals are not
-the same vectors): each caller names its own, and unifying them is a separate change.
+  normals", J. Graphics Tools 4(2): exact for vertices on a sphere).
 
 Floating-point sums depend on their order, and every caller keeps the order that gives
 its outputs' bytes (:data:`ORDERS`): ``"corners"`` adds the facets' contributions to
@@ -207,8 +205,10 @@ def vertex_normals_and_areas(vertices, face_chunks) -> tuple[np.ndarray, np.ndar
 
 
 def lat_long_vertex_normals(grid, radii, stretch=(1.0, 1.0, 1.0), *,
-                            lon_table: np.ndarray | None = None) -> np.ndarray:
-    """Unit area-weighted vertex normals, float32 (N, 3), of the lat/long mesh of
+                            lon_table: np.ndarray | None = None,
+                            weighting: str = "area") -> np.ndarray:
+    """Unit vertex normals, float32 (N, 3), ``"area"`` or ``"angle"`` weighted, of the
+    lat/long mesh of
     ``grid`` (a :class:`~latlong.LatLongGrid`) whose vertex ``i`` is
     ``stretch * radii[i] * u_i``: accumulated band by band in float32 (12 B a vertex, no
     triangle array, and 8 B a vertex of longitude cosines and sines while it runs; pass
@@ -216,6 +216,8 @@ def lat_long_vertex_normals(grid, radii, stretch=(1.0, 1.0, 1.0), *,
     and normalised in place."""
     from .._grid_kernels import lon_table as make_lon_table
 
+    if weighting not in ("area", "angle"):
+        raise ValueError(f"`weighting` must be 'area' or 'angle'; got {weighting!r}")
     m = grid.magnitude
     radii = np.ascontiguousarray(radii, dtype=np.float64)
     if radii.shape != (grid.n_vertices,):
@@ -226,7 +228,8 @@ def lat_long_vertex_normals(grid, radii, stretch=(1.0, 1.0, 1.0), *,
                          f"({3 * m * (m + 1)}, 2) float64")
     acc = np.zeros((grid.n_vertices, 3), dtype=np.float32)
     _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), radii,
-                               np.ascontiguousarray(stretch, dtype=np.float64), table, acc)
+                               np.ascontiguousarray(stretch, dtype=np.float64), table, acc,
+                               weighting == "angle")
     _normalize_rows_kernel(acc)
     return acc
 

@@ -280,12 +280,12 @@ class RayMesh:
 
     @property
     def vertex_normals(self) -> np.ndarray:
-        """(n, 3) float64 unit vertex normals with Max's weights (Max 1999, "Weights for
-        computing vertex normals from facet normals", J. Graphics Tools 4(2): exact for
-        vertices on a sphere), computed once; they follow the faces' orientation; smooth
-        shading blends them."""
+        """(n, 3) float64 unit vertex normals, angle-weighted (each facet's unit normal times
+        its angle at the vertex: :mod:`latlong.geometry.normals`, as Mitsuba 3 and Blender
+        weight them and as the glTF export writes them), computed once; they follow the
+        faces' orientation; smooth shading blends them."""
         if self._vertex_normals is None:
-            out = weighted_vertex_normals(self._vertices, self._index, "max")
+            out = weighted_vertex_normals(self._vertices, self._index, "angle")
             out.flags.writeable = False
             self._vertex_normals = out
         return self._vertex_normals

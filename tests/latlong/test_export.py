@@ -144,6 +144,17 @@ def test_glb_loads_in_three_readers(body, tmp_path):
         assert d.max() <= patch["radius_m"] * (1 + 1e-6) + 1e-6
 
 
+def test_the_camera_shades_with_the_gltf_normals(body):
+    """One vertex-normal definition (angle-weighted, as Mitsuba 3 and Blender compute
+    theirs): the camera's smooth shading normals of a body are the glTF export's."""
+    from latlong.geometry.normals import lat_long_vertex_normals
+    from latlong.sensors import RayMesh
+
+    camera = RayMesh(*body.mesh()).vertex_normals
+    gltf = lat_long_vertex_normals(body.grid, body.radii_m, body.stretch, weighting="angle")
+    assert np.abs(camera - gltf).max() < 1e-6  # float32 in the file
+
+
 def test_separate_levels_are_one_file_each(body, tmp_path, run_cli):
     """--lods separate: level l in <stem>.lod<l>.glb, one scene each (what Blender's
     importer needs: it puts every scene of one file into one Blender scene)."""
@@ -268,8 +279,13 @@ def test_longitude_table_is_the_unit_vectors():
 
 def reference_patches(body, patch_k):
     """The glTF patch data the numpy way (the export before its kernels): per leaf the
-    joined strip, np.unique, float32 positions (u * r) * s, normals, bounds."""
-    grid, normals = body.grid, body.vertex_normals()
+    joined strip, np.unique, float32 positions (u * r) * s, normals (angle-weighted, as
+    the camera's: the streamed kernel, itself checked against numpy in test_patchdata),
+    bounds."""
+    from latlong.geometry.normals import lat_long_vertex_normals
+
+    grid = body.grid
+    normals = lat_long_vertex_normals(grid, body.radii_m, body.stretch, weighting="angle")
     radii, stretch = np.asarray(body.radii_m), np.asarray(body.stretch)
     for leaf in patch_tree(grid, patch_k).leaves():
         strip = join_strips(leaf.strips(grid))

@@ -312,9 +312,16 @@ def test_streamed_normals_match_the_vertex_array(rng, m):
     acc = np.zeros((grid.n_vertices, 3))
     _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), body.radii_m,
                                np.asarray(body.stretch), lon_table(m, grid.ring_offsets()),
-                               acc)
+                               acc, False)
     want, _ = reference_vertex_normals(body.vertices(), grid.triangles())
     np.testing.assert_allclose(acc, want, rtol=1e-10, atol=1e-9)
+    # the angle weighting (the camera's and the glTF's): numpy's unit normal x corner angle
+    acc[:] = 0.0
+    _normals_from_radii_kernel(m, grid.ring_offsets(), grid.band_offsets(), body.radii_m,
+                               np.asarray(body.stretch), lon_table(m, grid.ring_offsets()),
+                               acc, True)
+    want = vertex_normal_sums(body.vertices(), grid.triangles(), "angle")
+    np.testing.assert_allclose(acc, want, rtol=1e-10, atol=1e-12)
 
 
 def test_normalised_rows_match_numpy(rng):

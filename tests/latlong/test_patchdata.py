@@ -14,6 +14,7 @@ from latlong import Body, LatLongGrid
 from latlong._export_kernels import _glb_positions_kernel
 from latlong._grid_kernels import lon_table
 from latlong._window_kernels import _window_normals_kernel, _window_positions_kernel
+from latlong.geometry.normals import lat_long_vertex_normals, vertex_normals
 
 
 def _body(m, stretch=(1.0, 1.0, 1.0), seed=0):
@@ -32,16 +33,22 @@ def test_window_positions_and_normals_equal_the_whole_body(m, stretch):
     st = np.array(stretch)
     whole = np.empty((g.n_vertices, 3), np.float32)
     _glb_positions_kernel(m, offs, body.radii_m, st, lon_table(m, offs), whole)
-    normals = g.vertex_normals(body.radii_m, stretch)
+    normals = {w: lat_long_vertex_normals(g, body.radii_m, stretch, weighting=w)
+               for w in ("area", "angle")}
+    assert normals["area"].tobytes() == g.vertex_normals(body.radii_m, stretch).tobytes()
+    # the streamed angle-weighted normals (the glTF's) are the numpy reference's
+    ref = vertex_normals(*body.mesh(), "angle")
+    assert np.abs(normals["angle"] - ref).max() < 2e-6
     for r0 in range(2 * m + 1):
         for r1 in range(r0, 2 * m + 1):
             a, b = offs[r0], offs[r1 + 1]
             pos = np.empty((b - a, 3), np.float32)
             _window_positions_kernel(m, offs, body.radii_m, st, r0, r1, pos)
-            nrm = np.empty((b - a, 3), np.float32)
-            _window_normals_kernel(m, offs, body.radii_m, st, r0, r1, nrm)
             assert pos.tobytes() == whole[a:b].tobytes(), (r0, r1)
-            assert nrm.tobytes() == normals[a:b].tobytes(), (r0, r1)
+            for w, angle in (("area", False), ("angle", True)):
+                nrm = np.empty((b - a, 3), np.float32)
+                _window_normals_kernel(m, offs, body.radii_m, st, r0, r1, nrm, angle)
+                assert nrm.tobytes() == normals[w][a:b].tobytes(), (r0, r1, w)
 
 
 def _sha(path):
