@@ -466,3 +466,19 @@ def test_pds_pointer_below_the_label_folder_is_read(tmp_path):
 
 if __name__ == "__main__":  # pragma: no cover
     sys.exit(pytest.main([__file__, "-q"]))
+
+
+@pytest.mark.parametrize("umask, file_mode, folder_mode", [(0o022, 0o644, 0o755),
+                                                           (0o027, 0o640, 0o750),
+                                                           (0o002, 0o664, 0o775)])
+def test_outputs_take_the_umasks_modes(tmp_path, umask, file_mode, folder_mode):
+    """Outputs get the modes open/mkdir would give them under the umask (a web server or a
+    colleague reads them as the user's other files), not the temporaries' private 0600."""
+    code = (f"import os, stat; os.umask({umask}); "
+            "from craters._shared.files import atomic_path, output_mode; "
+            f"p = {str(tmp_path / 'a.txt')!r}\n"
+            "with atomic_path(p) as t: t.write_text('x')\n"
+            "print(oct(stat.S_IMODE(os.stat(p).st_mode)), oct(output_mode(folder=True)))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == [oct(file_mode), oct(folder_mode)]
