@@ -73,6 +73,9 @@ class DescentFrame:
     lidar: LidarFrame | None = None
     """The LIDAR's returns from the camera's pose (with ``descent(lidar=...)``), labelled
     with :attr:`craters`."""
+    crs_wkt: str = ""
+    """The CRS of the positions (body-fixed Cartesian on the body's sphere), OGC WKT: the
+    LAS files' CRS."""
 
 
 def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
@@ -123,6 +126,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         render,
     )
     from ..sensors.engine import RayMesh
+    from ..sensors.lidar_files import body_fixed_wkt
     from ..sensors.scene_geometry import SceneGeometry
 
     if isinstance(scene, Scene):
@@ -176,7 +180,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
             rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)
         n_craters, n_rocks = counts
         yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
-                           catalog, returns)
+                           catalog, returns, body_fixed_wkt("craterform body",
+                                                            field.base.radius_m))
 
 
 def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:
@@ -243,7 +248,8 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
             if f.lidar is not None:
                 files["lidar"] = f"lidar_{i:04d}.las"
                 files["lidar_range"] = f"lidar_range_{i:04d}.npy"
-                write_las(f.lidar, tmp / files["lidar"], point_source_id=i)
+                write_las(f.lidar, tmp / files["lidar"], point_source_id=i,
+                          crs_wkt=f.crs_wkt or None)
                 np.save(tmp / files["lidar_range"], f.lidar.range_image, allow_pickle=False)
                 extra["lidar_returns"] = len(f.lidar)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,

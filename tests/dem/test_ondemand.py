@@ -87,6 +87,10 @@ def test_dem_descent_writes_the_frames_strip_and_manifest(tmp_path):
     assert meta["lidar"]["beams"] == [8, 8] and meta["lidar_seed"] == 0
     assert all(f["lidar_returns"] == 64 for f in meta["frames"])
     assert (out / "lidar_0002.las").is_file() and (out / "lidar_range_0002.npy").is_file()
+    import laspy
+
+    crs = laspy.read(out / "lidar_0002.las").header.parse_crs()  # body-fixed Cartesian
+    assert crs is not None and crs.is_geocentric
     # a LIDAR wider than the frames' terrain: one line naming the flag, nothing written
     assert main(["descent", str(LOLA), "--lat-deg", "10", "--lon-deg", "180", "--frames", "1",
                  "--craters", "c=0.08,k=-2,d_min_m=10,d_max_m=100", "--lidar",
