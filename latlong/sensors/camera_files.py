@@ -378,6 +378,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
     albedo = ejecta_albedo(geometry, contrast=settings.bright_ejecta) \
         if settings.bright_ejecta else None
+    bands = settings.band_models()
     rims = None  # the rims of the craters seen, fitted to the surface once each
     if geometry.craters is not None and len(geometry.craters):
         rims = FittedRims(geometry.craters, geometry)
@@ -387,7 +388,6 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
             def render_at(camera, pose, sun=suns[k], planet=planets[k]):
-                bands = settings.band_models()
                 return render(mesh, camera, pose, sun,
                               reflectance=None if bands else settings.reflectance, bands=bands,
                               sensor=settings.sensor,

@@ -125,9 +125,9 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
     for k in range(samples):
         _bounce_rays_kernel(p, g, h, SHADOW_OFFSET, centre, floor, seed, k, o, d, above)
         face, q, nq, hits = _secondary_hits(mesh, o, d, above)
-        light = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun, seed)
-        for b in range(len(models)):
-            total[:, b] += light[:, b]
+        light, va = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun,
+                                seed)
+        total += light
         front = np.flatnonzero((face >= 0) & (np.einsum("ij,ij->i", nq, d) < 0.0))
         if bounces < 2 or not len(front):
             continue
@@ -139,11 +139,10 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         _bounce_rays_kernel(q2, n2, n2, SHADOW_OFFSET, centre, floor, seed,
                             SECOND_BOUNCE + k, o2, d2, above2)
         face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
-        light2 = _seen_light(mesh, models, d2, face2, r2, nr2, hits2, vertex_albedo, sun,
-                             seed)
-        va = vertex_albedo_at(mesh, vertex_albedo, hits)[front]
+        light2, _ = _seen_light(mesh, models, d2, face2, r2, nr2, hits2, vertex_albedo, sun,
+                                seed)
         for b in range(len(models)):
-            total[front, b] += normal_albedo[b] * va * light2[:, b]
+            total[front, b] += normal_albedo[b] * va[front] * light2[:, b]
     out = np.empty_like(total)
     for b in range(len(models)):
         out[:, b] = normal_albedo[b] * albedo * total[:, b] / samples
@@ -163,9 +162,9 @@ def _secondary_hits(mesh: RayMesh, o, d, above):
 
 
 def _seen_light(mesh: RayMesh, models, d, face, q, nq, hits, vertex_albedo, sun: Sun,
-                seed: int) -> np.ndarray:
-    """(n, bands): the direct I/F of each secondary hit seen back along its ray (0 for a
-    miss)."""
+                seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """((n, bands) direct I/F of each secondary hit seen back along its ray (0 for a
+    miss), (n,) the albedo factor at the hits)."""
     facing = (face >= 0) & (nq @ sun.direction > 0.0)
     lit = sunlit(mesh, q, nq, facing, sun, 0, seed)
     va = vertex_albedo_at(mesh, vertex_albedo, hits)
@@ -175,7 +174,7 @@ def _seen_light(mesh: RayMesh, models, d, face, q, nq, hits, vertex_albedo, sun:
         _bounce_light_kernel(model.code, model.vector(), d, face, mesh.face_normals, va,
                              sun.direction, lit, light)
         out[:, b] = light
-    return out
+    return out, va
 
 
 def planet_light(mesh: RayMesh, models, origin, dirs, hits, vnormals, planet: Planet,
