@@ -92,6 +92,9 @@ class LidarSettings:
     pulse_rate_hz: float = setting(100_000.0, "beams per second of scan and rosette",
                                    unit="Hz", range=">0")
     """Beams per second of the scanning patterns (scan, rosette)."""
+    las_version: str = setting("1.4", "LAS files: 1.4 (point format 6, CRS as WKT) or 1.2 "
+                               "(point format 1, for older readers)", choices=("1.4", "1.2"))
+    """The LAS files' version (:func:`~latlong.sensors.lidar_files.write_las`)."""
 
     def __post_init__(self):
         # values kept as given (lidar.json records them); the beams as a tuple of ints

@@ -28,7 +28,13 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import atomic_path, normalize_rng, package_version, progress_bar
+from craters._shared import (
+    ParameterError,
+    atomic_path,
+    normalize_rng,
+    package_version,
+    progress_bar,
+)
 
 from .engine import RayMesh
 from .lidar import LidarFrame, LidarSettings, lidar_frame
@@ -64,16 +70,21 @@ def las_crs_wkt(geometry) -> str:
 
 
 def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
-              crs_wkt: str | None = None) -> Path:
-    """Write one frame's returns to a LAS 1.4 file (point format 6), atomically: the
-    global encoding's WKT bit set (point formats 6-10 require it) and, with ``crs_wkt``,
-    the CRS as an OGC WKT coordinate-system VLR, as PDAL and QGIS read it."""
+              crs_wkt: str | None = None, version: str = "1.4") -> Path:
+    """Write one frame's returns to a LAS file, atomically: LAS 1.4 point format 6 with
+    the global encoding's WKT bit set (point formats 6-10 require it) or, ``version``
+    "1.2", point format 1 for older readers (loaders.gl, deck.gl); with ``crs_wkt`` the
+    CRS as an OGC WKT coordinate-system VLR, as PDAL and QGIS read it (a 1.2 file has no
+    WKT bit: readers that only take GeoTIFF keys see no CRS)."""
     import laspy
     from laspy.vlrs.known import WktCoordinateSystemVlr
 
+    if version not in ("1.4", "1.2"):
+        raise ParameterError("version", f"must be '1.4' or '1.2'; got {version!r}")
     path = Path(path)
-    header = laspy.LasHeader(point_format=6, version="1.4")
-    header.global_encoding.wkt = True
+    header = laspy.LasHeader(point_format=6 if version == "1.4" else 1, version=version)
+    if version == "1.4":
+        header.global_encoding.wkt = True
     if crs_wkt:
         header.vlrs.append(WktCoordinateSystemVlr(crs_wkt))
     header.creation_date = _LAS_DATE
@@ -98,6 +109,9 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
     las = laspy.LasData(header)
     las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
     las.intensity = frame.intensity
+    if version == "1.2" and len(xyz) and int(np.max(frame.number_of_returns)) > 7:
+        raise ParameterError("las_version", f"1.2 holds at most 7 returns a beam; a beam has "
+                             f"{int(np.max(frame.number_of_returns))}: use 1.4")
     las.return_number = frame.return_number
     las.number_of_returns = frame.number_of_returns
     las.gps_time = frame.time_s
@@ -155,7 +169,8 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
                              time_s=float(poses.time_s[k]), rng=np.random.default_rng([seed, k]),
                              ground_truth=geometry)
             names = {"points": f"lidar_{k:04d}.las", "range": f"range_{k:04d}.npy"}
-            write_las(fr, tmp / names["points"], point_source_id=k, crs_wkt=crs_wkt)
+            write_las(fr, tmp / names["points"], point_source_id=k, crs_wkt=crs_wkt,
+                      version=settings.las_version)
             np.save(tmp / names["range"], fr.range_image, allow_pickle=False)
             frames.append({"time_s": fr.frame_time_s, "position_m": fr.pose["position_m"],
                            "quaternion_wxyz": fr.pose["quaternion_wxyz"],

@@ -157,3 +157,32 @@ def test_las_round_trip_keeps_a_tenth_of_a_millimetre(body_file, tmp_path):
     np.testing.assert_array_equal(las.intensity, fr.intensity)
     assert (las.gps_time == 3.25).all() and (las.point_source_id == 7).all()
     np.testing.assert_array_equal(las.crater_id, fr.crater_id)
+
+
+def test_las_1_2_for_older_readers(body_file, tmp_path):
+    """LAS 1.2, point format 1 (loaders.gl 4.5 reads <= 1.3 only: checked by hand, its
+    first point equal to laspy's): the same points, labels and CRS VLR, no WKT bit."""
+    import dataclasses
+
+    from latlong.sensors.engine import RayMesh
+    from latlong.sensors.lidar import lidar_frame
+
+    geo = scene_geometry(latlong.load_surface(body_file))
+    q = _look_at([700.0, 0, 0], [0.0, 0, 0])
+    fr = lidar_frame(RayMesh(geo.vertices, geo.faces), LidarSettings(beams=(16, 16),
+                     fov_deg=50.0), [700.0, 0, 0], q, time_s=3.25, ground_truth=geo)
+    las = laspy.read(write_las(fr, tmp_path / "f.las", version="1.2", crs_wkt="GEOCCS["
+                               '"b",DATUM["b",SPHEROID["b",400,0]],PRIMEM["R",0],UNIT["metre",1]]'))
+    assert las.header.version == "1.2" and las.header.point_format.id == 1
+    assert not las.header.global_encoding.wkt and las.header.parse_crs().is_geocentric
+    xyz = np.stack([las.x, las.y, las.z], 1)
+    assert np.abs(xyz - fr.position_m).max() <= 0.5e-4 + 1e-9
+    np.testing.assert_array_equal(las.crater_id, fr.crater_id)
+    assert (las.gps_time == 3.25).all()
+    many = dataclasses.replace(fr, number_of_returns=np.full(len(fr.number_of_returns), 9,
+                                                             dtype=fr.number_of_returns.dtype))
+    with pytest.raises(ValueError, match="las_version.*7 returns"):
+        write_las(many, tmp_path / "g.las", version="1.2")
+    assert not (tmp_path / "g.las").exists()
+    with pytest.raises(ValueError, match="version"):
+        write_las(fr, tmp_path / "h.las", version="2.0")
