@@ -34,6 +34,7 @@ from craters._shared import (
 )
 from craters._shared.settings import check_declared, setting
 
+from .crscode import check_crs
 from .fractal import MAX_ROUGHNESS
 from .terrains import TERRAINS
 
@@ -106,7 +107,7 @@ def _parse_crater_spec(spec: str):
 _RUN_KEYS = ("output", "force", "quiet")
 #: Fields the manifest records as given (a TOML integer stays an integer), checked only.
 _AS_GIVEN = ("fractal_dimension", "roughness", "seed", "band", "pixel_size_m", "body_radius_m",
-             "gravity_m_s2", "body")
+             "crs", "gravity_m_s2", "body")
 
 
 def parse_xy(text) -> tuple[float, float]:
@@ -228,6 +229,10 @@ class EnhanceConfig:
         default_text="the body the DEM's CRS names, else moon")
     """The target body of the craters (:data:`craters.TARGETS`: morphology, transition
     diameters, diffusivity); default: the body the DEM's CRS names, else the Moon."""
+    crs: str | None = setting(None, "the input's CRS instead of the file's: a code "
+                              "(IAU_2015:30100, the Moon), a WKT or a PROJ string",
+                              metavar="CRS", default_text="the file's")
+    """The input's CRS instead of the file's (:func:`dem.read`'s ``crs``)."""
     gravity_m_s2: float | None = setting(
         None, "surface gravity: crater transition diameters scale as 1/g", unit="m/s^2",
         range=">0", metavar="G", default_text="the body's")
@@ -247,6 +252,8 @@ class EnhanceConfig:
         if self.source_crater_px == 0:
             put("source_crater_px", None)
         check_declared(self, keep=_AS_GIVEN)
+        if self.crs is not None:
+            check_crs(self.crs)
         if self.terrain is not None:
             for other in ("roughness", "fractal_dimension"):
                 if getattr(self, other) is not None:

@@ -20,7 +20,7 @@ from rasterio.crs import CRS
 from rasterio.errors import CRSError, NotGeoreferencedWarning
 from rasterio.io import MemoryFile
 
-__all__ = ["CRS_TAG", "crs_tags", "restore_crs"]
+__all__ = ["CRS_TAG", "check_crs", "crs_tags", "restore_crs"]
 
 logger = logging.getLogger(__name__)
 
@@ -83,3 +83,18 @@ def restore_crs(crs, tags: dict, where: str):
     logger.warning("%s: ignoring the tag %s = %r: the file's CRS is another", where, CRS_TAG,
                    code)
     return crs
+
+
+def check_crs(crs, parameter: str = "crs"):
+    """``crs`` (a code such as ``IAU_2015:30100``, a WKT, a PROJ string or a CRS) as a
+    rasterio CRS, or a one-line error naming ``parameter``."""
+    import rasterio
+
+    from craters._shared import ParameterError
+
+    try:
+        with rasterio.Env():  # GDAL's messages go to logging, not to stderr
+            return crs if isinstance(crs, CRS) else CRS.from_user_input(crs)
+    except (CRSError, TypeError, ValueError):
+        raise ParameterError(parameter, f"must be a CRS PROJ knows (a code such as "
+                             f"IAU_2015:30100, a WKT or a PROJ string); got {crs!r}") from None

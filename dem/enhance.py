@@ -284,7 +284,8 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
                          f"{human_bytes(physical_memory_bytes())}")
     base = dem if dem is not None else read(cfg.input, band=cfg.band,
                                             pixel_size_m=cfg.pixel_size_m,
-                                            body_radius_m=cfg.body_radius_m, body=cfg.body)
+                                            body_radius_m=cfg.body_radius_m, body=cfg.body,
+                                            crs=cfg.crs)
     seed = cfg.seed  # checked by the config
     if seed is None:
         entropy = np.random.SeedSequence().entropy

@@ -34,7 +34,7 @@ from craters._shared import (
 from craters._shared.files import check_regular_file
 
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
-from .crscode import CRS_TAG, crs_tags, restore_crs
+from .crscode import CRS_TAG, check_crs, crs_tags, restore_crs
 from .pdsimage import read_pds
 from .zarrio import (
     ZARR_OPTIONS,
@@ -67,24 +67,17 @@ _COG_OPTIONS = {"compress": "DEFLATE", "predictor": "FLOATING_POINT", "blocksize
 
 # --------------------------------------------------------------------------- read
 def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = None,
-         body: str | None = None, *, window=None, allow_unknown: bool = False) -> Dem:
+         body: str | None = None, *, window=None, allow_unknown: bool = False,
+         crs=None) -> Dem:
     """Read a DEM: a GeoTIFF (or any raster GDAL reads) or a PDS3 ``.IMG``/``.LBL`` pair.
 
     NoData pixels become NaN; the band's scale and offset are applied; the CRS (with
     its IAU or other authority code, also where the GeoTIFF keys lose it:
     :mod:`dem.crscode`), transform and tags are kept. PDS3 products (``.lbl`` or
     ``.img`` suffix, detached or attached label) are read through GDAL's PDS driver
-    behind craterform's label checks (:mod:`dem.pdsimage`: the ``^IMAGE`` pointer may
-    only name a file beside the label or below its folder): heights are ``DN *
-    SCALING_FACTOR`` (metres; kilometres if the image's ``UNIT`` says so, as in LOLA's
-    floating-point polar products), ``MISSING_CONSTANT`` pixels are NaN; a simple-cylindrical map
-    centred on the equator gives a geographic CRS on a sphere of the label's
-    ``A_AXIS_RADIUS``, any other projection GDAL knows (polar stereographic, ...) its
-    projected CRS; ``A_AXIS_RADIUS`` is then also the body radius. A label ``OFFSET``
-    within 10 % of that radius is the reference
-    radius of the heights (as in LOLA's GDR products: radius = height + OFFSET), so it
-    is recorded in the tag ``PDS_REFERENCE_RADIUS_M`` and not added; any other
-    ``OFFSET`` is added as the PDS standard says.
+    behind craterform's label checks, heights in metres, ``MISSING_CONSTANT`` as NaN, a
+    simple-cylindrical map as the IAU_2015 CRS of its body's sphere where PROJ knows
+    it (:mod:`dem.pdsimage`: pointers, units, ``OFFSET`` and the reference radius).
 
     Parameters
     ----------
@@ -102,6 +95,10 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     body : str, optional
         A body of :data:`craters.TARGETS` (``moon``, ``mars`` ...): its mean radius when
         neither ``body_radius_m`` nor the file gives one (a geographic CRS needs it).
+    crs : str or CRS, optional
+        The CRS to use instead of the file's (an authority code such as
+        ``IAU_2015:30100``, a WKT or a PROJ string): for a file without one, or with a
+        wrong one (as ``gdal_edit -a_srs``).
     window : rasterio Window or (row_off, col_off, rows, cols), optional
         Read only these pixels (integers, inside the raster): the result is
         ``read(path).crop(window)`` - its transform, lattice origin and pixel size are
@@ -125,14 +122,17 @@ def read(path, band: int = 1, pixel_size_m=None, body_radius_m: float | None = N
     with about("band"):
         band = check_int("band", band, 1)
     win = None if window is None else _check_window(window)
+    given = None if crs is None else check_crs(crs)
     if path.suffix.lower() in PDS_SUFFIXES:
         heights, transform, crs, tags, label_radius = read_pds(path, band, win)
         if body_radius_m is None:
             body_radius_m = label_radius
     else:
         heights, transform, crs, tags = _read_gdal(path, band, win)
+        crs = crs if given is None else given
         body_radius_m, pixel_size_m = _written_sizes(tags, path, crs, body_radius_m,
                                                      pixel_size_m)
+    crs = crs if given is None else given
     if body_radius_m is None and body is not None and crs is not None and crs.is_geographic:
         body_radius_m = get_target(body).radius_m
     if not allow_unknown:

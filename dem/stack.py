@@ -47,7 +47,7 @@ from craters._shared import (
     sweep_temporaries,
     temp_folder,
 )
-from craters._shared.files import check_regular_file, output_mode
+from craters._shared.files import check_regular_file
 
 from .core import Dem, crs_label
 from .frame import (
@@ -459,7 +459,6 @@ def _atomic_folder(folder: Path):
     tmp = temp_folder(folder)
     try:
         yield tmp
-        os.chmod(tmp, output_mode(folder=True))
         replace_output(tmp, folder)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)

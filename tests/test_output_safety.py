@@ -475,10 +475,11 @@ def test_outputs_take_the_umasks_modes(tmp_path, umask, file_mode, folder_mode):
     """Outputs get the modes open/mkdir would give them under the umask (a web server or a
     colleague reads them as the user's other files), not the temporaries' private 0600."""
     code = (f"import os, stat; os.umask({umask}); "
-            "from craters._shared.files import atomic_path, output_mode; "
+            "from craters._shared import atomic_path, temp_folder; "
             f"p = {str(tmp_path / 'a.txt')!r}\n"
             "with atomic_path(p) as t: t.write_text('x')\n"
-            "print(oct(stat.S_IMODE(os.stat(p).st_mode)), oct(output_mode(folder=True)))")
+            f"f = temp_folder({str(tmp_path / 'run')!r})\n"
+            "print(oct(stat.S_IMODE(os.stat(p).st_mode)), oct(stat.S_IMODE(os.stat(f).st_mode)))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True).stdout.split()
     assert out == [oct(file_mode), oct(folder_mode)]

@@ -12,7 +12,7 @@ from pathlib import Path
 from .outputs import replace_output, sweep_temporaries, temp_file
 
 __all__ = ["atomic_path", "check_output_path", "check_parent_folder", "check_regular_file",
-           "check_suffix", "load_toml", "output_mode"]
+           "check_suffix", "load_toml"]
 
 
 def check_parent_folder(path) -> None:
@@ -29,10 +29,8 @@ def check_suffix(path, suffixes: Sequence[str]) -> Path:
     """The output's suffix is one of ``suffixes`` (one-line ValueError)."""
     path = Path(path)
     if path.suffix.lower() not in suffixes:
-        raise ValueError(
-            f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}; "
-            f"allowed: {' '.join(suffixes)}"
-        )
+        raise ValueError(f"output {str(path)!r}: unknown format {path.suffix or '(no suffix)'!r}"
+                         f"; allowed: {' '.join(suffixes)}")
     return path
 
 
@@ -52,27 +50,6 @@ def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = Non
     return path
 
 
-def _umask() -> int:
-    """The process's umask, read without changing it (Linux: /proc/self/status), else
-    through os.umask (set and restored at once)."""
-    try:
-        with open("/proc/self/status", encoding="ascii") as fh:
-            for line in fh:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except (OSError, ValueError):
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def output_mode(folder: bool = False) -> int:
-    """The mode of a new output as ``open``/``mkdir`` would give it under the umask
-    (0644 / 0755 with the usual 022): temporaries are private until they are moved."""
-    return (0o777 if folder else 0o666) & ~_umask()
-
-
 @contextlib.contextmanager
 def atomic_path(path) -> Iterator[Path]:
     """Yield a temporary path in the target folder; move it onto ``path`` on success.
@@ -81,11 +58,9 @@ def atomic_path(path) -> Iterator[Path]:
     an output group (:func:`~craters._shared.outputs.output_group`) the move can be taken
     back if a later output of the group fails.
     """
-    path = Path(path)
-    tmp = temp_file(path, path.suffix)
+    tmp = temp_file(path, Path(path).suffix)
     try:
         yield tmp
-        os.chmod(tmp, output_mode())
         replace_output(tmp, path)
     except BaseException:
         with contextlib.suppress(FileNotFoundError):

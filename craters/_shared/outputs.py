@@ -23,8 +23,8 @@ import contextvars
 import logging
 import os
 import re
+import secrets
 import shutil
-import tempfile
 import time
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
@@ -45,32 +45,39 @@ def _folder_of(path: Path) -> Path:
     return path.parent if str(path.parent) else Path(".")
 
 
+def _new_temporary(path, suffix: str, make) -> Path:
+    """``make`` a new entry next to ``path`` under a fresh temporary name."""
+    path = Path(path)
+    for _ in range(100):
+        name = _folder_of(path) / f".{path.name}.{os.getpid()}.{secrets.token_hex(4)}.tmp{suffix}"
+        with contextlib.suppress(FileExistsError):
+            make(name)
+            return name
+    raise FileExistsError(f"no free temporary name next to {str(path)!r}")
+
+
 def temp_file(path, suffix: str = "") -> Path:
     """Create an empty temporary file next to ``path`` under the project's temporary name
-    (``.<name>.<pid>.<random>.tmp<suffix>``) and return its path."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp" + suffix,
-                               dir=_folder_of(path))
-    os.close(fd)
-    return Path(tmp)
+    (``.<name>.<pid>.<random>.tmp<suffix>``) and return its path; its mode is what the
+    umask gives a new file (0644 with 022), the output's once it is moved into place."""
+    return _new_temporary(path, suffix, lambda p: os.close(
+        os.open(p, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o666)))
 
 
 def temp_folder(path, suffix: str = "") -> Path:
-    """Create an empty temporary folder next to ``path`` (named like :func:`temp_file`)."""
-    path = Path(path)
-    return Path(tempfile.mkdtemp(prefix=f".{path.name}.{os.getpid()}.", suffix=".tmp" + suffix,
-                                 dir=_folder_of(path)))
+    """Create an empty temporary folder next to ``path`` (named like :func:`temp_file`,
+    the umask's mode: 0755 with 022)."""
+    return _new_temporary(path, suffix, lambda p: os.mkdir(p, 0o777))
 
 
 def _process_gone(pid: int) -> bool:
-    if pid <= 0:
-        return False
     try:
-        os.kill(pid, 0)
+        if pid > 0:  # 0 and -1 would signal process groups
+            os.kill(pid, 0)
     except ProcessLookupError:
         return True
-    except (PermissionError, OverflowError, OSError):
-        return False
+    except (OverflowError, OSError):  # another user's process, or not a process number
+        pass
     return False
 
 

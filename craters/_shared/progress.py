@@ -50,6 +50,7 @@ class _Silent:
         return self
 
     def __exit__(self, *exc):
+        self.close()
         return False
 
 
@@ -81,10 +82,6 @@ class _LogLines(_Silent):
 
     def set_description(self, desc: str) -> None:
         self._desc = desc
-
-    def __exit__(self, *exc):
-        self.close()
-        return False
 
     def close(self) -> None:
         if self._lines:  # a long job said where it was: say that it ended

@@ -43,7 +43,7 @@ DEM = declared_keys(EnhanceConfig)
 #: The input DEM of a command.
 INPUT = dataclasses.replace(DEM["input"], run=True)
 #: How a DEM input is read (band, pixel size, body radius, body).
-READ = {k: DEM[k] for k in ("band", "pixel_size_m", "body_radius_m", "body")}
+READ = {k: DEM[k] for k in ("band", "pixel_size_m", "body_radius_m", "body", "crs")}
 #: How a command writes (every command that writes).
 RUN = {"quiet": QUIET, "force": FORCE}
 #: The inputs and outputs of ``dem slopes`` and ``dem spectrum``.
@@ -53,7 +53,7 @@ REPORT_OPTIONS = {
     "compare": Setting(help="more inputs to overlay", many="+", metavar="OTHER", run=True),
     "label": Setting(help="legend labels, one per input (a stack counts one per layer)",
                      many="+", metavar="LABEL", run=True, default_text="the file names"),
-    **{k: READ[k] for k in ("pixel_size_m", "body_radius_m", "body")},
+    **{k: READ[k] for k in ("pixel_size_m", "body_radius_m", "body", "crs")},
     "csv": REPORT["csv"], "plot": REPORT["plot"], **RUN,
 }
 
@@ -96,7 +96,7 @@ def read_input(v: Values, path=None, **kw):
     (``kw``: more of :func:`dem.read`'s, e.g. a window)."""
     return read(v["input"] if path is None else path, band=v.get("band", 1),
                 pixel_size_m=v["pixel_size_m"], body_radius_m=v["body_radius_m"],
-                body=v.get("body"), **kw)
+                body=v.get("body"), crs=v.get("crs"), **kw)
 
 
 def begin(v: Values, name: str):

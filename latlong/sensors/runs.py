@@ -15,7 +15,6 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from craters._shared import replace_output, sweep_temporaries, temp_folder
-from craters._shared.files import output_mode
 
 __all__ = ["check_output_folder", "move_run", "run_folder"]
 
@@ -56,12 +55,10 @@ def run_folder(folder, manifest: str) -> Iterator[Path]:
 
 
 def move_run(tmp: Path, folder: Path, manifest: str) -> None:
-    """Move the finished run in ``tmp`` into ``folder`` (files readable by all): a rename
-    when ``folder`` does not exist yet, else file by file with ``manifest`` last."""
-    for p in tmp.iterdir():
-        os.chmod(p, output_mode())
+    """Move the finished run in ``tmp`` into ``folder`` (its files and folder have the
+    umask's modes: :func:`~craters._shared.outputs.temp_folder`): a rename when
+    ``folder`` does not exist yet, else file by file with ``manifest`` last."""
     if not folder.exists():
-        os.chmod(tmp, output_mode(folder=True))
         replace_output(tmp, folder)
         return
     names = sorted(p.name for p in tmp.iterdir())

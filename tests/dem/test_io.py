@@ -371,3 +371,22 @@ def test_read_lattice_tags(tiny_geotiff, caplog):
         d = dem.read(tiny_geotiff)
     assert (d.level, d.origin) == (0, (0, 0))
     assert "ignoring malformed CRATERFORM_LEVEL/CRATERFORM_ORIGIN tags" in caplog.text
+
+
+def test_a_crs_given_replaces_the_files(tmp_path, run_cli):
+    """``crs`` / ``--crs``: the CRS of a file without one (or with a wrong one), checked
+    before anything is read."""
+    path = tmp_path / "nocrs.tif"
+    with rasterio.open(path, "w", driver="GTiff", width=8, height=8, count=1,
+                       dtype="float32", transform=Affine(0.25, 0, 148, 0, -0.25, 32)) as ds:
+        ds.write(np.ones((8, 8), "float32"), 1)
+    d = dem.read(path, crs="IAU_2015:30100")
+    assert d.crs.to_authority() == ("IAU_2015", "30100") and d.body_radius_m == 1737400.0
+    assert d.pixel_size_m[1] == pytest.approx(0.25 * np.pi / 180 * 1737400.0)
+    with pytest.raises(ValueError, match="`crs` must be a CRS PROJ knows"):
+        dem.read(path, crs="IAU_2015:1")
+    proc = run_cli("dem", "info", str(path), "--crs", "IAU_2015:30100")
+    assert proc.returncode == 0 and "IAU_2015:30100" in proc.stdout, proc.stderr
+    proc = run_cli("dem", "info", str(path), "--crs", "nowhere")
+    assert proc.returncode == 2 and proc.stderr.startswith("error: --crs must be")
+    assert proc.stderr.count("\n") == 1
