@@ -47,26 +47,37 @@ def _add_triangle_normal(pos, a, b, c, out):
 
 
 @njit(cache=True, inline="always")
+def _corner_angle(dot, la, lb):
+    """The angle between two edges of lengths ``la``, ``lb`` whose dot product is ``dot``
+    (0 for a degenerate edge)."""
+    if not (la > 0.0 and lb > 0.0):
+        return 0.0
+    return np.arccos(min(1.0, max(-1.0, dot / (la * lb))))
+
+
+@njit(cache=True, inline="always")
 def _add_triangle_angle_normal(pos, a, b, c, out):
     """Add triangle (a, b, c)'s unit normal times its angle at each corner to that
     corner's row of ``out`` (the ``"angle"`` weighting: Mitsuba's and Blender's smooth
     normals); a degenerate triangle adds nothing."""
-    cx, cy, cz = _triangle_cross(pos, a, b, c)
+    e1x, e1y, e1z, e2x, e2y, e2z = _triangle_edges(pos, a, b, c)  # b - a, c - a
+    cx, cy, cz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
     norm = np.sqrt(cx * cx + cy * cy + cz * cz)
     if not norm > 0.0:
         return
+    fx, fy, fz = e2x - e1x, e2y - e1y, e2z - e1z  # c - b
+    l1 = np.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
+    l2 = np.sqrt(e2x * e2x + e2y * e2y + e2z * e2z)
+    l3 = np.sqrt(fx * fx + fy * fy + fz * fz)
+    d12 = e1x * e2x + e1y * e2y + e1z * e2z
+    d13 = e1x * fx + e1y * fy + e1z * fz
+    d23 = e2x * fx + e2y * fy + e2z * fz
     nx, ny, nz = cx / norm, cy / norm, cz / norm
-    for v, p, q in ((a, b, c), (b, c, a), (c, a, b)):
-        ux, uy, uz = pos[p, 0] - pos[v, 0], pos[p, 1] - pos[v, 1], pos[p, 2] - pos[v, 2]
-        wx, wy, wz = pos[q, 0] - pos[v, 0], pos[q, 1] - pos[v, 1], pos[q, 2] - pos[v, 2]
-        lu = np.sqrt(ux * ux + uy * uy + uz * uz)
-        lw = np.sqrt(wx * wx + wy * wy + wz * wz)
-        if lu > 0.0 and lw > 0.0:
-            cosang = (ux * wx + uy * wy + uz * wz) / (lu * lw)
-            ang = np.arccos(min(1.0, max(-1.0, cosang)))
-            out[v, 0] += ang * nx
-            out[v, 1] += ang * ny
-            out[v, 2] += ang * nz
+    for v, ang in ((a, _corner_angle(d12, l1, l2)), (b, _corner_angle(-d13, l1, l3)),
+                   (c, _corner_angle(d23, l2, l3))):
+        out[v, 0] += ang * nx
+        out[v, 1] += ang * ny
+        out[v, 2] += ang * nz
 
 
 @njit(cache=True)
@@ -84,6 +95,15 @@ def _area_normals_kernel(verts, tris, out, area):
             third = np.sqrt(nx * nx + ny * ny + nz * nz) / 3.0
             for v in (a, b, c):
                 area[v] += third
+
+
+@njit(cache=True)
+def _angle_normals_kernel(verts, tris, out):
+    """Angle-weighted vertex normal sums, triangle after triangle (the ``"faces"``
+    order): each triangle's unit normal times its angle at each corner added to that
+    corner's row of ``out``."""
+    for t in range(tris.shape[0]):
+        _add_triangle_angle_normal(verts, tris[t, 0], tris[t, 1], tris[t, 2], out)
 
 
 @njit(cache=True)

@@ -285,7 +285,7 @@ class RayMesh:
         weight them and as the glTF export writes them), computed once; they follow the
         faces' orientation; smooth shading blends them."""
         if self._vertex_normals is None:
-            out = weighted_vertex_normals(self._vertices, self._index, "angle")
+            out = weighted_vertex_normals(self._vertices, self._index, "angle", order="faces")
             out.flags.writeable = False
             self._vertex_normals = out
         return self._vertex_normals

@@ -332,3 +332,19 @@ def test_normalised_rows_match_numpy(rng):
     want /= np.where(norm > 0, norm, 1.0)[:, None].astype(np.float32)
     _normalize_rows_kernel(acc)
     assert np.array_equal(acc, want)
+
+
+def test_angle_kernel_is_the_numpy_angle_weighting(rng):
+    """The camera's normals (the angle weighting summed facet after facet in numba) are
+    numpy's angle-weighted sums (corner angles by arccos, unit facet normals)."""
+    from latlong.geometry._normal_kernels import _angle_normals_kernel
+
+    grid = LatLongGrid(7)
+    v = grid.unit_vectors() * (50.0 + rng.uniform(0, 5, (grid.n_vertices, 1)))
+    f = grid.triangles()
+    out = np.zeros_like(v)
+    _angle_normals_kernel(v, f, out)
+    np.testing.assert_allclose(out, vertex_normal_sums(v, f, "angle"), rtol=1e-12,
+                               atol=1e-13)
+    faces = vertex_normal_sums(v, f, "angle", order="faces")
+    assert np.array_equal(faces, out)
