@@ -25,6 +25,8 @@ from craters._shared import (
     package_version,
 )
 
+from .crscode import check_crs
+
 __all__ = ["Dem", "HISTORY_TAG", "crs_label", "crs_sphere_radius_m", "parse_region",
            "raster_pixel_size_m"]
 
@@ -263,11 +265,8 @@ class Dem:
             raise TypeError(f"`transform` must be an affine.Affine; got {type(transform).__name__}")
         if not math.isfinite(transform.determinant) or transform.determinant == 0:
             raise ValueError(f"`transform` must be invertible; got {tuple(transform)[:6]}")
-        if crs is not None and not isinstance(crs, CRS):
-            try:
-                crs = CRS.from_user_input(crs)
-            except CRSError as exc:
-                raise ValueError(f"`crs` is not a CRS rasterio understands: {exc}") from None
+        if crs is not None:
+            crs = check_crs(crs)
         with about("body_radius_m"):
             radius = None if body_radius_m is None else check_range(
                 "body_radius_m", body_radius_m, *BODY_RADIUS_RANGE_M)

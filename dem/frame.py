@@ -190,6 +190,11 @@ def grid_affine(a: Affine, pixel_m: float) -> Affine:
 _BODY_KEYS = ("R", "a", "b", "rf", "f", "ellps", "datum", "pm", "towgs84")
 
 
+def _body_of(crs) -> dict:
+    """The PROJ parameters of the sphere or ellipsoid ``crs`` lives on ({} for none)."""
+    return {} if crs is None else {k: v for k, v in crs.to_dict().items() if k in _BODY_KEYS}
+
+
 def geographic_crs(crs):
     """The longitude/latitude CRS (degrees, east) of the sphere or ellipsoid ``crs`` lives
     on -- the IAU_2015 (or EPSG) CRS of that body when PROJ identifies one (the Moon's
@@ -197,9 +202,7 @@ def geographic_crs(crs):
     from rasterio.crs import CRS
     from rasterio.errors import CRSError
 
-    if crs is None:
-        return None
-    body = {k: v for k, v in crs.to_dict().items() if k in _BODY_KEYS}
+    body = _body_of(crs)
     if not body:
         return None
     try:
@@ -234,7 +237,7 @@ def world_to_lonlat(crs, x, y):
     from rasterio.errors import CRSError
     from rasterio.warp import transform
 
-    body = {k: v for k, v in crs.to_dict().items() if k in _BODY_KEYS}
+    body = _body_of(crs)
     if not body or not x.size:
         return (x.copy(), y.copy()) if body else None
     try:

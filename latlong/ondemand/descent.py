@@ -156,6 +156,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
             raise TypeError(f"`lidar` must be LidarSettings; got {type(lidar).__name__}")
         _check_lidar_inside(lidar, fov_deg)
         lidar_seed = check_int("lidar_seed", lidar_seed, 0, 2**63 - 1)
+    crs_wkt = body_fixed_wkt("craterform body", field.base.radius_m)  # the LAS files' CRS
     for i, h in enumerate(alts):
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
@@ -180,8 +181,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
             rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)
         n_craters, n_rocks = counts
         yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
-                           catalog, returns, body_fixed_wkt("craterform body",
-                                                            field.base.radius_m))
+                           catalog, returns, crs_wkt)
 
 
 def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:

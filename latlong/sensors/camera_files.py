@@ -52,7 +52,7 @@ from .motion import timed_frame
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry, with_albedo
 from .planetshine import Planet
 from .poses import Poses
-from .render import Frame, Sun, render
+from .render import Frame, Sun, band_name_ok, render
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
 from .sensor import Sensor, display_image
@@ -309,7 +309,7 @@ def parse_bands(spec: str) -> dict[str, float]:
     for item in filter(None, (i.strip() for i in spec.split(","))):
         name, sep, value = item.partition("=")
         name = name.strip()
-        if not sep or not name or not name.replace("_", "").replace("-", "").isalnum():
+        if not sep or not band_name_ok(name):
             raise ParameterError("bands", f"items are NAME=ALBEDO (a name of letters, digits, "
                                  f"- and _); got {item!r}")
         if name in out:

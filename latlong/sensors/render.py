@@ -140,6 +140,12 @@ def _photometry(reflectance):
     return reflectance
 
 
+def band_name_ok(name: str) -> bool:
+    """A band's name is letters, digits, ``-`` and ``_`` (a file's band description, an
+    EXR channel, a TOML value)."""
+    return bool(name) and name.replace("_", "").replace("-", "").isalnum()
+
+
 def _models(reflectance, bands) -> tuple[list, tuple[str, ...]]:
     """(the reflectance model of each band, the band names: () for one band)."""
     if bands is None:
@@ -150,7 +156,7 @@ def _models(reflectance, bands) -> tuple[list, tuple[str, ...]]:
     if not isinstance(bands, Mapping) or not 1 <= len(bands) <= 64:
         raise ParameterError("bands", "must map 1 to 64 band names to reflectance models")
     names = tuple(str(k) for k in bands)
-    if any(not n or not n.replace("_", "").replace("-", "").isalnum() for n in names):
+    if not all(map(band_name_ok, names)):
         raise ParameterError("bands", f"names must be letters, digits, - and _; got {names}")
     return [_photometry(m) for m in bands.values()], names
 
