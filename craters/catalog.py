@@ -215,7 +215,10 @@ def read_catalog(path) -> np.ndarray:
     check_regular_file(path, "catalog")
     with open(path, newline="", encoding="utf-8") as fh:
         lines = [ln for ln in fh if not ln.startswith("#")]
-    rows = list(csv.reader(lines))
+    try:
+        rows = list(csv.reader(lines))
+    except csv.Error as exc:  # a field over 128 KiB, a NUL byte
+        raise ValueError(f"catalog {str(path)!r}: {exc}") from None
     if not rows:
         raise ValueError(f"catalog {str(path)!r} is empty")
     names, body = rows[0], rows[1:]

@@ -48,6 +48,7 @@ from craters._shared import (
     temp_folder,
 )
 from craters._shared.files import check_regular_file
+from craters._shared.outputs import claim
 
 from .core import Dem, crs_label
 from .frame import (
@@ -396,6 +397,7 @@ def check_stack_folder(folder, *, force: bool, inputs=()) -> Path:
                 raise ValueError(f"output {str(folder)!r} holds {foreign[0]!r}{more}, which a "
                                  f"stack does not write; refusing to replace it")
     sweep_temporaries(folder.parent if str(folder.parent) else Path("."))
+    claim(folder, force=force)
     return folder
 
 

@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import check_parent_folder, replace_output, sweep_temporaries, temp_folder
+from craters._shared.outputs import claim
 
 __all__ = ["ARRAY", "ZARR_OPTIONS", "ZARR_SUFFIXES", "ChunkWriter", "ZarrStore",
            "check_zarr_output", "is_zarr", "is_zarr_store"]
@@ -81,6 +82,7 @@ def check_zarr_output(path, *, force: bool) -> Path:
                         else "is a folder without .zgroup, not a Zarr DEM")
                 raise ValueError(f"output {str(path)!r} {what}; refusing to replace it")
     sweep_temporaries(path.parent if str(path.parent) else Path("."))
+    claim(path, force=force)
     return path
 
 

@@ -24,6 +24,7 @@ from craters._shared import (
     check_suffix,
     same_file,
 )
+from craters._shared.outputs import claim
 from craters._shared.settings import by_key, check_declared, setting
 
 from .body import EXPORT_SUFFIXES
@@ -154,6 +155,7 @@ class Outputs:
                 if extra.is_dir() or (os.path.lexists(extra) and not force):
                     raise ParameterError(key, f"{str(path)!r} also writes {str(extra)!r}, "
                                          f"which exists; use --force to overwrite")
+                claim(extra, force=force)
 
 
 #: The keys of a scene file that say what to write (not what to make).

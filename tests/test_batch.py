@@ -208,7 +208,7 @@ def test_serial_backend_gives_the_dask_bytes(tmp_path, scene, scheduler, monkeyp
     ({"backend": "serial", "workers": 2}, "`workers` applies to the dask backend"),
     ({"backend": "serial", "scheduler": "tcp://127.0.0.1:9"},
      "`scheduler` applies to the dask backend"),
-    ({"workers": 0}, "`workers` must be an integer >= 1; got 0"),
+    ({"workers": 0}, "`workers` must be an integer in [1, "),
 ])
 def test_backend_choice_errors_before_any_work(tmp_path, scene, how, message):
     with pytest.raises(ValueError, match=re.escape(message)):
@@ -307,7 +307,7 @@ def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys, monkeypat
                          "tcp://127.0.0.1:9"])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1, err
-    assert "--scheduler tcp://127.0.0.1:9: cannot connect within 2 s" in err
+    assert "--scheduler tcp://127.0.0.1:9: no dask scheduler answered within 2 s" in err
     assert not out.exists()
 
 
@@ -446,7 +446,7 @@ def test_expand_tiles_as_tasks_give_the_same_bytes(tmp_path, scheduler):
 
 
 @pytest.mark.parametrize("args, message", [
-    (["--workers", "0"], "--workers must be an integer >= 1; got 0"),
+    (["--workers", "0"], "--workers must be an integer in [1, "),
     (["--scheduler", "nowhere"], "--scheduler must be a dask scheduler address"),
     (["--scheduler", "tcp://127.0.0.1:9", "--workers", "2"], "--workers applies to the local"),
 ])

@@ -1,6 +1,6 @@
 """The safety of a run's outputs: the project's temporary names, sweeping the temporaries
-of killed runs, output groups that appear together or not at all, outputs that are never
-an input.
+of killed runs, output locks, output groups that appear together or not at all, outputs
+that are never an input.
 
 Every temporary the project writes next to an output is named
 ``.<name>.<pid>.<8 random characters>.tmp<suffix>`` (:func:`temp_file`,
@@ -9,17 +9,21 @@ left (:func:`sweep_temporaries`: only these names, only when their process is go
 they are a week old; never another file).
 
 An output group (:func:`output_group`; the command lines run every command but batches
-in one) remembers each output moved into place (:func:`replace_output`) with a hard link
-to the file it replaced; if the group fails (an error, Ctrl-C, SIGTERM) every output of
-it is taken back and the replaced files restored, so a failed run writes nothing and a
-``.glb`` never stands next to another run's ``.json``. Groups nest: an inner group that
-succeeds hands its outputs to the outer one.
+in one) is a run: each output it checks is locked (:func:`claim`: ``.<name>.lock``,
+``flock``) so that a second run writing it fails at once naming this one; each output
+finished inside (:func:`replace_output`) is staged under a temporary name, and when the
+group ends without an error all are moved into place back to back, after a journal that
+lets the next run take them back if this one is killed in between. A failed run (an
+error, Ctrl-C, SIGTERM) writes nothing, and a ``.glb`` never stands next to another run's
+``.json``. Groups nest: an inner group that succeeds hands its outputs to the outer one.
 """
 
 from __future__ import annotations
 
 import contextlib
 import contextvars
+import fcntl
+import json
 import logging
 import os
 import re
@@ -30,8 +34,8 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-__all__ = ["TEMP_MAX_AGE_S", "check_outside_folder", "output_group",
-           "replace_output", "same_file", "sweep_temporaries", "temp_file", "temp_folder"]
+__all__ = ["TEMP_MAX_AGE_S", "check_outside_folder", "claim", "lock_output", "output_group",
+           "output_lock", "replace_output", "staged_path", "unlock_output", "same_file", "sweep_temporaries", "temp_file", "temp_folder"]
 
 logger = logging.getLogger(__name__)
 
@@ -102,8 +106,11 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
     except OSError:
         return removed
     me = os.getpid()
+    entries.sort(key=lambda e: not e.name.endswith(".journal"))  # take back killed runs first
     for entry in entries:
         m = _TEMP_NAME.match(entry.name)
+        if m is None and entry.name.endswith(".lock"):
+            _remove_stale_lock(Path(entry.path))
         if m is None or int(m["pid"]) == me:
             continue
         try:
@@ -112,6 +119,8 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
             continue
         if not (_process_gone(int(m["pid"])) or now - st.st_mtime > TEMP_MAX_AGE_S):
             continue
+        if entry.name.endswith(".journal"):
+            _recover(Path(entry.path))
         try:
             if entry.is_dir(follow_symlinks=False):
                 shutil.rmtree(entry.path)
@@ -126,48 +135,143 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
     return removed
 
 
+# --------------------------------------------------------------------------- locks
+_HELD: dict[str, tuple[int, Path]] = {}  # this process's output locks: path -> (fd, lock file)
+
+
+def lock_output(path) -> bool:
+    """Take the advisory lock of the output ``path``: ``.<name>.lock`` beside it, locked
+    with ``flock`` and holding this process's id (the kernel drops the lock when the process
+    dies, however it dies). False if this process holds it already; a one-line ValueError
+    naming the other process if another run holds it."""
+    key = os.path.abspath(path)
+    if key in _HELD:
+        return False
+    name = _folder_of(Path(path)) / f".{Path(path).name}.lock"
+    while True:
+        fd = os.open(name, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            other = os.pread(fd, 24, 0).decode("ascii", "replace").strip() or "?"
+            os.close(fd)
+            raise ValueError(f"output {str(path)!r} is being written by another run (process "
+                             f"{other}, lock {str(name)!r}); let it finish first") from None
+        st = os.fstat(fd)
+        if _ident(name) == (st.st_dev, st.st_ino):
+            break
+        os.close(fd)  # its last holder removed it meanwhile: lock the file there now
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    _HELD[key] = (fd, name)
+    return True
+
+
+def _remove_stale_lock(name: Path) -> None:
+    """Remove an output lock (:func:`lock_output`) its killed run left: a pid line of a
+    process that is gone, and nobody holds it."""
+    try:
+        fd = os.open(name, os.O_RDWR | os.O_NOFOLLOW | os.O_CLOEXEC)
+    except OSError:
+        return
+    try:
+        text = os.pread(fd, 24, 0).decode("ascii", "replace")
+        if re.fullmatch(r"[0-9]{1,10}\n", text) and _process_gone(int(text)):
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            st = os.fstat(fd)
+            if _ident(name) == (st.st_dev, st.st_ino):
+                os.unlink(name)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def unlock_output(path) -> None:
+    """Release (and remove) the lock :func:`lock_output` took on ``path``."""
+    fd, name = _HELD.pop(os.path.abspath(path), (-1, Path()))
+    if fd >= 0:
+        with contextlib.suppress(OSError):
+            os.unlink(name)
+        os.close(fd)
+
+
+@contextlib.contextmanager
+def output_lock(path) -> Iterator[None]:
+    """:func:`lock_output` for a ``with`` block."""
+    took = lock_output(path)
+    try:
+        yield
+    finally:
+        if took:
+            unlock_output(path)
+
+
+def claim(path, *, force: bool) -> None:
+    """Inside an output group (a command's run): lock ``path`` until the run ends, and
+    without ``force`` make its move into place refuse a file that appeared meanwhile (the
+    check at the start is repeated at the rename, atomically)."""
+    root = _ROOT.get()
+    if root is None:
+        return
+    if lock_output(path):
+        root.locked.append(os.path.abspath(path))
+    if not force:
+        root.keep.add(os.path.abspath(path))
+
+
 # --------------------------------------------------------------------------- groups
 @dataclass
-class _Moved:
-    path: Path
-    backup: Path | None
-    ident: tuple[int, int] | None
-    holder: Path | None  # a replaced folder waits in holder/old
+class _Entry:
+    path: str
+    backup: str | None  # where the replaced output waits until the run ends
+    new: tuple[int, int] | None  # (device, inode) of the new output
 
 
 @dataclass
 class _Group:
-    moved: list[_Moved] = field(default_factory=list)
+    staged: list[tuple[Path, Path]] = field(default_factory=list)  # (temporary, output)
+    parent: _Group | None = None
+    locked: list[str] = field(default_factory=list)
+    keep: set[str] = field(default_factory=set)
 
     def commit(self) -> None:
-        for m in self.moved:
-            gone = m.holder or m.backup
-            if gone is not None:
-                _remove(gone)
-        self.moved.clear()
+        """Journal, then move every staged output into place back to back; a failure (or a
+        signal) in between takes back what moved. A run killed in between is taken back
+        by the next sweep of one of its folders (:func:`sweep_temporaries` reads the
+        journal): readers find the complete old outputs or the complete new ones."""
+        if not self.staged:
+            return
+        entries = [_Entry(str(path.absolute()), _backup_name(path), _ident(tmp))
+                   for tmp, path in self.staged]
+        journals = _write_journals(entries)
+        try:
+            for (tmp, _), entry in zip(self.staged, entries, strict=True):
+                _install(tmp, entry, keep=entry.path in self.keep)
+        except BaseException:
+            _take_back(entries)
+            raise
+        finally:
+            self.discard()
+            for j in journals:
+                _remove(j)
+        for e in entries:
+            if e.backup is not None:
+                _remove(Path(e.backup))
 
-    def rollback(self) -> None:
-        for m in reversed(self.moved):
-            try:
-                if _ident(m.path) == m.ident:
-                    _remove(m.path)
-                if m.backup is not None and os.path.lexists(m.backup):
-                    if os.path.lexists(m.path):  # never moved: the backup is a link to it
-                        _remove(m.backup)
-                    else:
-                        os.replace(m.backup, m.path)
-                if m.holder is not None:
-                    _remove(m.holder)
-            except OSError as exc:
-                logger.warning("could not take back %s: %s", m.path, exc)
-        self.moved.clear()
+    def discard(self) -> None:
+        for tmp, _ in self.staged:
+            _remove(tmp)
+        self.staged.clear()
 
 
 _GROUP: contextvars.ContextVar[_Group | None] = contextvars.ContextVar("craterform_outputs",
                                                                      default=None)
+_ROOT: contextvars.ContextVar[_Group | None] = contextvars.ContextVar("craterform_run",
+                                                                    default=None)
 
 
-def _ident(path: Path) -> tuple[int, int] | None:
+def _ident(path) -> tuple[int, int] | None:
     try:
         st = os.lstat(path)
     except OSError:
@@ -183,65 +287,144 @@ def _remove(path: Path) -> None:
             os.unlink(path)
 
 
+def _backup_name(path: Path) -> str | None:
+    if not os.path.lexists(path):
+        return None
+    name = temp_file(path, ".bak")  # reserves the name; the backup takes it
+    os.unlink(name)
+    return str(name.absolute())
+
+
+def _write_journals(entries: list[_Entry]) -> list[Path]:
+    """One journal in each folder the run writes into (a sweep of any of them finds it)."""
+    folders = dict.fromkeys(_folder_of(Path(e.path)) for e in entries)
+    journals = [temp_file(f / "outputs", ".journal") for f in folders]
+    text = json.dumps({"outputs": [[e.path, e.backup, e.new] for e in entries],
+                       "journals": [str(j.absolute()) for j in journals]})
+    for j in journals:
+        j.write_text(text, encoding="utf-8")
+    return journals
+
+
+def _install(tmp: Path, entry: _Entry, *, keep: bool) -> None:
+    """Move one staged output into place; the one it replaces waits as ``entry.backup``
+    (a hard link to a file, the moved folder)."""
+    path = entry.path
+    if os.path.lexists(path) and (keep or entry.backup is None):
+        raise ValueError(f"output {path!r} appeared while this run wrote it; nothing was "
+                         f"replaced")
+    if entry.backup is not None and os.path.lexists(path):
+        if os.path.isdir(tmp):
+            os.replace(path, entry.backup)
+        else:
+            try:
+                os.link(path, entry.backup, follow_symlinks=False)
+            except OSError:  # no hard links here: a copy
+                shutil.copy2(path, entry.backup, follow_symlinks=False)
+    if keep and not os.path.isdir(tmp):
+        try:
+            os.link(tmp, path)  # never replaces a file that appeared this instant
+            return
+        except FileExistsError:
+            raise ValueError(f"output {path!r} appeared while this run wrote it; nothing "
+                             f"was replaced") from None
+        except OSError:  # no hard links here
+            pass
+    os.replace(tmp, path)
+
+
+def _take_back(entries: list[_Entry]) -> None:
+    """Put back what ``entries`` replaced: the new output removed where it is in place,
+    the backup moved back where the output is missing; a backup not needed removed."""
+    for e in reversed(entries):
+        try:
+            if e.new is not None and _ident(e.path) == tuple(e.new):
+                _remove(Path(e.path))
+            if e.backup is not None and os.path.lexists(e.backup):
+                if os.path.lexists(e.path):  # the old output is in place: a spare link
+                    _remove(Path(e.backup))
+                else:
+                    os.replace(e.backup, e.path)
+        except OSError as exc:
+            logger.warning("could not take back %s: %s", e.path, exc)
+
+
+def _recover(journal: Path) -> None:
+    """Take back the outputs of a run killed while it moved them into place."""
+    try:
+        record = json.loads(journal.read_text(encoding="utf-8"))
+        entries = [_Entry(p, b, None if n is None else (int(n[0]), int(n[1])))
+                   for p, b, n in record["outputs"]]
+        journals = [Path(j) for j in record["journals"]]
+    except (OSError, ValueError, KeyError, TypeError):
+        return
+    _take_back(entries)
+    for j in journals:
+        _remove(j)
+    logger.warning("took back the outputs of a killed run: %s",
+                   ", ".join(e.path for e in entries))
+
+
 @contextlib.contextmanager
 def output_group() -> Iterator[None]:
     """Outputs moved into place inside (:func:`replace_output`) appear together or not at
-    all: on any exception (KeyboardInterrupt included) each is taken back and the file
-    it replaced restored."""
+    all: they are staged, and moved into place back to back when the outermost group ends
+    without an error; on any exception (KeyboardInterrupt included) nothing is moved. The
+    outermost group is a run: the outputs it :func:`claim` stay locked until it ends."""
     outer = _GROUP.get()
-    group = _Group()
+    group = _Group(parent=outer)
     token = _GROUP.set(group)
+    root = _ROOT.set(group) if outer is None else None
     try:
         yield
-    except BaseException:
-        group.rollback()
-        raise
-    else:
         if outer is None:
             group.commit()
         else:
-            outer.moved.extend(group.moved)
+            outer.staged.extend(group.staged)
+    except BaseException:
+        group.discard()
+        raise
     finally:
         _GROUP.reset(token)
+        if root is not None:
+            _ROOT.reset(root)
+            for path in group.locked:
+                unlock_output(path)
 
 
 def replace_output(tmp, path) -> None:
     """Move the finished temporary ``tmp`` (a file or a folder) onto ``path``; inside an
-    :func:`output_group` the group can take it back. A folder replaces a folder: the old
-    one is removed once the move is final."""
+    :func:`output_group` it is staged (renamed to a temporary name of ``path``'s) and moved
+    when the group ends (at once inside a temporary folder: that is not an output yet).
+    A folder replaces a folder whole."""
     tmp, path = Path(tmp), Path(path)
     group = _GROUP.get()
-    if tmp.is_dir() and not tmp.is_symlink():
-        holder = temp_folder(path, ".old") if os.path.lexists(path) else None
-        if group is not None:  # recorded first: a signal from here on is taken back
-            group.moved.append(_Moved(path, None if holder is None else holder / "old",
-                                      _ident(tmp), holder))
-        try:
-            if holder is not None:
-                os.replace(path, holder / "old")
-            os.replace(tmp, path)
-        except BaseException:
-            if group is None and holder is not None:
-                if not os.path.lexists(path) and os.path.lexists(holder / "old"):
-                    os.replace(holder / "old", path)
-                _remove(holder)
-            raise
-        if group is None and holder is not None:
-            _remove(holder)
+    # inside a temporary folder (work in progress, itself an output later): at once
+    if group is not None and not any(_TEMP_NAME.match(p.name) for p in path.parents):
+        staged = (temp_folder if tmp.is_dir() and not tmp.is_symlink() else temp_file)(
+            path, ".new")
+        os.replace(tmp, staged)
+        group.staged.append((staged, path))
         return
-    if group is None:
-        os.replace(tmp, path)
+    if tmp.is_dir() and not tmp.is_symlink() and os.path.lexists(path):
+        entry = _Entry(str(path.absolute()), _backup_name(path), None)
+        _install(tmp, entry, keep=False)
+        if entry.backup is not None:
+            _remove(Path(entry.backup))
         return
-    backup = None
-    if os.path.lexists(path):
-        backup = temp_file(path, ".bak")
-        os.unlink(backup)
-        try:
-            os.link(path, backup, follow_symlinks=False)
-        except OSError:  # no hard links here: a copy
-            shutil.copy2(path, backup, follow_symlinks=False)
-    group.moved.append(_Moved(path, backup, _ident(tmp), None))
     os.replace(tmp, path)
+
+
+def staged_path(path) -> Path:
+    """Where the output ``path`` is now: its staged temporary while the run that wrote it
+    goes on (:func:`replace_output`), else ``path``."""
+    group, key = _GROUP.get(), Path(path).absolute()
+    while group is not None:
+        for tmp, out in reversed(group.staged):
+            if out.absolute() == key:
+                return tmp
+        group = group.parent
+    return Path(path)
 
 
 # --------------------------------------------------------------------------- inputs

@@ -6,6 +6,7 @@ from __future__ import annotations
 import dataclasses
 from pathlib import Path
 
+from craters._shared import staged_path
 from craters.cli.options import Setting, Values
 
 from ..mesh import MESH_SUFFIXES, to_mesh
@@ -32,7 +33,7 @@ def _mesh(v: Values) -> int:
     path = to_mesh(src, v["output"], progress=show, boulders=not v["no_boulders"])
     if show:
         n = len(src) if hasattr(src, "layers") else 1
-        print(f"dem mesh: {n} layer(v), {path.stat().st_size / 2**20:.1f} MiB")
+        print(f"dem mesh: {n} layer(v), {staged_path(path).stat().st_size / 2**20:.1f} MiB")
         print(f"wrote {path}")
     return 0
 

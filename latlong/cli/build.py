@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import human_bytes, progress_bar
+from craters._shared import human_bytes, progress_bar, staged_path
 from craters.cli.kit import CliError
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
@@ -132,7 +132,7 @@ def _build(v: Values) -> int:
     if show:
         print(_summary(made, scene))
         for out in files:
-            print(f"wrote {out} ({human_bytes(Path(out).stat().st_size)})")
+            print(f"wrote {out} ({human_bytes(staged_path(out).stat().st_size)})")
     return 0
 
 

@@ -214,14 +214,27 @@ def poses_of(v: Values, mesh=None):
                     vertical=v.vertical)
 
 
+#: The farthest a sensor may be from the model, in model radii (the Moon seen from the
+#: Earth is 220 radii away; 1e6 radii make a 1 km body 0.2 microradians wide).
+MAX_RANGE_RADII = 1e6
+
+
 def refuse_inside(mesh, poses, v: Values, sensor: str) -> None:
-    """A one-line error if a pose puts the sensor inside the model."""
+    """A one-line error if a pose puts the sensor inside the model or absurdly far from it."""
     from latlong.sensors import camera_inside
 
+    v_m = mesh.vertices
+    centre = 0.5 * (v_m.min(axis=0) + v_m.max(axis=0))
+    radius = max(float(np.linalg.norm(v_m - centre, axis=1).max()), 1e-3)
+    where = v.where("position_m" if v.position_m is not None else
+                    "poses" if v.poses is not None else "range_m")
     for k in range(len(poses)):
+        far = float(np.linalg.norm(poses.position_m[k] - centre))
+        if far > MAX_RANGE_RADII * radius:
+            raise CliError(f"{where}: the {sensor} of frame {k} is {far:.3g} m "
+                           f"from the model, more than {MAX_RANGE_RADII:g} times its "
+                           f"{radius:.3g} m radius (it would be far below a pixel)")
         if camera_inside(mesh, poses.position_m[k]):
-            where = v.where("position_m" if v.position_m is not None else
-                            "poses" if v.poses is not None else "range_m")
             raise CliError(f"{where}: the {sensor} of frame {k} at "
                            f"{poses.position_m[k].tolist()} m is inside the model "
                            f"{str(v.model)!r}")

@@ -196,24 +196,62 @@ def _triangle_ply(path: Path):
             elif words[0] == "end_header":
                 break
         names = [e[0] for e in elements]
-        if fmt != "binary_little_endian" or names != ["vertex", "face"]:
+        if fmt not in _PLY_FORMATS or names != ["vertex", "face"]:
             return None
         (_, nv, vprops), (_, nf, fprops) = elements
         if any(len(p) != 2 or p[0] not in _PLY_TYPES for p in vprops) or len(fprops) != 1 \
                 or fprops[0][0] != "list" or fprops[0][1] not in _PLY_TYPES \
                 or fprops[0][2] not in _PLY_TYPES:
             return None
-        vdt = np.dtype([(p[1], _PLY_TYPES[p[0]]) for p in vprops])
+        order = _PLY_FORMATS[fmt]
+        vdt = np.dtype([(p[1], _PLY_TYPES[p[0]].replace("<", order)) for p in vprops])
         assert vdt.names is not None  # made from a list of fields
-        fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]]), ("i", _PLY_TYPES[fprops[0][2]], 3)])
-        verts = np.fromfile(fh, dtype=vdt, count=nv)
-        faces = np.fromfile(fh, dtype=fdt, count=nf)
+        if fmt == "ascii":  # VTK's reader crashes on an index past the vertices: read here
+            verts, faces = _ascii_body(fh, vdt, nv, nf)
+            nf = len(faces)  # polygons fanned
+        else:
+            fdt = np.dtype([("n", _PLY_TYPES[fprops[0][1]].replace("<", order)),
+                            ("i", _PLY_TYPES[fprops[0][2]].replace("<", order), 3)])
+            verts = np.fromfile(fh, dtype=vdt, count=nv)
+            faces = np.fromfile(fh, dtype=fdt, count=nf)
     if len(verts) != nv or len(faces) != nf or not {"x", "y", "z"} <= set(vdt.names) \
             or (faces["n"] != 3).any():
         return None
     xyz = np.stack([verts["x"], verts["y"], verts["z"]], 1).astype(np.float64)
     fields = {k: verts[k] for k in vdt.names if k not in ("x", "y", "z")}
     return xyz, faces["i"].astype(np.int64), fields
+
+
+#: PLY formats read here -> their byte order (ascii: parsed as text).
+_PLY_FORMATS = {"binary_little_endian": "<", "binary_big_endian": ">", "ascii": "<"}
+
+
+def _ascii_body(fh, vdt: np.dtype, nv: int, nf: int):
+    """The vertex and face elements of an ASCII PLY (polygons fanned into triangles)."""
+    assert vdt.names is not None
+    rows = [fh.readline().split() for _ in range(nv)]
+    if any(len(r) != len(vdt.names) for r in rows):
+        raise _Unreadable(f"an ASCII vertex line does not hold its {len(vdt.names)} properties")
+    try:
+        verts = np.array([tuple(r) for r in rows], dtype=vdt) if nv else np.zeros(0, vdt)
+    except ValueError:
+        raise _Unreadable("an ASCII vertex line holds a value that is not a number") from None
+    tris = []
+    for _ in range(nf):
+        words = fh.readline().split()
+        if not words or len(words) != int(words[0]) + 1 or int(words[0]) < 3:
+            raise _Unreadable("an ASCII face line does not hold its vertex count and indices")
+        try:
+            idx = [int(w) for w in words[1:]]
+        except ValueError:
+            text = b" ".join(words)[:40].decode(errors="replace")
+            raise _Unreadable(f"an ASCII face line holds {text!r}") from None
+        tris += [(3, idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+    faces = np.zeros(len(tris), dtype=[("n", "i4"), ("i", "i8", 3)])
+    if tris:
+        t = np.array(tris, dtype=np.int64)
+        faces["n"], faces["i"] = t[:, 0], t[:, 1:]
+    return verts, faces
 
 
 def read_ply(path: Path):
@@ -223,6 +261,8 @@ def read_ply(path: Path):
         raise _Unreadable(problem)
     try:
         ply = _triangle_ply(path)
+    except _Unreadable:
+        raise
     except (OSError, ValueError):
         ply = None
     return ply if ply is not None else read_vtk_mesh(path)

@@ -50,6 +50,18 @@ BACKENDS = ("serial", "dask")
 _ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
 _CONNECT_S = 10
 _WORKERS_S = 60
+#: A local cluster's workers at most: per core, and one per this much memory (a worker
+#: process with numpy, numba and its task's arrays).
+WORKERS_PER_CORE = 4
+WORKER_MEMORY_GIB = 0.5
+
+
+def max_workers() -> int:
+    """The most worker processes a local cluster may start on this machine."""
+    from craters._shared.system import physical_memory_bytes
+
+    by_memory = int(physical_memory_bytes() / (WORKER_MEMORY_GIB * 2**30))
+    return max(1, min(WORKERS_PER_CORE * (os.cpu_count() or 1), by_memory))
 
 
 class Backend(Protocol):
@@ -171,8 +183,10 @@ def choose_backend(backend: str | None = None, scheduler: str | None = None,
                              f"{backend!r}")
     if scheduler is None:
         if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int)
-                                    or workers < 1):
-            raise ParameterError("workers", f"must be an integer >= 1; got {workers!r}")
+                                    or not 1 <= workers <= max_workers()):
+            raise ParameterError("workers", f"must be an integer in [1, {max_workers()}] on "
+                                 f"this machine ({WORKERS_PER_CORE} per core, one per "
+                                 f"{WORKER_MEMORY_GIB} GiB of memory); got {workers!r}")
     else:
         if not isinstance(scheduler, str) or not _ADDRESS.fullmatch(scheduler):
             raise ParameterError("scheduler", f"must be a dask scheduler address like "
@@ -210,6 +224,26 @@ def open_backend(backend: str | None = None, *, scheduler: str | None = None,
         quiet.setLevel(level)
 
 
+def _probe(scheduler: str, timeout_s: float) -> None:
+    """A dask scheduler sends its handshake as soon as it accepts a connection: refuse
+    within ``timeout_s`` an address that does not accept or accepts and stays silent
+    (dask's own client would wait for ever)."""
+    import socket
+
+    m = re.fullmatch(r"(?:tcp://)?\[?([^\]]+?)\]?:([0-9]+)", scheduler)
+    if m is None:
+        return  # tls:// and others: dask's own timeout
+    try:
+        with socket.create_connection((m[1], int(m[2])), timeout=timeout_s) as sock:
+            sock.settimeout(timeout_s)
+            if not sock.recv(1):
+                raise ConnectionResetError
+    except (OSError, ValueError) as exc:
+        why = "no answer" if isinstance(exc, TimeoutError) else type(exc).__name__
+        raise ParameterError("scheduler", f"{scheduler}: no dask scheduler answered within "
+                             f"{timeout_s:g} s ({why})") from None
+
+
 @contextlib.contextmanager
 def _connected(scheduler: str | None, workers: int | None):
     from distributed import Client, LocalCluster
@@ -223,6 +257,7 @@ def _connected(scheduler: str | None, workers: int | None):
                 Client(cluster) as client:
             yield client
         return
+    _probe(scheduler, _CONNECT_S)
     try:
         client = Client(scheduler, timeout=_CONNECT_S)
     except (OSError, TimeoutError) as exc:

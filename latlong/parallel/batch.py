@@ -46,6 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from craters._shared.files import atomic_path, check_parent_folder
+from craters._shared.outputs import output_lock
 from craters._shared.progress import progress_bar
 from craters._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
@@ -282,9 +283,13 @@ def read_index(path) -> list[dict]:
     the last row of a variant wins."""
     with open(path, newline="", encoding="utf-8") as fh:
         reader = csv.DictReader(fh)
-        rows = {r["variant"]: r for r in reader
-                if None not in r.values() and r.get("status") in ("ok", "failed")
-                and len(r.get("settings_sha256") or "") == 64}
+        try:
+            rows = {r["variant"]: r for r in reader
+                    if None not in r.values() and r.get("status") in ("ok", "failed")
+                    and len(r.get("settings_sha256") or "") == 64}
+        except (csv.Error, KeyError) as exc:  # a field over 128 KiB; no variant column
+            raise ValueError(f"batch index {str(path)!r} is not one a batch wrote: "
+                             f"{exc}") from None
     return list(rows.values())
 
 
@@ -359,6 +364,16 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
         raise ParameterError("jobs", "must be a non-empty list of uniquely named variants")
     choose_backend(backend, scheduler, workers)
     folder = _check_folder(out, jobs, resume=resume, force=force)
+    with output_lock(folder):  # a second batch into this folder fails fast, naming this one
+        return _fill(folder, jobs, task, backend=backend, scheduler=scheduler, workers=workers,
+                     resume=resume, progress=progress, retries=retries, on_done=on_done,
+                     started=started)
+
+
+def _fill(folder: Path, jobs: Sequence[Job], task, *, backend, scheduler, workers, resume,
+          progress, retries, on_done, started) -> BatchResult:
+    """:func:`run_batch` in its checked and locked folder."""
+    names = [j.variant.name for j in jobs]
     columns = _columns([k for k, _ in jobs[0].variant.values])
     index = folder / INDEX
     previous = _previous_rows(index, columns) if resume and index.is_file() else {}
@@ -391,7 +406,11 @@ def _previous_rows(index: Path, columns: list[str]) -> dict[str, dict]:
     """The rows of an earlier run's index by variant (``resume``); its columns must be
     this batch's."""
     with open(index, newline="", encoding="utf-8") as fh:
-        header = next(csv.reader(fh), [])
+        try:
+            header = next(csv.reader(fh), [])
+        except csv.Error as exc:
+            raise ParameterError("resume", f"{str(index)!r} is not a batch index: {exc}") \
+                from None
     if header != columns:
         raise ParameterError("resume", f"{str(index)!r} has the columns {header}; this "
                              f"batch's are {columns}")

@@ -88,7 +88,7 @@ def read_poses(path) -> Poses:
     try:
         with open(path, newline="") as fh:
             rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:  # csv: a field over 128 KiB
         raise ValueError(f"cannot read poses {str(path)!r}: {exc}") from None
     rows = [r for r in rows
             if r and any(c.strip() for c in r) and not r[0].lstrip().startswith("#")]

@@ -1,0 +1,292 @@
+"""Issue 34 items 1-3: a run's outputs are locked while it runs (a second writer fails fast
+naming the first), the no-clobber check is repeated atomically at the rename, a run killed
+with SIGKILL while it moves its outputs into place is taken back by the next run, and
+work too large for the disk or the machine is refused before it starts.
+
+Another run is played by a small helper process that takes the output's lock the way a
+run does (``flock`` on ``.<name>.lock``) and waits: each command then runs in this
+process and must exit 2 with one line naming that process and the lock, writing nothing.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+DATA = Path(__file__).parent / "data"
+
+
+def _helpers():
+    """The command runner and checks of test_output_safety.py (tests import by path)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "_output_safety", Path(__file__).with_name("test_output_safety.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_h = _helpers()
+BUILD, ENHANCE, assert_refused, run, snapshot, tiny_tif = (
+    _h.BUILD, _h.ENHANCE, _h.assert_refused, _h.run, _h.snapshot, _h.tiny_tif)
+
+_HOLD = r"""
+import fcntl, os, sys, time
+fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT, 0o666)
+fcntl.flock(fd, fcntl.LOCK_EX)
+os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+print("locked", flush=True)
+time.sleep(120)
+"""
+
+
+class Holder:
+    """A process holding the lock of an output (as a run writing it would)."""
+
+    def __init__(self, output: Path):
+        lock = output.parent / f".{output.name}.lock"
+        self.proc = subprocess.Popen([sys.executable, "-c", _HOLD, str(lock)],
+                                     stdout=subprocess.PIPE, text=True)
+        assert self.proc.stdout.readline().strip() == "locked"
+        self.lock = lock
+
+    def close(self):
+        self.proc.kill()
+        self.proc.wait()
+        self.proc.stdout.close()
+        self.lock.unlink(missing_ok=True)
+
+
+def _cases(tmp: Path) -> dict[str, tuple[str, list, Path]]:
+    """(program, arguments, the output the other run holds) per kind of output."""
+    tif = tiny_tif(tmp / "in.tif")
+    body = tmp / "in.npz"
+    scene = tmp / "scene.toml"
+    scene.write_text('base = "sphere"\nmagnitude = 8\noutput = "b.npz"\n')
+    return {
+        "npz": ("latlong", [*BUILD, "-o", tmp / "o.npz"], tmp / "o.npz"),
+        "ply": ("latlong", [*BUILD, "-o", tmp / "o.ply"], tmp / "o.ply"),
+        "glb": ("latlong", [*BUILD, "-o", tmp / "o.glb"], tmp / "o.glb"),
+        "glb's json": ("latlong", [*BUILD, "-o", tmp / "o.glb"], tmp / "o.json"),
+        "preview": ("latlong", [*BUILD, "-o", tmp / "o.npz", "--preview", tmp / "p.png"],
+                    tmp / "p.png"),
+        "tif": ("dem", ["convert", tif, "-o", tmp / "o.tif"], tmp / "o.tif"),
+        "zarr": ("dem", ["convert", tif, "-o", tmp / "o.zarr"], tmp / "o.zarr"),
+        "stack folder": ("dem", [*ENHANCE, tif, "-o", tmp / "site"], tmp / "site"),
+        "camera folder": ("latlong", ["camera", body, "-o", tmp / "cam", "--size", "8x8",
+                                      "--fov-deg", "30", "--sun-direction", "1,0,0",
+                                      "--target-lat-lon", "0,0", "--range-m", "900,800"],
+                          tmp / "cam"),
+        "lidar folder": ("latlong", ["lidar", body, "-o", tmp / "scan", "--beams", "4x4",
+                                     "--fov-deg", "10", "--target-lat-lon", "0,0",
+                                     "--range-m", "900,800"], tmp / "scan"),
+        "batch folder": ("latlong", ["batch", scene, "--seeds", "1-1", "-o", tmp / "batch"],
+                         tmp / "batch"),
+    }
+
+
+KINDS = ["npz", "ply", "glb", "glb's json", "preview", "tif", "zarr", "stack folder",
+         "camera folder", "lidar folder", "batch folder"]
+
+
+@pytest.mark.parametrize("kind", KINDS)
+def test_a_second_writer_fails_fast_naming_the_first(capsys, tmp_path, kind):
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "in.npz")
+    assert code == 0, err
+    prog, argv, held = _cases(tmp_path)[kind]
+    before = snapshot(tmp_path)
+    other = Holder(held)
+    try:
+        start = time.perf_counter()
+        code, _, err = run(capsys, prog, *argv)
+        took = time.perf_counter() - start
+        after = snapshot(tmp_path)
+        after.pop(str(other.lock.relative_to(tmp_path)))  # the other run's
+    finally:
+        other.close()
+    assert_refused(code, err, "being written by another run", f"process {other.proc.pid}",
+                   other.lock.name)
+    assert took < 5, took  # before any work
+    assert after == before
+
+
+def test_two_real_runs_at_once_one_succeeds(tmp_path):
+    out = tmp_path / "o.ply"
+    argv = [str(Path(sys.executable).parent / "latlong"), "build", "--preset", "fbm-cratered",
+            "--magnitude", "40", "--seed", "1", "-q", "-o", str(out)]
+    procs = [subprocess.Popen(argv, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    results = [(p.returncode, p.communicate(timeout=300)[1]) for p in procs]
+    results = [(p.returncode, err) for p, (_, err) in zip(procs, results, strict=True)]
+    codes = sorted(c for c, _ in results)
+    assert codes == [0, 2], results
+    (err,) = [e for c, e in results if c == 2]
+    # the later one found the lock, or - if the first had finished - the file
+    assert "being written by another run" in err or "exists; use --force" in err, err
+    assert [p.name for p in tmp_path.iterdir()] == ["o.ply"]
+
+
+def test_a_file_that_appears_meanwhile_is_never_replaced(tmp_path):
+    from craters._shared import atomic_path, check_output_path, output_group
+
+    out = tmp_path / "o.txt"
+    with pytest.raises(ValueError, match="appeared while this run wrote it"):
+        with output_group():
+            check_output_path(out, force=False)
+            with atomic_path(out) as tmp:
+                tmp.write_text("ours")
+            out.write_text("someone else's")  # after the check, before the rename
+    assert out.read_text() == "someone else's"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.txt"]
+
+
+# the kill of test_output_safety's SIGTERM case, as a SIGKILL that leaves no chance to clean
+_KILL_IN_COMMIT = _h._KILL_BETWEEN.replace("signal.SIGTERM", "signal.SIGKILL")
+assert "SIGKILL" in _KILL_IN_COMMIT
+
+
+def test_sigkill_between_the_renames_is_taken_back_by_the_next_run(capsys, tmp_path):
+    old = {"o.glb": b"old glb", "o.json": b"old json"}
+    for name, data in old.items():
+        (tmp_path / name).write_bytes(data)
+    proc = subprocess.run([sys.executable, "-c", _KILL_IN_COMMIT, *BUILD, "-o",
+                           str(tmp_path / "o.glb"), "--force"], capture_output=True, timeout=300)
+    assert proc.returncode == -signal.SIGKILL
+    assert (tmp_path / "o.glb").read_bytes()[:4] == b"glTF"  # the mix a kill -9 leaves
+    journals = [p for p in tmp_path.iterdir() if p.name.endswith(".journal")]
+    assert len(journals) == 1 and json.loads(journals[0].read_text())["outputs"]
+    # the next run into the folder reads the journal and puts the old pair back
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "other.npz")
+    assert code == 0, err
+    assert {k: v for k, v in snapshot(tmp_path).items() if k in old} == old
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.glb", "o.json", "other.npz"]
+
+
+def test_an_expansion_larger_than_the_disk_is_refused_up_front(capsys, tmp_path):
+    start = time.perf_counter()
+    code, _, err = run(capsys, "dem", "expand", DATA / "ldem4_crop.lbl", "-o",
+                       tmp_path / "big.tif", "--levels", "12", "--seed", "1")
+    assert_refused(code, err, "1048577 x 1048577", "TiB", "free", "fewer levels")
+    assert time.perf_counter() - start < 5
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_more_workers_than_the_machine_holds_are_refused(capsys, tmp_path):
+    from latlong.parallel.backends import max_workers
+
+    scene = tmp_path / "scene.toml"
+    scene.write_text('base = "sphere"\nmagnitude = 8\n')
+    code, _, err = run(capsys, "latlong", "batch", scene, "--seeds", "1-2", "-o",
+                       tmp_path / "b", "--workers", "100000")
+    assert_refused(code, err, "--workers", f"[1, {max_workers()}]", "100000")
+    assert [p.name for p in tmp_path.iterdir()] == ["scene.toml"]
+    assert 1 <= max_workers() <= 4 * (os.cpu_count() or 1)
+
+
+# --------------------------------------------------------------- bounded inputs (item 3)
+_ASCII_PLY = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+              "property float z\nelement face 1\nproperty list uchar int vertex_indices\n"
+              "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 {last}\n")
+SENSOR = ["--target-lat-lon", "10,30", "--range-m", "150,25", "--frames", "1", "--fov-deg",
+          "20"]
+
+
+@pytest.mark.parametrize("last", ["99999999", "-5", "x"])
+@pytest.mark.parametrize("sensor", ["camera", "lidar"])
+def test_an_ascii_ply_with_bad_indices_is_refused_not_a_crash(capsys, tmp_path, last, sensor):
+    # VTK's reader dies with SIGSEGV on an index past the vertices: ASCII PLYs are read here
+    ply = tmp_path / "bad.ply"
+    ply.write_text(_ASCII_PLY.format(last=last))
+    extra = ["--size", "8x8", "--sun-direction", "1,0,0"] if sensor == "camera" else \
+        ["--beams", "4x4"]
+    code, _, err = run(capsys, "latlong", sensor, ply, "-o", tmp_path / "o", *SENSOR, *extra)
+    assert_refused(code, err, "bad.ply")
+    assert not (tmp_path / "o").exists()
+
+
+def test_an_ascii_ply_of_polygons_reads_as_triangles(tmp_path):
+    from latlong.meshio.readers import read_mesh
+
+    quad = tmp_path / "quad.ply"
+    quad.write_text(_ASCII_PLY.replace("vertex 3", "vertex 4").replace(
+        "3 0 1 {last}", "0 1 1\n4 0 1 2 3"))
+    mesh = read_mesh(quad, units="m")
+    assert mesh.faces.tolist() == [[0, 1, 2], [0, 2, 3]] and mesh.vertices.shape == (4, 3)
+
+
+def test_a_csv_field_over_128_kib_is_one_line(capsys, tmp_path):
+    poses = tmp_path / "poses.csv"
+    poses.write_text("time_s,x_m\n1," + "x" * 200_000 + "\n")
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "b.npz")
+    assert code == 0, err
+    code, _, err = run(capsys, "latlong", "camera", tmp_path / "b.npz", "-o", tmp_path / "c",
+                       "--poses", poses, "--size", "8x8", "--fov-deg", "20",
+                       "--sun-direction", "1,0,0")
+    assert_refused(code, err, "poses.csv", "field larger than field limit")
+    from craters.catalog import read_catalog
+
+    with pytest.raises(ValueError, match="field larger than field limit"):
+        read_catalog(poses)
+
+
+def test_a_frame_larger_than_memory_and_a_camera_far_away_are_refused(capsys, tmp_path,
+                                                                       monkeypatch):
+    from latlong.sensors import camera_files
+
+    monkeypatch.setattr(camera_files, "physical_memory_bytes", lambda: 24 * 2**30)
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "b.npz")
+    assert code == 0, err
+    start = time.perf_counter()
+    code, _, err = run(capsys, "latlong", "camera", tmp_path / "b.npz", "-o", tmp_path / "c",
+                       *SENSOR, "--size", "16384x16384", "--sun-direction", "1,0,0")
+    assert_refused(code, err, "--size 16384x16384", "of memory", "smaller frame")
+    assert time.perf_counter() - start < 5
+    code, _, err = run(capsys, "latlong", "camera", tmp_path / "b.npz", "-o", tmp_path / "c",
+                       "--target-lat-lon", "10,30", "--range-m", "1e20,1e19", "--frames", "1",
+                       "--fov-deg", "20", "--size", "8x8", "--sun-direction", "1,0,0")
+    assert_refused(code, err, "--range-m", "1e+20 m from the model", "times its")
+    assert not (tmp_path / "c").exists()
+
+
+def test_a_silent_scheduler_fails_within_the_timeout(tmp_path, monkeypatch):
+    import socket
+
+    import latlong
+    from latlong.parallel import backends
+
+    monkeypatch.setattr(backends, "_CONNECT_S", 1)
+    scene = tmp_path / "scene.toml"
+    scene.write_text('base = "sphere"\nmagnitude = 8\n')
+    with socket.socket() as silent:  # accepts connections, never speaks
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(4)
+        address = f"tcp://127.0.0.1:{silent.getsockname()[1]}"
+        start = time.perf_counter()
+        with pytest.raises(ValueError, match="no dask scheduler answered within 1 s"):
+            latlong.batch(scene, "1", out=tmp_path / "b", scheduler=address)
+        assert time.perf_counter() - start < 5
+
+
+def test_force_replaces_a_camera_run_whole_and_keeps_the_users_files(capsys, tmp_path):
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "b.npz")
+    assert code == 0, err
+    cam = ["camera", tmp_path / "b.npz", "-o", tmp_path / "c", "--target-lat-lon", "10,30",
+           "--fov-deg", "20", "--size", "8x8", "--sun-direction", "1,0,0"]
+    code, _, err = run(capsys, "latlong", *cam, "--range-m", "900,800", "--frames", "3")
+    assert code == 0, err
+    (tmp_path / "c" / "notes.txt").write_text("mine")
+    code, _, err = run(capsys, "latlong", *cam, "--range-m", "700,600", "--frames", "1",
+                       "--force")
+    assert code == 0, err
+    names = sorted(p.name for p in (tmp_path / "c").iterdir())
+    assert "notes.txt" in names and not [n for n in names if "_0001" in n or "_0002" in n]
+    assert len(json.loads((tmp_path / "c" / "frames.json").read_text())["frames"]) == 1
+    assert (tmp_path / "c" / "notes.txt").read_text() == "mine"
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".")]
