@@ -42,7 +42,7 @@ _HOLD = r"""
 import fcntl, os, sys, time
 fd = os.open(sys.argv[1], os.O_RDWR | os.O_CREAT, 0o666)
 fcntl.flock(fd, fcntl.LOCK_EX)
-os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+os.pwrite(fd, f"craterform {os.getpid()}\n".encode(), 0)
 print("locked", flush=True)
 time.sleep(120)
 """

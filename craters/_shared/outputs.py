@@ -136,6 +136,7 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
 
 
 # --------------------------------------------------------------------------- locks
+_LOCK_TAG = "craterform"  # a lock file holds "craterform PID"
 _HELD: dict[str, tuple[int, Path]] = {}  # this process's output locks: path -> (fd, lock file)
 
 
@@ -153,16 +154,15 @@ def lock_output(path) -> bool:
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            other = os.pread(fd, 24, 0).decode("ascii", "replace").strip() or "?"
+            other = os.pread(fd, 32, 0).decode("ascii", "replace").split()[-1:] or ["?"]
             os.close(fd)
             raise ValueError(f"output {str(path)!r} is being written by another run (process "
-                             f"{other}, lock {str(name)!r}); let it finish first") from None
-        st = os.fstat(fd)
-        if _ident(name) == (st.st_dev, st.st_ino):
+                             f"{other[0]}, lock {str(name)!r}); let it finish first") from None
+        if _ident(name) == tuple(os.fstat(fd))[1:3]:  # the file it locked is still there
             break
         os.close(fd)  # its last holder removed it meanwhile: lock the file there now
     os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    os.pwrite(fd, f"{_LOCK_TAG} {os.getpid()}\n".encode(), 0)
     _HELD[key] = (fd, name)
     return True
 
@@ -175,11 +175,11 @@ def _remove_stale_lock(name: Path) -> None:
     except OSError:
         return
     try:
-        text = os.pread(fd, 24, 0).decode("ascii", "replace")
-        if re.fullmatch(r"[0-9]{1,10}\n", text) and _process_gone(int(text)):
+        m = re.fullmatch(_LOCK_TAG + r" ([0-9]{1,10})\n",
+                         os.pread(fd, 32, 0).decode("ascii", "replace"))
+        if m is not None and _process_gone(int(m[1])):
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-            st = os.fstat(fd)
-            if _ident(name) == (st.st_dev, st.st_ino):
+            if _ident(name) == tuple(os.fstat(fd))[1:3]:
                 os.unlink(name)
     except OSError:
         pass
@@ -225,7 +225,7 @@ def claim(path, *, force: bool) -> None:
 class _Entry:
     path: str
     backup: str | None  # where the replaced output waits until the run ends
-    new: tuple[int, int] | None  # (device, inode) of the new output
+    new: tuple[int, int] | None  # (inode, device) of the new output
 
 
 @dataclass
@@ -242,7 +242,7 @@ class _Group:
         journal): readers find the complete old outputs or the complete new ones."""
         if not self.staged:
             return
-        entries = [_Entry(str(path.absolute()), _backup_name(path), _ident(tmp))
+        entries = [_Entry(os.path.abspath(path), _backup_name(path), _ident(tmp))
                    for tmp, path in self.staged]
         journals = _write_journals(entries)
         try:
@@ -272,11 +272,11 @@ _ROOT: contextvars.ContextVar[_Group | None] = contextvars.ContextVar("craterfor
 
 
 def _ident(path) -> tuple[int, int] | None:
+    """(inode, device) of ``path`` itself (a link is not followed)."""
     try:
-        st = os.lstat(path)
+        return tuple(os.lstat(path))[1:3]  # type: ignore[return-value]
     except OSError:
         return None
-    return st.st_dev, st.st_ino
 
 
 def _remove(path: Path) -> None:
@@ -407,7 +407,7 @@ def replace_output(tmp, path) -> None:
         group.staged.append((staged, path))
         return
     if tmp.is_dir() and not tmp.is_symlink() and os.path.lexists(path):
-        entry = _Entry(str(path.absolute()), _backup_name(path), None)
+        entry = _Entry(os.path.abspath(path), _backup_name(path), None)
         _install(tmp, entry, keep=False)
         if entry.backup is not None:
             _remove(Path(entry.backup))
@@ -418,10 +418,10 @@ def replace_output(tmp, path) -> None:
 def staged_path(path) -> Path:
     """Where the output ``path`` is now: its staged temporary while the run that wrote it
     goes on (:func:`replace_output`), else ``path``."""
-    group, key = _GROUP.get(), Path(path).absolute()
+    group, key = _GROUP.get(), os.path.abspath(path)
     while group is not None:
         for tmp, out in reversed(group.staged):
-            if out.absolute() == key:
+            if os.path.abspath(out) == key:
                 return tmp
         group = group.parent
     return Path(path)
