@@ -22,7 +22,7 @@ from .._shared.outputs import output_group, same_file
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
 __all__ = ["CliError", "OneLineParser", "batch_reporter", "batch_summary", "check_not_input",
-           "check_report_outputs", "parse_seed", "run_cli"]
+           "check_report_outputs", "parse_seed", "print_written", "run_cli"]
 
 
 class CliError(Exception):
@@ -132,6 +132,13 @@ def check_report_outputs(args, inputs=()) -> None:
     if args.plot:
         check_not_input(args.plot, inputs, flag="--plot")
         check_output_path(args.plot, force=args.force, suffixes=(".png",))
+
+
+def print_written(args) -> None:
+    """A ``wrote`` line for each of ``--csv`` and ``--plot`` given (unless ``--quiet``)."""
+    for path in (args.csv, args.plot):
+        if path and not args.quiet:
+            print(f"wrote {path}")
 
 
 # --------------------------------------------------------------------------- batches

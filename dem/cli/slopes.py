@@ -3,7 +3,7 @@ one input), several overlaid in one plot and listed in one CSV and one summary t
 
 from __future__ import annotations
 
-from craters.cli.kit import check_report_outputs
+from craters.cli.kit import check_report_outputs, print_written
 from craters.cli.options import Setting, Values, default_of
 from craters.cli.report import plot_slopes, slope_csv, slope_table
 
@@ -37,6 +37,7 @@ def _slopes(v: Values) -> int:
                     title=f"slope-area distribution ({v.method})")
     if not v.quiet:
         print(slope_table(results))
+    print_written(v)
     return 0
 
 

@@ -5,7 +5,7 @@ summary table."""
 from __future__ import annotations
 
 from craters._shared import ParameterError
-from craters.cli.kit import CliError, check_report_outputs
+from craters.cli.kit import CliError, check_report_outputs, print_written
 from craters.cli.options import Values
 from craters.cli.report import plot_spectra, write_csv
 
@@ -59,6 +59,7 @@ def _spectrum(v: Values) -> int:
                 notes.append(f"{label}: {warning}")
         for note in notes:
             print(note)
+    print_written(v)
     return 0
 
 

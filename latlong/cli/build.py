@@ -19,7 +19,7 @@ from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared
 from latlong import LatLongGrid, Scene, build
 from latlong.scratch import drop_pages
 
-from ..outputs import OUTPUT_SETTINGS, Outputs, output_kind, write_outputs
+from ..outputs import OUTPUT_SETTINGS, Outputs, companions, output_kind, write_outputs
 from ..scene import SETTING_PARTS, SETTINGS
 
 __all__ = ["GROUPS", "OPTIONS", "register"]
@@ -76,10 +76,11 @@ def _summary(made, scene: Scene) -> str:
                 f"on folds), {n_boulders} boulders, seed {scene.seed}")
     lo, hi = _distance_range(made)
     n_craters = 0 if made.craters is None else len(made.craters)
+    n_boulders = 0 if made.boulders is None else len(made.boulders)
     assert scene.base is not None  # a lat/long scene
     return (f"body: magnitude {made.magnitude}, {made.n_vertices} vertices, base "
-            f"{scene.base.name} ({scene.preset or '-'}), {n_craters} craters, seed "
-            f"{scene.seed}, surface {lo:.4g}..{hi:.4g} m from the centre")
+            f"{scene.base.name} ({scene.preset or '-'}), {n_craters} craters, {n_boulders} "
+            f"boulders, seed {scene.seed}, surface {lo:.4g}..{hi:.4g} m from the centre")
 
 
 def _distance_range(body) -> tuple[float, float]:
@@ -131,8 +132,9 @@ def _build(v: Values) -> int:
     bar.close()
     if show:
         print(_summary(made, scene))
-        for out in files:
-            print(f"wrote {out} ({human_bytes(staged_path(out).stat().st_size)})")
+        for out in [f for path in files for f in (path, *companions(path))]:
+            if staged_path(out).exists():  # a .glb's external buffer only past 4 GiB
+                print(f"wrote {out} ({human_bytes(staged_path(out).stat().st_size)})")
     return 0
 
 

@@ -31,6 +31,12 @@ def _info(v: Values) -> int:
         d = cat["diameter_m"]
         print(f"craters    {len(cat)} stamped, D {d.min():.4g}..{d.max():.4g} m, "
               f"degradation {cat['degradation'].min():.2f}..{cat['degradation'].max():.2f}")
+    rocks = body.boulders
+    if rocks is not None and len(rocks):
+        d = rocks["diameter_m"]
+        print(f"boulders   {len(rocks)} placed, D {d.min():.4g}..{d.max():.4g} m, buried "
+              f"{rocks['burial_frac'].min():.2f}..{rocks['burial_frac'].max():.2f} of their "
+              f"height")
     return 0
 
 

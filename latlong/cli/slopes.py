@@ -13,7 +13,7 @@ import textwrap
 
 import numpy as np
 
-from craters.cli.kit import CliError, check_report_outputs
+from craters.cli.kit import CliError, check_report_outputs, print_written
 from craters.cli.options import REPORT, Setting, Values, command, default_of
 from craters.cli.report import plot_slopes, slope_csv, slope_table
 from latlong import gravity, slope_summary, slopes_and_areas
@@ -104,6 +104,7 @@ def _slopes(v: Values) -> int:
                     full_range=True)
     if not v.quiet:
         print(slope_table(results))
+    print_written(v)
     return 0
 
 

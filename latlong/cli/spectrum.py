@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from craters.cli.kit import check_report_outputs
+from craters.cli.kit import check_report_outputs, print_written
 from craters.cli.options import REPORT, Setting, Values, command
 from craters.cli.report import plot_spectra, write_csv
 from latlong import radius_spectrum
@@ -65,6 +65,7 @@ def _spectrum(v: Values) -> int:
             beta = float(-np.polyfit(np.log(d[sel]), np.log(p[sel]), 1)[0]) if sel.sum() > 2 \
                 else float("nan")
             print(f"{label[:28]:<28} {r:13.4g} {rms:12.4g} {-beta:10.2f}")
+    print_written(v)
     return 0
 
 
