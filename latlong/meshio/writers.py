@@ -10,13 +10,15 @@ timestamps, no host names).
 
 Formats
 -------
-* ``.ply``: binary little-endian; float32 ``x y z`` plus the fields (as their numpy
-  types), faces ``uchar 3`` + three ``int`` (``uint`` past 2^31 vertices) indices.
-* ``.obj``: text, ``v`` with 9 significant digits, 1-based ``f``; face groups ``g``.
+* ``.ply``: binary little-endian; float32 ``x y z`` (float64 for a mesh far from its
+  origin: :attr:`MeshSource.position_type`) plus the fields (as their numpy types),
+  faces ``uchar 3`` + three ``int`` (``uint`` past 2^31 vertices) indices.
+* ``.obj``: text, ``v`` with 9 significant digits (12 for float64 positions), 1-based
+  ``f``; face groups ``g``.
 * ``.stl``: binary, float32 facet normal and corners, 80-byte header.
-* ``.vtp``: VTK XML PolyData, raw appended binary (UInt64 headers): float32 points,
+* ``.vtp``: VTK XML PolyData, raw appended binary (UInt64 headers): float32 (float64) points,
   the fields, Int32 (Int64 if needed) connectivity and offsets.
-* ``.vtk``: VTK legacy binary (big-endian), POINTS float, POLYGONS, POINT_DATA fields.
+* ``.vtk``: VTK legacy binary (big-endian), POINTS float (double), POLYGONS, POINT_DATA fields.
 * ``.glb``: glTF 2.0 binary, one node (rotated so the model's +Z is glTF's +Y, up:
   :data:`Y_UP`) and mesh: float32 POSITION (with bounds), uint32
   triangle indices (fields are not written).
@@ -87,6 +89,11 @@ class MeshSource:
     """Optional fast path of the PLY writer: yields the faces, in order, as records of
     the given dtype (``n`` = 3, ``v`` = the three indices), as :func:`pack_faces`
     makes of ``faces``; buffers alternate as in ``vertex_records``."""
+    position_type: str = "<f4"
+    """``x y z`` of PLY, VTP and VTK files: ``"<f4"``, or ``"<f8"`` for a mesh far from its
+    origin (a window of the Moon in its body frame: float32 steps are 0.125 m at 1737 km;
+    :func:`array_source` picks it past :data:`FLOAT64_BEYOND_M`). STL and glTF are float32;
+    VTK's PLY reader reads float32 whatever the file holds (VTK keeps float64 from .vtp)."""
     own_writers: dict[str, Callable[[Path, bool], object]] = field(default_factory=dict)
     """Writers of this mesh that replace the shared one for a suffix:
     ``{suffix: writer(path, progress)}`` writing the file atomically (a lat/long body's
@@ -128,9 +135,15 @@ def array_source(vertices, faces, title: str, **fields) -> MeshSource:
         raise ValueError(f"`vertices` and `faces` must be (n, 3) and (m, 3); got {v.shape} "
                          f"and {f.shape}")
     values = {k: np.asarray(a) for k, a in fields.items()}
+    far = len(v) > 0 and float(np.abs(v).max()) > FLOAT64_BEYOND_M
     return MeshSource(len(v), len(f), lambda: [(v, values)], lambda: [(None, [f])],
                       lambda: [v[f]], tuple((k, a.dtype.str) for k, a in values.items()),
-                      title)
+                      title, position_type="<f8" if far else "<f4")
+
+
+#: :func:`array_source` writes float64 positions past this distance from the origin
+#: (float32 steps are 7.8 mm at 100 km, 0.125 m at the Moon's radius).
+FLOAT64_BEYOND_M = 1e5
 
 
 def _dtype(code: str) -> np.dtype:
@@ -142,8 +155,9 @@ def _index_type(n_vertices: int) -> tuple[str, str]:
 
 
 def ply_vertex_dtype(src: MeshSource) -> np.dtype:
-    """The packed PLY vertex record of ``src``: float32 ``x y z`` then its fields."""
-    return np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"),
+    """The packed PLY vertex record of ``src``: ``x y z`` then its fields."""
+    pt = src.position_type
+    return np.dtype([("x", pt), ("y", pt), ("z", pt),
                      *((n, _dtype(t)) for n, t in src.fields)])
 
 
@@ -179,7 +193,7 @@ def write_ply(src: MeshSource, fh, progress: bool = False) -> None:
     idx = _index_type(src.n_vertices)[0]
     header = ["ply", "format binary_little_endian 1.0", f"comment {src.title}",
               *(f"comment {c}" for c in src.comments), f"element vertex {src.n_vertices}",
-              "property float x", "property float y", "property float z",
+              *(f"property {_PLY_TYPES[src.position_type[1:]]} {c}" for c in "xyz"),
               *(f"property {_PLY_TYPES[_dtype(t).str[1:]]} {n}" for n, t in src.fields),
               f"element face {src.n_faces}", f"property list uchar {idx} vertex_indices",
               "end_header"]
@@ -206,8 +220,9 @@ def write_obj(src: MeshSource, fh, progress: bool = False) -> None:
     """Wavefront OBJ text (module notes)."""
     out = io.TextIOWrapper(fh, encoding="ascii", newline="\n")
     out.write(f"# {src.obj_title or src.title}\n")
+    digits = 12 if src.position_type == "<f8" else 9
     for xyz, _ in src.vertex_chunks():
-        for text in _text_blocks(np.asarray(xyz), "v %.9g %.9g %.9g\n"):
+        for text in _text_blocks(np.asarray(xyz), f"v %.{digits}g %.{digits}g %.{digits}g\n"):
             out.write(text)
     bar = progress_bar(total=None, enabled=progress, desc=src.progress_label or "OBJ")
     for group, chunks in src.face_groups():
@@ -245,7 +260,8 @@ def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
     itype, idt = ("Int32", "<i4") if 3 * n_f < 2**31 - 1 else ("Int64", "<i8")
     isize = np.dtype(idt).itemsize
     fields = [(n, _dtype(t)) for n, t in src.fields]
-    sizes = [12 * n_v, *([n_v * fields[0][1].itemsize] if fields else []),
+    pt = np.dtype(src.position_type)
+    sizes = [3 * pt.itemsize * n_v, *([n_v * fields[0][1].itemsize] if fields else []),
              3 * n_f * isize, n_f * isize, *(n_v * t.itemsize for _, t in fields[1:])]
     offs = np.concatenate([[0], np.cumsum([8 + s for s in sizes])])
     first = 1 if fields else 0  # blocks: points, [field 0], connectivity, offsets, fields...
@@ -264,8 +280,8 @@ def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
         f'<Piece NumberOfPoints="{n_v}" NumberOfVerts="0" NumberOfLines="0" '
         f'NumberOfStrips="0" NumberOfPolys="{n_f}">\n'
         f"<PointData{scalars}>\n" + "".join(arrays) + "</PointData>\n<Points>\n"
-        f'<DataArray type="Float32" Name="Points" NumberOfComponents="3" format="appended" '
-        f'offset="{offs[0]}"/>\n'
+        f'<DataArray type="{_VTK_XML_TYPES[pt.str[1:]]}" Name="Points" NumberOfComponents="3" '
+        f'format="appended" offset="{offs[0]}"/>\n'
         "</Points>\n<Polys>\n"
         f'<DataArray type="{itype}" Name="connectivity" format="appended" '
         f'offset="{offs[first + 1]}"/>\n'
@@ -284,7 +300,7 @@ def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
 
     fh.write(np.uint64(sizes[0]).tobytes())
     for xyz, _ in src.vertex_chunks():
-        fh.write(np.asarray(xyz).astype("<f4").tobytes())
+        fh.write(np.asarray(xyz).astype(pt).tobytes())
     if fields:
         field_block(0)
     fh.write(np.uint64(3 * n_f * isize).tobytes())
@@ -306,9 +322,10 @@ def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
 def write_vtk(src: MeshSource, fh, progress: bool = False) -> None:
     """VTK legacy binary PolyData, big-endian (module notes)."""
     fh.write(f"# vtk DataFile Version 4.2\n{src.title[:255]}\nBINARY\nDATASET POLYDATA\n"
-             f"POINTS {src.n_vertices} float\n".encode("ascii"))
+             f"POINTS {src.n_vertices} {_VTK_LEGACY_TYPES[src.position_type[1:]]}\n"
+             .encode("ascii"))
     for xyz, _ in src.vertex_chunks():
-        fh.write(np.asarray(xyz).astype(">f4").tobytes())
+        fh.write(np.asarray(xyz).astype(">" + src.position_type[1:]).tobytes())
     fh.write(f"\nPOLYGONS {src.n_faces} {4 * src.n_faces}\n".encode("ascii"))
     for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "VTK"):
         rec = np.empty((len(tri), 4), dtype=">i4")
