@@ -17,6 +17,7 @@ import pytest
 #: order of the run depends on it.
 LONGEST_FIRST = (
     "tests/test_readme_commands.py",     # 262 s
+    "tests/test_types.py",               # 39 (mypy, one thread)
     "tests/latlong/test_cli.py",         # 134
     "tests/dem/test_ondemand.py",        # 114
     "tests/latlong/test_boulders.py",    # 113
