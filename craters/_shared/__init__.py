@@ -54,7 +54,7 @@ __all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about",
            "load_toml", "normalize_rng", "package_version", "parameter_of",
            "parse_spec",
            "output_group", "physical_memory_bytes",
-           "progress_bar", "replace_output", "same_file", "staged_path", "sweep_temporaries", "temp_file",
-           "temp_folder"]
+           "progress_bar", "replace_output", "same_file", "staged_path", "sweep_temporaries",
+           "temp_file", "temp_folder"]
 
 lazy_package(__name__)

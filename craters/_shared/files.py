@@ -10,11 +10,11 @@ import tomllib
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
-from .system import human_bytes
 from .outputs import claim, replace_output, sweep_temporaries, temp_file
+from .system import human_bytes
 
-__all__ = ["atomic_path", "check_free_space", "check_output_path", "check_parent_folder", "check_regular_file",
-           "check_suffix", "load_toml"]
+__all__ = ["atomic_path", "check_free_space", "check_output_path", "check_parent_folder",
+           "check_regular_file", "check_suffix", "load_toml"]
 
 
 def check_parent_folder(path) -> None:

@@ -35,7 +35,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["TEMP_MAX_AGE_S", "check_outside_folder", "claim", "lock_output", "output_group",
-           "output_lock", "replace_output", "staged_path", "unlock_output", "same_file", "sweep_temporaries", "temp_file", "temp_folder"]
+           "output_lock", "replace_output", "same_file", "staged_path", "sweep_temporaries",
+           "temp_file", "temp_folder", "unlock_output"]
 
 logger = logging.getLogger(__name__)
 
@@ -136,7 +137,6 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
 
 
 # --------------------------------------------------------------------------- locks
-_LOCK_TAG = "craterform"  # a lock file holds "craterform PID"
 _HELD: dict[str, tuple[int, Path]] = {}  # this process's output locks: path -> (fd, lock file)
 
 
@@ -162,7 +162,7 @@ def lock_output(path) -> bool:
             break
         os.close(fd)  # its last holder removed it meanwhile: lock the file there now
     os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{_LOCK_TAG} {os.getpid()}\n".encode(), 0)
+    os.pwrite(fd, f"craterform {os.getpid()}\n".encode(), 0)  # what a stale lock shows
     _HELD[key] = (fd, name)
     return True
 
@@ -175,8 +175,8 @@ def _remove_stale_lock(name: Path) -> None:
     except OSError:
         return
     try:
-        m = re.fullmatch(_LOCK_TAG + r" ([0-9]{1,10})\n",
-                         os.pread(fd, 32, 0).decode("ascii", "replace"))
+        text = os.pread(fd, 32, 0).decode("ascii", "replace")
+        m = re.fullmatch(r"craterform ([0-9]{1,10})\n", text)
         if m is not None and _process_gone(int(m[1])):
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
             if _ident(name) == tuple(os.fstat(fd))[1:3]:
@@ -310,9 +310,10 @@ def _install(tmp: Path, entry: _Entry, *, keep: bool) -> None:
     """Move one staged output into place; the one it replaces waits as ``entry.backup``
     (a hard link to a file, the moved folder)."""
     path = entry.path
+    appeared = ValueError(f"output {path!r} appeared while this run wrote it; nothing was "
+                          f"replaced")
     if os.path.lexists(path) and (keep or entry.backup is None):
-        raise ValueError(f"output {path!r} appeared while this run wrote it; nothing was "
-                         f"replaced")
+        raise appeared
     if entry.backup is not None and os.path.lexists(path):
         if os.path.isdir(tmp):
             os.replace(path, entry.backup)
@@ -326,8 +327,7 @@ def _install(tmp: Path, entry: _Entry, *, keep: bool) -> None:
             os.link(tmp, path)  # never replaces a file that appeared this instant
             return
         except FileExistsError:
-            raise ValueError(f"output {path!r} appeared while this run wrote it; nothing "
-                             f"was replaced") from None
+            raise appeared from None
         except OSError:  # no hard links here
             pass
     os.replace(tmp, path)
@@ -338,7 +338,7 @@ def _take_back(entries: list[_Entry]) -> None:
     the backup moved back where the output is missing; a backup not needed removed."""
     for e in reversed(entries):
         try:
-            if e.new is not None and _ident(e.path) == tuple(e.new):
+            if e.new is not None and _ident(e.path) == e.new:
                 _remove(Path(e.path))
             if e.backup is not None and os.path.lexists(e.backup):
                 if os.path.lexists(e.path):  # the old output is in place: a spare link

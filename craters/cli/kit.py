@@ -18,11 +18,13 @@ import threading
 from collections.abc import Callable, Iterator, Mapping
 
 from .._shared.files import check_output_path
-from .._shared.outputs import output_group, same_file
+from .._shared.outputs import output_group, same_file, staged_path
+from .._shared.system import human_bytes
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
 __all__ = ["CliError", "OneLineParser", "batch_reporter", "batch_summary", "check_not_input",
-           "check_report_outputs", "parse_seed", "print_written", "run_cli"]
+           "check_report_outputs", "parse_seed", "print_written", "run_cli",
+           "wrote_line"]
 
 
 class CliError(Exception):
@@ -132,6 +134,12 @@ def check_report_outputs(args, inputs=()) -> None:
     if args.plot:
         check_not_input(args.plot, inputs, flag="--plot")
         check_output_path(args.plot, force=args.force, suffixes=(".png",))
+
+
+def wrote_line(path) -> str:
+    """``wrote PATH (SIZE)`` for an output of this run (its staged temporary until the run
+    ends: :func:`~craters._shared.outputs.staged_path`)."""
+    return f"wrote {path} ({human_bytes(staged_path(path).stat().st_size)})"
 
 
 def print_written(args) -> None:

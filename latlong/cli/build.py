@@ -13,8 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import human_bytes, progress_bar, staged_path
-from craters.cli.kit import CliError
+from craters._shared import progress_bar, staged_path
+from craters.cli.kit import CliError, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
 from latlong.scratch import drop_pages
@@ -134,7 +134,7 @@ def _build(v: Values) -> int:
         print(_summary(made, scene))
         for out in [f for path in files for f in (path, *companions(path))]:
             if staged_path(out).exists():  # a .glb's external buffer only past 4 GiB
-                print(f"wrote {out} ({human_bytes(staged_path(out).stat().st_size)})")
+                print(wrote_line(out))
     return 0
 
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from craters._shared import check_output_path, human_bytes, staged_path
-from craters.cli.kit import CliError, check_not_input
+from craters._shared import check_output_path
+from craters.cli.kit import CliError, check_not_input, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, default_of
 from latlong import export_glb, export_vtp_strips, load
 from latlong.gltf import LOD_LAYOUTS, level_path
@@ -63,7 +63,7 @@ def _export(v: Values) -> int:
         export_vtp_strips(body, out)
         summary = f"{2 * body.magnitude} strips"
     if not v["quiet"]:
-        print(f"wrote {out} ({human_bytes(staged_path(out).stat().st_size)}): {summary}")
+        print(f"{wrote_line(out)}: {summary}")
     return 0
 
 

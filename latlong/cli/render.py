@@ -2,10 +2,8 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from craters._shared import check_output_path, human_bytes, staged_path
-from craters.cli.kit import check_not_input
+from craters._shared import check_output_path
+from craters.cli.kit import check_not_input, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import PreviewSettings, load, render_preview
 
@@ -28,7 +26,7 @@ def _render(v: Values) -> int:
     body = load(v["model"])
     render_preview(body, v["output"], settings)
     if not v["quiet"]:
-        print(f"wrote {v['output']} ({human_bytes(staged_path(v['output']).stat().st_size)})")
+        print(wrote_line(v["output"]))
     return 0
 
 

@@ -223,9 +223,8 @@ def refuse_inside(mesh, poses, v: Values, sensor: str) -> None:
     """A one-line error if a pose puts the sensor inside the model or absurdly far from it."""
     from latlong.sensors import camera_inside
 
-    v_m = mesh.vertices
-    centre = 0.5 * (v_m.min(axis=0) + v_m.max(axis=0))
-    radius = max(float(np.linalg.norm(v_m - centre, axis=1).max()), 1e-3)
+    centre, radius = mesh.bounding_sphere
+    radius = max(radius, 1e-3)
     where = v.where("position_m" if v.position_m is not None else
                     "poses" if v.poses is not None else "range_m")
     for k in range(len(poses)):

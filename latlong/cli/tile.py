@@ -9,8 +9,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from craters._shared import check_output_path, human_bytes, staged_path
-from craters.cli.kit import CliError
+from craters._shared import check_output_path
+from craters.cli.kit import CliError, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 
 from ..meshio.writers import MESH_SUFFIXES
@@ -88,7 +88,7 @@ def _tile(v: Values) -> int:
               f"{made.n_rocks} rocks >= {made.min_crater_m:.3g} m, seed {scene.seed}",
               file=sys.stderr)
         for path in outs.values():
-            print(f"wrote {path} ({human_bytes(staged_path(path).stat().st_size)})")
+            print(wrote_line(path))
     return 0
 
 

@@ -238,15 +238,13 @@ def _ascii_body(fh, vdt: np.dtype, nv: int, nf: int):
         raise _Unreadable("an ASCII vertex line holds a value that is not a number") from None
     tris = []
     for _ in range(nf):
-        words = fh.readline().split()
-        if not words or len(words) != int(words[0]) + 1 or int(words[0]) < 3:
-            raise _Unreadable("an ASCII face line does not hold its vertex count and indices")
         try:
-            idx = [int(w) for w in words[1:]]
+            idx = [int(w) for w in fh.readline().split()]
         except ValueError:
-            text = b" ".join(words)[:40].decode(errors="replace")
-            raise _Unreadable(f"an ASCII face line holds {text!r}") from None
-        tris += [(3, idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+            raise _Unreadable("an ASCII face line holds a value that is not an integer") from None
+        if not idx or idx[0] < 3 or len(idx) != idx[0] + 1:
+            raise _Unreadable("an ASCII face line does not hold its vertex count and indices")
+        tris += [(3, idx[1], idx[k], idx[k + 1]) for k in range(2, len(idx) - 1)]
     faces = np.zeros(len(tris), dtype=[("n", "i4"), ("i", "i8", 3)])
     if tris:
         t = np.array(tris, dtype=np.int64)
