@@ -5,9 +5,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ._calls import read_only_inputs
+
 from ._rng_kernels import GOLDEN, _hash_normal, _mix64, _splitmix64
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _noise_kernel(seeds, out):
     """out[i, k] = a standard normal determined by (seeds[i], k) alone (Box-Muller on

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from ._calls import read_only_inputs
+
 
 @njit(cache=True, parallel=True)
 def _blend_tables(stack, a, b, j0, fd, ft, depth, rows, out):
@@ -54,6 +56,7 @@ def _rim_spectra(phases, coef, sign, harmonics, spec):
             spec[c, harmonics[k]] = coef[k] * np.exp(1j * phases[c, k]) * sign[k]
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _scale_rims(rho, irr, out):
     """``out[c] = rho[c] / peak * irr[c]`` with peak = max |rho[c]| (1 where 0)."""

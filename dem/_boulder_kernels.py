@@ -6,9 +6,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import bilinear
+from craters.kernels import bilinear, read_only_inputs
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _bilinear_kernel(z, cols, rows, out):
     """Bilinear heights at fractional pixels (cols[i], rows[i]) into ``out``; NaN outside
@@ -17,6 +18,7 @@ def _bilinear_kernel(z, cols, rows, out):
         out[i] = bilinear(z, rows[i], cols[i], True)
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _bilinear_serial_kernel(z, cols, rows, out):
     """:func:`_bilinear_kernel` without a parallel region (small calls)."""
@@ -41,6 +43,7 @@ def _gradient_at(z, known, r, c, axis, p):
     return (a - b) / ((hi - lo) * p)
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _window_gradient_kernel(z, known, p, r0, r1, c0, c1, out):
     """Mean height gradient (d/dcol, d/drow per metre) over the windows

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import bilinear
+from craters.kernels import bilinear, read_only_inputs
 
 from ._rng_kernels import STREAM_EXPAND, _pixel_normal
 
@@ -44,6 +44,7 @@ def _displace(total, n, sd, amp, amp_row0, amp_col0, inv_scale, key, level, row,
     return mean + sd * a * _pixel_normal(key, STREAM_EXPAND, level, row, col)
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _expand_kernel(old, key, level, row0, col0, sd_square, sd_diamond, amp, amp_row0,
                    amp_col0, inv_scale, out):

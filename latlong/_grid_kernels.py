@@ -5,6 +5,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 
 @njit(cache=True)
 def _ring_size(r, m):
@@ -123,6 +125,7 @@ def _interpolate_one(m, ring_offsets, values, colat, lon):
     return acc
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _interpolate_kernel(m, ring_offsets, values, colat, lon, out):
     """:func:`_interpolate_one` at many points (parallel)."""
@@ -435,6 +438,7 @@ def _surface_radius_one(m, ring_offsets, radii, colat, lon, p0, p1, p2, d, best)
     return best[1]
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _surface_radius_kernel(m, ring_offsets, radii, colat, lon, out):
     """:func:`_surface_radius_one` at many directions (parallel over chunks)."""

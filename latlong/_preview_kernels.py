@@ -5,9 +5,12 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from craters.kernels import read_only_inputs
+
 __all__ = ["_extent_kernel"]
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _extent_kernel(vertices, centre, view, right, up, out):
     """``out = [max (p - c).view, max |(p - c).right|, max |(p - c).up|]`` over the

@@ -42,7 +42,6 @@ from craters.targets import Target
 from ._crater_kernels import _stamp_body_kernel
 from ._wave_kernels import _balance_waves_kernel, _stamp_waves_kernel, _wave_schedule_kernel
 from .body import Body
-from .mesh.cratering import down_directions
 from .surface import band_areas, sample_surface_points
 
 __all__ = ["WaveScheduleOutgrown", "body_population", "crater_extents_deg", "stamp_craters"]
@@ -140,6 +139,8 @@ def _gravity_up(body: Body, lat_deg, lon_deg) -> np.ndarray:
     points = u * body.stretch * body.grid.interpolate(body.radii_m, np.pi / 2 - lat, lon)[:, None]
     # lumps of 512 faces: ~ 20 000 point masses on a 6 M-vertex body; directions to a few
     # degrees, which is what telling a wall from a floor needs
+    from .mesh.cratering import down_directions  # (latlong.mesh loads on this use only)
+
     return -down_directions(body.vertices(), body.grid.triangles(), points, block=512)
 
 

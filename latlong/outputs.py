@@ -28,7 +28,7 @@ from craters._shared.outputs import claim
 from craters._shared.settings import by_key, check_declared, setting
 
 from .body import EXPORT_SUFFIXES
-from .implicit import MESH_SUFFIXES
+from .meshio.writers import MESH_SUFFIXES
 from .preview import render_preview
 from .scene import Scene
 from .settings import ShapeBase

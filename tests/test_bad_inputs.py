@@ -308,9 +308,10 @@ def test_bad_numba_num_threads(tmp_path, command, argv, value, launcher):
 @pytest.mark.parametrize("delay_s", [0.3, 1.0])
 @pytest.mark.parametrize("launcher", ["script", "-m"])
 def test_ctrl_c_during_start_up(tmp_path, delay_s, launcher):
-    """One line and exit code 130, as a Ctrl-C later in a run (run_cli)."""
-    proc = subprocess.Popen([*console_script("latlong", launcher), "build", "--magnitude", "8",
-                             *OUT],
+    """One line and exit code 130, as a Ctrl-C later in a run (run_cli). A body of 6 M
+    vertices (~3 s) so that the later signal lands inside the run."""
+    proc = subprocess.Popen([*console_script("latlong", launcher), "build", "--magnitude",
+                             "1000", *OUT],
                             cwd=tmp_path, stderr=subprocess.PIPE, text=True)
     time.sleep(delay_s)
     proc.send_signal(signal.SIGINT)

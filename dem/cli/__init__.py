@@ -21,39 +21,28 @@ from __future__ import annotations
 import sys
 
 from craters.cli.kit import run_cli
-from craters.cli.options import main_parser
+from craters.cli.options import add_commands, main_parser
 
-from . import (
-    batch,
-    convert,
-    descent,
-    enhance,
-    expand,
-    fill,
-    info,
-    mesh,
-    sensors,
-    slopes,
-    spectrum,
-    tile,
-)
+__all__ = ["COMMANDS", "build_parser", "main"]
 
-__all__ = ["build_parser", "main"]
+#: The commands, in the order ``dem --help`` lists them, and their modules.
+COMMANDS = {**{name: name for name in ("info", "convert", "fill", "expand", "enhance", "mesh",
+                                       "batch", "slopes", "spectrum")},
+            "camera": "sensors", "lidar": "sensors", "tile": "tile", "descent": "descent"}
 
 
-def build_parser():
-    """The ``dem`` argument parser with every command."""
+def build_parser(argv: list[str] | None = None):
+    """The ``dem`` argument parser: every command, or only the one ``argv`` names."""
     parser, sub = main_parser("dem", "DEMs: gap filling, RMD expansion, layer stacks with "
                               "craters, meshes, info.")
-    for command in (info, convert, fill, expand, enhance, mesh, batch, slopes, spectrum,
-                    sensors, tile, descent):
-        command.register(sub)
+    add_commands(sub, __name__, COMMANDS, argv)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``dem`` with ``argv`` (default: the process's arguments); the exit code."""
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
     return run_cli(lambda: args.func(args), atomic=args.command != "batch")
 
 

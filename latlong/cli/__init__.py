@@ -13,38 +13,30 @@ import argparse
 import sys
 
 from craters.cli.kit import run_cli
-from craters.cli.options import flag_of, main_parser
+from craters.cli.options import add_commands, flag_of, main_parser
 
-from . import (
-    batch,
-    build,
-    camera,
-    descent,
-    export,
-    info,
-    lidar,
-    presets,
-    render,
-    slopes,
-    spectrum,
-    tile,
-)
+__all__ = ["COMMANDS", "build_parser", "main"]
 
-__all__ = ["build_parser", "main"]
+#: The commands, in the order ``latlong --help`` lists them, and their modules.
+COMMANDS = {name: name for name in ("build", "batch", "info", "presets", "render", "export",
+                                    "slopes", "spectrum", "camera", "lidar", "tile",
+                                    "descent")}
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The ``latlong`` argument parser: every command, or only the one ``argv`` names."""
     parser, sub = main_parser("latlong", "Asteroid bodies on the lat/long mesh.")
-    for command in (build, batch, info, presets, render, export, slopes, spectrum, camera,
-                    lidar, tile, descent):
-        command.register(sub)
+    add_commands(sub, __name__, COMMANDS, argv)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = build_parser()
-    args = parser.parse_args(argv)
-    flags = {k: flag_of(k, s) for k, s in build.OPTIONS.items()}
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
+    # library errors about a scene's settings are named by their flags (the commands that
+    # read a scene load the build module)
+    build = sys.modules.get(f"{__name__}.build")
+    flags = {k: flag_of(k, s) for k, s in build.OPTIONS.items()} if build else {}
     return run_cli(lambda: args.func(args), flags=flags, atomic=args.command != "batch")
 
 

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 from .._grid_kernels import _lon_row, _ring_positions, _ring_size
 
 
@@ -80,6 +82,7 @@ def _add_triangle_angle_normal(pos, a, b, c, out):
         out[v, 2] += ang * nz
 
 
+@read_only_inputs("out", "area")
 @njit(cache=True)
 def _area_normals_kernel(verts, tris, out, area):
     """Area-weighted vertex normal sums, triangle after triangle (the ``"faces"`` order):
@@ -97,6 +100,7 @@ def _area_normals_kernel(verts, tris, out, area):
                 area[v] += third
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _angle_normals_kernel(verts, tris, out):
     """Angle-weighted vertex normal sums, triangle after triangle (the ``"faces"``
@@ -106,6 +110,7 @@ def _angle_normals_kernel(verts, tris, out):
         _add_triangle_angle_normal(verts, tris[t, 0], tris[t, 1], tris[t, 2], out)
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _max_normals_kernel(vertices, faces, out):
     """Unit vertex normals with Max's (1999) weights, triangle after triangle: the sum over
@@ -136,6 +141,7 @@ def _max_normals_kernel(vertices, faces, out):
             out[v, 2] /= n
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _scatter_add_kernel(index, values, out):
     """``out[index[t]] += values[t]`` in the order of t (``np.add.at``, (N,) or (N, k))."""
@@ -198,6 +204,7 @@ def _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, ba
                   angle)
 
 
+@read_only_inputs("acc")
 @njit(cache=True, parallel=True)
 def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lon_table, acc,
                                angle):

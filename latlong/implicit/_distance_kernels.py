@@ -19,6 +19,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 # feature codes of _closest_on_triangle: 0 face, 1..3 vertex a, b, c; 4..6 edge ab, bc, ca
 _FACE, _EDGE_AB = 0, 4
 
@@ -136,6 +138,7 @@ def _band_distance_kernel(origin, h, active, bsize, nbins, offsets, items, lo, h
                     face_id[k, j, i] = f
 
 
+@read_only_inputs("foot", "normal")
 @njit(cache=True, parallel=True)
 def _feet_kernel(points, fids, verts, faces, face_n, foot, normal):
     """Closest point on face fids[s] of every point, and the unit normal of the tangent

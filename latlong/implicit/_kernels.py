@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import lcsn_height
+from craters.kernels import lcsn_height, read_only_inputs
 
 
 # --------------------------------------------------------------------------- voxelising
@@ -391,6 +391,7 @@ def _gabor_points_kernel(points, pos, wave, env, amp, phase, cutoff2, out):
 
 
 # --------------------------------------------------------------------------- distance
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _closest_distance_kernel(origin, h, nearest, seed_id, foot, normal, first_order, far2,
                             reach, out):

@@ -11,6 +11,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 from ..geometry._normal_kernels import _triangle_edges
 
 
@@ -199,6 +201,7 @@ def _face_box(pos, faces, f):
             min(pos[a, 2], min(pos[b, 2], pos[c, 2])), max(pos[a, 2], max(pos[b, 2], pos[c, 2])))
 
 
+@read_only_inputs("offsets", "items")
 @njit(cache=True)
 def _grid_kernel(pos, faces, lo, h, dims, offsets, items, fill):
     """Count (``fill`` False: cells' counts into ``offsets[1:]``) or list (``fill`` True:
@@ -269,6 +272,7 @@ def _closest_on_triangle(px, py, pz, pos, faces, f):
     return q0 * q0 + q1 * q1 + q2 * q2, u, v
 
 
+@read_only_inputs("out_face", "out_uv", "out_dist")
 @njit(cache=True, parallel=True)
 def _closest_points_kernel(points, pos, faces, lo, h, dims, offsets, items, out_face,
                            out_uv, out_dist):
@@ -340,6 +344,7 @@ def _line_hit(px, py, pz, n0, n1, n2, pos, faces, f):
     return (e20 * q0 + e21 * q1 + e22 * q2) * inv
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _depths_kernel(points, normals, margin, pos, faces, lo, h, dims, offsets, items, out):
     """Depth of each point below the surface along its row's normal (the nearest

@@ -8,9 +8,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import cell_id, face_point, face_uv
+from craters.kernels import cell_id, face_point, face_uv, read_only_inputs
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _cells_kernel(points, level, out):
     """Cell id of each direction at ``level``."""

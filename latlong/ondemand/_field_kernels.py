@@ -11,13 +11,7 @@ import numpy as np
 from numba import njit, prange
 
 from craters.kernels import (
-    face_point,
-    fbm2,
-    roughness_amp,
-    slope_factor,
-    table,
-    table_value,
-    warp_x,
+    face_point, fbm2, read_only_inputs, roughness_amp, slope_factor, table, table_value, warp_x,
 )
 
 # crater record columns (float64 array "fc", one row per crater)
@@ -208,6 +202,7 @@ def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims
     fc[k, ACTIVE] = 1.0 if scale > 0.0 else 0.0
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _points_kernel(points, block_of, blk_start, blk_list, base, fc, tabs, rims, seeds, rough,
                    gain, octaves, xe, xb, age_key, diam, out):

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import fbm2
+from craters.kernels import fbm2, read_only_inputs
 
 from ._field_kernels import _far, _local
 
@@ -51,6 +51,7 @@ def _rock_height(rc, seeds, k, p0, p1, p2):
     return z if z > 0.0 else 0.0
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _rocks_kernel(points, block_of, blk_start, blk_list, rc, seeds, out):
     """Adds to each point the tallest rock over it (of its block's rocks)."""

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import lattice_coord, mix64
+from craters.kernels import lattice_coord, mix64, read_only_inputs
 
 _KX = np.uint64(0x9E3779B97F4A7C15)
 _KY = np.uint64(0xC2B2AE3D27D4EB4F)
@@ -41,6 +41,7 @@ def _value3(seed, x, y, z):
     return b0 + w * (b1 - b0)
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
     """fBm of ``octaves`` octaves of :func:`_value3` from ``wavelength_m`` halving each
@@ -60,6 +61,7 @@ def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
         out[i] = total
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _ejecta_kernel(verts, order, keys, lo, cell, dims, centres, radii, gains, reach, n_threads,
                    out):

@@ -7,7 +7,7 @@ import math
 
 from numba import njit, prange
 
-from craters.kernels import splitmix64
+from craters.kernels import read_only_inputs, splitmix64
 
 from ._photometry_kernels import _radiance_factor
 from ._render_kernels import _key, _lift, _uniform
@@ -47,6 +47,7 @@ def _bounce_rays_kernel(pos, ng, ns, offset, centre, floor, seed, sample, out_o,
         above[i] = ng[i, 0] * dx + ng[i, 1] * dy + ng[i, 2] * dz > 0.0
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _bounce_light_kernel(code, params, dirs, face, face_normals, albedo_w, sun, lit, out):
     """I/F of each secondary hit seen back along its ray: the model at (cos i to the sun,

@@ -13,6 +13,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 #: Rays per parallel iteration.
 BLOCK = 256
 _INVALID = np.uint32(0xFFFFFFFF)
@@ -117,6 +119,7 @@ def _load_ray(buf, ibuf, origins, directions, i, centre, t0, tnear, tfar):
     ibuf[19] = _INVALID
 
 
+@read_only_inputs("t_out", "face_out", "u_out", "v_out")
 @njit(cache=True, parallel=True)
 def _intersect_kernel(intersect1, scene, origins, directions, t_max, centre, radius,
                       vertices, faces, t_out, face_out, u_out, v_out):
@@ -184,6 +187,7 @@ def _unit_kernel(directions, out):
     return bad if bad < n else -1
 
 
+@read_only_inputs("out")
 @njit(cache=True)
 def _shift_kernel(vertices, centre, out):
     """``out[:n] = float32(vertices - centre)``; returns the largest squared distance of a

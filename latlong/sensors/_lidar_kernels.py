@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import hash_normal, mix64, splitmix64
+from craters.kernels import hash_normal, mix64, read_only_inputs, splitmix64
 
 
 @njit(cache=True, inline="always")
@@ -32,6 +32,7 @@ def _cos_incidence(normals, f, d, i):
     return min(c, 1.0)
 
 
+@read_only_inputs("out_n", "out_range", "out_lambert", "out_best")
 @njit(cache=True, parallel=True)
 def _returns_kernel(t, face, d, normals, weight, spacing, cos_floor, multiple, separation,
                     max_returns, noise_sigma, key, beam0, out_n, out_range, out_lambert,

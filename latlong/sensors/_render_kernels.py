@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import GOLDEN, hash_normal, mix64, splitmix64
+from craters.kernels import GOLDEN, hash_normal, mix64, read_only_inputs, splitmix64
 
 from ._photometry_kernels import _radiance_factor
 
@@ -34,6 +34,7 @@ def _uniform(h):
     return (h >> _S11) * _TWO_POW_M53
 
 
+@read_only_inputs("pos", "ng_out", "ns_out", "cosines", "facing")
 @njit(cache=True, parallel=True)
 def _surface_kernel(origin, dirs, t, face, u, v, vertices, faces, vnormals, smooth, sun,
                     pos, ng_out, ns_out, cosines, facing):
@@ -90,6 +91,7 @@ def _surface_kernel(origin, dirs, t, face, u, v, vertices, faces, vnormals, smoo
         facing[i] = nx * sun[0] + ny * sun[1] + nz * sun[2] > 0.0
 
 
+@read_only_inputs("depth", "rng", "angles", "normals", "sunlit")
 @njit(cache=True, parallel=True)
 def _ground_truth_kernel(t, face, dirs, axis, cosines, ns, lit, depth, rng, angles, normals,
                          sunlit):
@@ -110,6 +112,7 @@ def _ground_truth_kernel(t, face, dirs, axis, cosines, ns, lit, depth, rng, angl
             normals[i, k] = ns[i, k]
 
 
+@read_only_inputs("out_o", "out_d", "facing")
 @njit(cache=True, parallel=True)
 def _shadow_rays_kernel(pos, ng, offset, centre, floor, sun, radius_rad, seed, sample, out_o,
                         out_d, facing):

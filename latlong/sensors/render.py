@@ -253,8 +253,8 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     refl = refl[:, 0].reshape(h, w) if not names else refl.reshape(shape)
     depth, rng_m, lit32 = (np.empty(n, dtype=np.float32) for _ in range(3))
     angles, normals32 = (np.empty((n, 3), dtype=np.float32) for _ in range(2))
-    _ground_truth_kernel(hits.t_m, face, dirs, pose.rotation[:, 2], cosines, ns, lit, depth,
-                         rng_m, angles, normals32, lit32)
+    _ground_truth_kernel(hits.t_m, face, dirs, np.ascontiguousarray(pose.rotation[:, 2]),
+                         cosines, ns, lit, depth, rng_m, angles, normals32, lit32)
     exposure = exposure_for(refl, sensor)
     seen = np.stack([np.where(face >= 0, albedo * getattr(m, "albedo", 1.0), np.nan)
                      for m in models], axis=-1)

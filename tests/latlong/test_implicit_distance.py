@@ -80,7 +80,7 @@ def test_band_kernel_matches_reference():
     lo, hi = _face_boxes(verts, faces, grid, band)
     nbins, offsets, items, active = grid.bins(lo, hi)
     dist = np.full(grid.shape, np.nan)
-    face_id = np.full(grid.shape, -1, np.int64)
+    face_id = np.full(grid.shape, -1, np.int32)  # as mesh_distance: one compiled kernel
     DK._band_distance_kernel(grid.origin, grid.h, active, grid.bin_size, nbins, offsets, items,
                              lo, hi, verts, faces, face_n, edge_n, vert_n, band, dist, face_id)
     k, j, i = np.meshgrid(*(np.arange(m) for m in grid.shape), indexing="ij")

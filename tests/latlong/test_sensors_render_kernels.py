@@ -47,7 +47,7 @@ def test_shadow_rays_match_numpy():
 def test_surface_kernel_matches_numpy():
     rng = np.random.default_rng(2)
     verts = rng.normal(size=(30, 3)) * 50.0
-    faces = rng.integers(0, 30, size=(40, 3))
+    faces = rng.integers(0, 30, size=(40, 3)).astype(np.uint32)  # a RayMesh's faces' type
     faces = faces[(faces[:, 0] != faces[:, 1]) & (faces[:, 1] != faces[:, 2])
                   & (faces[:, 0] != faces[:, 2])]
     vn = _rng_unit(rng, 30)
