@@ -62,8 +62,9 @@ from .._shared.validation import ParameterError, ParameterTypeError, parameter_o
 from .kit import CliError
 
 __all__ = ["CONFIG", "FORCE", "QUIET", "REPORT", "Setting", "Values", "add_commands",
-           "add_options", "batch_error", "batch_options", "command", "declared_keys", "default_of", "flag_of",
-           "help_text", "main_parser", "parse_vary", "read_config", "shown_value", "values_of"]
+           "add_options", "batch_error", "batch_options", "command", "declared_keys",
+           "default_of", "flag_of", "help_text", "main_parser", "parse_vary", "read_config",
+           "shown_value", "values_of"]
 
 
 # --------------------------------------------------------------------------- text -> value
