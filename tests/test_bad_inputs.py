@@ -310,9 +310,12 @@ def test_bad_numba_num_threads(tmp_path, command, argv, value, launcher):
 def test_ctrl_c_during_start_up(tmp_path, delay_s, launcher):
     """One line and exit code 130, as a Ctrl-C later in a run (run_cli). A body of 6 M
     vertices (~3 s) so that the later signal lands inside the run."""
+    # SIGINT as at a terminal: a test run started in the background (CI under nohup, `&`)
+    # hands its children SIGINT ignored, and Python then never raises KeyboardInterrupt
     proc = subprocess.Popen([*console_script("latlong", launcher), "build", "--magnitude",
                              "1000", *OUT],
-                            cwd=tmp_path, stderr=subprocess.PIPE, text=True)
+                            cwd=tmp_path, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(delay_s)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=300)
