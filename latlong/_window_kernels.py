@@ -37,7 +37,9 @@ def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out, ang
     band_hi = min(r_hi, two_m - 1)
     for parity in range(2):
         first = band_lo + ((parity - band_lo) % 2)
-        for hb in prange((band_hi - first) // 2 + 1 if band_hi >= first else 0):
+        # (a conditional expression as prange's bound made numba run the loop serially)
+        count = max((band_hi - first) // 2 + 1, 0)
+        for hb in prange(count):
             _band_area_vectors(m, ring_offsets, radii, stretch, no_table, first + 2 * hb, acc,
                                base, angle)
     skip = ring_offsets[r_lo] - base
