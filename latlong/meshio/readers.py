@@ -285,11 +285,16 @@ def read_vtk_mesh(path: Path):
         vtkObject.SetGlobalWarningDisplay(shown)
     if isinstance(mesh, pv.MultiBlock):
         mesh = mesh.combine(merge_points=False)
-    if not isinstance(mesh, pv.PolyData):
-        mesh = mesh.extract_surface(algorithm="dataset_surface")
-    mesh = mesh.triangulate()
-    faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) if mesh.n_cells \
-        else np.zeros((0, 3), np.int64)
+    triangles = isinstance(mesh, pv.UnstructuredGrid) and mesh.n_cells \
+        and (np.asarray(mesh.celltypes) == pv.CellType.TRIANGLE).all()
+    if triangles:  # as written (craterform's .vtk): vertices and faces in the file's order
+        faces = np.asarray(mesh.cells).reshape(-1, 4)[:, 1:].astype(np.int64)
+    else:
+        if not isinstance(mesh, pv.PolyData):
+            mesh = mesh.extract_surface(algorithm="dataset_surface")
+        mesh = mesh.triangulate()
+        faces = np.asarray(mesh.faces).reshape(-1, 4)[:, 1:].astype(np.int64) \
+            if mesh.n_cells else np.zeros((0, 3), np.int64)
     return (np.asarray(mesh.points, dtype=np.float64), faces,
             {k: np.asarray(mesh.point_data[k]) for k in mesh.point_data.keys()})
 

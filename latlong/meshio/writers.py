@@ -18,7 +18,9 @@ Formats
 * ``.stl``: binary, float32 facet normal and corners, 80-byte header.
 * ``.vtp``: VTK XML PolyData, raw appended binary (UInt64 headers): float32 (float64) points,
   the fields, Int32 (Int64 if needed) connectivity and offsets.
-* ``.vtk``: VTK legacy binary (big-endian), POINTS float (double), POLYGONS, POINT_DATA fields.
+* ``.vtk``: VTK legacy binary (big-endian), an UNSTRUCTURED_GRID of triangles (what
+  meshio, VTK and ParaView all read; meshio has no reader for legacy POLYDATA): POINTS
+  float (double), CELLS, CELL_TYPES 5, POINT_DATA fields.
 * ``.glb``: glTF 2.0 binary, one node (rotated so the model's +Z is glTF's +Y, up:
   :data:`Y_UP`) and mesh: float32 POSITION (with bounds), uint32
   triangle indices (fields are not written).
@@ -320,18 +322,23 @@ def write_vtp(src: MeshSource, fh, progress: bool = False) -> None:
 
 
 def write_vtk(src: MeshSource, fh, progress: bool = False) -> None:
-    """VTK legacy binary PolyData, big-endian (module notes)."""
-    fh.write(f"# vtk DataFile Version 4.2\n{src.title[:255]}\nBINARY\nDATASET POLYDATA\n"
+    """VTK legacy binary unstructured grid of triangles, big-endian (module notes)."""
+    fh.write(f"# vtk DataFile Version 4.2\n{src.title[:255]}\nBINARY\n"
+             f"DATASET UNSTRUCTURED_GRID\n"
              f"POINTS {src.n_vertices} {_VTK_LEGACY_TYPES[src.position_type[1:]]}\n"
              .encode("ascii"))
     for xyz, _ in src.vertex_chunks():
         fh.write(np.asarray(xyz).astype(">" + src.position_type[1:]).tobytes())
-    fh.write(f"\nPOLYGONS {src.n_faces} {4 * src.n_faces}\n".encode("ascii"))
+    fh.write(f"\nCELLS {src.n_faces} {4 * src.n_faces}\n".encode("ascii"))
     for tri in progress_bar(src.faces(), enabled=progress, desc=src.progress_label or "VTK"):
         rec = np.empty((len(tri), 4), dtype=">i4")
         rec[:, 0] = 3
         rec[:, 1:] = tri
         fh.write(rec.tobytes())
+    fh.write(f"\nCELL_TYPES {src.n_faces}\n".encode("ascii"))
+    triangle = np.full(1 << 16, 5, dtype=">i4").tobytes()  # VTK_TRIANGLE
+    for start in range(0, src.n_faces, 1 << 16):
+        fh.write(triangle[:4 * min(1 << 16, src.n_faces - start)])
     if src.fields:
         fh.write(f"\nPOINT_DATA {src.n_vertices}\n".encode("ascii"))
     for name, t in src.fields:

@@ -28,7 +28,8 @@ def test_formats_read_back(tmp_path, suffix, fields):
                                                  np.sort(v, 0))
         return
     assert np.array_equal(mesh.points, v.astype(np.float32))
-    assert np.array_equal(mesh.faces.reshape(-1, 4)[:, 1:], f)
+    cells = mesh.cells if suffix == ".vtk" else mesh.faces  # .vtk: an unstructured grid
+    assert np.array_equal(cells.reshape(-1, 4)[:, 1:], f)
     if fields and suffix == ".ply":  # VTK's PLY reader skips extra properties: parse them
         raw = (tmp_path / "t.ply").read_bytes()
         body = raw[raw.index(b"end_header\n") + 11:]
@@ -129,3 +130,27 @@ def test_ordered_chunks_keeps_order_and_bounds_the_buffers(threads):
 
     with pytest.raises(OSError, match="disk full"):
         list(ordered_chunks(fails, range(20), lambda: None, threads=threads))
+
+
+def test_meshio_reads_the_legacy_vtk(tmp_path):
+    """The legacy .vtk is an unstructured grid of triangles: meshio reads it (it has no
+    reader for legacy POLYDATA, and exits on one), with its points, triangles and fields;
+    VTK and craterform's own reader read the same, in the same order."""
+    meshio = pytest.importorskip("meshio")  # in the test extra
+    import pyvista as pv
+
+    from latlong.meshio.readers import read_vtk_mesh
+
+    v, f, src = _tetra(True)
+    path = write_mesh(src, tmp_path / "t.vtk")
+    mesh = meshio.read(path)
+    assert np.array_equal(mesh.points, v.astype(np.float32))
+    assert [c.type for c in mesh.cells] == ["triangle"]
+    assert np.array_equal(mesh.cells[0].data, f)
+    assert np.array_equal(mesh.point_data["height_m"].ravel(), [0.5, 1.5, 2.5, 3.5])
+    assert np.array_equal(mesh.point_data["layer"].ravel(), [0, 1, 1, 2])
+    grid = pv.read(path)
+    assert isinstance(grid, pv.UnstructuredGrid) and grid.n_cells == 4
+    points, faces, fields = read_vtk_mesh(path)
+    assert np.array_equal(points, v) and np.array_equal(faces, f)
+    assert np.array_equal(fields["layer"], [0, 1, 1, 2])
