@@ -62,7 +62,8 @@ from .._shared.validation import ParameterError, ParameterTypeError, parameter_o
 from .kit import CliError
 
 __all__ = ["CONFIG", "FORCE", "QUIET", "REPORT", "Setting", "Values", "add_commands",
-           "add_options", "batch_error", "batch_options", "command", "declared_keys",
+           "add_options", "batch_error", "batch_options", "command", "command_modules",
+           "declared_keys",
            "default_of", "flag_of", "help_text", "main_parser", "parse_vary", "read_config",
            "shown_value", "values_of"]
 
@@ -435,17 +436,23 @@ def batch_options(what: str) -> dict[str, Setting]:
     }
 
 
-def add_commands(sub, package: str, modules: Mapping[str, str],
-                 argv: list[str] | None = None) -> None:
-    """Register the commands of the command-line package ``package`` on the sub-command
-    parser ``sub``: ``modules`` maps each command to the module of ``package`` whose
-    ``register(sub)`` adds it. When ``argv`` names a command first only its module is
-    imported, so a run does not load the libraries of the other commands (0.1-0.5 s a
+def command_modules(package: str, modules: Mapping[str, str],
+                    argv: list[str] | None = None) -> list:
+    """The modules of the command-line package ``package`` that ``argv`` needs, imported:
+    ``modules`` maps each command to its module. When ``argv`` names a command first only
+    its module, so a run does not load the libraries of the other commands (0.1-0.5 s a
     start); otherwise (no ``argv``, ``--help``, a mistyped command) all of them."""
     wanted = modules.get(argv[0]) if argv else None
-    for module in dict.fromkeys(modules.values()):
-        if wanted in (None, module):
-            importlib.import_module(f"{package}.{module}").register(sub)
+    return [importlib.import_module(f"{package}.{module}")
+            for module in dict.fromkeys(modules.values()) if wanted in (None, module)]
+
+
+def add_commands(sub, package: str, modules: Mapping[str, str],
+                 argv: list[str] | None = None) -> None:
+    """Register on the sub-command parser ``sub`` the commands of :func:`command_modules`
+    (each module's ``register(sub)``)."""
+    for module in command_modules(package, modules, argv):
+        module.register(sub)
 
 
 def main_parser(prog: str, description: str):

@@ -33,6 +33,16 @@ def environment_problem() -> str | None:
     return None
 
 
+def _warm_numba() -> None:
+    """Set up numba's typing and target contexts (the modules it imports at the first call
+    of any kernel, ~0.25 s): a Ctrl-C inside those imports made the process die by SIGINT
+    after its "interrupted" line; here it is only noted."""
+    from numba.core.registry import cpu_target
+
+    cpu_target.typing_context.refresh()
+    cpu_target.target_context.refresh()
+
+
 def start_command(cli_module: str, argv: list[str] | None) -> int:
     """Import the command line ``cli_module`` (``"latlong.cli"``) and run its ``main`` with
     ``argv`` (default the process's arguments); the exit code."""
@@ -41,14 +51,29 @@ def start_command(cli_module: str, argv: list[str] | None) -> int:
         sys.stderr.write(f"error: {problem}\n")
         return 2
     # a Ctrl-C while the libraries load is noted, not raised: a KeyboardInterrupt inside
-    # the import machinery can be swallowed ("Exception ignored in ...") and the run go on
+    # the import machinery can be swallowed ("Exception ignored in ...") and the run go on.
+    # One handler for the whole run (swapping handlers after loading left a window in
+    # which the process died by SIGINT after its message); a SIGINT already ignored (a
+    # background job) stays ignored.
+    loading = [True]
     interrupted: list[int] = []
-    previous = signal.signal(signal.SIGINT, lambda signum, frame: interrupted.append(signum))
+
+    def on_sigint(signum, frame) -> None:
+        interrupted.append(signum)
+        if not loading[0]:
+            raise KeyboardInterrupt
+
+    if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
+        signal.signal(signal.SIGINT, on_sigint)
     try:
-        main = importlib.import_module(cli_module).main
-    finally:
-        signal.signal(signal.SIGINT, previous)
-    try:
+        module = importlib.import_module(cli_module)
+        main = module.main
+        args = sys.argv[1:] if argv is None else list(argv)
+        if hasattr(module, "load"):  # the command's own modules (and its libraries)
+            module.load(args)
+        if "numba" in sys.modules and not {"-h", "--help"} & set(args):
+            _warm_numba()
+        loading[0] = False
         if interrupted:
             raise KeyboardInterrupt
         code = main(argv)
