@@ -15,6 +15,7 @@ import importlib
 import os
 import signal
 import sys
+import threading
 
 __all__ = ["environment_problem", "start_command"]
 
@@ -33,14 +34,21 @@ def environment_problem() -> str | None:
     return None
 
 
-def _warm_numba() -> None:
-    """Set up numba's typing and target contexts (the modules it imports at the first call
-    of any kernel, ~0.25 s): a Ctrl-C inside those imports made the process die by SIGINT
-    after its "interrupted" line; here it is only noted."""
-    from numba.core.registry import cpu_target
+#: Code a KeyboardInterrupt must not interrupt: the import machinery (numba imports
+#: dozens of modules at the first call of any kernel; an interrupt there made the process
+#: die by SIGINT after its line) and numba's and llvmlite's own Python code (an interrupt
+#: inside llvmlite's object-cache callback was swallowed and the run went on).
+_DEFERRED = ("<frozen importlib", f"{os.sep}numba{os.sep}", f"{os.sep}llvmlite{os.sep}")
 
-    cpu_target.typing_context.refresh()
-    cpu_target.target_context.refresh()
+
+def _deferred(frame) -> bool:
+    """Whether ``frame`` (or a caller) runs code of :data:`_DEFERRED`."""
+    while frame is not None:
+        name = frame.f_code.co_filename
+        if name.startswith(_DEFERRED[0]) or any(part in name for part in _DEFERRED[1:]):
+            return True
+        frame = frame.f_back
+    return False
 
 
 def start_command(cli_module: str, argv: list[str] | None) -> int:
@@ -59,9 +67,14 @@ def start_command(cli_module: str, argv: list[str] | None) -> int:
     interrupted: list[int] = []
 
     def on_sigint(signum, frame) -> None:
-        interrupted.append(signum)
-        if not loading[0]:
-            raise KeyboardInterrupt
+        if loading[0] or _deferred(frame):
+            if not loading[0]:  # raised once out of that code: the signal again
+                again = threading.Timer(0.05, os.kill, (os.getpid(), signal.SIGINT))
+                again.daemon = True
+                again.start()
+            interrupted.append(signum)
+            return
+        raise KeyboardInterrupt
 
     if signal.getsignal(signal.SIGINT) is not signal.SIG_IGN:
         signal.signal(signal.SIGINT, on_sigint)
@@ -71,8 +84,6 @@ def start_command(cli_module: str, argv: list[str] | None) -> int:
         args = sys.argv[1:] if argv is None else list(argv)
         if hasattr(module, "load"):  # the command's own modules (and its libraries)
             module.load(args)
-        if "numba" in sys.modules and not {"-h", "--help"} & set(args):
-            _warm_numba()
         loading[0] = False
         if interrupted:
             raise KeyboardInterrupt
