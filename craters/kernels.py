@@ -41,8 +41,7 @@ Grids and point sets:
 Calling kernels from Python:
 
 * ``read_only_inputs(*outputs)``: a kernel's decorator (outside ``njit``) passing every
-  array argument but its outputs read-only, so it compiles once; ``read_only(a)``: a
-  read-only view
+  array argument but its outputs read-only, so it compiles once
 
 Cube-sphere cells (:mod:`craters.cells`):
 
@@ -50,7 +49,7 @@ Cube-sphere cells (:mod:`craters.cells`):
   ``cell_id(level, face, u, v)``: the uint64 id of the cell holding (u, v)
 """
 
-from ._calls import read_only, read_only_inputs
+from ._calls import read_only_inputs
 from ._counter_kernels import _cell_id as cell_id
 from ._counter_kernels import _face_point as face_point
 from ._counter_kernels import _face_uv as face_uv
@@ -80,6 +79,6 @@ from ._stamp_kernels import _warp_x as warp_x
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
            "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",
-           "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add", "read_only",
-           "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves", "slope_factor",
-           "splitmix64", "table", "table_value", "warp_x"]
+           "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
+           "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
+           "slope_factor", "splitmix64", "table", "table_value", "warp_x"]

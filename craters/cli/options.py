@@ -63,9 +63,8 @@ from .kit import CliError
 
 __all__ = ["CONFIG", "FORCE", "QUIET", "REPORT", "Setting", "Values", "add_commands",
            "add_options", "batch_error", "batch_options", "command", "command_modules",
-           "declared_keys",
-           "default_of", "flag_of", "help_text", "main_parser", "parse_vary", "read_config",
-           "shown_value", "values_of"]
+           "declared_keys", "default_of", "flag_of", "help_text", "main_parser", "parse_vary",
+           "read_config", "shown_value", "values_of"]
 
 
 # --------------------------------------------------------------------------- text -> value

@@ -81,9 +81,11 @@ def start_command(cli_module: str, argv: list[str] | None) -> int:
     try:
         module = importlib.import_module(cli_module)
         main = module.main
-        args = sys.argv[1:] if argv is None else list(argv)
-        if hasattr(module, "load"):  # the command's own modules (and its libraries)
-            module.load(args)
+        if hasattr(module, "COMMANDS"):  # the command's own modules (and its libraries)
+            from .options import command_modules
+
+            command_modules(cli_module, module.COMMANDS,
+                            sys.argv[1:] if argv is None else list(argv))
         loading[0] = False
         if interrupted:
             raise KeyboardInterrupt

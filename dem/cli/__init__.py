@@ -21,20 +21,14 @@ from __future__ import annotations
 import sys
 
 from craters.cli.kit import run_cli
-from craters.cli.options import add_commands, command_modules, main_parser
+from craters.cli.options import add_commands, main_parser
 
-__all__ = ["COMMANDS", "build_parser", "load", "main"]
+__all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The commands, in the order ``dem --help`` lists them, and their modules.
-COMMANDS = {**{name: name for name in ("info", "convert", "fill", "expand", "enhance", "mesh",
-                                       "batch", "slopes", "spectrum")},
-            "camera": "sensors", "lidar": "sensors", "tile": "tile", "descent": "descent"}
-
-
-def load(argv: list[str]) -> None:
-    """Import the command modules ``argv`` needs (:mod:`craters.cli.start` calls it while
-    a Ctrl-C is only noted: the libraries load here)."""
-    command_modules(__name__, COMMANDS, argv)
+COMMANDS = {name: "sensors" if name in ("camera", "lidar") else name
+            for name in ("info", "convert", "fill", "expand", "enhance", "mesh", "batch",
+                         "slopes", "spectrum", "camera", "lidar", "tile", "descent")}
 
 
 def build_parser(argv: list[str] | None = None):

@@ -13,20 +13,14 @@ import argparse
 import sys
 
 from craters.cli.kit import run_cli
-from craters.cli.options import add_commands, command_modules, flag_of, main_parser
+from craters.cli.options import add_commands, flag_of, main_parser
 
-__all__ = ["COMMANDS", "build_parser", "load", "main"]
+__all__ = ["COMMANDS", "build_parser", "main"]
 
 #: The commands, in the order ``latlong --help`` lists them, and their modules.
 COMMANDS = {name: name for name in ("build", "batch", "info", "presets", "render", "export",
                                     "slopes", "spectrum", "camera", "lidar", "tile",
                                     "descent")}
-
-
-def load(argv: list[str]) -> None:
-    """Import the command modules ``argv`` needs (:mod:`craters.cli.start` calls it while
-    a Ctrl-C is only noted: the libraries load here)."""
-    command_modules(__name__, COMMANDS, argv)
 
 
 def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
