@@ -79,40 +79,45 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
             add += (roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
                     * fbm2(seed, u1, u2, wavelength, octaves, gain))
         return True, add / cz + table(delta, az) * outer_weight(x, xe)
+    return True, tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, qa, qb, qc,
+                             rough, rough[3], has_rough, seed, wavelength, octaves, gain, fr)
+
+
+@njit(cache=True)
+def tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, qa, qb, qc, rough, warp,
+                has_rough, seed, wavelength, octaves, gain, fr):
+    """The radial change t that puts a point inside the rim of a crater stamped in the
+    tilted frame ``fr`` on the crater's surface (:func:`_tilted_change`; the point's
+    in-plane coordinates ``u1, u2`` and height ``w0`` along the base normal; ``rough``: the
+    bowl, wall and ejecta amplitudes, ``warp``: :func:`craters.kernels.warp_x`'s)."""
+    c = (radius, tab, scale, depth, xe, rim_tab, qa, qb, qc, rough, warp, has_rough, seed,
+         wavelength, octaves, gain, fr)
     # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z: g is bounded (the crater's
     # relief), so stepping from t = 0 against f's sign brackets it; then Illinois false
     # position (a plain fixed point diverges where |grad W| tan(tilt) > 1)
     ta = 0.0
-    fa = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, ta, radius, tab, scale, depth,
-                        xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves,
-                        gain) - ta
+    fa = _target(u1, u2, w0, ta, c) - ta
     if fa == 0.0:
-        return True, 0.0
+        return 0.0
     step = fa
     tb = ta + step
-    fb = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, tb, radius, tab, scale, depth,
-                        xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves,
-                        gain) - tb
+    fb = _target(u1, u2, w0, tb, c) - tb
     k = 0
     while fa * fb > 0.0 and k < 30:
         ta, fa = tb, fb
         step *= 2.0
         tb = ta + step
-        fb = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, tb, radius, tab, scale,
-                            depth, xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength,
-                            octaves, gain) - tb
+        fb = _target(u1, u2, w0, tb, c) - tb
         k += 1
     if fa * fb > 0.0:
-        return True, 0.0  # no sign change (not reached: g is bounded)
+        return 0.0  # no sign change (not reached: g is bounded)
     side = 0
     tol = 1e-9 * radius
     for _ in range(_TILT_ITERATIONS):
         t = (ta * fb - tb * fa) / (fb - fa)
-        ft = _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale,
-                            depth, xe, rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength,
-                            octaves, gain) - t
+        ft = _target(u1, u2, w0, t, c) - t
         if abs(ft) <= tol or abs(tb - ta) <= tol:
-            return True, t
+            return t
         if ft * fb > 0.0:
             tb, fb = t, ft
             if side == -1:
@@ -123,12 +128,22 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
             if side == 1:
                 fb *= 0.5
             side = 1
-    return True, (ta * fb - tb * fa) / (fb - fa)
+    return (ta * fb - tb * fa) / (fb - fa)
+
+
+@njit(cache=True, inline="always")
+def _target(u1, u2, w0, t, c):
+    """:func:`_tilted_target` with the crater's constants ``c`` (:func:`tilted_root`)."""
+    (radius, tab, scale, depth, xe, rim_tab, qa, qb, qc, rough, warp, has_rough, seed,
+     wavelength, octaves, gain, fr) = c
+    return _tilted_target(u1, u2, fr[2], fr[5], fr[0], fr[1], fr[3], fr[4], fr[9], w0, t,
+                          radius, tab, scale, depth, xe, rim_tab, qa, qb, qc, rough, warp,
+                          has_rough, seed, wavelength, octaves, gain)
 
 
 @njit(cache=True)
 def _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale, depth, xe,
-                   rim_tab, qa, qb, qc, rough, has_rough, seed, wavelength, octaves, gain):
+                   rim_tab, qa, qb, qc, rough, warp, has_rough, seed, wavelength, octaves, gain):
     """g(t) of :func:`_tilted_change`: the radial change that would put the point moved
     radially by t on the crater's surface inside the rim."""
     v1 = u1 + t * ez
@@ -143,7 +158,7 @@ def _tilted_target(u1, u2, ez, mz, ex, ey, mx, my, cz, w0, t, radius, tab, scale
     hx = v1 * ex + v2 * mx
     hy = v1 * ey + v2 * my
     target = (qa * hx * hx + qb * hx * hy + qc * hy * hy) * cz
-    target += scale * table_value(tab, warp_x(xv, v1, v2, radius, rough[3], seed), xe)
+    target += scale * table_value(tab, warp_x(xv, v1, v2, radius, warp, seed), xe)
     if has_rough:
         target += (roughness_amp(xv, xe, rough[0], rough[1], rough[2]) * depth * scale
                    * fbm2(seed, v1, v2, wavelength, octaves, gain))

@@ -10,6 +10,8 @@ from numba import njit, prange
 
 from craters.kernels import cell_id, face_point, face_uv, read_only_inputs
 
+from ._field_kernels import C0, C1, C2, COS_FAR, E0, N0
+
 
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
@@ -97,3 +99,124 @@ def _reach_kernel(centres, angles, level, occ, out):
                 hit = True
                 break
         out[k] = hit
+
+
+@njit(cache=True, parallel=True)
+def _cap_blocks_kernel(fc, craters, level, occ, cos_margin):
+    """Pairs (block, crater): the occupied blocks (sorted cell ids ``occ`` at ``level``)
+    that crater caps may reach (:func:`_cap_blocks_one`), crater by crater in the order
+    given. Craters in parallel, counted first, then written at their offsets."""
+    n_cr = craters.shape[0]
+    counts = np.zeros(n_cr + 1, dtype=np.int64)
+    none = np.empty(0, dtype=np.int64)
+    for t in prange(n_cr):
+        counts[t + 1] = _cap_blocks_one(fc, craters[t], level, occ, cos_margin, none, none,
+                                        0, False)
+    offsets = np.cumsum(counts)
+    out_blk = np.empty(offsets[n_cr], dtype=np.int64)
+    out_crater = np.empty(offsets[n_cr], dtype=np.int64)
+    for t in prange(n_cr):
+        _cap_blocks_one(fc, craters[t], level, occ, cos_margin, out_blk, out_crater,
+                        offsets[t], True)
+    return out_blk, out_crater
+
+
+@njit(cache=True)
+def _cap_blocks_one(fc, k, level, occ, cos_margin, out_blk, out_crater, at, write):
+    """The occupied blocks crater k's cap may reach, written from ``at`` when ``write``;
+    returns how many. A cap narrower than 0.3 rad is projected on each face it can touch
+    and the blocks of its bounding box are looked up; a wider one is tested against every
+    occupied block (its centre within the cap widened by ``cos_margin``, the blocks'
+    angular radius)."""
+    n = 0
+    nside = 1 << level
+    n_samples = 64
+    bp = np.empty((n_samples + 1, 3))
+    cosf = fc[k, COS_FAR]
+    ang = np.arccos(min(1.0, max(-1.0, cosf)))
+    c = np.array([fc[k, C0], fc[k, C1], fc[k, C2]])
+    if ang >= 0.3:
+        # angle(c, block) <= ang + margin
+        cos_tot = np.cos(min(np.pi, ang + np.arccos(cos_margin)))
+        for b in range(occ.shape[0]):
+            cell = occ[b]
+            lv = int(cell >> np.uint64(57))
+            face = int((cell >> np.uint64(54)) & np.uint64(7))
+            i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
+            j = int(cell & np.uint64((1 << 27) - 1))
+            sc = 2.0 / (1 << lv)
+            w = face_point(face, -1.0 + (i + 0.5) * sc, -1.0 + (j + 0.5) * sc)
+            nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
+            if (w[0] * c[0] + w[1] * c[1] + w[2] * c[2]) / nw >= cos_tot:
+                if write:
+                    out_blk[at + n] = b
+                    out_crater[at + n] = k
+                n += 1
+        return n
+    sa = np.sin(ang)
+    for s in range(n_samples):
+        phi = 2.0 * np.pi * s / n_samples
+        for d in range(3):
+            bp[s, d] = cosf * c[d] + sa * (np.cos(phi) * fc[k, E0 + d]
+                                           + np.sin(phi) * fc[k, N0 + d])
+    for d in range(3):
+        bp[n_samples, d] = c[d]
+    for face in range(6):
+        a = face // 2
+        sgn = 1.0 if face % 2 == 0 else -1.0
+        ok = True
+        umin = 1e300
+        umax = -1e300
+        vmin = 1e300
+        vmax = -1e300
+        for s in range(n_samples + 1):
+            m = sgn * bp[s, a]
+            if m <= 0.0:
+                ok = False
+                break
+            u = bp[s, (a + 1) % 3] / m
+            v = bp[s, (a + 2) % 3] / m
+            umin = min(umin, u)
+            umax = max(umax, u)
+            vmin = min(vmin, v)
+            vmax = max(vmax, v)
+        if not ok:
+            continue
+        big = max(max(abs(umin), abs(umax)), max(abs(vmin), abs(vmax)))
+        pad = 0.02 * ang * (1.0 + 2.0 * big * big) + 1e-12
+        umin -= pad
+        umax += pad
+        vmin -= pad
+        vmax += pad
+        if umin > 1.0 or umax < -1.0 or vmin > 1.0 or vmax < -1.0:
+            continue
+        i0 = max(int(np.floor((max(umin, -1.0) + 1.0) * 0.5 * nside)), 0)
+        i1 = min(int(np.floor((min(umax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
+        j0 = max(int(np.floor((max(vmin, -1.0) + 1.0) * 0.5 * nside)), 0)
+        j1 = min(int(np.floor((min(vmax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
+        if (i1 - i0 + 1) * (j1 - j0 + 1) > occ.shape[0]:
+            # fewer occupied blocks than cells in the box: test those
+            for pos in range(occ.shape[0]):
+                cell = occ[pos]
+                if int((cell >> np.uint64(54)) & np.uint64(7)) != face:
+                    continue
+                i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
+                j = int(cell & np.uint64((1 << 27) - 1))
+                if i0 <= i <= i1 and j0 <= j <= j1:
+                    if write:
+                        out_blk[at + n] = pos
+                        out_crater[at + n] = k
+                    n += 1
+            continue
+        for i in range(i0, i1 + 1):
+            for j in range(j0, j1 + 1):
+                cell = (np.uint64(level) << np.uint64(57)) \
+                    | (np.uint64(face) << np.uint64(54)) \
+                    | (np.uint64(i) << np.uint64(27)) | np.uint64(j)
+                pos = np.searchsorted(occ, cell)
+                if pos < occ.shape[0] and occ[pos] == cell:
+                    if write:
+                        out_blk[at + n] = pos
+                        out_crater[at + n] = k
+                    n += 1
+    return n

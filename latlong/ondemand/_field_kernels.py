@@ -11,8 +11,10 @@ import numpy as np
 from numba import njit, prange
 
 from craters.kernels import (
-    face_point, fbm2, read_only_inputs, roughness_amp, slope_factor, table, table_value, warp_x,
+    fbm2, read_only_inputs, roughness_amp, slope_factor, table, table_value, warp_x,
 )
+
+from .._tilt_kernels import _TILT_MAX_COS, TILT_MIN_DEG, _tilted_frame, tilted_root
 
 # crater record columns (float64 array "fc", one row per crater)
 C0, C1, C2 = 0, 1, 2          # centre direction (unit)
@@ -28,7 +30,9 @@ ACTIVE = 20                   # 1 when stamped (0: erased by slope erosion, or n
 FAR = 21                      # the widest ejecta edge's angle (radians)
 CHORD2 = 22                   # squared chord of that angle, (2 sin(FAR / 2))^2
 WARP = 23                     # wall warp (craters.kernels.warp_x): 0 simple .. 1 complex
-N_COLS = 24
+TILT = 24                     # the tilted base's frame E', N', N (9) and N_z (0: radial frame)
+TILT_CZ = TILT + 9
+N_COLS = TILT + 10
 
 
 @njit(cache=True, inline="always")
@@ -79,6 +83,8 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if _far(fc, k, CHORD2, p0, p1, p2):
         return False, 1.0, 0.0  # beyond the widest ejecta edge: nothing else to compute
     cosang, dist, x, y, az = _local(fc, k, p0, p1, p2)
+    if fc[k, TILT_CZ] > 0.0:
+        return _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y)
     radius = fc[k, RAD]
     xr = dist / (radius * (1.0 + table(rims[k], az)))
     if not xr < xe:
@@ -98,6 +104,43 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
         t = (xb - xr) / (xb - 1.0)
         w = 1.0 - t * t
         return True, w, (1.0 - w) * q + prof
+    return True, 1.0, prof
+
+
+@njit(cache=True)
+def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
+    """:func:`_step` of a crater made in its tilted base's frame (as the sequential stamp,
+    :func:`latlong._tilt_kernels._tilted_change`): the point's in-plane coordinates and
+    height along the base normal are those of its foot on the base plane, so the map
+    does not depend on the height before it; inside the rim the radius where the radial
+    line meets the crater's surface, outside the profile along the normal (over N_z)."""
+    fr = fc[k, TILT:TILT + 10]
+    r2 = fc[k, GX] * x + fc[k, GY] * y  # the foot on the base plane (w0 = 0 but rounding)
+    u1 = x * fr[0] + y * fr[1] + r2 * fr[2]
+    u2 = x * fr[3] + y * fr[4] + r2 * fr[5]
+    w0 = x * fr[6] + y * fr[7] + r2 * fr[8]
+    az = np.arctan2(u2, u1)
+    radius = fc[k, RAD]
+    xr = np.sqrt(u1 * u1 + u2 * u2) / (radius * (1.0 + table(rims[k], az)))
+    if not xr < xe:
+        return False, 1.0, 0.0
+    scale = fc[k, SCALE]
+    amp_max = max(rough[0], max(rough[1], rough[2])) * fc[k, DEPTH] * scale
+    has_rough = octaves > 0 and amp_max > 1e-6 * radius
+    if xr <= 1.0:
+        t_root = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, DEPTH], xe, rims[k],
+                             fc[k, QA], fc[k, QB], fc[k, QC], rough, fc[k, WARP], has_rough,
+                             seeds[k], radius, octaves, gain, fr)
+        return True, 0.0, (fc[k, RHO] + fc[k, P0] + r2) + t_root
+    add = scale * table_value(tabs[k], xr, xe)
+    if has_rough:
+        amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
+        add += amp * fbm2(seeds[k], u1, u2, radius, octaves, gain)
+    prof = add / fr[9]
+    if xr < xb:
+        t = (xb - xr) / (xb - 1.0)
+        w = 1.0 - t * t
+        return True, w, (1.0 - w) * (fc[k, RHO] + _quadric(fc, k, x, y)) + prof
     return True, 1.0, prof
 
 
@@ -195,6 +238,10 @@ def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims
     cr2 = l0 * r1 - l1 * r0
     slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
                                   l0 * r0 + l1 * r1 + l2 * r2))
+    # on steep ground the crater is made in its base's frame (issue 36), as sequentially
+    if _tilted_frame(gx, gy, fc[k, TILT:TILT + 10]) < TILT_MIN_DEG \
+            or fc[k, TILT_CZ] < _TILT_MAX_COS:
+        fc[k, TILT_CZ] = 0.0
     scale = slope_factor(slope, onset, full) if slope_erosion else 1.0
     if slope_erosion and slope >= full:
         scale = 0.0  # steeper than the angle of repose: erased, not stamped
@@ -264,127 +311,6 @@ def _dep_kernel(owners, owner_cell, lo, hi, cand_sorted, fc, diam):
         _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, out_owner, out_dep,
                   offsets[s], True)
     return out_owner, out_dep
-
-
-@njit(cache=True, parallel=True)
-def _cap_blocks_kernel(fc, craters, level, occ, cos_margin):
-    """Pairs (block, crater): the occupied blocks (sorted cell ids ``occ`` at ``level``)
-    that crater caps may reach (:func:`_cap_blocks_one`), crater by crater in the order
-    given. Craters in parallel, counted first, then written at their offsets."""
-    n_cr = craters.shape[0]
-    counts = np.zeros(n_cr + 1, dtype=np.int64)
-    none = np.empty(0, dtype=np.int64)
-    for t in prange(n_cr):
-        counts[t + 1] = _cap_blocks_one(fc, craters[t], level, occ, cos_margin, none, none,
-                                        0, False)
-    offsets = np.cumsum(counts)
-    out_blk = np.empty(offsets[n_cr], dtype=np.int64)
-    out_crater = np.empty(offsets[n_cr], dtype=np.int64)
-    for t in prange(n_cr):
-        _cap_blocks_one(fc, craters[t], level, occ, cos_margin, out_blk, out_crater,
-                        offsets[t], True)
-    return out_blk, out_crater
-
-
-@njit(cache=True)
-def _cap_blocks_one(fc, k, level, occ, cos_margin, out_blk, out_crater, at, write):
-    """The occupied blocks crater k's cap may reach, written from ``at`` when ``write``;
-    returns how many. A cap narrower than 0.3 rad is projected on each face it can touch
-    and the blocks of its bounding box are looked up; a wider one is tested against every
-    occupied block (its centre within the cap widened by ``cos_margin``, the blocks'
-    angular radius)."""
-    n = 0
-    nside = 1 << level
-    n_samples = 64
-    bp = np.empty((n_samples + 1, 3))
-    cosf = fc[k, COS_FAR]
-    ang = np.arccos(min(1.0, max(-1.0, cosf)))
-    c = np.array([fc[k, C0], fc[k, C1], fc[k, C2]])
-    if ang >= 0.3:
-        # angle(c, block) <= ang + margin
-        cos_tot = np.cos(min(np.pi, ang + np.arccos(cos_margin)))
-        for b in range(occ.shape[0]):
-            cell = occ[b]
-            lv = int(cell >> np.uint64(57))
-            face = int((cell >> np.uint64(54)) & np.uint64(7))
-            i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
-            j = int(cell & np.uint64((1 << 27) - 1))
-            sc = 2.0 / (1 << lv)
-            w = face_point(face, -1.0 + (i + 0.5) * sc, -1.0 + (j + 0.5) * sc)
-            nw = np.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
-            if (w[0] * c[0] + w[1] * c[1] + w[2] * c[2]) / nw >= cos_tot:
-                if write:
-                    out_blk[at + n] = b
-                    out_crater[at + n] = k
-                n += 1
-        return n
-    sa = np.sin(ang)
-    for s in range(n_samples):
-        phi = 2.0 * np.pi * s / n_samples
-        for d in range(3):
-            bp[s, d] = cosf * c[d] + sa * (np.cos(phi) * fc[k, E0 + d]
-                                           + np.sin(phi) * fc[k, N0 + d])
-    for d in range(3):
-        bp[n_samples, d] = c[d]
-    for face in range(6):
-        a = face // 2
-        sgn = 1.0 if face % 2 == 0 else -1.0
-        ok = True
-        umin = 1e300
-        umax = -1e300
-        vmin = 1e300
-        vmax = -1e300
-        for s in range(n_samples + 1):
-            m = sgn * bp[s, a]
-            if m <= 0.0:
-                ok = False
-                break
-            u = bp[s, (a + 1) % 3] / m
-            v = bp[s, (a + 2) % 3] / m
-            umin = min(umin, u)
-            umax = max(umax, u)
-            vmin = min(vmin, v)
-            vmax = max(vmax, v)
-        if not ok:
-            continue
-        big = max(max(abs(umin), abs(umax)), max(abs(vmin), abs(vmax)))
-        pad = 0.02 * ang * (1.0 + 2.0 * big * big) + 1e-12
-        umin -= pad
-        umax += pad
-        vmin -= pad
-        vmax += pad
-        if umin > 1.0 or umax < -1.0 or vmin > 1.0 or vmax < -1.0:
-            continue
-        i0 = max(int(np.floor((max(umin, -1.0) + 1.0) * 0.5 * nside)), 0)
-        i1 = min(int(np.floor((min(umax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
-        j0 = max(int(np.floor((max(vmin, -1.0) + 1.0) * 0.5 * nside)), 0)
-        j1 = min(int(np.floor((min(vmax, 1.0) + 1.0) * 0.5 * nside)), nside - 1)
-        if (i1 - i0 + 1) * (j1 - j0 + 1) > occ.shape[0]:
-            # fewer occupied blocks than cells in the box: test those
-            for pos in range(occ.shape[0]):
-                cell = occ[pos]
-                if int((cell >> np.uint64(54)) & np.uint64(7)) != face:
-                    continue
-                i = int((cell >> np.uint64(27)) & np.uint64((1 << 27) - 1))
-                j = int(cell & np.uint64((1 << 27) - 1))
-                if i0 <= i <= i1 and j0 <= j <= j1:
-                    if write:
-                        out_blk[at + n] = pos
-                        out_crater[at + n] = k
-                    n += 1
-            continue
-        for i in range(i0, i1 + 1):
-            for j in range(j0, j1 + 1):
-                cell = (np.uint64(level) << np.uint64(57)) \
-                    | (np.uint64(face) << np.uint64(54)) \
-                    | (np.uint64(i) << np.uint64(27)) | np.uint64(j)
-                pos = np.searchsorted(occ, cell)
-                if pos < occ.shape[0] and occ[pos] == cell:
-                    if write:
-                        out_blk[at + n] = pos
-                        out_crater[at + n] = k
-                    n += 1
-    return n
 
 
 @njit(cache=True, parallel=True)

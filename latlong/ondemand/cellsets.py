@@ -117,7 +117,7 @@ def block_pairs(records: np.ndarray, active: np.ndarray, level: int, occ: np.nda
     cos of the reach; :mod:`._field_kernels`) that may reach it, ordered by ``rank``;
     block ``b``'s are ``list[start[b]:start[b + 1]]``."""
     margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
-    ob, oc = K._cap_blocks_kernel(records, np.ascontiguousarray(active, dtype=np.int64), level,
+    ob, oc = C._cap_blocks_kernel(records, np.ascontiguousarray(active, dtype=np.int64), level,
                                   occ, margin)
     srt = np.lexsort((rank[oc], ob))
     return (np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64),

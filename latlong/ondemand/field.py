@@ -26,13 +26,20 @@ in the README, "Terrain on demand"):
    rim stays continuous whatever lies under it). The height at a point is the
    composition over the craters that reach it, youngest first in the fixed (age, id)
    order, stopping at the first rim that holds the point; then the base shape.
-   The sequential stamp instead shifts the older terrain outside the rim by its offset
-   from the base at the rim (an azimuth table sampled from everything older), which
-   would make a crater depend on every older crater at its rim; the blend keeps the
-   point local but damps the older terrain's roughness within 1.5 radii. Where that
-   roughness is all a crater's relief (craters diffused flat on the faulted preset:
-   measured d/D -35 % on one seed, -12 % with the blend to 1.2 radii, which moves the
-   fBm preset from +6 % to +10 %), the two models differ; craters with relief agree.
+   On ground tilted more than 10 deg from the radial a crater is made in its
+   base plane's own frame, as the sequential stamp makes it (issue 36): a point's foot on
+   the base plane gives its in-plane coordinates; inside the rim the height is where the
+   radial line meets the crater's surface (the stamp's root finder), outside the profile
+   is added along the base normal. Made radially instead, a crater on ground tilted
+   49 deg had its rim 1.50 radii out along the dip and 1.01 across.
+   The sequential stamp shifts the older terrain outside the rim by its offset from the
+   base at the rim (an azimuth table sampled from everything older), and fits its base to
+   everything older; both would make a crater depend on every older crater around it.
+   The blend and the fit to larger craters keep the point local, and leave the terrain
+   around craters diffused flat somewhat smoother than sequential stamping makes it
+   (on the faulted preset ~10 % less relief at their scale, which their rim-minus-floor
+   depth, a small difference of two noise maxima, turns into -40 %); craters with relief
+   agree (figures: ``tests/benchmarks/ondemand_faithfulness.py``).
 
 Which craters are needed for a set of points is found bin by bin, smallest first: those
 in the cells around the points, and then every larger crater that reaches a stencil
@@ -334,6 +341,23 @@ class CraterField:
         # oldest first: the composition's (age, id) order reversed
         return cat[np.lexsort((cr.id, cr.age_gyr))[::-1]]
 
+    # ------------------------------------------------------------------ parameters
+    _PARAM_COLS = np.r_[K.P0:K.ACTIVE + 1, K.TILT:K.TILT + 10]
+
+    def _recall(self, keys: list, fc: np.ndarray) -> np.ndarray:
+        """Fill ``fc``'s parameter columns (base quadric, slope erosion, tilted frame) of
+        the craters an earlier call computed; returns which those are."""
+        known = np.array([k in self._params for k in keys], dtype=bool)
+        if known.any():
+            fc[np.ix_(known, self._PARAM_COLS)] = np.array(
+                [self._params[k] for k, h in zip(keys, known, strict=True) if h])
+        return known
+
+    def _remember(self, keys: list, fc: np.ndarray) -> None:
+        if len(self._params) + len(keys) > PARAMS_CACHE:
+            self._params.clear()
+        self._params.update(zip(keys, fc[:, self._PARAM_COLS], strict=True))
+
     # ------------------------------------------------------------------ heights
     def radii(self, units: np.ndarray, d_min: float) -> np.ndarray:
         """Radius (m) in each direction ``units`` (n, 3) with craters >= ``d_min``."""
@@ -354,8 +378,11 @@ class CraterField:
         fc = cr.fc
         rank = np.empty(n, dtype=np.int64)
         rank[np.lexsort((cr.id, cr.age_gyr))] = np.arange(n)  # 0: the youngest
+        # a layer's fixed degradation overrides the one its ages give (as in a build)
+        fixed = np.array([np.nan if la.degradation is None else la.degradation
+                          for la in self.layers] or [np.nan])
         cat = make_catalog(lat_deg=np.zeros(n), lon_deg=np.zeros(n), diameter_m=cr.diameter_m,
-                           age_gyr=cr.age_gyr, degradation=np.full(n, np.nan))
+                           age_gyr=cr.age_gyr, degradation=fixed[cr.layer])
         prof = stamping_profiles(cat, self.target, ejecta_edge=self.xe)
         tabs = np.ascontiguousarray(prof.tables)
         rims = np.ascontiguousarray(rim_perturbations_from_phases(cr.rim_phases,
@@ -373,11 +400,8 @@ class CraterField:
         # craters whose parameters an earlier call computed (a crater's parameters are a
         # function of the crater alone: the same bits whenever they are computed)
         keys = list(zip(cr.cell.tolist(), cr.id.tolist(), strict=True))
-        known = np.array([k in self._params for k in keys], dtype=bool)
-        if known.any():
-            fc[known, K.P0:K.ACTIVE + 1] = np.array(
-                [self._params[k] for k, h in zip(keys, known, strict=True) if h])
-            fc[known, K.DEPTH] = prof.depth_m[known]
+        known = self._recall(keys, fc)
+        fc[known, K.DEPTH] = prof.depth_m[known]
         new = np.flatnonzero(~known)
         stencil = np.zeros((n, len(STENCIL_XY), 3))
         st_base = np.zeros((n, len(STENCIL_XY)))
@@ -396,10 +420,7 @@ class CraterField:
                          rims,
                          seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
                          rank, diam, up, 20.0, 45.0, True)
-        if len(self._params) + len(new) > PARAMS_CACHE:
-            self._params.clear()
-        rows = fc[new, K.P0:K.ACTIVE + 1]
-        self._params.update(zip([keys[i] for i in new], rows, strict=True))
+        self._remember([keys[i] for i in new], fc[new])
         order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
         active = order[fc[order, K.ACTIVE] > 0]
         blk_start, blk_list = block_pairs(fc, active, level, occ, rank)

@@ -92,9 +92,10 @@ from scipy.spatial import cKDTree
 
 from crater_depth import rim_minus_floor
 
-from craters.kernels import fbm2, roughness_amp, table_value
+from craters.kernels import fbm2, roughness_amp, table, table_value
 from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_profiles
 from latlong import Body, LatLongGrid, Scene, stamp_craters
+from latlong._tilt_kernels import tilted_root  # the tilted frame's root finder
 from latlong.cratering import crater_extents_deg
 from latlong.ondemand import _field_kernels as K  # the field's per-crater record columns
 from latlong.ondemand.base import grid_catalog, grid_directions
@@ -244,6 +245,10 @@ def _interior_residual(units, radii, top, fc, tabs, rims, seeds, rough, gain, oc
         rim = rims[k, k0] + w * (rims[k, k1] - rims[k, k0])
         radius = fc[k, K.RAD]
         xr = dist / (radius * (1.0 + rim))
+        if fc[k, K.TILT_CZ] > 0.0:  # made in its tilted base's frame
+            out[i] = _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe,
+                                      radii[i])
+            continue
         if xr > 1.0:
             continue
         scale = fc[k, K.SCALE]
@@ -255,6 +260,30 @@ def _interior_residual(units, radii, top, fc, tabs, rims, seeds, rough, gain, oc
         q = (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
              + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
         out[i] = radii[i] - (fc[k, K.RHO] + q + prof)
+
+
+@njit(cache=False)
+def _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe, radius_now):
+    """Surface minus crater k's interior for a crater made in its tilted base's frame
+    (NaN outside its rim): the point's foot on the base plane in the frame's coordinates,
+    and the radial line's meeting with the crater's surface (the sequential stamp's
+    root finder, ``latlong._tilt_kernels.tilted_root``)."""
+    fr = fc[k, K.TILT:K.TILT + 10]
+    r2 = fc[k, K.GX] * x + fc[k, K.GY] * y
+    u1 = x * fr[0] + y * fr[1] + r2 * fr[2]
+    u2 = x * fr[3] + y * fr[4] + r2 * fr[5]
+    w0 = x * fr[6] + y * fr[7] + r2 * fr[8]
+    radius = fc[k, K.RAD]
+    xr = np.sqrt(u1 * u1 + u2 * u2) / (radius * (1.0 + table(rims[k], np.arctan2(u2, u1))))
+    if xr > 1.0:
+        return np.nan
+    scale = fc[k, K.SCALE]
+    has_rough = octaves > 0 and (max(rough[0], max(rough[1], rough[2])) * fc[k, K.DEPTH]
+                                 * scale > 1e-6 * radius)
+    t = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, K.DEPTH], xe, rims[k],
+                    fc[k, K.QA], fc[k, K.QB], fc[k, K.QC], rough, fc[k, K.WARP], has_rough,
+                    seeds[k], radius, octaves, gain, fr)
+    return radius_now - ((fc[k, K.RHO] + fc[k, K.P0] + r2) + t)
 
 
 def older_inside_check(field, units, radii, tree):
@@ -286,8 +315,15 @@ def older_inside_check(field, units, radii, tree):
         xe_ = pu @ fc[k, K.E0:K.E2 + 1]
         xn = pu @ fc[k, K.N0:K.N2 + 1]
         dist = np.arctan2(np.hypot(xe_, xn), c) * fc[k, K.RHO]
-        rim = _table_np(np.broadcast_to(rims[k], (len(near), rims.shape[1])),
-                        np.arctan2(xn, xe_))
+        az = np.arctan2(xn, xe_)
+        if fc[k, K.TILT_CZ] > 0.0:  # the reach in the tilted base's frame, as the kernel
+            s_ = np.maximum(np.hypot(xe_, xn), 1e-300)
+            x, y = dist * xe_ / s_, dist * xn / s_
+            fr = fc[k, K.TILT:K.TILT + 10]
+            foot = np.stack([x, y, fc[k, K.GX] * x + fc[k, K.GY] * y], axis=1)
+            u1, u2 = foot @ fr[0:3], foot @ fr[3:6]
+            dist, az = np.hypot(u1, u2), np.arctan2(u2, u1)
+        rim = _table_np(np.broadcast_to(rims[k], (len(near), rims.shape[1])), az)
         xr = dist / (fc[k, K.RAD] * (1.0 + rim))
         # reach by the chord, as the kernel tests it (a cosine test misses the last
         # micrometres of a younger crater's ejecta tail: residuals of ~1e-6 m)
