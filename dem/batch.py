@@ -48,7 +48,8 @@ _RUN_KEYS = ("output", "force", "quiet")
 def batch(config, seeds, *, out, vary: Mapping | None = None, backend: str | None = None,
           scheduler: str | None = None, workers: int | None = None, resume: bool = False,
           force: bool = False, progress: bool = False, retries: int = 2,
-          on_done: Callable[[dict], None] | None = None) -> BatchResult:
+          on_done: Callable[[dict], None] | None = None,
+          connect_timeout_s: float | None = None) -> BatchResult:
     """Build every variant of a stack description (on dask.distributed) into ``out``.
 
     Parameters
@@ -64,9 +65,10 @@ def batch(config, seeds, *, out, vary: Mapping | None = None, backend: str | Non
     vary : Mapping, optional
         Key -> list of values (:meth:`EnhanceConfig.keys` but ``seed``; values as in the
         file); every combination is built.
-    backend, scheduler, workers, resume, force, progress, retries, on_done
+    backend, scheduler, workers, resume, force, progress, retries, on_done, connect_timeout_s
         As :func:`latlong.batch`: dask (default) or ``"serial"`` in this process, a
-        running scheduler's address or a local cluster of ``workers`` processes, keep
+        running scheduler's address (answering within ``connect_timeout_s``) or a local
+        cluster of ``workers`` processes, keep
         finished variants, redo all, a progress bar, retries of tasks that raised
         something other than a bad-input error, a callback per finished variant's index
         row.
@@ -90,7 +92,7 @@ def batch(config, seeds, *, out, vary: Mapping | None = None, backend: str | Non
         jobs.append(Job(v, (cfg, where), describe, (v.name,)))
     return run_batch(jobs, _enhance_variant, out, backend=backend, scheduler=scheduler,
                      workers=workers, resume=resume, force=force, progress=progress,
-                     retries=retries, on_done=on_done)
+                     retries=retries, on_done=on_done, connect_timeout_s=connect_timeout_s)
 
 
 def _config_keys(config) -> dict:

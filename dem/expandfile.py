@@ -41,7 +41,8 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
                    roughness: float | None = None, region=None, rng=None, *,
                    tile_px: int | None = None, backend: str | None = None,
                    scheduler: str | None = None, workers: int | None = None,
-                   progress: bool = False) -> ExpandedFile:
+                   progress: bool = False, connect_timeout_s: float | None = None,
+                   ) -> ExpandedFile:
     """:func:`expand` written tile by tile into a GeoTIFF: results bigger than memory.
 
     The region is expanded as square tiles of ``2^k + 1`` input pixels sharing their
@@ -61,9 +62,10 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     tile_px : int, optional
         Largest output tile side in pixels (>= 3); default :data:`TILE_PX` (2049, about
         80 MB a tile).
-    backend, scheduler, workers : optional
+    backend, scheduler, workers, connect_timeout_s : optional
         Expand the tiles as dask.distributed tasks (:mod:`latlong.parallel.backends`): on
-        the scheduler at an address such as ``tcp://127.0.0.1:8786``, or on a local
+        the scheduler at an address such as ``tcp://127.0.0.1:8786`` (answering within
+        ``connect_timeout_s``, default 10 s), or on a local
         cluster of ``workers`` processes (``backend="dask"`` alone: one per core); each
         tile is written as it arrives (the same bytes; the input DEM is sent to each
         worker once). None of them (or ``backend="serial"``): tile after tile in this
@@ -93,12 +95,10 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
 
     with about("tile_px"):
         tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
-    choose_backend(backend, scheduler, workers)  # before any work (map_tiles checks later)
+    choose_backend(backend, scheduler, workers, connect_timeout_s=connect_timeout_s)
     plan = plan_expansion(dem, levels, fractal_dimension, roughness, region, rng)
     t_in, t_out = _tile_sides(plan, tile_px)
-    check_free_space(path, 4.0 * plan.side**2, f"a float32 DEM of {plan.side} x {plan.side} "
-                     f"pixels (deflate saves ~1 % of fractal terrain)",
-                     advice="; give fewer levels or a smaller region")
+    _check_disk(path, plan)
     n = (plan.width - 1) // (t_in - 1)
     tags = dem.step_tags("dem.expand", plan.seed, plan.params, level=dem.level + plan.levels,
                          origin=plan.origin)
@@ -108,7 +108,7 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
         tiles = [(i, j) for i in range(n) for j in range(n)]
         corners = [(plan.r0 + i * (t_in - 1), plan.c0 + j * (t_in - 1), t_in) for i, j in tiles]
         made = map_tiles(_tile_task, (dem, plan), corners, backend=backend, scheduler=scheduler,
-                         workers=workers)
+                         workers=workers, connect_timeout_s=connect_timeout_s)
         for k, z in progress_bar(made, enabled=progress, total=len(tiles), desc="expand tiles"):
             i, j = tiles[k]
             # tiles share their edge pixels: each writes all but its last row / column,
@@ -117,6 +117,13 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
             cols = t_out if j == n - 1 else t_out - 1
             out.write(z[:rows, :cols], i * (t_out - 1), j * (t_out - 1))
     return ExpandedFile(out.path, (plan.side, plan.side), plan.seed, plan.params, len(tiles))
+
+
+def _check_disk(path, plan: ExpansionPlan) -> None:
+    """The free space for the output, before any work (a float32 pixel each)."""
+    check_free_space(path, 4.0 * plan.side**2, f"a float32 DEM of {plan.side} x {plan.side} "
+                     f"pixels (deflate saves ~1 % of fractal terrain)",
+                     advice="; give fewer levels or a smaller region")
 
 
 def _tile_sides(plan: ExpansionPlan, tile_px: int) -> tuple[int, int]:

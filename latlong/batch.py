@@ -45,7 +45,8 @@ _RUN_ONLY = ("quiet", "force")
 def batch(scene, seeds, *, out, vary: Mapping | None = None, backend: str | None = None,
           scheduler: str | None = None, workers: int | None = None, resume: bool = False,
           force: bool = False, progress: bool = False, retries: int = 2,
-          on_done: Callable[[dict], None] | None = None) -> BatchResult:
+          on_done: Callable[[dict], None] | None = None,
+          connect_timeout_s: float | None = None) -> BatchResult:
     """Build every variant of a scene (on dask.distributed) and write it into ``out``.
 
     Parameters
@@ -80,6 +81,8 @@ def batch(scene, seeds, *, out, vary: Mapping | None = None, backend: str | None
         disk, ...) is tried again.
     on_done : callable, optional
         Called with each finished variant's index row (a dict), in this process.
+    connect_timeout_s : float
+        Seconds the ``scheduler`` has to answer (a one-line error after that).
 
     Returns
     -------
@@ -105,7 +108,7 @@ def batch(scene, seeds, *, out, vary: Mapping | None = None, backend: str | None
         jobs.append(Job(v, (s, named), describe, tuple(named.files())))
     return run_batch(jobs, _build_variant, out, backend=backend, scheduler=scheduler,
                      workers=workers, resume=resume, force=force, progress=progress,
-                     retries=retries, on_done=on_done)
+                     retries=retries, on_done=on_done, connect_timeout_s=connect_timeout_s)
 
 
 def _scene_parts(scene, vary) -> tuple[dict | None, Outputs]:

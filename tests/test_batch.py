@@ -298,13 +298,10 @@ def test_bad_options_are_one_line_errors(tmp_path, scene, capsys, args, message)
     assert err.count("\n") == 1 and not out.exists()
 
 
-def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys, monkeypatch):
-    import latlong.parallel.backends as engine
-
-    monkeypatch.setattr(engine, "_CONNECT_S", 2)
+def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys):
     out = tmp_path / "batch"
     code = latlong_main(["batch", str(scene), "--seeds", "1", "-o", str(out), "--scheduler",
-                         "tcp://127.0.0.1:9"])
+                         "tcp://127.0.0.1:9", "--connect-timeout-s", "2"])
     err = capsys.readouterr().err
     assert code == 2 and err.count("\n") == 1, err
     assert "--scheduler tcp://127.0.0.1:9: no dask scheduler answered within 2 s" in err

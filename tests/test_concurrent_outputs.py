@@ -255,13 +255,11 @@ def test_a_frame_larger_than_memory_and_a_camera_far_away_are_refused(capsys, tm
     assert not (tmp_path / "c").exists()
 
 
-def test_a_silent_scheduler_fails_within_the_timeout(tmp_path, monkeypatch):
+def test_a_silent_scheduler_fails_within_the_timeout(tmp_path):
     import socket
 
     import latlong
-    from latlong.parallel import backends
 
-    monkeypatch.setattr(backends, "_CONNECT_S", 1)
     scene = tmp_path / "scene.toml"
     scene.write_text('base = "sphere"\nmagnitude = 8\n')
     with socket.socket() as silent:  # accepts connections, never speaks
@@ -270,8 +268,46 @@ def test_a_silent_scheduler_fails_within_the_timeout(tmp_path, monkeypatch):
         address = f"tcp://127.0.0.1:{silent.getsockname()[1]}"
         start = time.perf_counter()
         with pytest.raises(ValueError, match="no dask scheduler answered within 1 s"):
-            latlong.batch(scene, "1", out=tmp_path / "b", scheduler=address)
+            latlong.batch(scene, "1", out=tmp_path / "b", scheduler=address,
+                          connect_timeout_s=1)
         assert time.perf_counter() - start < 5
+
+
+def _silent_commands(tmp_path):
+    """Every command that takes --scheduler, with its other arguments."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text('base = "sphere"\nmagnitude = 8\n')
+    tif = tiny_tif(tmp_path / "tiny.tif")
+    config = tmp_path / "site.toml"
+    config.write_text(f'input = "{tif}"\nlayers = 2\nsize = 17\n')
+    return {
+        "latlong build": ["latlong", *BUILD, "--on-demand", "-o", tmp_path / "b.npz"],
+        "latlong batch": ["latlong", "batch", scene, "--seeds", "1", "-o", tmp_path / "lb"],
+        "dem expand": ["dem", "expand", tif, "-o", tmp_path / "e.tif"],
+        "dem batch": ["dem", "batch", config, "--seeds", "1", "-o", tmp_path / "db"],
+    }
+
+
+@pytest.mark.parametrize("command", ["latlong build", "latlong batch", "dem expand",
+                                     "dem batch"])
+def test_connect_timeout_bounds_every_command_with_a_scheduler(capsys, tmp_path, command):
+    import socket
+
+    argv = _silent_commands(tmp_path)[command]
+    with socket.socket() as silent:  # accepts connections, never speaks
+        silent.bind(("127.0.0.1", 0))
+        silent.listen(4)
+        address = f"tcp://127.0.0.1:{silent.getsockname()[1]}"
+        start = time.perf_counter()
+        code, _, err = run(capsys, *argv, "--scheduler", address, "--connect-timeout-s", "0.5")
+        took = time.perf_counter() - start
+    assert code == 2 and err.count("\n") == 1, err
+    assert "no dask scheduler answered within 0.5 s (no answer)" in err, err
+    assert took < 0.5 + 3.0  # the timeout, plus reading the inputs (not asserted tightly)
+    assert not [p for p in tmp_path.iterdir() if p.suffix not in (".toml", ".tif")]
+    # out of range: refused before anything runs
+    code, _, err = run(capsys, *argv, "--scheduler", address, "--connect-timeout-s", "0")
+    assert code == 2 and "--connect-timeout-s" in err and "[0.1, 3600]" in err, err
 
 
 def test_force_replaces_a_camera_run_whole_and_keeps_the_users_files(capsys, tmp_path):

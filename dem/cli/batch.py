@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from craters.cli.kit import batch_reporter, batch_summary
 from craters.cli.options import Setting, Values, batch_error, batch_options, command, parse_vary
+from latlong.parallel.backends import CONNECT_TIMEOUT
 
 from ..batch import batch
 from .options import DEM
@@ -21,6 +22,7 @@ OPTIONS = {
                       "not used: each variant's stack goes to FOLDER/NAME)", flag="CONFIG",
                       required=True, run=True),
     **batch_options("one stack folder per variant, named seedNNNN[_KEY=VALUE...]"),
+    "connect_timeout_s": CONNECT_TIMEOUT,
 }
 #: The settings a batch varies: every key of the stack's description but the seed.
 VARY = {k: s for k, s in DEM.items() if k != "seed"}
@@ -32,7 +34,7 @@ def _batch(v: Values) -> int:
     try:
         result = batch(v["config"], v.seeds, vary=vary, out=v.output, scheduler=v.scheduler,
                        workers=v.workers, resume=v.resume, force=v.force, progress=progress,
-                       on_done=on_done)
+                       on_done=on_done, connect_timeout_s=v["connect_timeout_s"])
     except (TypeError, ValueError) as exc:
         raise batch_error(exc, v, v["config"]) from None
     return batch_summary(result, v.quiet)

@@ -5,6 +5,7 @@ as dask tasks with ``--workers`` or ``--scheduler``, the same bytes)."""
 from __future__ import annotations
 
 from craters.cli.options import Setting, Values, default_of
+from latlong.parallel.backends import CONNECT_TIMEOUT
 
 from ..core import parse_region
 from ..expandfile import TILE_PX, expand_to_file
@@ -27,6 +28,7 @@ OPTIONS = {
     "workers": Setting(help="expand the tiles as tasks on a local dask cluster of N worker "
                        "processes on 127.0.0.1 (the same bytes)", kind=int, metavar="N",
                        default_text="tiles in this process"),
+    "connect_timeout_s": CONNECT_TIMEOUT,
     **{k: DEM[k] for k in ("fractal_dimension", "roughness")},
     "region": Setting(help="square to expand, 2^n+1 pixels: ROW,COL,SIZE in pixels or "
                       "LEFT,BOTTOM,RIGHT,TOP in CRS units", parse=parse_region, commas=True,
@@ -42,7 +44,8 @@ def _expand(v: Values) -> int:
     bar.set_description("expand")
     made = expand_to_file(dem, v["output"], v["levels"], v["fractal_dimension"],
                           v["roughness"], v["region"], rng=seed, tile_px=v["tile_px"],
-                          scheduler=v["scheduler"], workers=v["workers"], progress=show)
+                          scheduler=v["scheduler"], workers=v["workers"], progress=show,
+                          connect_timeout_s=v["connect_timeout_s"])
     bar.update()
     bar.update()
     bar.close()

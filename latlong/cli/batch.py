@@ -20,6 +20,7 @@ from craters.cli.options import (
     read_config,
 )
 from latlong import batch as run_batch
+from latlong.parallel.backends import CONNECT_TIMEOUT
 
 from ..outputs import OUTPUT_SETTINGS
 from ..scene import SETTINGS
@@ -32,6 +33,7 @@ OPTIONS = {
                      f"({', '.join(OUTPUT_SETTINGS)}) included", flag="SCENE", required=True,
                      run=True),
     **batch_options("each variant's files named seedNNNN[_KEY=VALUE...][_FILE]"),
+    "connect_timeout_s": CONNECT_TIMEOUT,
 }
 #: The settings a batch varies: every scene setting but the seed.
 VARY = {k: s for k, s in BUILD_OPTIONS.items() if k in SETTINGS and k != "seed"}
@@ -44,7 +46,8 @@ def _batch(v: Values) -> int:
     try:
         result = run_batch(scene, v.seeds, vary=vary, out=v.output, scheduler=v.scheduler,
                            workers=v.workers, resume=v.resume, force=v.force,
-                           progress=progress, on_done=on_done)
+                           progress=progress, on_done=on_done,
+                           connect_timeout_s=v["connect_timeout_s"])
     except (TypeError, ValueError) as exc:
         raise batch_error(exc, v, v.scene) from None
     return batch_summary(result, v.quiet)

@@ -17,6 +17,7 @@ from craters._shared import progress_bar, staged_path
 from craters.cli.kit import CliError, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 from latlong import LatLongGrid, Scene, build
+from latlong.parallel.backends import CONNECT_TIMEOUT
 from latlong.scratch import drop_pages
 
 from ..outputs import OUTPUT_SETTINGS, Outputs, companions, output_kind, write_outputs
@@ -36,6 +37,7 @@ ON_DEMAND_RUN = {
                        "(--on-demand)", kind=int, range=(1, 1024), run=True),
     "scheduler": Setting(help="patches on the dask scheduler at this address, e.g. "
                          "tcp://127.0.0.1:8786 (--on-demand)", run=True),
+    "connect_timeout_s": CONNECT_TIMEOUT,
 }
 OPTIONS = declared_keys(*SETTING_PARTS, ("output", Outputs),
                         ("output", {"quiet": QUIET, "force": FORCE}), ("body", ON_DEMAND_RUN))
@@ -111,9 +113,10 @@ def _build(v: Values) -> int:
             n = LatLongGrid(scene.body.magnitude).n_vertices
             print(f"keeping the {n:.3g} radii ({n * 8 / 1e9:.3g} GB) in a scratch file in "
                   f"{str(scratch)!r} (--radii-on-disk)", file=sys.stderr)
-    run = {k: v[k] for k in ("patches", "workers", "scheduler") if k in v.given}
+    run = {k: v[k] for k in ("patches", "workers", "scheduler", "connect_timeout_s")
+           if k in v.given}
     if run and not scene.on_demand:
-        raise CliError(f"--{next(iter(run))} applies to an --on-demand build")
+        raise CliError(f"--{next(iter(run)).replace('_', '-')} applies to an --on-demand build")
     if scene.on_demand:
         from latlong.ondemand.patches import build_patches, patch_count
         from latlong.scratch import disk_radii
@@ -122,7 +125,8 @@ def _build(v: Values) -> int:
         patches = patch_count(n, v["patches"])
         patch_bar = progress_bar(total=patches, enabled=show, desc="patches")
         made = build_patches(scene, patches=patches, workers=v["workers"],
-                             scheduler=v["scheduler"], progress=lambda *_: patch_bar.update(),
+                             scheduler=v["scheduler"], connect_timeout_s=v["connect_timeout_s"],
+                             progress=lambda *_: patch_bar.update(),
                              out=None if scratch is None else disk_radii(n, scratch))
         patch_bar.close()
     else:

@@ -66,10 +66,12 @@ def _patch(scene: Scene, item: tuple[int, int]) -> tuple[np.ndarray, np.ndarray]
 
 def build_patches(scene: Scene, *, patches: int | None = None, backend: str | None = None,
                   scheduler: str | None = None, workers: int | None = None,
-                  progress=None, out: np.ndarray | None = None) -> Body:
+                  progress=None, out: np.ndarray | None = None,
+                  connect_timeout_s: float | None = None) -> Body:
     """The scene's body on its ``M``-grid as terrain on demand, in ``patches`` patches
     (module notes; default: patches of at most :data:`PATCH_VERTICES`); ``backend``,
-    ``scheduler``, ``workers`` as in :func:`latlong.parallel.tiles.map_tiles`;
+    ``scheduler``, ``workers``, ``connect_timeout_s`` as in
+    :func:`latlong.parallel.tiles.map_tiles`;
     ``progress(done, total)`` is called as patches arrive; ``out``: the radii's array
     (e.g. a scratch file's map, :func:`latlong.scratch.disk_radii`), one float64 per
     vertex."""
@@ -87,8 +89,9 @@ def build_patches(scene: Scene, *, patches: int | None = None, backend: str | No
     if radii.shape != (grid.n_vertices,) or radii.dtype != np.float64:
         raise ValueError(f"`out` must be a float64 array of {grid.n_vertices} radii")
     cats: list[np.ndarray] = [np.zeros(0)] * len(items)
-    for done, (i, (r, cat)) in enumerate(map_tiles(_patch, scene, items, backend=backend,
-                                                   scheduler=scheduler, workers=workers)):
+    made = map_tiles(_patch, scene, items, backend=backend, scheduler=scheduler,
+                     workers=workers, connect_timeout_s=connect_timeout_s)
+    for done, (i, (r, cat)) in enumerate(made):
         start, stop = items[i]
         radii[start:stop] = r
         drop_pages(radii, start, stop)  # radii on disk: the patch leaves memory now

@@ -40,15 +40,19 @@ import uuid
 from collections.abc import Callable, Iterator, Sequence
 from typing import Any, Protocol
 
+from craters._shared.settings import Setting
 from craters._shared.validation import ParameterError
 
-__all__ = ["BACKENDS", "Backend", "Dask", "Serial", "choose_backend", "limit_numba_threads",
-           "open_backend", "run_task"]
+__all__ = ["BACKENDS", "CONNECT_TIMEOUT", "Backend", "Dask", "Serial", "choose_backend",
+           "limit_numba_threads", "open_backend", "run_task"]
 
 #: The backends :func:`choose_backend` knows.
 BACKENDS = ("serial", "dask")
 _ADDRESS = re.compile(r"((tcp|tls|ws|wss|ucx)://)?[A-Za-z0-9.\-\[\]:]+:[0-9]{1,5}")
-_CONNECT_S = 10
+#: Seconds a scheduler at an address has to answer (``--connect-timeout-s``).
+CONNECT_TIMEOUT = Setting(10.0, "how long the dask scheduler at --scheduler has to answer "
+                          "(then the run stops with a one-line error)", unit="s",
+                          range=(0.1, 3600.0), run=True, metavar="S")
 _WORKERS_S = 60
 #: A local cluster's workers at most: per core, and one per this much memory (a worker
 #: process with numpy, numba and its task's arrays).
@@ -164,10 +168,11 @@ def limit_numba_threads(threads: int) -> None:
 
 
 def choose_backend(backend: str | None = None, scheduler: str | None = None,
-                   workers: int | None = None, *, default: str = "serial") -> str:
+                   workers: int | None = None, *, default: str = "serial",
+                   connect_timeout_s: float | None = None) -> str:
     """The backend that runs: ``backend`` if given, else ``"dask"`` when ``scheduler``
     (a dask scheduler address) or ``workers`` (a local cluster's processes) is given,
-    else ``default``. Checks the three (one-line errors naming the parameter).
+    else ``default``. Checks them (one-line errors naming the parameter).
 
     Examples
     --------
@@ -178,6 +183,8 @@ def choose_backend(backend: str | None = None, scheduler: str | None = None,
     ...
     craters._shared.validation.ParameterError: `workers` applies to the dask backend
     """
+    if connect_timeout_s is not None:
+        CONNECT_TIMEOUT.check("connect_timeout_s", connect_timeout_s)
     if backend is not None and backend not in BACKENDS:
         raise ParameterError("backend", f"must be one of {', '.join(BACKENDS)}; got "
                              f"{backend!r}")
@@ -203,11 +210,14 @@ def choose_backend(backend: str | None = None, scheduler: str | None = None,
 
 @contextlib.contextmanager
 def open_backend(backend: str | None = None, *, scheduler: str | None = None,
-                 workers: int | None = None, default: str = "serial") -> Iterator[Backend]:
+                 workers: int | None = None, default: str = "serial",
+                 connect_timeout_s: float | None = None) -> Iterator[Backend]:
     """The backend :func:`choose_backend` picks, open for a ``with`` block: dask connects
-    to the scheduler (which must have workers) or starts a local cluster, and closes the
-    client and the local cluster at the end."""
-    if choose_backend(backend, scheduler, workers, default=default) == "serial":
+    to the scheduler (which must answer within ``connect_timeout_s`` and have workers) or
+    starts a local cluster, and closes the client and the local cluster at the end
+    (``connect_timeout_s``: default ``CONNECT_TIMEOUT.default``, 10 s)."""
+    if choose_backend(backend, scheduler, workers, default=default,
+                      connect_timeout_s=connect_timeout_s) == "serial":
         yield Serial()
         return
     import distributed  # noqa: F401 - its import sets the level of its loggers
@@ -218,7 +228,8 @@ def open_backend(backend: str | None = None, *, scheduler: str | None = None,
     # cut short when the local cluster closes, a lost worker) would only be noise
     quiet.setLevel(logging.CRITICAL)
     try:
-        with _connected(scheduler, workers) as client:
+        timeout_s = CONNECT_TIMEOUT.default if connect_timeout_s is None else connect_timeout_s
+        with _connected(scheduler, workers, float(timeout_s)) as client:
             yield Dask(client, threads=1 if scheduler is None else None)
     finally:
         quiet.setLevel(level)
@@ -245,7 +256,7 @@ def _probe(scheduler: str, timeout_s: float) -> None:
 
 
 @contextlib.contextmanager
-def _connected(scheduler: str | None, workers: int | None):
+def _connected(scheduler: str | None, workers: int | None, timeout_s: float):
     from distributed import Client, LocalCluster
 
     if scheduler is None:
@@ -257,12 +268,12 @@ def _connected(scheduler: str | None, workers: int | None):
                 Client(cluster) as client:
             yield client
         return
-    _probe(scheduler, _CONNECT_S)
+    _probe(scheduler, timeout_s)
     try:
-        client = Client(scheduler, timeout=_CONNECT_S)
+        client = Client(scheduler, timeout=timeout_s)
     except (OSError, TimeoutError) as exc:
-        raise ParameterError("scheduler", f"{scheduler}: cannot connect within {_CONNECT_S} s "
-                             f"({type(exc).__name__})") from None
+        raise ParameterError("scheduler", f"{scheduler}: cannot connect within {timeout_s:g} "
+                             f"s ({type(exc).__name__})") from None
     with client:
         try:
             client.wait_for_workers(1, timeout=_WORKERS_S)

@@ -353,25 +353,26 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
               backend: str | None = None, scheduler: str | None = None,
               workers: int | None = None, resume: bool = False, force: bool = False,
               progress: bool = False, retries: int = 2,
-              on_done: Callable[[dict], None] | None = None) -> BatchResult:
+              on_done: Callable[[dict], None] | None = None,
+              connect_timeout_s: float | None = None) -> BatchResult:
     """Run ``task(payload, folder, name)`` of every job into the folder ``out`` (module
     notes) on ``backend`` (:func:`.backends.choose_backend`; default: dask, a local
-    cluster unless a ``scheduler`` is given); ``on_done(row)`` after each finished
-    variant (in the caller)."""
+    cluster unless a ``scheduler`` is given, which must answer within
+    ``connect_timeout_s``); ``on_done(row)`` after each finished variant (in the caller)."""
     started = time.perf_counter()
     names = [j.variant.name for j in jobs]
     if not jobs or len(set(names)) != len(names):
         raise ParameterError("jobs", "must be a non-empty list of uniquely named variants")
-    choose_backend(backend, scheduler, workers)
+    choose_backend(backend, scheduler, workers, connect_timeout_s=connect_timeout_s)
     folder = _check_folder(out, jobs, resume=resume, force=force)
     with output_lock(folder):  # a second batch into this folder fails fast, naming this one
         return _fill(folder, jobs, task, backend=backend, scheduler=scheduler, workers=workers,
                      resume=resume, progress=progress, retries=retries, on_done=on_done,
-                     started=started)
+                     started=started, connect_timeout_s=connect_timeout_s)
 
 
 def _fill(folder: Path, jobs: Sequence[Job], task, *, backend, scheduler, workers, resume,
-          progress, retries, on_done, started) -> BatchResult:
+          progress, retries, on_done, started, connect_timeout_s) -> BatchResult:
     """:func:`run_batch` in its checked and locked folder."""
     names = [j.variant.name for j in jobs]
     columns = _columns([k for k, _ in jobs[0].variant.values])
@@ -382,7 +383,8 @@ def _fill(folder: Path, jobs: Sequence[Job], task, *, backend, scheduler, worker
     ours = set(names)
     others = [r for name, r in previous.items() if name not in ours]
     redo = {j.variant.name for j in todo}
-    with (open_backend(backend, scheduler=scheduler, workers=workers, default="dask")
+    with (open_backend(backend, scheduler=scheduler, workers=workers, default="dask",
+                       connect_timeout_s=connect_timeout_s)
           if todo else contextlib.nullcontext()) as runner:
         folder.mkdir(exist_ok=True)  # only once the cluster is there
         for stale in folder.glob(f".*{TMP_SUFFIX}"):

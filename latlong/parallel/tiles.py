@@ -26,16 +26,19 @@ __all__ = ["map_tiles"]
 def map_tiles(fn: Callable[[Any, Any], Any], shared: Any, items: Sequence, *,
               backend: str | None = None, scheduler: str | None = None,
               workers: int | None = None, window: int | None = None,
-              retries: int = 2) -> Iterator[tuple[int, Any]]:
+              retries: int = 2, connect_timeout_s: float | None = None,
+              ) -> Iterator[tuple[int, Any]]:
     """Yield ``(i, fn(shared, items[i]))`` for every item: in this process, in order,
     unless ``backend`` is ``"dask"`` or a ``scheduler`` or ``workers`` is given (then on
-    dask, in the order they finish; :func:`.backends.choose_backend`).
+    dask, in the order they finish; :func:`.backends.choose_backend`; a scheduler must
+    answer within ``connect_timeout_s``).
 
     Examples
     --------
     >>> sorted(map_tiles(lambda s, x: s * x, 10, [1, 2, 3]))
     [(0, 10), (1, 20), (2, 30)]
     """
-    with open_backend(backend, scheduler=scheduler, workers=workers) as runner:
+    with open_backend(backend, scheduler=scheduler, workers=workers,
+                      connect_timeout_s=connect_timeout_s) as runner:
         yield from runner.map(fn, items, shared=shared, window=window, retries=retries,
                               label="tile")
