@@ -113,7 +113,8 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
     :func:`latlong._tilt_kernels._tilted_change`): the point's in-plane coordinates and
     height along the base normal are those of its foot on the base plane, so the map
     does not depend on the height before it; inside the rim the radius where the radial
-    line meets the crater's surface, outside the profile along the normal (over N_z)."""
+    line meets the crater's surface over the base plane (plus the base's curvature,
+    radially), outside the profile along the normal (over N_z)."""
     fr = fc[k, TILT:TILT + 10]
     r2 = fc[k, GX] * x + fc[k, GY] * y  # the foot on the base plane (w0 = 0 but rounding)
     u1 = x * fr[0] + y * fr[1] + r2 * fr[2]
@@ -128,10 +129,13 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
     amp_max = max(rough[0], max(rough[1], rough[2])) * fc[k, DEPTH] * scale
     has_rough = octaves > 0 and amp_max > 1e-6 * radius
     if xr <= 1.0:
+        # the crater over its base plane in the plane's frame; the base's curvature (the
+        # quadric's quadratic part) radially, as outside: the rim meets the blend whatever
+        # the curvature (a crater in a larger crater's bowl: 100 m over its radius)
         t_root = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, DEPTH], xe, rims[k],
-                             fc[k, QA], fc[k, QB], fc[k, QC], rough, fc[k, WARP], has_rough,
-                             seeds[k], radius, octaves, gain, fr)
-        return True, 0.0, (fc[k, RHO] + fc[k, P0] + r2) + t_root
+                             0.0, 0.0, 0.0, rough, fc[k, WARP], has_rough, seeds[k], radius,
+                             octaves, gain, fr)
+        return True, 0.0, (fc[k, RHO] + _quadric(fc, k, x, y)) + t_root
     add = scale * table_value(tabs[k], xr, xe)
     if has_rough:
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale

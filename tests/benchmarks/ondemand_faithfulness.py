@@ -266,8 +266,9 @@ def _interior_residual(units, radii, top, fc, tabs, rims, seeds, rough, gain, oc
 def _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe, radius_now):
     """Surface minus crater k's interior for a crater made in its tilted base's frame
     (NaN outside its rim): the point's foot on the base plane in the frame's coordinates,
-    and the radial line's meeting with the crater's surface (the sequential stamp's
-    root finder, ``latlong._tilt_kernels.tilted_root``)."""
+    and the radial line's meeting with the crater's surface over the base plane (the
+    sequential stamp's root finder, ``latlong._tilt_kernels.tilted_root``) plus the
+    quadric's curvature radially."""
     fr = fc[k, K.TILT:K.TILT + 10]
     r2 = fc[k, K.GX] * x + fc[k, K.GY] * y
     u1 = x * fr[0] + y * fr[1] + r2 * fr[2]
@@ -281,9 +282,11 @@ def _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe, r
     has_rough = octaves > 0 and (max(rough[0], max(rough[1], rough[2])) * fc[k, K.DEPTH]
                                  * scale > 1e-6 * radius)
     t = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, K.DEPTH], xe, rims[k],
-                    fc[k, K.QA], fc[k, K.QB], fc[k, K.QC], rough, fc[k, K.WARP], has_rough,
-                    seeds[k], radius, octaves, gain, fr)
-    return radius_now - ((fc[k, K.RHO] + fc[k, K.P0] + r2) + t)
+                    0.0, 0.0, 0.0, rough, fc[k, K.WARP], has_rough, seeds[k], radius, octaves,
+                    gain, fr)
+    q = (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
+         + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
+    return radius_now - ((fc[k, K.RHO] + q) + t)
 
 
 def older_inside_check(field, units, radii, tree):

@@ -132,8 +132,9 @@ def _step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, p):
 def _tilted_step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, x, y):
     """The step of a crater made in its tilted base's frame, in numpy: the point's foot on
     the base plane in the frame (E', N', N), the rim in that plane; inside it the
-    radial line's meeting with the crater's surface (the sequential stamp's root finder),
-    outside the profile along the normal over N_z, blended into the base quadric."""
+    radial line's meeting with the crater's surface over the base plane (the sequential
+    stamp's root finder) plus the quadric's curvature radially, outside the profile along
+    the normal over N_z, blended into the base quadric."""
     fr = fc[k, K.TILT:K.TILT + 10]
     foot = np.array([x, y, fc[k, K.GX] * x + fc[k, K.GY] * y])
     u1, u2, w0 = foot @ fr[0:3], foot @ fr[3:6], foot @ fr[6:9]
@@ -144,17 +145,17 @@ def _tilted_step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, x, y):
         return False, 1.0, 0.0
     scale, depth = fc[k, K.SCALE], fc[k, K.DEPTH]
     has_rough = max(rough) * depth * scale > 1e-6 * radius
+    q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
+                        + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
     if xr <= 1.0:
         t = tilted_root.py_func(u1, u2, w0, radius, tabs[k], scale, depth, xe, rims[k],
-                                fc[k, K.QA], fc[k, K.QB], fc[k, K.QC], rough, fc[k, K.WARP],
-                                has_rough, seeds[k], radius, ROUGHNESS_OCTAVES, gain, fr)
-        return True, 0.0, fc[k, K.RHO] + fc[k, K.P0] + foot[2] + t
+                                0.0, 0.0, 0.0, rough, fc[k, K.WARP], has_rough, seeds[k],
+                                radius, ROUGHNESS_OCTAVES, gain, fr)
+        return True, 0.0, q + t
     add = scale * table_value.py_func(tabs[k], xr, xe)
     if has_rough:
         add += (roughness_amp.py_func(xr, xe, *rough) * depth * scale
                 * fbm2.py_func(seeds[k], u1, u2, radius, ROUGHNESS_OCTAVES, gain))
-    q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
-                        + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
     w = 1.0 - ((BLEND_EDGE - xr) / (BLEND_EDGE - 1.0)) ** 2 if xr < BLEND_EDGE else 1.0
     return True, w, (1.0 - w) * q + add / fr[9]
 
