@@ -29,9 +29,10 @@ in the README, "Terrain on demand"):
    On ground tilted more than 10 deg from the radial a crater is made in its
    base plane's own frame, as the sequential stamp makes it (issue 36): a point's foot on
    the base plane gives its in-plane coordinates; inside the rim the height is where the
-   radial line meets the crater's surface (the stamp's root finder), outside the profile
-   is added along the base normal. Made radially instead, a crater on ground tilted
-   49 deg had its rim 1.50 radii out along the dip and 1.01 across.
+   radial line meets the crater's surface over the base plane (the stamp's root finder)
+   plus the base quadric's curvature taken radially, as outside, where the profile is
+   added along the base normal. Made radially instead, a crater on ground tilted 49 deg
+   had its rim 1.50 radii out along the dip and 1.01 across.
    The sequential stamp shifts the older terrain outside the rim by its offset from the
    base at the rim (an azimuth table sampled from everything older), and fits its base to
    everything older; both would make a crater depend on every older crater around it.
