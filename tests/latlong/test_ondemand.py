@@ -280,6 +280,47 @@ def test_the_point_kernel_matches_numpy_on_craters_made_in_a_tilted_frame():
                                        abs=1e-9), i
 
 
+def _rim_jumps(fc, k, tables, field, n_az=16):
+    """Height just inside minus just outside crater k's rim (its tilted step, the height
+    before it taken as the base quadric) at ``n_az`` azimuths of the crater's plane."""
+    tabs, rims = tables
+    cr = field.last["craters"]
+    seeds = np.ascontiguousarray(cr.seed)
+    out = []
+    for phi in np.linspace(-np.pi, np.pi, n_az, endpoint=False):
+        def step(d, phi=phi):
+            x, y = d * np.cos(phi), d * np.sin(phi)
+            hit, a, b = K._tilted_step(fc, k, tabs, rims, seeds, field.rough, field.gain,
+                                       ROUGHNESS_OCTAVES, field.xe, BLEND_EDGE, x, y)
+            q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y
+                                + fc[k, K.QA] * x * x + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
+            return a, b + a * q
+        lo, hi = 0.3 * fc[k, K.RAD], 1.5 * fc[k, K.RAD]
+        for _ in range(60):  # the rim: where the step stops replacing the terrain
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if step(mid)[0] == 0.0 else (lo, mid)
+        out.append(step(lo)[1] - step(hi)[1])
+    return np.array(out)
+
+
+def test_a_tilted_craters_rim_does_not_move_with_its_bases_curvature():
+    # a crater in a larger crater's bowl sits on a strongly curved base: over the LOLA
+    # site a 663 m crater had 110 m of curvature over its radius, and with the curvature
+    # taken along the tilted normal inside the rim (radially outside) its rim was a 37 m
+    # cliff. Taken radially on both sides the jump at the rim is the curvature's none
+    field = CraterField(_steep_scene())
+    g = np.random.default_rng(0).normal(size=(2000, 3))
+    field.radii(g / np.linalg.norm(g, axis=1)[:, None], 100.0)
+    k, *_, tilt, radius = max(_steep_craters(field), key=lambda c: c[6])
+    tables = tuple(np.ascontiguousarray(t) for t in _reference_tables(field))
+    flat = field.last["fc"].copy()
+    flat[k, K.QA:K.QC + 1] = 0.0
+    curved = flat.copy()
+    curved[k, K.QA], curved[k, K.QC] = 1.5e-3, 1.5e-3  # 11 m over its 85 m radius
+    a, b = _rim_jumps(flat, k, tables, field), _rim_jumps(curved, k, tables, field)
+    assert tilt > 40.0 and np.abs(a - b).max() < 1e-6 * radius, np.abs(a - b).max()
+
+
 def test_a_layer_with_a_fixed_degradation_keeps_it_on_demand():
     field = CraterField(_steep_scene("degradation=0.6"))
     g = np.random.default_rng(0).normal(size=(2000, 3))
