@@ -133,7 +133,8 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
         # quadric's quadratic part) radially, as outside: the rim meets the blend whatever
         # the curvature (a crater in a larger crater's bowl: 100 m over its radius)
         t_root = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, DEPTH], xe, rims[k],
-                             rough, fc[k, WARP], has_rough, seeds[k], radius, octaves, gain, fr)
+                             0.0, 0.0, 0.0, rough, fc[k, WARP], has_rough, seeds[k], radius,
+                             octaves, gain, fr)
         return True, 0.0, (fc[k, RHO] + _quadric(fc, k, x, y)) + t_root
     add = scale * table_value(tabs[k], xr, xe)
     if has_rough:
