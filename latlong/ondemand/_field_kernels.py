@@ -37,22 +37,23 @@ N_COLS = TILT + 10
 
 @njit(cache=True, inline="always")
 def _local(fc, k, p0, p1, p2):
-    """(cos angle, distance in metres, x, y in the crater's frame, azimuth) of direction
-    p from crater k's centre (azimuthal equidistant at the crater's reference radius)."""
+    """(cos angle, distance in metres, x, y in the crater's frame, east and north
+    components) of direction p from crater k's centre (azimuthal equidistant at the
+    crater's reference radius); :func:`_azimuth` of the last two is its azimuth."""
     c = fc[k, C0] * p0 + fc[k, C1] * p1 + fc[k, C2] * p2
     xe = fc[k, E0] * p0 + fc[k, E1] * p1 + fc[k, E2] * p2
     xn = fc[k, N0] * p0 + fc[k, N1] * p1 + fc[k, N2] * p2
     s = np.sqrt(xe * xe + xn * xn)
     dist = np.arctan2(s, c) * fc[k, RHO]
     if s > 0.0:
-        x = dist * xe / s
-        y = dist * xn / s
-        az = np.arctan2(xn, xe)
-    else:
-        x = 0.0
-        y = 0.0
-        az = 0.0
-    return c, dist, x, y, az
+        return c, dist, dist * xe / s, dist * xn / s, xe, xn
+    return c, dist, 0.0, 0.0, 0.0, 0.0
+
+
+@njit(cache=True, inline="always")
+def _azimuth(xe, xn):
+    """The azimuth of :func:`_local`'s east and north components (0 at the centre)."""
+    return np.arctan2(xn, xe) if xe != 0.0 or xn != 0.0 else 0.0
 
 
 @njit(cache=True, inline="always")
@@ -82,11 +83,11 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     terrain is."""
     if _far(fc, k, CHORD2, p0, p1, p2):
         return False, 1.0, 0.0  # beyond the widest ejecta edge: nothing else to compute
-    cosang, dist, x, y, az = _local(fc, k, p0, p1, p2)
+    cosang, dist, x, y, ue, un = _local(fc, k, p0, p1, p2)
     if fc[k, TILT_CZ] > 0.0:
         return _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y)
     radius = fc[k, RAD]
-    xr = dist / (radius * (1.0 + table(rims[k], az)))
+    xr = dist / (radius * (1.0 + table(rims[k], _azimuth(ue, un))))
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
@@ -133,8 +134,7 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
         # quadric's quadratic part) radially, as outside: the rim meets the blend whatever
         # the curvature (a crater in a larger crater's bowl: 100 m over its radius)
         t_root = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, DEPTH], xe, rims[k],
-                             0.0, 0.0, 0.0, rough, fc[k, WARP], has_rough, seeds[k], radius,
-                             octaves, gain, fr)
+                             rough, fc[k, WARP], has_rough, seeds[k], radius, octaves, gain, fr)
         return True, 0.0, (fc[k, RHO] + _quadric(fc, k, x, y)) + t_root
     add = scale * table_value(tabs[k], xr, xe)
     if has_rough:

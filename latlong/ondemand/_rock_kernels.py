@@ -34,7 +34,7 @@ def _rock_height(rc, seeds, k, p0, p1, p2):
     (``seeds[k]``); 0 outside."""
     if _far(rc, k, CHORD2, p0, p1, p2):
         return 0.0
-    _, _, x, y, _ = _local(rc, k, p0, p1, p2)
+    _, _, x, y, _, _ = _local(rc, k, p0, p1, p2)
     xi = (x * rc[k, CA] + y * rc[k, SA]) / rc[k, A]
     eta = (y * rc[k, CA] - x * rc[k, SA]) / rc[k, B]
     q2 = xi * xi + eta * eta

@@ -281,9 +281,8 @@ def _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe, r
     scale = fc[k, K.SCALE]
     has_rough = octaves > 0 and (max(rough[0], max(rough[1], rough[2])) * fc[k, K.DEPTH]
                                  * scale > 1e-6 * radius)
-    t = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, K.DEPTH], xe, rims[k],
-                    0.0, 0.0, 0.0, rough, fc[k, K.WARP], has_rough, seeds[k], radius, octaves,
-                    gain, fr)
+    t = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, K.DEPTH], xe, rims[k], rough,
+                    fc[k, K.WARP], has_rough, seeds[k], radius, octaves, gain, fr)
     q = (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
          + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
     return radius_now - ((fc[k, K.RHO] + q) + t)

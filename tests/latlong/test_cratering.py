@@ -10,7 +10,9 @@ import craters
 from latlong import (
     Body,
     LatLongGrid,
+    Scene,
     body_population,
+    build,
     load,
     perlin_fbm,
     stamp_craters,
@@ -362,3 +364,61 @@ def test_tilted_frame_is_orthonormal_with_the_base_normal():
         assert np.allclose(np.cross(n, e), m) and e[0] > 0
         assert np.cross(n, [1.0, 0.0, 0.0]) @ e == pytest.approx(0.0, abs=1e-12)
         assert tilt == pytest.approx(np.degrees(np.arccos(want_n[2])))
+
+
+def test_a_tilted_crater_replaces_the_terrain_inside_its_rim_whatever_its_height():
+    # the build's tilted stamp (issue 36) decides inside and outside at the vertex's foot
+    # on the base plane, as the field does: inside the rim a vertex lands where its radial
+    # line meets the crater's surface over the base plane (plus the base's curvature,
+    # radially), whatever its height before; outside the ejecta add along the normal.
+    # Deciding at the vertex itself caught vertices far off a poorly fitted base
+    from craters.kernels import table_value
+    from latlong._tilt_kernels import _tilted_change, _tilted_frame
+
+    gx, gy, p0, qa, qb, qc = 0.9, -0.2, 3.0, 1e-3, -5e-4, 2e-3
+    fr = np.zeros(10)
+    assert _tilted_frame(gx, gy, fr) > 40.0
+    radius, xe, n = 10.0, 3.0, 600
+    xs = np.linspace(0.0, xe, 97)
+    tab = np.where(xs < 1.0, 2.0 * xs * xs - 1.5, 0.5 / np.maximum(xs, 1.0) ** 3)  # bowl, ejecta
+    rim, delta, rough = np.zeros(64), np.zeros(64), np.zeros(4)
+    rng = np.random.default_rng(3)
+    xl, yl = rng.uniform(-20.0, 20.0, (2, n))
+    foot = np.stack([xl, yl, gx * xl + gy * yl])  # the radial line meets the base plane
+    x_foot = np.hypot(fr[0:3] @ foot, fr[3:6] @ foot) / radius
+    inside, outside = x_foot <= 1.0, (x_foot > 1.0) & (x_foot < xe)
+    assert inside.sum() > 50 and outside.sum() > 200
+    news = []
+    for hgt in (p0 + foot[2] + rng.normal(0.0, 1.0, n), p0 + rng.normal(0.0, 30.0, n)):
+        got = np.array([_tilted_change(q, xl, yl, hgt, radius, tab, 1.0, 1.0, xe, rim, delta,
+                                       p0, qa, qb, qc, rough, 1, radius, 0, 0.5, fr)
+                        for q in range(n)], dtype=object)
+        hit = got[:, 0].astype(bool)
+        dh = got[:, 1].astype(float)
+        assert np.array_equal(hit, x_foot < xe)
+        want = np.array([table_value(tab, x, xe) for x in x_foot[outside]]) / fr[9]
+        assert np.allclose(dh[outside], want, rtol=0, atol=1e-12)
+        news.append(hgt + dh)
+        # inside: on the crater's surface over the base plane, in the plane's frame
+        v = np.stack([xl, yl, hgt + dh - p0 - (qa * xl * xl + qb * xl * yl + qc * yl * yl)])
+        u1, u2, w = fr[0:3] @ v, fr[3:6] @ v, fr[6:9] @ v
+        xv = np.minimum(np.hypot(u1, u2) / radius, 1.0)
+        surface = np.array([table_value(tab, x, xe) for x in xv])
+        assert np.allclose(w[inside], surface[inside], rtol=0, atol=1e-7)
+    # whatever the height before (1 m or 30 m off the base), inside the rim: the same
+    assert np.allclose(news[0][inside], news[1][inside], rtol=0, atol=1e-7)
+
+
+def test_a_tilted_crater_moves_no_vertex_farther_than_a_level_one():
+    # examples/plot_slope_study.py's small run (fig5c, M = 40): 13 m craters on 44 deg
+    # ground moved vertices up to 40 m while craters on level ground moved them at most
+    # 6.8 m (each replaces the terrain inside its rim by its fitted base)
+    scene = Scene.from_settings({"preset": "fig5c", "magnitude": 40, "radius_m": 100.0,
+                                 "craters": ["c=0.5,k=-2,d_min_m=9.817,d_max_m=15"],
+                                 "seed": 9})
+    cat = build(scene).craters
+    level = cat["slope_deg"] < 10.0
+    assert level.sum() >= 10 and (~level).sum() >= 100
+    moved = np.abs(cat["max_change_m"])
+    assert moved[~level].max() <= 2.0 * moved[level].max(), (moved[~level].max(),
+                                                             moved[level].max())

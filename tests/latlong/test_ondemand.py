@@ -148,9 +148,9 @@ def _tilted_step_reference(fc, k, tabs, rims, seeds, rough, gain, xe, x, y):
     q = fc[k, K.RHO] + (fc[k, K.P0] + fc[k, K.GX] * x + fc[k, K.GY] * y + fc[k, K.QA] * x * x
                         + fc[k, K.QB] * x * y + fc[k, K.QC] * y * y)
     if xr <= 1.0:
-        t = tilted_root.py_func(u1, u2, w0, radius, tabs[k], scale, depth, xe, rims[k],
-                                0.0, 0.0, 0.0, rough, fc[k, K.WARP], has_rough, seeds[k],
-                                radius, ROUGHNESS_OCTAVES, gain, fr)
+        t = tilted_root.py_func(u1, u2, w0, radius, tabs[k], scale, depth, xe, rims[k], rough,
+                                fc[k, K.WARP], has_rough, seeds[k], radius, ROUGHNESS_OCTAVES,
+                                gain, fr)
         return True, 0.0, q + t
     add = scale * table_value.py_func(tabs[k], xr, xe)
     if has_rough:
