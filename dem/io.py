@@ -42,6 +42,7 @@ from .zarrio import (
     ChunkWriter,
     ZarrStore,
     check_zarr_output,
+    drop_unresolvable_crs_id,
     is_zarr,
     is_zarr_store,
 )
@@ -439,6 +440,7 @@ class WindowWriter:
                                                    pixel_size_m))
             if self._zarr is not None:  # GDAL wrote the metadata; the heights go in chunks
                 self._ds.close()
+                drop_unresolvable_crs_id(self._zarr.store)
                 self._chunks = ChunkWriter(self._zarr.store)
         except BaseException:
             self._discard()

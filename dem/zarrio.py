@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import shutil
 import zlib
 from pathlib import Path
@@ -37,7 +38,7 @@ from craters._shared import check_parent_folder, replace_output, sweep_temporari
 from craters._shared.outputs import claim
 
 __all__ = ["ARRAY", "ZARR_OPTIONS", "ZARR_SUFFIXES", "ChunkWriter", "ZarrStore",
-           "check_zarr_output", "is_zarr", "is_zarr_store"]
+           "check_zarr_output", "drop_unresolvable_crs_id", "is_zarr", "is_zarr_store"]
 
 #: Suffixes of Zarr outputs.
 ZARR_SUFFIXES = (".zarr",)
@@ -50,6 +51,8 @@ ZARR_OPTIONS = {"FORMAT": "ZARR_V2", "COMPRESS": "ZLIB", "ZLIB_LEVEL": "6",
 _ARRAY_META = {"chunks": [512, 512], "compressor": {"id": "zlib", "level": 6},
                "dtype": "<f4", "fill_value": "NaN", "filters": None, "order": "C",
                "zarr_format": 2}
+# the identifier GDAL gives an IAU_2015 CRS in a store's `_CRS` (the version dropped)
+_IAU_ID = re.compile(r',ID\["IAU",[0-9]+\]\]$')
 # what a store craterform writes holds (and all --force may replace)
 _ENTRIES = frozenset({".zgroup", ".zattrs", ".zmetadata", "X", "Y", ARRAY})
 
@@ -159,3 +162,27 @@ class ChunkWriter:
         except FileNotFoundError:
             return np.full(self._chunk, np.nan, dtype="<f4")
         return np.frombuffer(raw, dtype="<f4").reshape(self._chunk).copy()
+
+
+def drop_unresolvable_crs_id(store) -> None:
+    """Remove from the store's ``_CRS`` the identifier GDAL writes for an ``IAU_2015`` CRS,
+    ``ID["IAU",30100]`` (no version), which no PROJ resolves: GDAL, rasterio and pyproj
+    then read a CRS without a code (``to_authority()`` None, the Moon's sphere unnamed)
+    where the same CRS in a GeoTIFF is identified as ``IAU_2015:30100``. Without it they
+    identify the CRS by its definition, as they do the GeoTIFF's. Other CRSs unchanged."""
+    store = Path(store)
+    paths = (store / ARRAY / ".zattrs", store / ".zmetadata")
+    docs = [json.loads(path.read_text(encoding="utf-8")) for path in paths]
+    changed = False
+    for attrs in (docs[0], docs[1]["metadata"][f"{ARRAY}/.zattrs"]):
+        crs = attrs.get("_CRS")
+        if not isinstance(crs, dict) or not _IAU_ID.search(crs.get("wkt", "")):
+            continue
+        crs["wkt"] = _IAU_ID.sub("]", crs["wkt"])
+        ident = crs.get("projjson", {}).get("id", {})
+        if ident.get("authority") == "IAU" and "version" not in ident:
+            del crs["projjson"]["id"]
+        changed = True
+    if changed:
+        for path, doc in zip(paths, docs, strict=True):
+            path.write_text(json.dumps(doc, indent=2) + "\n", encoding="utf-8")

@@ -175,3 +175,26 @@ def test_a_failed_write_leaves_nothing(lola, tmp_path):
         w.write(lola.heights[:10], 0, 0)
         raise RuntimeError("stop")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_other_readers_resolve_the_stores_iau_code_and_warp_it_as_the_geotiff(lola, tmp_path):
+    # GDAL writes an IAU_2015 CRS into `_CRS` as ID["IAU",30100] (no version), which no PROJ
+    # resolves: rasterio and pyproj saw a CRS without a code where the GeoTIFF of the same
+    # DEM reads as IAU_2015:30100. Warping (GDAL's transformer, which follows the CRS's
+    # axis order) gives the GeoTIFF's pixels: latitude and longitude are not swapped
+    import rasterio
+    from rasterio.warp import Resampling, reproject
+
+    dem.write(lola, tmp_path / "m.zarr")
+    dem.write(lola, tmp_path / "m.tif")
+    assert str(dem.read(tmp_path / "m.zarr").crs) == "IAU_2015:30100"
+    warped = []
+    for name in ("m.zarr", "m.tif"):
+        with rasterio.open(tmp_path / name) as src:
+            assert src.crs.to_authority() == ("IAU_2015", "30100")
+            out = np.full((60, 80), np.nan, np.float32)
+            reproject(rasterio.band(src, 1), out, dst_crs=src.crs,
+                      dst_transform=rasterio.Affine(0.5, 0.0, 160.0, 0.0, -0.5, 20.0),
+                      resampling=Resampling.nearest)
+            warped.append(out)
+    assert np.isfinite(warped[0]).all() and np.array_equal(warped[0], warped[1])
