@@ -216,9 +216,10 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
     auto-exposure would);
     ``strip.png`` puts the pictures side by side; ``frames.json`` the intrinsics and per
     frame the altitude, ground pixel, exposure, terrain, craters, rocks, pose, sun and
-    files; frames with LIDAR returns add ``lidar_NNNN.las`` (LAS 1.4, crater labels as
-    extra bytes) and ``lidar_range_NNNN.npy`` (first-return range image), and the
-    manifest the LIDAR's settings ``lidar`` and ``lidar_seed``. ``report(i, frame)`` is
+    files; frames with LIDAR returns add ``lidar_NNNN.las`` (LAS 1.4 unless the settings
+    say 1.2, ``.laz`` with ``laz``; crater labels as extra bytes) and
+    ``lidar_range_NNNN.npy`` (first-return range image), and the manifest the LIDAR's
+    settings ``lidar`` and ``lidar_seed``. ``report(i, frame)`` is
     called as frames are written. Returns the number of frames."""
     from PIL import Image
 
@@ -226,7 +227,7 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
     from craters.catalog import write_catalog
 
     from ..sensors.camera_files import write_frame, write_manifest
-    from ..sensors.lidar_files import settings_json, write_las
+    from ..sensors.lidar_files import las_name, settings_json, write_las
     from ..sensors.runs import run_folder
 
     entries, pictures = [], []
@@ -246,10 +247,11 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
             pictures.append(pic)
             extra = {}
             if f.lidar is not None:
-                files["lidar"] = f"lidar_{i:04d}.las"
+                files["lidar"] = las_name(f"lidar_{i:04d}", lidar)
                 files["lidar_range"] = f"lidar_range_{i:04d}.npy"
                 write_las(f.lidar, tmp / files["lidar"], point_source_id=i,
-                          crs_wkt=f.crs_wkt or None)
+                          crs_wkt=f.crs_wkt or None,
+                          version="1.4" if lidar is None else lidar.las_version)
                 np.save(tmp / files["lidar_range"], f.lidar.range_image, allow_pickle=False)
                 extra["lidar_returns"] = len(f.lidar)
             entries.append({"altitude_m": f.altitude_m, "ground_pixel_m": f.ground_pixel_m,

@@ -95,6 +95,10 @@ class LidarSettings:
     las_version: str = setting("1.4", "LAS files: 1.4 (point format 6, CRS as WKT) or 1.2 "
                                "(point format 1, for older readers)", choices=("1.4", "1.2"))
     """The LAS files' version (:func:`~latlong.sensors.lidar_files.write_las`)."""
+    laz: bool = setting(False, "compress the point files: LAZ (.laz, LASzip through lazrs) "
+                        "instead of LAS")
+    """Write the point files as LAZ (``lidar_NNNN.laz``: the same points, header and VLRs,
+    LASzip-compressed) instead of LAS."""
 
     def __post_init__(self):
         # values kept as given (lidar.json records them); the beams as a tuple of ints

@@ -1,7 +1,8 @@
 """LIDAR outputs: LAS 1.4 point clouds (laspy), float32 range images and the ``lidar.json``
 manifest of a run (the layout of the camera's ``frames.json``).
 
-A run folder holds, per frame ``k``, ``lidar_k.las`` (point format 6: x, y, z in the body
+A run folder holds, per frame ``k``, ``lidar_k.las`` (``lidar_k.laz``, LASzip-compressed,
+with the ``laz`` setting; point format 6: x, y, z in the body
 frame, metres; intensity; return number; number of returns; GPS time = the beam's time in
 seconds; point source id = frame index; extra dimensions ``crater_id`` and
 ``boulder_id``, int32, -1 = none; the WKT bit set and the CRS as a WKT VLR:
@@ -75,7 +76,8 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
     the global encoding's WKT bit set (point formats 6-10 require it) or, ``version``
     "1.2", point format 1 for older readers (loaders.gl, deck.gl); with ``crs_wkt`` the
     CRS as an OGC WKT coordinate-system VLR, as PDAL and QGIS read it (a 1.2 file has no
-    WKT bit: readers that only take GeoTIFF keys see no CRS)."""
+    WKT bit: readers that only take GeoTIFF keys see no CRS). A ``.laz`` path is written
+    LASzip-compressed (lazrs)."""
     import laspy
     from laspy.vlrs.known import WktCoordinateSystemVlr
 
@@ -119,8 +121,13 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
     las.crater_id = frame.crater_id
     las.boulder_id = frame.boulder_id
     with atomic_path(path) as tmp:
-        las.write(str(tmp))
+        las.write(str(tmp), do_compress=path.suffix.lower() == ".laz")
     return path
+
+
+def las_name(stem: str, settings: LidarSettings | None) -> str:
+    """``stem`` with the point files' suffix: ``.laz`` when ``settings.laz``, else ``.las``."""
+    return f"{stem}.laz" if settings is not None and settings.laz else f"{stem}.las"
 
 
 def settings_json(settings: LidarSettings) -> dict:
@@ -168,7 +175,8 @@ def lidar_run(model, settings: LidarSettings, poses: Poses, folder, *, craters=N
             fr = lidar_frame(mesh, settings, poses.position_m[k], poses.quaternion_wxyz[k],
                              time_s=float(poses.time_s[k]), rng=np.random.default_rng([seed, k]),
                              ground_truth=geometry)
-            names = {"points": f"lidar_{k:04d}.las", "range": f"range_{k:04d}.npy"}
+            names = {"points": las_name(f"lidar_{k:04d}", settings),
+                     "range": f"range_{k:04d}.npy"}
             write_las(fr, tmp / names["points"], point_source_id=k, crs_wkt=crs_wkt,
                       version=settings.las_version)
             np.save(tmp / names["range"], fr.range_image, allow_pickle=False)

@@ -186,3 +186,29 @@ def test_las_1_2_for_older_readers(body_file, tmp_path):
     assert not (tmp_path / "g.las").exists()
     with pytest.raises(ValueError, match="version"):
         write_las(fr, tmp_path / "h.las", version="2.0")
+
+
+@pytest.mark.parametrize("version", ["1.4", "1.2"])
+def test_laz_holds_the_las_points_header_and_crs(run_cli, body_file, tmp_path, version):
+    """``--laz``: LASzip-compressed point files (lazrs) with the LAS file's points, labels,
+    header and CRS VLR, smaller, the same bytes on every run."""
+    runs = {}
+    for name, extra in (("las", []), ("laz", ["--laz"]), ("laz2", ["--laz"])):
+        out = tmp_path / name
+        r = run_cli("latlong", "lidar", str(body_file), "-o", str(out), "--position", POS,
+                    "--quaternion", Q, "--beams", "64x48", "--fov-deg", "40", "--seed", "3",
+                    "--las-version", version, "-q", *extra)
+        assert r.returncode == 0, r.stderr
+        runs[name] = out
+    man = json.loads((runs["laz"] / "lidar.json").read_text())
+    name = man["frames"][0]["files"]["points"]
+    assert name == "lidar_0000.laz" and man["settings"]["laz"] is True
+    assert digest(runs["laz"]) == digest(runs["laz2"])
+    las, laz = laspy.read(runs["las"] / "lidar_0000.las"), laspy.read(runs["laz"] / name)
+    assert laz.header.are_points_compressed and not las.header.are_points_compressed
+    assert laz.header.version == las.header.version == version
+    for dim in ("X", "Y", "Z", "intensity", "gps_time", "return_number", "crater_id"):
+        np.testing.assert_array_equal(laz[dim], las[dim])
+    assert laz.header.parse_crs() == las.header.parse_crs() is not None
+    sizes = [(runs[k] / n).stat().st_size for k, n in (("laz", name), ("las", "lidar_0000.las"))]
+    assert sizes[0] < 0.8 * sizes[1], sizes
