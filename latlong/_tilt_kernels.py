@@ -96,10 +96,10 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
 def tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough,
                 seed, wavelength, octaves, gain, fr):
     """The radial change t that puts a point inside the rim of a crater stamped in the
-    tilted frame ``fr`` on the crater's surface over the base plane (:func:`_tilted_change`;
-    the point's
-    in-plane coordinates ``u1, u2`` and height ``w0`` along the base normal; ``rough``: the
-    bowl, wall and ejecta amplitudes, ``warp``: :func:`craters.kernels.warp_x`'s)."""
+    tilted frame ``fr`` on the crater's surface over the base plane
+    (:func:`_tilted_change`; the point's in-plane coordinates ``u1, u2`` and height ``w0``
+    along the base normal; ``rough``: the bowl, wall and ejecta amplitudes, ``warp``:
+    :func:`craters.kernels.warp_x`'s)."""
     c = (radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough, seed, wavelength,
          octaves, gain, fr)
     # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z: g is bounded (the crater's
