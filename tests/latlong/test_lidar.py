@@ -314,3 +314,15 @@ def test_face_normals_match_numpy(scene):
     n = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     np.testing.assert_allclose(RayMesh(v, f).face_normals,
                                n / np.linalg.norm(n, axis=1, keepdims=True), atol=1e-12)
+
+
+def test_beam_axes_rotate_as_the_matrix_product():
+    # lidar._rotated replaces `v @ rot.T` (BLAS's spinning worker threads slowed the ray
+    # kernel after it): the same rotation to rounding
+    from latlong.sensors.lidar import _rotated
+
+    rng = np.random.default_rng(4)
+    v = rng.normal(size=(500, 3))
+    rot = np.linalg.qr(rng.normal(size=(3, 3)))[0]
+    np.testing.assert_allclose(_rotated(v, rot), v @ rot.T, rtol=0, atol=1e-14)
+    np.testing.assert_array_equal(_rotated(v, np.eye(3)), v)
