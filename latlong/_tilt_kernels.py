@@ -64,16 +64,10 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
     the vertex's own position instead caught vertices far off a poorly fitted base (its
     radial line meeting the crater's surface beyond the rim) and moved them up to 40 m at
     a 13 m crater on 44 deg ground."""
-    ex, ey, ez, mx, my, mz, nx, ny, nz, cz = (fr[0], fr[1], fr[2], fr[3], fr[4], fr[5],
-                                              fr[6], fr[7], fr[8], fr[9])
+    cz = fr[9]
     r0, r1 = xl[q], yl[q]
-    r2 = -(nx * r0 + ny * r1) / nz  # the foot on the base plane (N = (-gx, -gy, 1) / l)
-    u1 = r0 * ex + r1 * ey + r2 * ez
-    u2 = r0 * mx + r1 * my + r2 * mz
-    w0 = r0 * nx + r1 * ny + r2 * nz
-    rho = np.sqrt(u1 * u1 + u2 * u2)
-    az = np.arctan2(u2, u1)
-    x = rho / (radius * (1.0 + table(rim_tab, az)))
+    r2 = -(fr[6] * r0 + fr[7] * r1) / fr[8]  # the foot on the base plane (N = (-gx, -gy, 1) / l)
+    u1, u2, w0, az, x = tilted_coords(r0, r1, r2, fr, radius, rim_tab)
     if not x < xe:
         return False, 0.0
     has_rough = rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0
@@ -90,6 +84,21 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
     t = tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, rough[3],
                     has_rough, seed, wavelength, octaves, gain, fr)
     return True, (p0 + r2 + (qa * r0 * r0 + qb * r0 * r1 + qc * r1 * r1) + t) - hgt[q]
+
+
+@njit(cache=True, inline="always")
+def tilted_coords(x, y, z, fr, radius, rim_tab):
+    """(u1, u2, w, azimuth, rim-relative radius) of the point (x, y, z) of the developed
+    local frame in the tilted frame ``fr`` (:func:`_tilted_frame`): its in-plane
+    coordinates along E' and N', its height along the base normal, the in-plane azimuth
+    and its in-plane distance over the rim radius at that azimuth (``rim_tab``: the rim
+    perturbation). One formula for the build (:func:`_tilted_change`) and the on-demand
+    field (:func:`latlong.ondemand._field_kernels._tilted_step`)."""
+    u1 = x * fr[0] + y * fr[1] + z * fr[2]
+    u2 = x * fr[3] + y * fr[4] + z * fr[5]
+    w = x * fr[6] + y * fr[7] + z * fr[8]
+    az = np.arctan2(u2, u1)
+    return u1, u2, w, az, np.sqrt(u1 * u1 + u2 * u2) / (radius * (1.0 + table(rim_tab, az)))
 
 
 @njit(cache=True)

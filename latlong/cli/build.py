@@ -15,7 +15,7 @@ import numpy as np
 
 from craters._shared import progress_bar, staged_path
 from craters.cli.kit import CliError, wrote_line
-from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
+from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys, flag_of
 from latlong import LatLongGrid, Scene, build
 from latlong.parallel.backends import CONNECT_TIMEOUT
 from latlong.scratch import drop_pages
@@ -116,7 +116,8 @@ def _build(v: Values) -> int:
     run = {k: v[k] for k in ("patches", "workers", "scheduler", "connect_timeout_s")
            if k in v.given}
     if run and not scene.on_demand:
-        raise CliError(f"--{next(iter(run)).replace('_', '-')} applies to an --on-demand build")
+        key = next(iter(run))
+        raise CliError(f"{flag_of(key, ON_DEMAND_RUN[key])} applies to an --on-demand build")
     if scene.on_demand:
         from latlong.ondemand.patches import build_patches, patch_count
         from latlong.scratch import disk_radii

@@ -14,7 +14,13 @@ from craters.kernels import (
     fbm2, read_only_inputs, roughness_amp, slope_factor, table, table_value, warp_x,
 )
 
-from .._tilt_kernels import _TILT_MAX_COS, TILT_MIN_DEG, _tilted_frame, tilted_root
+from .._tilt_kernels import (
+    _TILT_MAX_COS,
+    TILT_MIN_DEG,
+    _tilted_frame,
+    tilted_coords,
+    tilted_root,
+)
 
 # crater record columns (float64 array "fc", one row per crater)
 C0, C1, C2 = 0, 1, 2          # centre direction (unit)
@@ -39,7 +45,8 @@ N_COLS = TILT + 10
 def _local(fc, k, p0, p1, p2):
     """(cos angle, distance in metres, x, y in the crater's frame, east and north
     components) of direction p from crater k's centre (azimuthal equidistant at the
-    crater's reference radius); :func:`_azimuth` of the last two is its azimuth."""
+    crater's reference radius); ``arctan2(north, east)`` is its azimuth (0 at the
+    centre, where both are +0)."""
     c = fc[k, C0] * p0 + fc[k, C1] * p1 + fc[k, C2] * p2
     xe = fc[k, E0] * p0 + fc[k, E1] * p1 + fc[k, E2] * p2
     xn = fc[k, N0] * p0 + fc[k, N1] * p1 + fc[k, N2] * p2
@@ -48,12 +55,6 @@ def _local(fc, k, p0, p1, p2):
     if s > 0.0:
         return c, dist, dist * xe / s, dist * xn / s, xe, xn
     return c, dist, 0.0, 0.0, 0.0, 0.0
-
-
-@njit(cache=True, inline="always")
-def _azimuth(xe, xn):
-    """The azimuth of :func:`_local`'s east and north components (0 at the centre)."""
-    return np.arctan2(xn, xe) if xe != 0.0 or xn != 0.0 else 0.0
 
 
 @njit(cache=True, inline="always")
@@ -87,7 +88,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if fc[k, TILT_CZ] > 0.0:
         return _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y)
     radius = fc[k, RAD]
-    xr = dist / (radius * (1.0 + table(rims[k], _azimuth(ue, un))))
+    xr = dist / (radius * (1.0 + table(rims[k], np.arctan2(un, ue))))
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
@@ -118,12 +119,8 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
     radially), outside the profile along the normal (over N_z)."""
     fr = fc[k, TILT:TILT + 10]
     r2 = fc[k, GX] * x + fc[k, GY] * y  # the foot on the base plane (w0 = 0 but rounding)
-    u1 = x * fr[0] + y * fr[1] + r2 * fr[2]
-    u2 = x * fr[3] + y * fr[4] + r2 * fr[5]
-    w0 = x * fr[6] + y * fr[7] + r2 * fr[8]
-    az = np.arctan2(u2, u1)
     radius = fc[k, RAD]
-    xr = np.sqrt(u1 * u1 + u2 * u2) / (radius * (1.0 + table(rims[k], az)))
+    u1, u2, w0, _, xr = tilted_coords(x, y, r2, fr, radius, rims[k])
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]

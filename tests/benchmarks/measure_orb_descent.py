@@ -50,44 +50,48 @@ def _estimate(pa, pb, k, rel_r, rel_t, method: str):
     return rot, tr, inl.ravel() > 0
 
 
-def pair_errors(img_a, img_b, k, rel_r, rel_t, method: str, truth=None, seed: int = 0):
-    """(rotation error, translation-direction error, inliers, control rotation, control
-    translation) of ORB matches between two frames; the control (NaN without ``truth``,
-    a function from frame-a pixels to their true frame-b pixels) on the inliers' true
-    matches plus 0.3 px noise."""
+def orb_matches(img_a, img_b) -> tuple[np.ndarray, np.ndarray]:
+    """Pixels (OpenCV's convention) of the ORB matches (4000 features, Hamming, cross-check)
+    of frame a and frame b."""
     import cv2
 
     orb = cv2.ORB_create(4000)
     ka, da = orb.detectAndCompute(img_a, None)
     kb, db = orb.detectAndCompute(img_b, None)
     if da is None or db is None:
-        return math.nan, math.nan, 0, math.nan, math.nan
+        return np.zeros((0, 2)), np.zeros((0, 2))
     matches = cv2.BFMatcher(cv2.NORM_HAMMING, crossCheck=True).match(da, db)
-    pa = np.float64([ka[m.queryIdx].pt for m in matches])
-    pb = np.float64([kb[m.trainIdx].pt for m in matches])
+    return (np.float64([ka[m.queryIdx].pt for m in matches]).reshape(-1, 2),
+            np.float64([kb[m.trainIdx].pt for m in matches]).reshape(-1, 2))
+
+
+def pair_errors(pa, pb, k, rel_r, rel_t, method: str, truth=None, seed: int = 0):
+    """(rotation error, translation-direction error, inliers, control rotation, control
+    translation) of matches ``pa`` -> ``pb``; the control (NaN without ``truth``: the true
+    frame-b pixels of ``pa`` and which are valid, :func:`true_match`) on the inliers' true
+    matches plus 0.3 px noise."""
     if len(pa) < 8:
         return math.nan, math.nan, len(pa), math.nan, math.nan
     rot, tr, inl = _estimate(pa, pb, k, rel_r, rel_t, method)
     c_rot = c_tr = math.nan
     if truth is not None:
-        pt, ok = truth(pa)
+        pt, ok = truth
         keep = inl & ok
         noisy = pt[keep] + 0.3 * np.random.default_rng(seed).standard_normal((keep.sum(), 2))
         c_rot, c_tr, _ = _estimate(pa[keep], noisy, k, rel_r, rel_t, method)
     return rot, tr, int(inl.sum()), c_rot, c_tr
 
 
-def true_match(depth_a, k, rel_r, rel_t_m):
-    """Frame-a pixels (OpenCV's convention) -> (their true frame-b pixels, valid)."""
-    def f(pa):
-        rows = np.clip(np.round(pa[:, 1]).astype(int), 0, depth_a.shape[0] - 1)
-        cols = np.clip(np.round(pa[:, 0]).astype(int), 0, depth_a.shape[1] - 1)
-        z = depth_a[rows, cols]
-        ok = np.isfinite(z) & (z > 0)
-        xa = (np.linalg.solve(k, np.vstack([pa.T, np.ones(len(pa))])) * z).T
-        xb = xa @ rel_r.T + rel_t_m
-        return (xb[:, :2] / xb[:, 2:3]) @ k[:2, :2].T + k[:2, 2], ok
-    return f
+def true_match(pa, depth_a, k, rel_r, rel_t_m) -> tuple[np.ndarray, np.ndarray]:
+    """(The true frame-b pixels of frame-a pixels ``pa`` (OpenCV's convention), valid):
+    back-projected through frame a's depth, projected with the true relative pose."""
+    rows = np.clip(np.round(pa[:, 1]).astype(int), 0, depth_a.shape[0] - 1)
+    cols = np.clip(np.round(pa[:, 0]).astype(int), 0, depth_a.shape[1] - 1)
+    z = depth_a[rows, cols]
+    ok = np.isfinite(z) & (z > 0)
+    xa = (np.linalg.solve(k, np.vstack([pa.T, np.ones(len(pa))])) * z).T
+    xb = xa @ rel_r.T + rel_t_m
+    return (xb[:, :2] / xb[:, 2:3]) @ k[:2, :2].T + k[:2, 2], ok
 
 
 def main() -> int:
@@ -111,32 +115,37 @@ def main() -> int:
     i = doc["intrinsics"]
     k = np.array([[i["fx"], 0, i["cx"] - 0.5], [0, i["fy"], i["cy"] - 0.5], [0, 0, 1.0]])
     frames = doc["frames"]
-    for method in ("USAC_ACCURATE", "RANSAC"):
-        for label, key in (("linear 16-bit >> 8", "image"), ("sRGB display", "display")):
-            worst = [0.0, 0.0, 0.0, 0.0]
-            ok = 0
-            for j, (a, b) in enumerate(zip(frames[:-1], frames[1:], strict=True)):
-                imgs = []
-                for f in (a, b):
-                    arr = np.asarray(Image.open(work / "out/orb" / f["files"][key]))
-                    imgs.append((arr >> 8).astype(np.uint8) if arr.dtype == np.uint16 else arr)
-                ra, rb = (quaternion_to_matrix(f["quaternion_wxyz"]) for f in (a, b))
-                pa, pb = (np.asarray(f["position_m"]) for f in (a, b))
-                rel_t = rb.T @ (pa - pb)
-                with rasterio.open(work / "out/orb" / a["files"]["depth"]) as src:
-                    depth = src.read(1)
-                errs = pair_errors(*imgs, k, rb.T @ ra, rel_t / np.linalg.norm(rel_t), method,
-                                   true_match(depth, k, rb.T @ ra, rel_t), seed=j)
-                worst = [max(w, e) for w, e in zip(worst, errs[:2] + errs[3:], strict=True)]
-                ok += int(errs[0] <= 0.2 and errs[1] <= 2.0)
+    methods = ("USAC_ACCURATE", "RANSAC")
+    for label, key in (("linear 16-bit >> 8", "image"), ("sRGB display", "display")):
+        worst = {m: [0.0, 0.0, 0.0, 0.0] for m in methods}
+        ok = dict.fromkeys(methods, 0)
+        for j, (a, b) in enumerate(zip(frames[:-1], frames[1:], strict=True)):
+            imgs = []
+            for f in (a, b):
+                arr = np.asarray(Image.open(work / "out/orb" / f["files"][key]))
+                imgs.append((arr >> 8).astype(np.uint8) if arr.dtype == np.uint16 else arr)
+            ra, rb = (quaternion_to_matrix(f["quaternion_wxyz"]) for f in (a, b))
+            pos_a, pos_b = (np.asarray(f["position_m"]) for f in (a, b))
+            rel_r, rel_t = rb.T @ ra, rb.T @ (pos_a - pos_b)
+            with rasterio.open(work / "out/orb" / a["files"]["depth"]) as src:
+                depth = src.read(1)
+            pa, pb = orb_matches(*imgs)  # once a pair, for both estimators
+            truth = true_match(pa, depth, k, rel_r, rel_t)
+            for method in methods:
+                errs = pair_errors(pa, pb, k, rel_r, rel_t / np.linalg.norm(rel_t), method,
+                                   truth, seed=j)
+                worst[method] = [max(w, e) for w, e in zip(worst[method], errs[:2] + errs[3:],
+                                                           strict=True)]
+                ok[method] += int(errs[0] <= 0.2 and errs[1] <= 2.0)
                 print(f"  {method}, {label}: rotation {errs[0]:.3f} deg, translation "
                       f"direction {errs[1]:.2f} deg, {errs[2]} inliers; control "
                       f"{errs[3]:.3f} deg, {errs[4]:.2f} deg")
-            print(f"{method}, {label}: {ok} of {len(frames) - 1} pairs within 0.2 deg / 2 deg; "
-                  f"worst rotation {worst[0]:.3f} deg, translation direction {worst[1]:.2f} "
-                  f"deg; control (true matches + 0.3 px) worst {worst[2]:.3f} deg, "
-                  f"{worst[3]:.2f} deg (exposures "
-                  f"{[round(f['exposure_s'], 4) for f in frames]})")
+        for method in methods:
+            w = worst[method]
+            print(f"{method}, {label}: {ok[method]} of {len(frames) - 1} pairs within 0.2 deg "
+                  f"/ 2 deg; worst rotation {w[0]:.3f} deg, translation direction {w[1]:.2f} "
+                  f"deg; control (true matches + 0.3 px) worst {w[2]:.3f} deg, {w[3]:.2f} "
+                  f"deg (exposures {[round(f['exposure_s'], 4) for f in frames]})")
     cv2.setNumThreads(0)
     return 0
 
