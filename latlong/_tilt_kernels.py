@@ -25,6 +25,7 @@ TILT_MIN_DEG = 10.0
 #: height cannot follow the surface (the crater is stamped as on gentler ground).
 _TILT_MAX_COS = 0.2
 _TILT_ITERATIONS = 40
+_SECANT_ITERATIONS = 8  # before falling back to the bracketed root
 
 
 @njit(cache=True)
@@ -111,13 +112,32 @@ def tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, warp,
     :func:`craters.kernels.warp_x`'s)."""
     c = (radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough, seed, wavelength,
          octaves, gain, fr)
-    # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z: g is bounded (the crater's
-    # relief), so stepping from t = 0 against f's sign brackets it; then Illinois false
-    # position (a plain fixed point diverges where |grad W| tan(tilt) > 1)
+    # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z. Where g' < 1 (f falls: a
+    # single root; |grad W| tan(tilt) < 1, nearly every crater) the secant from t = 0 and
+    # the fixed point's first step g(0) finds it in a few evaluations. Elsewhere (f rising
+    # between two iterates, or no convergence): g is bounded (the crater's relief), so
+    # stepping from t = 0 against f's sign brackets a root; then Illinois false position
+    # (a plain fixed point diverges where |grad W| tan(tilt) > 1)
     ta = 0.0
     fa = _target(u1, u2, w0, ta, c) - ta
     if fa == 0.0:
         return 0.0
+    tol = 1e-9 * radius
+    t0, f0 = ta, fa
+    t1 = fa
+    f1 = _target(u1, u2, w0, t1, c) - t1
+    for _ in range(_SECANT_ITERATIONS):
+        if abs(f1) <= tol:
+            return t1
+        slope = (f1 - f0) / (t1 - t0)
+        if not slope < 0.0:
+            break
+        t2 = t1 - f1 / slope
+        if abs(t2 - t1) <= tol:
+            return t2
+        t0, f0 = t1, f1
+        t1 = t2
+        f1 = _target(u1, u2, w0, t1, c) - t1
     step = fa
     tb = ta + step
     fb = _target(u1, u2, w0, tb, c) - tb
@@ -131,7 +151,6 @@ def tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, warp,
     if fa * fb > 0.0:
         return 0.0  # no sign change (not reached: g is bounded)
     side = 0
-    tol = 1e-9 * radius
     for _ in range(_TILT_ITERATIONS):
         t = (ta * fb - tb * fa) / (fb - fa)
         ft = _target(u1, u2, w0, t, c) - t

@@ -227,7 +227,7 @@ class CraterField:
         d_have = np.zeros(0)
         at_level = self._cells_by_level(units, d_min)
         for b in sorted(self.levels):
-            if self._bin_top(b) <= d_min:
+            if self._tops[b] <= d_min:
                 continue
             level = self.levels[b]
             first_pair = len(owners_all)
@@ -294,7 +294,7 @@ class CraterField:
         """{level: the sorted distinct cells of the points} at every level a bin with
         craters >= ``d_min`` is drawn at: the finest once, the coarser ones by shifts."""
         at_level: dict[int, np.ndarray] = {}
-        drawn = {lv for b, lv in self.levels.items() if self._bin_top(b) > d_min}
+        drawn = {lv for b, lv in self.levels.items() if self._tops[b] > d_min}
         level_now = max(drawn, default=0)
         cells_now = unique_sorted(cells_of(units, level_now))
         for lv in sorted(drawn, reverse=True):
@@ -302,9 +302,6 @@ class CraterField:
             level_now = lv
             at_level[lv] = cells_now
         return at_level
-
-    def _bin_top(self, b: int) -> float:
-        return self._tops[b]
 
     def catalog(self, units: np.ndarray, d_min: float) -> np.ndarray:
         """The crater catalog (oldest first) of the craters that the heights at ``units``
@@ -377,8 +374,9 @@ class CraterField:
             self.rocks.add(units, out, d_min, level, occ, block_of)
             return out
         fc = cr.fc
+        order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)  # youngest first
         rank = np.empty(n, dtype=np.int64)
-        rank[np.lexsort((cr.id, cr.age_gyr))] = np.arange(n)  # 0: the youngest
+        rank[order] = np.arange(n)
         # a layer's fixed degradation overrides the one its ages give (as in a build)
         fixed = np.array([np.nan if la.degradation is None else la.degradation
                           for la in self.layers] or [np.nan])
@@ -395,6 +393,9 @@ class CraterField:
         # dependencies per owner, youngest first
         key = unique_sorted(owner * n + dep)
         owner, dep = key // n, key % n
+        # a base is fitted to older, larger craters: the younger left out (fewer generations)
+        older = (rank[dep] > rank[owner]) & (cr.diameter_m[dep] > cr.diameter_m[owner])
+        owner, dep = owner[older], dep[older]
         srt = np.lexsort((rank[dep], owner))
         dep_list = np.ascontiguousarray(dep[srt])
         dep_start = np.searchsorted(owner[srt], np.arange(n + 1)).astype(np.int64)
@@ -418,17 +419,14 @@ class CraterField:
         todo = todo[~known[todo]]
         gen_start = np.searchsorted(gen[todo], np.arange(gen.max() + 2)).astype(np.int64)
         K._params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, FIT, fc, tabs,
-                         rims,
-                         seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
+                         rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE,
                          rank, diam, up, 20.0, 45.0, True)
         self._remember([keys[i] for i in new], fc[new])
-        order = np.lexsort((cr.id, cr.age_gyr)).astype(np.int64)
         active = order[fc[order, K.ACTIVE] > 0]
         blk_start, blk_list = block_pairs(fc, active, level, occ, rank)
         out = np.empty(len(units))
-        K._points_kernel(units, block_of, blk_start, blk_list, base,
-                         fc, tabs, rims, seeds, rough, self.gain, ROUGHNESS_OCTAVES, self.xe,
-                         BLEND_EDGE, rank, diam, out)
+        K._points_kernel(units, block_of, blk_start, blk_list, base, fc, tabs, rims, seeds,
+                         rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE, rank, diam, out)
         self.rocks.add(units, out, d_min, level, occ, block_of)
         self.last = {"craters": cr, "fc": fc, "rank": rank, "n_pairs": len(key),
                      "fresh_depth_m": prof.fresh_depth_m}
