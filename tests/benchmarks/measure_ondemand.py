@@ -34,7 +34,8 @@ stand for the regolith's texture (the equilibrium law carried on: with craters e
    same camera, motion, number of tracks and track noise (``control_errors``): the
    error floor of the 5-point essential matrix for a nadir camera moving along its axis
    over near-planar ground, whatever the terrain. (c) The relative pose with its
-   length, from the same tracks and frame a's depth (``pnp_pose``: EPnP in RANSAC and a
+   length, from the same tracks and frame a's depth (``pnp_pose``: OpenCV's USAC with
+   MAGSAC++ and a least-squares polish; beside it EPnP in plain RANSAC and a
    Levenberg-Marquardt polish; the navigation filter's map or LIDAR): rotation error and
    |t_est - t_true| / |t_true|. Terrain that changed between the frames' resolutions
    would move the 3-D points away from where frame b sees them.
@@ -178,13 +179,19 @@ def control_errors(k: np.ndarray, ratio: float, n: int, noise_px: float, size: i
             float(np.degrees(np.arccos(min(1.0, abs(float(t[2])))))))
 
 
-def pnp_pose(p0: np.ndarray, p1: np.ndarray, depth_a: np.ndarray, k: np.ndarray):
+def pnp_pose(p0: np.ndarray, p1: np.ndarray, depth_a: np.ndarray, k: np.ndarray,
+             method: str = "USAC"):
     """(R, t, inliers) with x_b = R x_a + t from tracks ``p0`` (frame a, pixels with
     centres at integers) -> ``p1`` (frame b): p0 back-projected through frame a's depth
     (camera z, bilinear; what a LIDAR or the previous frame's map gives a navigation
-    filter), then EPnP in RANSAC and a Levenberg-Marquardt polish over the inliers. Unlike
-    the essential matrix it gives the translation with its length, and it is well posed
-    for a near-planar scene seen along the direction of motion."""
+    filter), then PnP. Unlike the essential matrix it gives the translation with its
+    length, and it is well posed for a near-planar scene seen along the direction of
+    motion, but poorly conditioned there: a small rotation and a lateral translation of
+    altitude times it move a narrow nadir view's points alike, so a bias of the tracks
+    leaks into both. ``"USAC"`` (default): OpenCV's USAC framework (MAGSAC++ scoring,
+    sigma-consensus local optimisation, a least-squares polish over the inliers; as the
+    essential matrix of ``measure_feature_tracking``); ``"RANSAC"``: EPnP in plain RANSAC
+    (1 px) and a Levenberg-Marquardt polish over its inliers."""
     import cv2
     from scipy.ndimage import map_coordinates
 
@@ -194,15 +201,24 @@ def pnp_pose(p0: np.ndarray, p1: np.ndarray, depth_a: np.ndarray, k: np.ndarray)
         return None
     ray = np.linalg.solve(k, np.vstack([p0[ok].T, np.ones(ok.sum())]))
     xa = (ray * z[ok]).T
-    found, rvec, tvec, inl = cv2.solvePnPRansac(
-        xa, p1[ok].astype(np.float64), k, None, flags=cv2.SOLVEPNP_EPNP,
-        reprojectionError=1.0, confidence=0.99999, iterationsCount=2000)
+    pb = p1[ok].astype(np.float64)
+    if method == "USAC":
+        prm = cv2.UsacParams()
+        prm.threshold, prm.confidence, prm.maxIterations = 1.0, 0.99999, 2000
+        prm.sampler, prm.score = cv2.SAMPLING_UNIFORM, cv2.SCORE_METHOD_MAGSAC
+        prm.loMethod, prm.loIterations, prm.loSampleSize = cv2.LOCAL_OPTIM_SIGMA, 10, 20
+        prm.final_polisher, prm.final_polisher_iterations = cv2.LSQ_POLISHER, 10
+        found, _, rvec, tvec, inl = cv2.solvePnPRansac(xa, pb, k, np.zeros(5), params=prm)
+    else:
+        found, rvec, tvec, inl = cv2.solvePnPRansac(
+            xa, pb, k, None, flags=cv2.SOLVEPNP_EPNP, reprojectionError=1.0,
+            confidence=0.99999, iterationsCount=2000)
     if not found or inl is None or len(inl) < 8:
         return None
     inl = inl.ravel()
-    rvec, tvec = cv2.solvePnPRefineLM(xa[inl], p1[ok][inl].astype(np.float64), k, None,
-                                      rvec, tvec)
-    return cv2.Rodrigues(rvec)[0], tvec.ravel(), len(inl)
+    if method != "USAC":
+        rvec, tvec = cv2.solvePnPRefineLM(xa[inl], pb[inl], k, None, rvec, tvec)
+    return cv2.Rodrigues(rvec)[0], np.ravel(tvec), len(inl)
 
 
 def tracking(run) -> list[dict]:
@@ -221,12 +237,13 @@ def tracking(run) -> list[dict]:
             r_true = rb.T @ ra
             t_full = rb.T @ (pa - pb)
             t_true = t_full / np.linalg.norm(t_full)
-            pnp = pnp_pose(p0, p1, fa.frame.depth_m, k)
-            if pnp is not None:
-                row["pnp_rotation_err_deg"] = mft.rotation_angle_deg(pnp[0] @ r_true.T)
-                row["pnp_translation_rel_err"] = float(np.linalg.norm(pnp[1] - t_full)
-                                                       / np.linalg.norm(t_full))
-                row["pnp_inliers"] = pnp[2]
+            for tag, method in (("pnp", "USAC"), ("pnp_ransac", "RANSAC")):
+                pnp = pnp_pose(p0, p1, fa.frame.depth_m, k, method)
+                if pnp is not None:
+                    row[f"{tag}_rotation_err_deg"] = mft.rotation_angle_deg(pnp[0] @ r_true.T)
+                    row[f"{tag}_translation_rel_err"] = float(
+                        np.linalg.norm(pnp[1] - t_full) / np.linalg.norm(t_full))
+                    row[f"{tag}_inliers"] = pnp[2]
             t_est = np.ravel(t_est) / np.linalg.norm(t_est)
             row["rotation_err_deg"] = mft.rotation_angle_deg(r_est @ r_true.T)
             row["translation_err_deg"] = float(np.degrees(np.arccos(np.clip(
@@ -293,14 +310,17 @@ def main() -> int:
                 print(f"  {name}: {int(np.sum((rot <= 1.0) & (tra <= lim)))} pairs within "
                       f"1 deg and 2 % ({lim:.3g} deg); median rotation {np.nanmedian(rot):.3g}"
                       f" deg, translation {np.nanmedian(tra):.3g} deg")
-            pn = [r for r in ok if "pnp_rotation_err_deg" in r]
-            if pn:
-                rot = np.array([r["pnp_rotation_err_deg"] for r in pn])
-                tra = np.array([r["pnp_translation_rel_err"] for r in pn])
-                print(f"  PnP on frame a's depth: {int(np.sum((rot <= 1.0) & (tra <= 0.02)))} "
-                      f"of {len(rows)} pairs within 1 deg and 2 % of the translation; worst "
-                      f"rotation {rot.max():.3g} deg, worst translation {tra.max():.3%}; "
-                      f"median {np.median(rot):.3g} deg, {np.median(tra):.3%}")
+            for tag, name in (("pnp", "USAC"), ("pnp_ransac", "EPnP-RANSAC + LM")):
+                pn = [r for r in ok if f"{tag}_rotation_err_deg" in r]
+                if not pn:
+                    continue
+                rot = np.array([r[f"{tag}_rotation_err_deg"] for r in pn])
+                tra = np.array([r[f"{tag}_translation_rel_err"] for r in pn])
+                print(f"  PnP ({name}) on frame a's depth: "
+                      f"{int(np.sum((rot <= 1.0) & (tra <= 0.02)))} of {len(rows)} pairs within "
+                      f"1 deg and 2 % of the translation; worst rotation {rot.max():.3g} deg, "
+                      f"worst translation {tra.max():.3%}; median {np.median(rot):.3g} deg, "
+                      f"{np.median(tra):.3%}")
             zoom = np.array([abs(r["zoom_error"]) for r in ok])
             print(f"  track geometry: |zoom / altitude ratio - 1| median {np.median(zoom):.2e}"
                   f" max {zoom.max():.2e}; shift median "
