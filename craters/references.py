@@ -151,6 +151,9 @@ REFERENCES = _entries(
     _R("hiesinger2016", ("Hiesinger, H.", "Marchi, S.", "Schmedemann, N.", "et al."), 2016,
        "Cratering on Ceres: Implications for its crust and evolution",
        "Science 353(6303), aaf4759", "10.1126/science.aaf4759"),
+    _R("gou2018", ("Gou, S.", "Yue, Z.", "Di, K.", "Liu, Z."), 2018,
+       "A global catalogue of Ceres impact craters >= 1 km and preliminary analysis",
+       "Icarus 302, 296-307", "10.1016/j.icarus.2017.11.028"),
     _R("marchi2015", ("Marchi, S.", "Chapman, C. R.", "Barnouin, O. S.", "Richardson, J. E.",
                       "Vincent, J.-B."), 2015, "Cratering on asteroids",
        "Asteroids IV (Michel, DeMeo & Bottke, eds.), University of Arizona Press, Tucson, 725 "

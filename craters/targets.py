@@ -33,8 +33,12 @@ Sources:
 * Mercury: Pike (1988, in Mercury, Univ. Arizona Press): simple d = 0.199 D^0.995,
   complex d = 0.353 D^0.496, transition 10.3 km (MESSENGER laser altimetry of fresh
   craters agrees with these Mariner 10 values: Barnouin et al. 2012, Icarus 219, 414).
-* Ceres: Hiesinger et al. (2016, Science 353): transition 7.5-12 km (10 km used), far
-  below 1/g scaling (an icy, weak crust).
+* Ceres: Hiesinger et al. (2016, Science 353, aaf4759): transition 7.5-12 km (10 km
+  used), far below 1/g scaling (an icy, weak crust). Fresh simple craters d/D 0.11 +-
+  0.04 (Gou et al. 2018, Icarus 302, 296: Dawn HAMO DTM, craters >= 1 km; degraded simple
+  0.05, complex 0.08 +- 0.04): simple d = 0.11 D. Complex depth: Pike's lunar exponent
+  0.301, continuous with the simple law at the transition (d/D 0.068 at 20 km, 0.036 at
+  50 km; not a measured fit).
 * Earth: transition ~2 km in sedimentary, ~4 km in crystalline targets (Grieve 1987);
   3 km used.
 * small-body: fresh asteroid craters d/D = 0.2 (Marchi et al. 2015, as used by Li et al.
@@ -157,6 +161,10 @@ _PIKE_COMPLEX_RIM = (0.236, 0.399)
 _STOPAR_FRESH = ((63.0, 0.13), (141.0, 0.15), (283.0, 0.17), (400.0, 0.21))
 
 
+# fresh simple craters on Ceres (Gou et al. 2018): d/D 0.11
+_CERES_SIMPLE_DEPTH = (0.11, 1.0)
+
+
 def _from_moon(name: str, radius_m: float, gravity: float, source: str, **measured) -> Target:
     """A body whose unmeasured laws are the Moon's scaled by 1/g."""
     f = _MOON_G / gravity
@@ -199,8 +207,10 @@ TARGETS: dict[str, Target] = {
                           complex_depth=(0.353, 0.496), flux_clock="mercury"),
     "earth": _from_moon("earth", 6_371_000.0, 9.81, "Grieve 1987 (transition)",
                         transition_m=3_000.0),
-    "ceres": _from_moon("ceres", 469_700.0, 0.28, "Hiesinger et al. 2016 (transition)",
-                        transition_m=10_000.0),
+    "ceres": _from_moon("ceres", 469_700.0, 0.28,
+                        "Hiesinger et al. 2016 (transition); Gou et al. 2018 (simple d/D)",
+                        transition_m=10_000.0, simple_depth=_CERES_SIMPLE_DEPTH,
+                        complex_depth=(_CERES_SIMPLE_DEPTH[0] * 10.0 ** (1.0 - 0.301), 0.301)),
     "vesta": _from_moon("vesta", 262_700.0, 0.25, "1/g scaling from the Moon"),
 }
 

@@ -86,6 +86,22 @@ def test_mars_and_mercury_fresh_depths_follow_their_fits(body, low, high, simple
             assert m["depth_m"] == pytest.approx(1000 * fit[0] * d_km ** fit[1], rel=0.10)
 
 
+def test_ceres_fresh_simple_craters_follow_gou_and_complex_ones_join_them():
+    """Gou et al. 2018 (Dawn HAMO DTM, craters >= 1 km): fresh simple d/D 0.11 +- 0.04,
+    complex craters 0.08 +- 0.04; transition 7.5-12 km (Hiesinger et al. 2016)."""
+    t = craters.get_target("ceres")
+    assert 7.5e3 <= t.transition_m <= 12e3
+    for d_km in (1.0, 3.0, 6.0):
+        m = crater_morphometry(d_km * 1000.0, target="ceres")
+        assert m["depth_m"] == pytest.approx(0.11 * 1000 * d_km, rel=0.10)
+    for d_km in (15.0, 20.0, 30.0):  # inside the measured spread of complex craters
+        ratio = crater_morphometry(d_km * 1000.0, target="ceres")["depth_m"] / (d_km * 1e3)
+        assert 0.04 <= ratio <= 0.12
+    d = np.geomspace(2e3, 60e3, 300)
+    depth = fresh_morphometry(d, "ceres")["depth_m"]
+    assert (np.abs(depth[1:] / depth[:-1] - 1.0) < 0.02).all()  # no step at the transition
+
+
 @pytest.mark.parametrize("d_m,ratio", [(40.0, 0.13), (63.0, 0.13), (100.0, 0.1415),
                                        (141.0, 0.15), (283.0, 0.17), (1000.0, 0.196)])
 def test_small_fresh_lunar_craters_are_shallower_stopar(d_m, ratio):
