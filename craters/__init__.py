@@ -13,7 +13,8 @@ Imports neither ``latlong`` nor ``dem``.
 ::
 
     targets -> morphology (fresh), diffusion (ageing) -> profile -> stamp
-      (numba: _stamp_kernels)
+      (numba: _stamp_kernels primitives, _raster_stamp_kernels writers, _tilt_kernels
+      craters on steep ground in their base's frame)
     chronology/ (production functions, chronologies, equilibrium; model-age sampling)
       -> layers (power-law and model-age layers) -> population (positions, ages)
       -> catalog (CSV, GeoJSON, craterstats .scc)

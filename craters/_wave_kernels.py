@@ -1,6 +1,6 @@
 """Numba kernels that stamp craters on a raster in parallel waves (issue 20).
 
-Craters whose boxes (:func:`craters._stamp_kernels._crater_box`: every pixel a crater
+Craters whose boxes (:func:`craters._raster_stamp_kernels._crater_box`: every pixel a crater
 reads or writes) are disjoint commute: stamping them in either order gives the same
 heights, bit for bit. :func:`_wave_schedule_kernel` gives each crater, in stamping order,
 the first wave after every earlier crater it may overlap (a greedy independent set per
@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._stamp_kernels import _stamp_one
+from ._raster_stamp_kernels import _stamp_one
 
 # pixels added around each crater's box in the schedule: the box already holds the plane
 # fit, the bilinear rim samples and the writes; the margin makes rounding moot
@@ -68,7 +68,7 @@ def _stamp_waves_kernel(order, starts, alone, n_threads, h, pixel, cx, cy, diam,
                         warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough,
                         gain, out_scale, out_slope, out_erased):
     """Stamp the waves ``order[starts[w]:starts[w + 1]]`` one after the other (arguments
-    from ``h`` on: :func:`craters._stamp_kernels._stamp_many_kernel`'s, full arrays).
+    from ``h`` on: :func:`craters._raster_stamp_kernels._stamp_many_kernel`'s, full arrays).
 
     ``order`` puts a wave's costliest craters first. Those with ``alone`` set (boxes of
     PARALLEL_MIN pixels and more), and a wave's only crater, are stamped one at a time

@@ -24,6 +24,11 @@ Crater profile and stamping:
 * ``lcsn_height(kind, r2, kappa, beta, gamma, a, b)``: LCSN crater kernel ``kind`` at
   squared distance r2 (the formulas of :func:`craters.lcsn_kernel`)
 * ``N_RIM``: samples per azimuth table
+* a crater on steep ground, made in the frame of its tilted base (:mod:`craters._tilt_kernels`):
+  ``tilted_frame(gx, gy, out)`` -> tilt (degrees), ``out`` = (E', N', N, N_z);
+  ``tilted_coords(x, y, z, fr, R, rim_tab)`` -> (u1, u2, w, azimuth, x/R);
+  ``tilted_root(...)``: the vertical change onto the crater's surface inside the rim;
+  ``TILT_MIN_DEG`` (from which a base counts as tilted), ``TILT_MAX_COS`` (the steepest)
 
 Counter-based random numbers:
 
@@ -76,9 +81,13 @@ from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
 from ._stamp_kernels import _table_value as table_value
 from ._stamp_kernels import _warp_x as warp_x
+from ._tilt_kernels import _TILT_MAX_COS as TILT_MAX_COS
+from ._tilt_kernels import TILT_MIN_DEG, tilted_coords, tilted_root
+from ._tilt_kernels import _tilted_frame as tilted_frame
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
            "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",
            "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
            "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
-           "slope_factor", "splitmix64", "table", "table_value", "warp_x"]
+           "slope_factor", "splitmix64", "table", "table_value", "TILT_MAX_COS", "TILT_MIN_DEG",
+           "tilted_coords", "tilted_frame", "tilted_root", "warp_x"]

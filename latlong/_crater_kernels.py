@@ -8,6 +8,8 @@ from numba import njit, prange
 from craters.kernels import (
     DC8,
     DR8,
+    TILT_MAX_COS,
+    TILT_MIN_DEG,
     crater_rough,
     fbm2,
     idw8,
@@ -18,6 +20,7 @@ from craters.kernels import (
     slope_factor,
     table,
     table_value,
+    tilted_frame,
     warp_x,
 )
 
@@ -30,7 +33,7 @@ from ._local_kernels import (  # noqa: F401 - re-exported for the mesh kernels a
     _quadric,
     _stretched,
 )
-from ._tilt_kernels import _TILT_MAX_COS, TILT_MIN_DEG, _tilted_change, _tilted_frame
+from ._tilt_kernels import _tilted_change
 
 
 @njit(cache=True)
@@ -408,8 +411,8 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
     rough = crater_rough(rough, warps[c])
     # on steep ground the crater is made in its base's frame (issue 36)
     fr = np.zeros(10)
-    tilt = _tilted_frame(gx, gy, fr)
-    if tilt < TILT_MIN_DEG or fr[9] < _TILT_MAX_COS:
+    tilt = tilted_frame(gx, gy, fr)
+    if tilt < TILT_MIN_DEG or fr[9] < TILT_MAX_COS:
         fr[9] = 0.0
     dh = np.empty(keep)
     if inner_parallel and keep >= PARALLEL_MIN:

@@ -1,10 +1,10 @@
-"""Numba kernels of a crater stamped in the frame of its tilted base on the lat/long body
-(split from :mod:`latlong._crater_kernels`; issue 36: on steep ground the radial frame
-squeezed craters along the dip into streaks)."""
+"""The lat/long body's writer of a crater made in the frame of its tilted base (split
+from :mod:`latlong._crater_kernels`; the frame and the root: :mod:`craters.kernels`,
+``tilted_frame``, ``tilted_coords``, ``tilted_root``; issue 36: on steep ground the
+radial frame squeezed craters along the dip into streaks)."""
 
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from craters.kernels import (
@@ -13,44 +13,16 @@ from craters.kernels import (
     roughness_amp,
     table,
     table_value,
-    warp_x,
+    tilted_coords,
+    tilted_root,
 )
-
-
-#: Tilt (degrees) of a crater's fitted base from the centre's radial above which it is
-#: stamped in the base's own frame (:func:`_tilted_change`); below it the radial frame
-#: differs from it by less than 1.5 % in distance.
-TILT_MIN_DEG = 10.0
-#: Cosine of the steepest tilt stamped in the base's frame: beyond ~78 deg a radial
-#: height cannot follow the surface (the crater is stamped as on gentler ground).
-_TILT_MAX_COS = 0.2
-_TILT_ITERATIONS = 40
-_SECANT_ITERATIONS = 8  # before falling back to the bracketed root
-
-
-@njit(cache=True)
-def _tilted_frame(gx, gy, out):
-    """The frame of a base of slopes (gx, gy) in the developed local frame (x east, y
-    north, z the centre's radial): ``out`` = (E' (3), N' (3), N (3), N_z): N the base's
-    unit normal, E' east projected on the base and N' = N x E'. Returns the tilt
-    (degrees) from the radial."""
-    ln = np.sqrt(1.0 + gx * gx + gy * gy)
-    nx, ny, nz = -gx / ln, -gy / ln, 1.0 / ln
-    ex, ey, ez = 1.0 - nx * nx, -nx * ny, -nx * nz  # east minus its normal part
-    le = np.sqrt(ex * ex + ey * ey + ez * ez)
-    ex, ey, ez = ex / le, ey / le, ez / le
-    out[0], out[1], out[2] = ex, ey, ez
-    out[3], out[4], out[5] = ny * ez - nz * ey, nz * ex - nx * ez, nx * ey - ny * ex
-    out[6], out[7], out[8] = nx, ny, nz
-    out[9] = nz
-    return np.degrees(np.arccos(min(nz, 1.0)))
 
 
 @njit(cache=True)
 def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta, p0, qa, qb,
                    qc, rough, seed, wavelength, octaves, gain, fr):
     """(inside the ejecta edge?, radial height change) of point ``q`` for a crater stamped
-    in the frame ``fr`` of its tilted base (:func:`_tilted_frame`; issue 36: on steep
+    in the frame ``fr`` of its tilted base (:func:`craters.kernels.tilted_frame`; issue 36: on steep
     ground the radial frame squeezes a crater along the dip into a streak).
 
     The point is taken at its foot on the base plane (where its radial line meets it),
@@ -85,114 +57,3 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
     t = tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, rough[3],
                     has_rough, seed, wavelength, octaves, gain, fr)
     return True, (p0 + r2 + (qa * r0 * r0 + qb * r0 * r1 + qc * r1 * r1) + t) - hgt[q]
-
-
-@njit(cache=True, inline="always")
-def tilted_coords(x, y, z, fr, radius, rim_tab):
-    """(u1, u2, w, azimuth, rim-relative radius) of the point (x, y, z) of the developed
-    local frame in the tilted frame ``fr`` (:func:`_tilted_frame`): its in-plane
-    coordinates along E' and N', its height along the base normal, the in-plane azimuth
-    and its in-plane distance over the rim radius at that azimuth (``rim_tab``: the rim
-    perturbation). One formula for the build (:func:`_tilted_change`) and the on-demand
-    field (:func:`latlong.ondemand._field_kernels._tilted_step`)."""
-    u1 = x * fr[0] + y * fr[1] + z * fr[2]
-    u2 = x * fr[3] + y * fr[4] + z * fr[5]
-    w = x * fr[6] + y * fr[7] + z * fr[8]
-    az = np.arctan2(u2, u1)
-    return u1, u2, w, az, np.sqrt(u1 * u1 + u2 * u2) / (radius * (1.0 + table(rim_tab, az)))
-
-
-@njit(cache=True)
-def tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough,
-                seed, wavelength, octaves, gain, fr):
-    """The radial change t that puts a point inside the rim of a crater stamped in the
-    tilted frame ``fr`` on the crater's surface over the base plane
-    (:func:`_tilted_change`; the point's in-plane coordinates ``u1, u2`` and height ``w0``
-    along the base normal; ``rough``: the bowl, wall and ejecta amplitudes, ``warp``:
-    :func:`craters.kernels.warp_x`'s)."""
-    c = (radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough, seed, wavelength,
-         octaves, gain, fr)
-    # the root of f(t) = g(t) - t, g(t) = (W(u(t)) - w0) / N_z. Where g' < 1 (f falls: a
-    # single root; |grad W| tan(tilt) < 1, nearly every crater) the secant from t = 0 and
-    # the fixed point's first step g(0) finds it in a few evaluations. Elsewhere (f rising
-    # between two iterates, or no convergence): g is bounded (the crater's relief), so
-    # stepping from t = 0 against f's sign brackets a root; then Illinois false position
-    # (a plain fixed point diverges where |grad W| tan(tilt) > 1)
-    ta = 0.0
-    fa = _target(u1, u2, w0, ta, c) - ta
-    if fa == 0.0:
-        return 0.0
-    tol = 1e-9 * radius
-    t0, f0 = ta, fa
-    t1 = fa
-    f1 = _target(u1, u2, w0, t1, c) - t1
-    for _ in range(_SECANT_ITERATIONS):
-        if abs(f1) <= tol:
-            return t1
-        slope = (f1 - f0) / (t1 - t0)
-        if not slope < 0.0:
-            break
-        t2 = t1 - f1 / slope
-        if abs(t2 - t1) <= tol:
-            return t2
-        t0, f0 = t1, f1
-        t1 = t2
-        f1 = _target(u1, u2, w0, t1, c) - t1
-    step = fa
-    tb = ta + step
-    fb = _target(u1, u2, w0, tb, c) - tb
-    k = 0
-    while fa * fb > 0.0 and k < 30:
-        ta, fa = tb, fb
-        step *= 2.0
-        tb = ta + step
-        fb = _target(u1, u2, w0, tb, c) - tb
-        k += 1
-    if fa * fb > 0.0:
-        return 0.0  # no sign change (not reached: g is bounded)
-    side = 0
-    for _ in range(_TILT_ITERATIONS):
-        t = (ta * fb - tb * fa) / (fb - fa)
-        ft = _target(u1, u2, w0, t, c) - t
-        if abs(ft) <= tol or abs(tb - ta) <= tol:
-            return t
-        if ft * fb > 0.0:
-            tb, fb = t, ft
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:
-            ta, fa = t, ft
-            if side == 1:
-                fb *= 0.5
-            side = 1
-    return (ta * fb - tb * fa) / (fb - fa)
-
-
-@njit(cache=True, inline="always")
-def _target(u1, u2, w0, t, c):
-    """:func:`_tilted_target` with the crater's constants ``c`` (:func:`tilted_root`)."""
-    (radius, tab, scale, depth, xe, rim_tab, rough, warp, has_rough, seed, wavelength,
-     octaves, gain, fr) = c
-    return _tilted_target(u1, u2, fr[2], fr[5], fr[9], w0, t, radius, tab, scale, depth, xe,
-                          rim_tab, rough, warp, has_rough, seed, wavelength, octaves, gain)
-
-
-@njit(cache=True)
-def _tilted_target(u1, u2, ez, mz, cz, w0, t, radius, tab, scale, depth, xe, rim_tab, rough,
-                   warp, has_rough, seed, wavelength, octaves, gain):
-    """g(t) of :func:`_tilted_change`: the radial change that would put the point moved
-    radially by t on the crater's surface inside the rim."""
-    v1 = u1 + t * ez
-    v2 = u2 + t * mz
-    xv = (np.sqrt(v1 * v1 + v2 * v2)
-          / (radius * (1.0 + table(rim_tab, np.arctan2(v2, v1)))))
-    if xv > 1.0:  # beyond the rim: W as at the rim (bounded in t, so a root is bracketed)
-        v1 /= xv
-        v2 /= xv
-        xv = 1.0
-    target = scale * table_value(tab, warp_x(xv, v1, v2, radius, warp, seed), xe)
-    if has_rough:
-        target += (roughness_amp(xv, xe, rough[0], rough[1], rough[2]) * depth * scale
-                   * fbm2(seed, v1, v2, wavelength, octaves, gain))
-    return (target - w0) / cz

@@ -11,15 +11,8 @@ import numpy as np
 from numba import njit, prange
 
 from craters.kernels import (
-    fbm2, read_only_inputs, roughness_amp, slope_factor, table, table_value, warp_x,
-)
-
-from .._tilt_kernels import (
-    _TILT_MAX_COS,
-    TILT_MIN_DEG,
-    _tilted_frame,
-    tilted_coords,
-    tilted_root,
+    TILT_MAX_COS, TILT_MIN_DEG, fbm2, read_only_inputs, roughness_amp, slope_factor, table,
+    table_value, tilted_coords, tilted_frame, tilted_root, warp_x,
 )
 
 # crater record columns (float64 array "fc", one row per crater)
@@ -112,7 +105,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
 @njit(cache=True)
 def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
     """:func:`_step` of a crater made in its tilted base's frame (as the sequential stamp,
-    :func:`latlong._tilt_kernels._tilted_change`): the point's in-plane coordinates and
+    the body's :func:`latlong._tilt_kernels._tilted_change`): the point's in-plane coordinates and
     height along the base normal are those of its foot on the base plane, so the map
     does not depend on the height before it; inside the rim the radius where the radial
     line meets the crater's surface over the base plane (plus the base's curvature,
@@ -240,8 +233,8 @@ def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims
     slope = np.degrees(np.arctan2(np.sqrt(cr0 * cr0 + cr1 * cr1 + cr2 * cr2),
                                   l0 * r0 + l1 * r1 + l2 * r2))
     # on steep ground the crater is made in its base's frame (issue 36), as sequentially
-    if _tilted_frame(gx, gy, fc[k, TILT:TILT + 10]) < TILT_MIN_DEG \
-            or fc[k, TILT_CZ] < _TILT_MAX_COS:
+    if tilted_frame(gx, gy, fc[k, TILT:TILT + 10]) < TILT_MIN_DEG \
+            or fc[k, TILT_CZ] < TILT_MAX_COS:
         fc[k, TILT_CZ] = 0.0
     scale = slope_factor(slope, onset, full) if slope_erosion else 1.0
     if slope_erosion and slope >= full:

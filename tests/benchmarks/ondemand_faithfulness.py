@@ -92,10 +92,9 @@ from scipy.spatial import cKDTree
 
 from crater_depth import rim_minus_floor
 
-from craters.kernels import fbm2, roughness_amp, table, table_value
+from craters.kernels import fbm2, roughness_amp, table, table_value, tilted_root
 from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_profiles
 from latlong import Body, LatLongGrid, Scene, stamp_craters
-from latlong._tilt_kernels import tilted_root  # the tilted frame's root finder
 from latlong.cratering import crater_extents_deg
 from latlong.ondemand import _field_kernels as K  # the field's per-crater record columns
 from latlong.ondemand.base import grid_catalog, grid_directions
@@ -267,7 +266,7 @@ def _tilted_interior(fc, k, x, y, tabs, rims, seeds, rough, gain, octaves, xe, r
     """Surface minus crater k's interior for a crater made in its tilted base's frame
     (NaN outside its rim): the point's foot on the base plane in the frame's coordinates,
     and the radial line's meeting with the crater's surface over the base plane (the
-    sequential stamp's root finder, ``latlong._tilt_kernels.tilted_root``) plus the
+    sequential stamp's root finder, ``craters.kernels.tilted_root``) plus the
     quadric's curvature radially."""
     fr = fc[k, K.TILT:K.TILT + 10]
     r2 = fc[k, K.GX] * x + fc[k, K.GY] * y

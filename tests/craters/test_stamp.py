@@ -67,20 +67,43 @@ def test_fresh_1km_on_flat_grid(grid_r):
 
 
 def test_degraded_on_tilted_plane(grid_r):
-    xx, _, r = grid_r
-    terrain = xx * PIX * np.tan(np.radians(20.0))
+    xx, yy, r = grid_r
+    g = np.tan(np.radians(20.0))
+    terrain = xx * PIX * g
     h, cat = stamp(terrain, PIX, Crater(C * PIX, C * PIX, 1000.0, degradation=0.3),
                    roughness=False, return_catalog=True)
     assert np.array_equal(h[r > 1525.0], terrain[r > 1525.0])  # far field bit-for-bit
     depth = cat["depth_m"][0]
     steps = max(np.abs(np.diff(h, axis=0)).max(), np.abs(np.diff(h, axis=1)).max())
     assert steps <= 0.1 * depth
-    # on a plane the crater is the flat-ground profile added to the plane
+    # on ground tilted by 10 deg or more the crater is made in the plane's frame (issue
+    # 36; stamped along z it was 6 % longer along the dip at 20 deg): the flat-ground
+    # profile of the in-plane distance, along the plane's normal
     one = craters.make_catalog(x_m=[0.0], y_m=[0.0], diameter_m=[1000.0], degradation=[0.3])
-    want = terrain + table_profile(r / 500.0, one)
-    assert np.allclose(h, want, rtol=0, atol=1e-6)
+    ln = np.hypot(g, 1.0)
+    dx, dy, dz = (xx - C) * PIX, (yy - C) * PIX, h - C * PIX * g
+    u, w = (dx + g * dz) / ln, (dz - g * dx) / ln
+    inside = np.hypot(u, dy) < 0.98 * 500.0
+    assert np.allclose(w[inside], table_profile(np.hypot(u, dy)[inside] / 500.0, one),
+                       rtol=0, atol=1e-5)  # inside the rim: on the crater's surface
+    # outside: the profile at the pixel's foot on the plane, over N_z, added vertically
+    x_foot = np.hypot(dx * ln, dy) / 500.0
+    out = (x_foot > 1.0) & (r <= 1525.0)
+    assert np.allclose(h[out], terrain[out] + ln * table_profile(x_foot[out], one), rtol=0,
+                       atol=1e-9)
     assert cat["degradation"][0] == pytest.approx(0.3, abs=0.01)
     assert cat["slope_deg"][0] == pytest.approx(20.0, abs=1e-6)
+
+
+def test_gentle_slopes_keep_the_vertical_stamp(grid_r):
+    """Below TILT_MIN_DEG (10 deg) the crater is the flat-ground profile added to the
+    plane (the frames differ by < 1.5 % in distance)."""
+    xx, _, r = grid_r
+    terrain = xx * PIX * np.tan(np.radians(8.0))
+    h = stamp(terrain, PIX, Crater(C * PIX, C * PIX, 1000.0, degradation=0.3),
+              roughness=False)
+    one = craters.make_catalog(x_m=[0.0], y_m=[0.0], diameter_m=[1000.0], degradation=[0.3])
+    assert np.allclose(h, terrain + table_profile(r / 500.0, one), rtol=0, atol=1e-6)
 
 
 def test_steep_slope_erodes_more():
@@ -113,8 +136,11 @@ def test_rough_terrain_no_steps_and_far_field(rng):
 
 
 def test_age_order_young_on_top():
-    cat = craters.make_catalog(x_m=[100.0, 130.0], y_m=[100.0, 100.0],
+    # overlapping, each on the other's gentle outer flank (< 10 deg: stamped along z, so
+    # a symmetric second difference shows the profile; on a wall it is tilted, issue 36)
+    cat = craters.make_catalog(x_m=[100.0, 150.0], y_m=[100.0, 100.0],
                                diameter_m=[80.0, 60.0], age_gyr=[1.0, 2.0])
+
     def bowl_intact(h, cx, diameter):
         # symmetric second differences cancel the fitted plane: a crater stamped last
         # shows exactly its profile's curvature around its centre
@@ -125,11 +151,11 @@ def test_age_order_young_on_top():
         return abs(got - 2 * (p[1] - p[0])) < 1e-9
 
     h = stamp_many(np.zeros((201, 201)), 1.0, cat, roughness=False, slope_erosion=False)
-    assert bowl_intact(h, 100, 80.0) and not bowl_intact(h, 130, 60.0)
+    assert bowl_intact(h, 100, 80.0) and not bowl_intact(h, 150, 60.0)
     swapped = cat.copy()
     swapped["age_gyr"] = [2.0, 1.0]
     h2 = stamp_many(np.zeros((201, 201)), 1.0, swapped, roughness=False, slope_erosion=False)
-    assert bowl_intact(h2, 130, 60.0) and not bowl_intact(h2, 100, 80.0)
+    assert bowl_intact(h2, 150, 60.0) and not bowl_intact(h2, 100, 80.0)
 
 
 def test_stamped_catalog_and_determinism():

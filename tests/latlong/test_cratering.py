@@ -351,7 +351,7 @@ def test_craters_on_steep_ground_are_made_in_the_base_frame():
 
 
 def test_tilted_frame_is_orthonormal_with_the_base_normal():
-    from latlong._tilt_kernels import _tilted_frame
+    from craters.kernels import tilted_frame as _tilted_frame
 
     for gx, gy in ((0.0, 0.0), (0.7, 0.0), (-0.3, 1.2)):
         fr = np.zeros(10)
@@ -373,7 +373,8 @@ def test_a_tilted_crater_replaces_the_terrain_inside_its_rim_whatever_its_height
     # radially), whatever its height before; outside the ejecta add along the normal.
     # Deciding at the vertex itself caught vertices far off a poorly fitted base
     from craters.kernels import table_value
-    from latlong._tilt_kernels import _tilted_change, _tilted_frame
+    from craters.kernels import tilted_frame as _tilted_frame
+    from latlong._tilt_kernels import _tilted_change
 
     gx, gy, p0, qa, qb, qc = 0.9, -0.2, 3.0, 1e-3, -5e-4, 2e-3
     fr = np.zeros(10)

@@ -8,10 +8,9 @@ import pytest
 
 from craters import CraterLayer
 from craters.cells import cell_ids, cell_of, cell_solid_angle
-from craters.kernels import fbm2, roughness_amp, table, table_value, warp_x
+from craters.kernels import fbm2, roughness_amp, table, table_value, tilted_root, warp_x
 from craters.local import bins, draw_cells
 from latlong import LatLongGrid, Scene, build
-from latlong._tilt_kernels import tilted_root
 from latlong.ondemand import _field_kernels as K
 from latlong.ondemand import heights_at, units_of
 from latlong.ondemand.cellsets import unique_inverse, unique_sorted
