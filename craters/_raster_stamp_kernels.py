@@ -1,7 +1,7 @@
 """Numba kernels that stamp Martin craters into a 2-D height grid (a DEM raster), in
 place, oldest first: per crater the plane fit, slope erosion, rim offsets and the writer
 (on steep ground in the frame of the tilted base: :mod:`craters._tilt_kernels`). The
-profile, noise and plane primitives are :mod:`craters._stamp_kernels`'; the wave-parallel
+profile, noise and plane primitives are in :mod:`craters._stamp_kernels`; the wave-parallel
 scheduler over :func:`_stamp_one` is :mod:`craters._wave_kernels`.
 """
 
@@ -13,6 +13,7 @@ from numba import njit, prange
 from ._stamp_kernels import (
     PARALLEL_MIN,
     _crater_rough,
+    _fbm2,
     _fit_plane,
     _outer_weight,
     _rim_offsets,
@@ -22,7 +23,6 @@ from ._stamp_kernels import (
     _table,
     _table_value,
     _warp_x,
-    _fbm2,
 )
 from ._tilt_kernels import _TILT_MAX_COS, TILT_MIN_DEG, _tilted_frame, _tilted_pixel
 

@@ -10,7 +10,7 @@ plane fit, bilinear sampling and hash come from ``_raster_kernels`` and ``_rng_k
 from __future__ import annotations
 
 import numpy as np
-from numba import njit, prange
+from numba import njit
 
 from ._raster_kernels import PLANE_SUMS0, _bilinear, _plane_solve, _plane_sums_add
 from ._rng_kernels import GOLDEN, _mix64

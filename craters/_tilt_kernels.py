@@ -19,19 +19,16 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._stamp_kernels import (
-    _fbm2 as fbm2,
-    _outer_weight as outer_weight,
-    _roughness_amp as roughness_amp,
-    _table as table,
-    _table_value as table_value,
-    _warp_x as warp_x,
-)
-
+from ._stamp_kernels import _fbm2 as fbm2
+from ._stamp_kernels import _outer_weight as outer_weight
+from ._stamp_kernels import _roughness_amp as roughness_amp
+from ._stamp_kernels import _table as table
+from ._stamp_kernels import _table_value as table_value
+from ._stamp_kernels import _warp_x as warp_x
 
 #: Tilt (degrees) of a crater's fitted base from the centre's radial above which it is
-#: stamped in the base's own frame; below it the radial frame
-#: differs from it by less than 1.5 % in distance.
+#: stamped in the base's own frame; below it the vertical (radial) frame differs from it
+#: by less than 1.5 % in distance.
 TILT_MIN_DEG = 10.0
 #: Cosine of the steepest tilt stamped in the base's frame: beyond ~78 deg a radial
 #: height cannot follow the surface (the crater is stamped as on gentler ground).

@@ -36,8 +36,8 @@ import numba
 import numpy as np
 
 from ._diffusion_kernels import _rim_and_floor, _rim_spectra, _scale_rims
-from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
 from ._raster_stamp_kernels import _stamp_many_kernel
+from ._shared import check_finite, check_positive, check_range, normalize_rng, progress_bar
 from ._stamp_kernels import N_RIM, PARALLEL_MIN
 from ._wave_kernels import WAVE_MARGIN, _stamp_waves_kernel, _wave_schedule_kernel
 from .catalog import make_catalog, sort_oldest_first, validate_catalog

@@ -11,8 +11,18 @@ import numpy as np
 from numba import njit, prange
 
 from craters.kernels import (
-    TILT_MAX_COS, TILT_MIN_DEG, fbm2, read_only_inputs, roughness_amp, slope_factor, table,
-    table_value, tilted_coords, tilted_frame, tilted_root, warp_x,
+    TILT_MAX_COS,
+    TILT_MIN_DEG,
+    fbm2,
+    read_only_inputs,
+    roughness_amp,
+    slope_factor,
+    table,
+    table_value,
+    tilted_coords,
+    tilted_frame,
+    tilted_root,
+    warp_x,
 )
 
 # crater record columns (float64 array "fc", one row per crater)
