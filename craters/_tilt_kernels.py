@@ -166,6 +166,21 @@ def _tilted_target(u1, u2, ez, mz, cz, w0, t, radius, tab, scale, depth, xe, rim
 
 
 @njit(cache=True, inline="always")
+def tilted_ejecta(x, xe, u1, u2, tab, scale, depth, rough, has_rough, seed, wavelength,
+                  octaves, gain, cz):
+    """Outside the rim (``x`` rim radii, in-plane coordinates ``u1, u2``) a tilted crater's
+    profile and roughness overlay (``rough``: bowl, wall, ejecta amplitudes; added when
+    ``has_rough``) along its base normal, as a vertical height (over N_z = ``cz``). The
+    writers add it to the terrain (a body's, a raster's) or to the blended base (the
+    on-demand field)."""
+    add = scale * table_value(tab, x, xe)
+    if has_rough:
+        add += (roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
+                * fbm2(seed, u1, u2, wavelength, octaves, gain))
+    return add / cz
+
+
+@njit(cache=True, inline="always")
 def _tilted_pixel(hv, dx, dy, radius, tab, scale, depth, xe, rim_tab, delta, p0, gx, gy, rough,
                   seed, wavelength, octaves, gain, fr):
     """(inside the ejecta edge?, new height) of a raster pixel at (dx, dy) metres from the
@@ -179,11 +194,9 @@ def _tilted_pixel(hv, dx, dy, radius, tab, scale, depth, xe, rim_tab, delta, p0,
         return False, hv
     has_rough = rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0
     if x > 1.0:
-        add = scale * table_value(tab, x, xe)
-        if has_rough:
-            add += (roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
-                    * fbm2(seed, u1, u2, wavelength, octaves, gain))
-        return True, hv + add / fr[9] + table(delta, az) * outer_weight(x, xe)
+        return True, (hv + tilted_ejecta(x, xe, u1, u2, tab, scale, depth, rough, has_rough,
+                                         seed, wavelength, octaves, gain, fr[9])
+                      + table(delta, az) * outer_weight(x, xe))
     t = tilted_root(u1, u2, w0, radius, tab, scale, depth, xe, rim_tab, rough, rough[3],
                     has_rough, seed, wavelength, octaves, gain, fr)
     return True, p0 + r2 + t

@@ -28,6 +28,7 @@ Crater profile and stamping:
   ``tilted_frame(gx, gy, out)`` -> tilt (degrees), ``out`` = (E', N', N, N_z);
   ``tilted_coords(x, y, z, fr, R, rim_tab)`` -> (u1, u2, w, azimuth, x/R);
   ``tilted_root(...)``: the vertical change onto the crater's surface inside the rim;
+  ``tilted_ejecta(...)``: its profile and roughness outside the rim, as a vertical height;
   ``TILT_MIN_DEG`` (from which a base counts as tilted), ``TILT_MAX_COS`` (the steepest)
 
 Counter-based random numbers:
@@ -82,7 +83,7 @@ from ._stamp_kernels import _table as table
 from ._stamp_kernels import _table_value as table_value
 from ._stamp_kernels import _warp_x as warp_x
 from ._tilt_kernels import _TILT_MAX_COS as TILT_MAX_COS
-from ._tilt_kernels import TILT_MIN_DEG, tilted_coords, tilted_root
+from ._tilt_kernels import TILT_MIN_DEG, tilted_coords, tilted_ejecta, tilted_root
 from ._tilt_kernels import _tilted_frame as tilted_frame
 
 __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
@@ -90,4 +91,4 @@ __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id"
            "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
            "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
            "slope_factor", "splitmix64", "table", "table_value", "TILT_MAX_COS", "TILT_MIN_DEG",
-           "tilted_coords", "tilted_frame", "tilted_root", "warp_x"]
+           "tilted_coords", "tilted_ejecta", "tilted_frame", "tilted_root", "warp_x"]

@@ -7,15 +7,7 @@ from __future__ import annotations
 
 from numba import njit
 
-from craters.kernels import (
-    fbm2,
-    outer_weight,
-    roughness_amp,
-    table,
-    table_value,
-    tilted_coords,
-    tilted_root,
-)
+from craters.kernels import outer_weight, table, tilted_coords, tilted_ejecta, tilted_root
 
 
 @njit(cache=True)
@@ -45,11 +37,9 @@ def _tilted_change(q, xl, yl, hgt, radius, tab, scale, depth, xe, rim_tab, delta
         return False, 0.0
     has_rough = rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0
     if x > 1.0:
-        add = scale * table_value(tab, x, xe)
-        if has_rough:
-            add += (roughness_amp(x, xe, rough[0], rough[1], rough[2]) * depth * scale
-                    * fbm2(seed, u1, u2, wavelength, octaves, gain))
-        return True, add / cz + table(delta, az) * outer_weight(x, xe)
+        return True, (tilted_ejecta(x, xe, u1, u2, tab, scale, depth, rough, has_rough, seed,
+                                    wavelength, octaves, gain, cz)
+                      + table(delta, az) * outer_weight(x, xe))
     # the crater over its base plane in the plane's frame, and the base's curvature (the
     # quadric's quadratic part) radially, as outside the rim (where the rim offset takes
     # the terrain to the quadric): the rim is continuous whatever the curvature (with the

@@ -20,6 +20,7 @@ from craters.kernels import (
     table,
     table_value,
     tilted_coords,
+    tilted_ejecta,
     tilted_frame,
     tilted_root,
     warp_x,
@@ -136,11 +137,8 @@ def _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y):
         t_root = tilted_root(u1, u2, w0, radius, tabs[k], scale, fc[k, DEPTH], xe, rims[k],
                              rough, fc[k, WARP], has_rough, seeds[k], radius, octaves, gain, fr)
         return True, 0.0, (fc[k, RHO] + _quadric(fc, k, x, y)) + t_root
-    add = scale * table_value(tabs[k], xr, xe)
-    if has_rough:
-        amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
-        add += amp * fbm2(seeds[k], u1, u2, radius, octaves, gain)
-    prof = add / fr[9]
+    prof = tilted_ejecta(xr, xe, u1, u2, tabs[k], scale, fc[k, DEPTH], rough, has_rough,
+                         seeds[k], radius, octaves, gain, fr[9])
     if xr < xb:
         t = (xb - xr) / (xb - 1.0)
         w = 1.0 - t * t
