@@ -1,19 +1,24 @@
 """Measure terrain on demand (issue 37): tile times at every scale, a descent from orbit to
 touchdown, and how consistent its frames are.
 
-Scene: a lunar-like equilibrium surface, the Moon's radius and crater morphology, power-
-law craters N_cum = 0.08 D^-2 per m^2 (about the lunar equilibrium density: Gault 1970,
-Radio Sci. 5, 273, finds N_cum ~ 10^-1.1 D^-2 for steady-state small craters) from 2.5
-mm to 20 km, one layer per octave of diameter, each layer's ages uniform up to the age at
-which diffusion has removed 90 % of its largest crater's fresh depth (``lifetime_gyr``:
-the project's diffusion model, Fassett & Thomson 2014/2015's D-dependent diffusivity;
-~10 Myr at 1 m, ~1.5 Gyr at 100 m, capped at 3.5 Gyr), so that every size shows the
-same mix of fresh and worn craters, as a steady state does (with one layer per decade
-the mix jumped at each decade and so did the pictures' fine detail); and rocks of 5 mm
-to 5 m (N_cum = 7e-4 D^-2.11 per m^2, examples/moon_site.toml). Below 2 cm the craters
-stand for the regolith's texture (the equilibrium law carried on: with craters ending at
-2 cm the frames below 2 m lost their fine detail, 0.24 of the 10 km share).
-
+Scene: a lunar mare at 3.5 Gyr, the Moon's radius and crater morphology. Below 163.84 m
+the surface is saturated: power-law craters N_cum = 0.08 D^-2 per m^2 (about the lunar
+equilibrium density: Gault 1970, Radio Sci. 5, 273, finds N_cum ~ 10^-1.1 D^-2 for
+steady-state small craters) from 2.5 mm, one layer per octave of diameter, each layer's
+ages uniform up to the age at which diffusion has removed 90 % of its largest crater's
+fresh depth (``lifetime_gyr``: the project's diffusion model, Fassett & Thomson
+2014/2015's D-dependent diffusivity; ~10 Myr at 1 m, ~1.5 Gyr at 100 m), so that every
+size shows the same mix of fresh and worn craters, as a steady state does (with one
+layer per decade the mix jumped at each decade and so did the pictures' fine detail).
+From 163.84 m to 20 km the craters are in production: Neukum's lunar production
+function at 3.5 Gyr, ages from the chronology's flux (``npf=moon,age_gyr=3.5``; it meets
+Trask's equilibrium at 179 m, ``craters.chronology.saturation_diameter_m``, and 163.84 m
+is the octave edge nearest). Until stop 53 the equilibrium law ran up to 20 km: 25 x the
+km-sized craters of a 3.5 Gyr mare, whose deep fresh bowls held the 10 km frames' power
+at their largest scales (top-octave share 0.018 against 0.03-0.08 closer in). Rocks of
+5 mm to 5 m (N_cum = 7e-4 D^-2.11 per m^2, examples/moon_site.toml). Below 2 cm the
+craters stand for the regolith's texture (the equilibrium law carried on: with craters
+ending at 2 cm the frames below 2 m lost their fine detail, 0.24 of the 10 km share).
 1. Tiles: a 1024^2 window (``latlong.ondemand.tile.tile``) at 100 m, 10 m, 1 m, 10 cm and
    1 cm pixels, the second of two runs (compiled; the field's kept crater parameters
    cleared, so every crater's base is fitted again), seconds and nanoseconds per pixel,
@@ -80,9 +85,13 @@ def octave_layers(d_lo_m: float = 0.02, d_hi_m: float = 20000.0) -> list[str]:
     return out
 
 
+#: Where the mare's craters leave equilibrium for production (module notes).
+SATURATED_BELOW_M = 163.84
 # the texture layers below 2 cm last: a layer's index is part of its craters' counter key,
 # so the layers above keep theirs (and their craters)
-LAYERS = octave_layers() + octave_layers(0.0025, 0.02)
+LAYERS = (octave_layers(0.02, SATURATED_BELOW_M)
+          + [f"npf=moon,age_gyr=3.5,d_min_m={SATURATED_BELOW_M:g},d_max_m=20000"]
+          + octave_layers(0.0025, 0.02))
 ROCKS = ["c=7e-4,k=-2.11,d_min_m=0.005,d_max_m=5,burial_max=0.5"]
 SITE = [0.0, 0.0]
 SUN_ELEVATION_DEG = [25.0]
