@@ -156,6 +156,49 @@ def _log_kernel(x, out):
         out[i] = _log(x[i])
 
 
+# --------------------------------------------------------------------------- model ages
+_LN10 = math.log(10.0)
+
+
+@njit(cache=True)
+def _pf_bisect_kernel(coeffs_rev, target, a, b, halvings, out):
+    """log10(D / km) where a production function's shape N(>D) / N(>1 km) meets
+    ``target`` (decreasing in D), bisected ``halvings`` times from [a, b]: the
+    operations of :func:`craters.local._bisect` over ``_pf_shape(layer, 10**v km)`` one
+    element at a time (``coeffs_rev``: the polynomial's coefficients but a0, highest
+    first), so the same bytes."""
+    for i in range(target.shape[0]):
+        lo = a
+        hi = b
+        for _ in range(halvings):
+            mid = 0.5 * (lo + hi)
+            x = _log(_exp(mid * _LN10) * 1e3 * 1e-3) / _LN10
+            s = 0.0
+            for c in coeffs_rev:
+                s = (s + c) * x
+            if _exp(s * _LN10) > target[i]:
+                lo = mid
+            else:
+                hi = mid
+        out[i] = 0.5 * (lo + hi)
+
+
+@njit(cache=True)
+def _age_bisect_kernel(c0, c1, c2, c3, target, a, b, halvings, out):
+    """The age (Gyr) where a chronology N(>1 km) = c0 (e^(c1 t) - 1) + c2 t^2 + c3 t
+    (increasing) meets ``target``, bisected as :func:`_pf_bisect_kernel`."""
+    for i in range(target.shape[0]):
+        lo = a
+        hi = b
+        for _ in range(halvings):
+            mid = 0.5 * (lo + hi)
+            if c0 * (_exp(c1 * mid) - 1.0) + c2 * mid * mid + c3 * mid < target[i]:
+                lo = mid
+            else:
+                hi = mid
+        out[i] = 0.5 * (lo + hi)
+
+
 # --------------------------------------------------------------------------- distributions
 @njit(cache=True)
 def _poisson(u, mean):

@@ -41,6 +41,7 @@ import math
 
 import numpy as np
 
+from ._counter_kernels import _age_bisect_kernel, _pf_bisect_kernel
 from .boulders import BoulderLayer
 from .boulders.placement import MIN_BURIAL
 from .cells import cell_parts, cell_points
@@ -171,30 +172,22 @@ def _bin_density(layer, lo: float, hi: float) -> tuple[float, float]:
     return (cap, cap / density) if cap < density else (density, 1.0)
 
 
-def _bisect(f, target: np.ndarray, a: float, b: float, increasing: bool) -> np.ndarray:
-    """x in [a, b] with f(x) = target (f monotone), by bisection: the same bytes
-    everywhere when f is portable."""
-    lo = np.full(target.shape, float(a))
-    hi = np.full(target.shape, float(b))
-    for _ in range(_BISECTIONS):
-        mid = 0.5 * (lo + hi)
-        below = (f(mid) < target) if increasing else (f(mid) > target)
-        lo = np.where(below, mid, lo)
-        hi = np.where(below, hi, mid)
-    return 0.5 * (lo + hi)
-
-
 def _model_age_draws(layer: ModelAgeLayer, lo: float, hi: float, share: float,
                      u_d: np.ndarray, u_age: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Diameters in [lo, hi) and formation ages of a model-age layer's bin from uniforms."""
     s = _pf_shape(layer, np.array([lo, hi]))
-    target = s[0] - u_d * (s[0] - s[1])
-    x = _bisect(lambda v: _pf_shape(layer, _p10(v) * 1e3), target,
-                math.log10(lo * 1e-3), math.log10(hi * 1e-3), increasing=False)
+    target = np.ascontiguousarray(s[0] - u_d * (s[0] - s[1]))
+    system = get_chronology_system(layer.npf)
+    x = np.empty_like(target)  # _bisect over _pf_shape(layer, 10**v km), compiled
+    _pf_bisect_kernel(np.array(system.production.coefficients[:0:-1], dtype=np.float64),
+                      target, math.log10(lo * 1e-3), math.log10(hi * 1e-3), _BISECTIONS, x)
     d = np.clip(_p10(x) * 1e3, lo, np.nextafter(hi, 0.0))
     age = layer.age_gyr
     n_t = float(_n1(layer, np.array([age]))[0])
-    ages = _bisect(lambda t: _n1(layer, t), u_age * share * n_t, 0.0, age, increasing=True)
+    ages = np.empty_like(target)  # _bisect over _n1(layer, t), compiled
+    c0, c1, c2, c3 = (float(c) for c in system.chronology.coefficients)
+    _age_bisect_kernel(c0, c1, c2, c3, np.ascontiguousarray(u_age * share * n_t), 0.0,
+                       float(age), _BISECTIONS, ages)
     return d, np.clip(ages, 0.0, age)
 
 
