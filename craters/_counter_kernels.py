@@ -164,9 +164,10 @@ _LN10 = math.log(10.0)
 def _pf_bisect_kernel(coeffs_rev, target, a, b, halvings, out):
     """log10(D / km) where a production function's shape N(>D) / N(>1 km) meets
     ``target`` (decreasing in D), bisected ``halvings`` times from [a, b]: the
-    operations of :func:`craters.local._bisect` over ``_pf_shape(layer, 10**v km)`` one
-    element at a time (``coeffs_rev``: the polynomial's coefficients but a0, highest
-    first), so the same bytes."""
+    operations of the numpy bisection over ``craters.local._pf_shape(layer, 10**v km)``
+    that it replaced (the reference in tests/craters/test_local_model_age.py), one
+    element at a time, so the same bytes (``coeffs_rev``: the polynomial's coefficients
+    but a0, highest first)."""
     for i in range(target.shape[0]):
         lo = a
         hi = b

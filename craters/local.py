@@ -178,13 +178,13 @@ def _model_age_draws(layer: ModelAgeLayer, lo: float, hi: float, share: float,
     s = _pf_shape(layer, np.array([lo, hi]))
     target = np.ascontiguousarray(s[0] - u_d * (s[0] - s[1]))
     system = get_chronology_system(layer.npf)
-    x = np.empty_like(target)  # _bisect over _pf_shape(layer, 10**v km), compiled
+    x = np.empty_like(target)  # halvings over _pf_shape(layer, 10**v km), compiled
     _pf_bisect_kernel(np.array(system.production.coefficients[:0:-1], dtype=np.float64),
                       target, math.log10(lo * 1e-3), math.log10(hi * 1e-3), _BISECTIONS, x)
     d = np.clip(_p10(x) * 1e3, lo, np.nextafter(hi, 0.0))
     age = layer.age_gyr
     n_t = float(_n1(layer, np.array([age]))[0])
-    ages = np.empty_like(target)  # _bisect over _n1(layer, t), compiled
+    ages = np.empty_like(target)  # halvings over _n1(layer, t), compiled
     c0, c1, c2, c3 = (float(c) for c in system.chronology.coefficients)
     _age_bisect_kernel(c0, c1, c2, c3, np.ascontiguousarray(u_age * share * n_t), 0.0,
                        float(age), _BISECTIONS, ages)
