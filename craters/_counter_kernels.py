@@ -157,7 +157,7 @@ def _log_kernel(x, out):
 
 
 # --------------------------------------------------------------------------- model ages
-_LN10 = math.log(10.0)
+_LN10 = math.log(10.0)  # (craters.local's too: the kernels and the numpy path agree)
 
 
 @njit(cache=True)

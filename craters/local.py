@@ -41,7 +41,7 @@ import math
 
 import numpy as np
 
-from ._counter_kernels import _age_bisect_kernel, _pf_bisect_kernel
+from ._counter_kernels import _LN10, _age_bisect_kernel, _pf_bisect_kernel
 from .boulders import BoulderLayer
 from .boulders.placement import MIN_BURIAL
 from .cells import cell_parts, cell_points
@@ -72,7 +72,6 @@ _RIM_COUNTERS = 4  # 16 words for the 15 rim phases
 _ROCK_COUNTERS = 6  # 24 words: 18 for the facets, 3 for elongation, height, burial
 _MAX_CANDIDATES = 64  # position candidates per crater (acceptance >= 0.19 a candidate)
 _TWO_PI = 2.0 * np.pi
-_LN10 = math.log(10.0)
 _BISECTIONS = 64  # halvings of a bracket: past the last bit of a double
 
 
