@@ -8,7 +8,9 @@ Gaussian. They take no validation: callers validate first.
 Crater profile and stamping:
 
 * ``table_value(tab, x, x_e)``: a crater's profile table (heights at evenly spaced radii
-  over [0, x_e], :func:`craters.diffusion.profile_tables`) at x radii (Catmull-Rom, C1)
+  over [0, x_e], :func:`craters.diffusion.profile_tables`) at x radii (Catmull-Rom, C1);
+  ``table_row_value(tabs, k, x, x_e)`` the same of row k, read in place (no row view in a
+  parallel loop)
 * ``outer_weight(x, x_e)``: the share of the plane-to-terrain offset at the rim carried
   at x outside the rim
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane
@@ -80,6 +82,7 @@ from ._stamp_kernels import _roughness_amp as roughness_amp
 from ._stamp_kernels import _roughness_octaves as roughness_octaves
 from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
+from ._stamp_kernels import _table_row_value as table_row_value
 from ._stamp_kernels import _table_value as table_value
 from ._stamp_kernels import _warp_x as warp_x
 from ._tilt_kernels import _TILT_MAX_COS as TILT_MAX_COS
@@ -90,5 +93,6 @@ __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id"
            "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",
            "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
            "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
-           "slope_factor", "splitmix64", "table", "table_value", "TILT_MAX_COS", "TILT_MIN_DEG",
+           "slope_factor", "splitmix64", "table", "table_row_value", "table_value", "TILT_MAX_COS",
+           "TILT_MIN_DEG",
            "tilted_coords", "tilted_ejecta", "tilted_frame", "tilted_root", "warp_x"]

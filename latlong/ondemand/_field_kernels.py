@@ -18,7 +18,7 @@ from craters.kernels import (
     roughness_amp,
     slope_factor,
     table,
-    table_value,
+    table_row_value,
     tilted_coords,
     tilted_ejecta,
     tilted_frame,
@@ -96,7 +96,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]
-    prof = scale * table_value(tabs[k], warp_x(xr, x, y, radius, fc[k, WARP], seeds[k]), xe)
+    prof = scale * table_row_value(tabs, k, warp_x(xr, x, y, radius, fc[k, WARP], seeds[k]), xe)
     if octaves > 0 and (rough[0] > 0.0 or rough[1] > 0.0 or rough[2] > 0.0):
         amp = roughness_amp(xr, xe, rough[0], rough[1], rough[2]) * fc[k, DEPTH] * scale
         # below a millionth of the radius (a crater diffused flat) the overlay is left out:
@@ -197,7 +197,7 @@ def _params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, fit, 
                            slope_erosion)
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims, seeds,
                    rough, gain, octaves, xe, xb, age_key, diam, up, onset, full, slope_erosion):
     """Base quadric and slope-erosion factor of crater k: the terrain of its older, larger
@@ -310,8 +310,9 @@ def _dep_kernel(owners, owner_cell, lo, hi, cand_sorted, fc, diam):
     out_owner = np.empty(offsets[n_own], dtype=np.int64)
     out_dep = np.empty(offsets[n_own], dtype=np.int64)
     for s in prange(n_own):
-        _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, out_owner, out_dep,
-                  offsets[s], True)
+        if counts[s + 1] > 0:  # most owners have none in a bin of larger craters
+            _dep_scan(s, owners, owner_cell, lo, hi, cand_sorted, fc, diam, out_owner,
+                      out_dep, offsets[s], True)
     return out_owner, out_dep
 
 

@@ -199,6 +199,18 @@ def test_table_value_is_the_c1_catmull_rom_spline(rng):
     assert np.allclose(near0[:, 0], tabs[:, 0], rtol=0, atol=1e-9)
 
 
+def test_table_row_value_is_table_value_of_the_row(rng):
+    from craters._stamp_kernels import _table_kernel, _table_rows_kernel
+
+    tabs = rng.normal(size=(3, 256))
+    x = np.concatenate([rng.uniform(0.0, 3.2, 500), np.linspace(0.0, 3.0, 256)[:7],
+                        [3.0, 3.0 - 1e-12, 5.0, 0.0]])
+    by_view, in_place = np.empty((3, len(x))), np.empty((3, len(x)))
+    _table_kernel(tabs, x, 3.0, by_view)
+    _table_rows_kernel(tabs, x, 3.0, in_place)
+    assert by_view.tobytes() == in_place.tobytes()
+
+
 @pytest.mark.parametrize(("wavelength", "spacing"), [(1.0, 1.0), (8.0, 1.0), (9.0, 1.0),
                                                      (1e6, 1.0), (100.0, 3.0)])
 def test_roughness_octaves(wavelength, spacing):
