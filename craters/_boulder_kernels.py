@@ -6,7 +6,6 @@ import numpy as np
 from numba import njit, prange
 
 from ._calls import read_only_inputs
-
 from ._rng_kernels import GOLDEN, _hash_normal, _mix64, _splitmix64
 
 

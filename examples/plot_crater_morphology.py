@@ -4,8 +4,9 @@ diffusion, and the same crater on different targets.
 Top row: fresh lunar craters stamped on flat ground - a simple bowl, a flat-floored
 transitional crater, complex craters with central peaks and terraced walls, and a
 peak-ring basin (Pike 1977; Baker et al. 2011) - with their roughness: irregular rims,
-scalloped terraces that wander, merge and split, and central peaks broken into massifs. Middle row: one 1 km crater at model
-ages from 0 to 3.8 Gyr, degraded by topographic diffusion (Fassett & Thomson 2014).
+scalloped terraces that wander, merge and split, and central peaks broken into massifs.
+Middle row: one 1 km crater at model ages from 0 to 3.8 Gyr, degraded by topographic
+diffusion (Fassett & Thomson 2014).
 Bottom: radial profiles with their depth/diameter, and the same 20 km crater on the
 Moon, Mars, Mercury and Ceres (Pike 1977/1988, Garvin & Frawley 1998; 1/g scaling).
 Writes ``crater_morphology.png``. Environment: ``CRATERFORM_EXAMPLE_OUT`` (default

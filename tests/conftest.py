@@ -9,7 +9,6 @@ import sys
 import numpy as np
 import pytest
 
-
 #: Test files that take longest on a cold CI run (seconds, 2 xdist workers, 2026-12-05), run
 #: first: pytest-xdist hands out whole files (``--dist loadfile``, so the two workers
 #: rarely need the same numba kernels at once and compile them twice) in this order, the

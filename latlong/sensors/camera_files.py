@@ -297,7 +297,7 @@ class CameraSettings:
         object.__setattr__(self, "all_ground_truth", bool(self.all_ground_truth))
         object.__setattr__(self, "datasets", ",".join(parse_datasets(self.datasets)))
         bands = parse_bands(self.bands)  # checked here, kept as written
-        for name, albedo in bands.items():
+        for albedo in bands.values():
             with_albedo(self.reflectance, albedo)  # in the model's range
         object.__setattr__(self, "bands", ",".join(f"{k}={v!r}" for k, v in bands.items()))
         check_declared(self)  # every declared range and choice, named by the field

@@ -66,7 +66,7 @@ def main() -> int:
     bad = 0
     from craters._shared import sweep_temporaries
 
-    for name, (argv, files) in CASES.items():
+    for name, (argv, _files) in CASES.items():
         with tempfile.TemporaryDirectory() as d:
             base, ref, work = Path(d) / "old", Path(d) / "new", Path(d) / "work"
             for folder in (base, ref, work):

@@ -1,11 +1,12 @@
 """Issue 21 acceptance figures for crater shapes (plain script, from the repository's top).
 
 Fresh lunar depth and rim height through ``craters profile`` against Pike (1977) at
-0.5-100 km (Pike's law holds from 400 m), the largest jump between neighbouring diameters across the simple->complex
-transition, the flat floor and central peak of 30 and 100 km craters, Mars (Garvin &
-Sakimoto & Frawley 2003) and Mercury (Pike 1988) transitions and simple and complex
-depths, fresh 40-400 m lunar craters stamped on a raster against Stopar et al. 2017, diffusion of a 1 km
-crater against the test suite's independent finite-difference solve, and what
+0.5-100 km (Pike's law holds from 400 m), the largest jump between neighbouring
+diameters across the simple->complex transition, the flat floor and central peak of 30
+and 100 km craters, Mars (Garvin & Sakimoto & Frawley 2003) and Mercury (Pike 1988)
+transitions and simple and complex depths, fresh 40-400 m lunar craters stamped on a
+raster against Stopar et al. 2017, diffusion of a 1 km crater against the test suite's
+independent finite-difference solve, and what
 ``degradation=1`` leaves. Usage: ``python tests/benchmarks/measure_crater_morphology.py``.
 """
 

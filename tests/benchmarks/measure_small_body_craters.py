@@ -18,10 +18,10 @@ import sys
 import time
 
 import numpy as np
+from ondemand_faithfulness import depth_ratios
 from scipy.spatial import cKDTree
 
 import latlong
-from ondemand_faithfulness import depth_ratios
 
 DALY = {"large": (10.0, np.inf, 0.10), "small": (0.0, 10.0, 0.13)}
 MIN_SPACINGS = 6.0
@@ -55,7 +55,7 @@ def main(seeds, **overrides) -> int:
               f"{np.isfinite(dd).sum()} measurable (>= {MIN_SPACINGS:g} spacings across)")
     d, dd = np.concatenate(ds), np.concatenate(dds)
     ok = True
-    for name, (lo, hi, ref) in DALY.items():
+    for _name, (lo, hi, ref) in DALY.items():
         sel = (d >= lo) & (d < hi) & np.isfinite(dd)
         med = float(np.median(dd[sel])) if sel.any() else float("nan")
         good = abs(med / ref - 1.0) <= 0.2

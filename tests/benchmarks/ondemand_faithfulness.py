@@ -87,10 +87,9 @@ from types import SimpleNamespace
 from unittest import mock
 
 import numpy as np
+from crater_depth import rim_minus_floor
 from numba import njit
 from scipy.spatial import cKDTree
-
-from crater_depth import rim_minus_floor
 
 from craters.kernels import fbm2, roughness_amp, table, table_value, tilted_root
 from craters.stamp import StampRequest, rim_perturbations_from_phases, stamping_profiles

@@ -10,12 +10,12 @@ import pytest
 import craters
 from craters import Roughness
 from craters._stamp_kernels import (
+    _WARP_SALT,
     PEAK_WARP,
     PEAK_WAVELENGTH,
     PEAK_ZONE,
     WALL_WARP,
     WALL_WAVELENGTH,
-    _WARP_SALT,
 )
 from craters.kernels import fbm2, warp_x
 
@@ -24,9 +24,10 @@ def warp_reference(x, u, v, radius, warp, seed):
     """The warped profile coordinate, written out from the module notes in numpy."""
     x = np.asarray(x, dtype=np.float64)
     s = np.uint64(seed) ^ _WARP_SALT
-    wall = np.array([fbm2(s, a, b, WALL_WAVELENGTH * radius, 2, 0.5) for a, b in zip(u, v)])
+    wall = np.array([fbm2(s, a, b, WALL_WAVELENGTH * radius, 2, 0.5)
+                     for a, b in zip(u, v, strict=True)])
     peak = np.array([fbm2(s + np.uint64(1), a, b, PEAK_WAVELENGTH * radius, 2, 0.5)
-                     for a, b in zip(u, v)])
+                     for a, b in zip(u, v, strict=True)])
     d = WALL_WARP * np.minimum(1.0, 4.0 * (1.0 - x)) * wall
     d = d + np.where(x < PEAK_ZONE, PEAK_WARP * np.clip(1.0 - x / PEAK_ZONE, 0, 1) ** 2 * peak,
                      0.0)
@@ -41,7 +42,7 @@ def test_the_warp_kernel_matches_numpy(warp, rng):
     theta = rng.uniform(-np.pi, np.pi, x.size)
     u, v = x * radius * np.cos(theta), x * radius * np.sin(theta)
     seed = np.uint64(987654321987)
-    got = np.array([warp_x(a, b, c, radius, warp, seed) for a, b, c in zip(x, u, v)])
+    got = np.array([warp_x(a, b, c, radius, warp, seed) for a, b, c in zip(x, u, v, strict=True)])
     np.testing.assert_allclose(got, warp_reference(x, u, v, radius, warp, seed),
                                rtol=0, atol=1e-15)
     # simple craters and everything outside the rim are untouched; inside it stays inside

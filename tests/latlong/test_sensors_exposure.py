@@ -15,8 +15,7 @@ from latlong.sensors import Camera, Pose, RayMesh
 from latlong.sensors.camera_files import CameraSettings, camera_run
 from latlong.sensors.poses import Poses
 from latlong.sensors.render import render
-from latlong.sensors.sensor import DEFAULT_EXPOSURE_S, Sensor, display_image, expose, \
-    exposure_for
+from latlong.sensors.sensor import DEFAULT_EXPOSURE_S, Sensor, display_image, expose, exposure_for
 
 R = 1000.0
 CAM = Camera.from_fov(40.0, 96, 72)
@@ -99,7 +98,7 @@ def test_a_run_writes_display_pictures_exposures_and_openexr(sphere, tmp_path):
         np.testing.assert_array_equal(shown, display_image(fr.image))
         tif = runs["tif"]["frames"][k]["files"]
 
-        def channels(name):
+        def channels(name, files=files):
             with OpenEXR.File(str(tmp_path / "exr" / files[name])) as f:
                 return {c: v.pixels for c, v in f.channels().items()}
 
