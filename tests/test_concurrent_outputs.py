@@ -15,6 +15,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -116,6 +117,34 @@ def test_a_second_writer_fails_fast_naming_the_first(capsys, tmp_path, kind):
                    other.lock.name)
     assert took < 5, took  # before any work
     assert after == before
+
+
+@pytest.mark.parametrize("kind", ["npz", "glb's json", "tif", "zarr", "camera folder"])
+def test_a_second_writer_with_wait_waits_for_the_first_to_end(capsys, caplog, tmp_path,
+                                                              kind):
+    code, _, err = run(capsys, "latlong", *BUILD, "-o", tmp_path / "in.npz")
+    assert code == 0, err
+    prog, argv, held = _cases(tmp_path)[kind]
+    other = Holder(held)
+    ended = threading.Event()
+
+    def end_the_other_run():  # once this run has found it and waits
+        while "waiting for process" not in caplog.text:
+            time.sleep(0.05)
+        other.close()
+        ended.set()
+
+    helper = threading.Thread(target=end_the_other_run, daemon=True)
+    helper.start()
+    try:
+        code, _, err = run(capsys, prog, *argv, "--wait")
+    finally:
+        helper.join(timeout=60)
+        other.close()
+    assert ended.is_set()
+    assert code == 0, err
+    assert f"waiting for process {other.proc.pid} to finish writing" in caplog.text
+    assert held.exists()
 
 
 def test_two_real_runs_at_once_one_succeeds(tmp_path):

@@ -4,17 +4,15 @@ from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import stat
 import tomllib
 from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from .outputs import claim, replace_output, sweep_temporaries, temp_file
-from .system import human_bytes
 
-__all__ = ["atomic_path", "check_free_space", "check_output_path", "check_parent_folder",
-           "check_regular_file", "check_suffix", "load_toml"]
+__all__ = ["atomic_path", "check_output_path", "check_parent_folder", "check_regular_file",
+           "check_suffix", "load_toml"]
 
 
 def check_parent_folder(path) -> None:
@@ -25,16 +23,6 @@ def check_parent_folder(path) -> None:
         raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} does not exist")
     if not os.access(folder, os.W_OK | os.X_OK):
         raise ValueError(f"output {str(path)!r}: folder {str(folder)!r} is not writable")
-
-
-def check_free_space(path, need_bytes: float, what: str, *, advice: str = "") -> None:
-    """Refuse up front (one-line ValueError) an output of about ``need_bytes`` that the
-    folder of ``path`` has no room for."""
-    folder = Path(path).parent if str(Path(path).parent) else Path(".")
-    free = shutil.disk_usage(folder).free
-    if need_bytes > free:
-        raise ValueError(f"output {str(path)!r}: {what} is about {human_bytes(need_bytes)}; "
-                         f"{str(folder)!r} has {human_bytes(free)} free{advice}")
 
 
 def check_suffix(path, suffixes: Sequence[str]) -> Path:
@@ -54,12 +42,12 @@ def check_output_path(path, *, force: bool, suffixes: Sequence[str] | None = Non
     """
     path = Path(path) if suffixes is None else check_suffix(path, suffixes)
     check_parent_folder(path)
+    claim(path, force=force)  # a run's outputs: locked until it ends (or waited for)
     if path.is_dir():
         raise ValueError(f"output {str(path)!r} is a folder")
     if os.path.lexists(path) and not force:  # a dangling symlink too
         raise ValueError(f"output {str(path)!r} exists; use --force to overwrite")
     sweep_temporaries(path.parent if str(path.parent) else Path("."))
-    claim(path, force=force)  # a run's outputs: locked until it ends
     return path
 
 

@@ -10,7 +10,8 @@ they are a week old; never another file).
 
 An output group (:func:`output_group`; the command lines run every command but batches
 in one) is a run: each output it checks is locked (:func:`claim`: ``.<name>.lock``,
-``flock``) so that a second run writing it fails at once naming this one; each output
+``flock``) so that a second run writing it fails at once naming this one, or inside
+:func:`waiting` (``--wait``) waits until this one ends; each output
 finished inside (:func:`replace_output`) is staged under a temporary name, and when the
 group ends without an error all are moved into place back to back, after a journal that
 lets the next run take them back if this one is killed in between. A failed run (an
@@ -35,8 +36,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 __all__ = ["TEMP_MAX_AGE_S", "check_outside_folder", "claim", "lock_output", "output_group",
-           "output_lock", "replace_output", "same_file", "staged_path", "sweep_temporaries",
-           "temp_file", "temp_folder", "unlock_output"]
+           "replace_output", "same_file", "staged_path", "sweep_temporaries", "temp_file",
+           "temp_folder", "unlock_output", "waiting"]
 
 logger = logging.getLogger(__name__)
 
@@ -138,17 +139,31 @@ def sweep_temporaries(folder, *, now: float | None = None) -> list[Path]:
 
 # --------------------------------------------------------------------------- locks
 _HELD: dict[str, tuple[int, Path]] = {}  # this process's output locks: path -> (fd, lock file)
+_WAIT: contextvars.ContextVar[bool] = contextvars.ContextVar("craterform_wait", default=False)
+_WAIT_POLL_S = 0.2
+
+
+@contextlib.contextmanager
+def waiting(wait: bool = True) -> Iterator[None]:
+    """Inside (with ``wait``), :func:`lock_output` waits for another run writing the output
+    to end (polling its lock; logged once) instead of refusing at once."""
+    token = _WAIT.set(bool(wait))
+    try:
+        yield
+    finally:
+        _WAIT.reset(token)
 
 
 def lock_output(path) -> bool:
     """Take the advisory lock of the output ``path``: ``.<name>.lock`` beside it, locked
     with ``flock`` and holding this process's id (the kernel drops the lock when the process
-    dies, however it dies). False if this process holds it already; a one-line ValueError
-    naming the other process if another run holds it."""
+    dies, however it dies). False if this process holds it already; if another run holds
+    it, a one-line ValueError naming it, or inside :func:`waiting` the wait for its end."""
     key = os.path.abspath(path)
     if key in _HELD:
         return False
     name = _folder_of(Path(path)) / f".{Path(path).name}.lock"
+    told = False
     while True:
         fd = os.open(name, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666)
         try:
@@ -156,6 +171,13 @@ def lock_output(path) -> bool:
         except BlockingIOError:
             other = os.pread(fd, 32, 0).decode("ascii", "replace").split()[-1:] or ["?"]
             os.close(fd)
+            if _WAIT.get():
+                if not told:
+                    logger.warning("waiting for process %s to finish writing %s", other[0],
+                                   path)
+                    told = True
+                time.sleep(_WAIT_POLL_S)
+                continue
             raise ValueError(f"output {str(path)!r} is being written by another run (process "
                              f"{other[0]}, lock {str(name)!r}); let it finish first") from None
         if _ident(name) == tuple(os.fstat(fd))[1:3]:  # the file it locked is still there
@@ -194,17 +216,6 @@ def unlock_output(path) -> None:
         with contextlib.suppress(OSError):
             os.unlink(name)
         os.close(fd)
-
-
-@contextlib.contextmanager
-def output_lock(path) -> Iterator[None]:
-    """:func:`lock_output` for a ``with`` block."""
-    took = lock_output(path)
-    try:
-        yield
-    finally:
-        if took:
-            unlock_output(path)
 
 
 def claim(path, *, force: bool) -> None:

@@ -57,6 +57,7 @@ import math
 from collections.abc import Callable, Iterator, Mapping
 
 from .._shared.files import load_toml
+from .._shared.outputs import waiting
 from .._shared.settings import Setting, by_key, default_of
 from .._shared.validation import ParameterError, ParameterTypeError, parameter_of
 from .kit import CliError
@@ -316,7 +317,11 @@ def command(sub, name: str, run: Callable[[Values], int | None],
             groups: Mapping[str, str] | None = None, config: bool = False, prog: str = ""):
     """Register the command ``name`` with its options (:func:`add_options`) on the
     sub-command parser ``sub``; ``run(values)`` does the work, its library errors named
-    by the options (:meth:`Values.named_errors`)."""
+    by the options (:meth:`Values.named_errors`). A command that writes outputs (it has
+    ``force``) also gets :data:`WAIT`: with it, an output another run is writing is
+    waited for (:func:`~craters._shared.outputs.waiting`), not refused."""
+    if "force" in options and "wait" not in options:
+        options = {**options, "wait": WAIT}
     p = sub.add_parser(name, help=help, description=description or help[0].upper() + help[1:]
                        + ".")
     add_options(p, {**options, **({"config": CONFIG} if config else {})}, groups)
@@ -324,7 +329,7 @@ def command(sub, name: str, run: Callable[[Values], int | None],
 
     def call(args: argparse.Namespace) -> int:
         values = values_of(args, label, options, config_file=config)
-        with values.named_errors():
+        with values.named_errors(), waiting(bool(values.get("wait"))):
             return int(run(values) or 0)
 
     # the table of the flags and config keys, for tests (an attribute of the function)
@@ -400,6 +405,9 @@ CONFIG = Setting(help="TOML file whose keys are the option names; options given 
 FORCE = Setting(False, "overwrite existing outputs", run=True)
 #: ``-q/--quiet``: no progress bars or messages.
 QUIET = Setting(False, "no progress bars or messages", flag="-q/--quiet", run=True)
+#: ``--wait``: every command with ``--force`` has it (:func:`command`).
+WAIT = Setting(False, "when another run is writing one of the outputs, wait for it to end "
+               "instead of failing at once", run=True)
 #: The outputs of an analysis command (a table and a plot).
 REPORT = {
     "csv": Setting(help="write the table (CSV, units in the header)", run=True),

@@ -46,7 +46,7 @@ from pathlib import Path
 from typing import Any
 
 from craters._shared.files import atomic_path, check_parent_folder
-from craters._shared.outputs import output_lock
+from craters._shared.outputs import lock_output, unlock_output
 from craters._shared.progress import progress_bar
 from craters._shared.validation import ParameterError, ParameterTypeError, parameter_of
 
@@ -365,10 +365,14 @@ def run_batch(jobs: Sequence[Job], task: Callable[[Any, Path, str], None], out, 
         raise ParameterError("jobs", "must be a non-empty list of uniquely named variants")
     choose_backend(backend, scheduler, workers, connect_timeout_s=connect_timeout_s)
     folder = _check_folder(out, jobs, resume=resume, force=force)
-    with output_lock(folder):  # a second batch into this folder fails fast, naming this one
+    took = lock_output(folder)  # a second batch into this folder fails fast, naming this one
+    try:
         return _fill(folder, jobs, task, backend=backend, scheduler=scheduler, workers=workers,
                      resume=resume, progress=progress, retries=retries, on_done=on_done,
                      started=started, connect_timeout_s=connect_timeout_s)
+    finally:
+        if took:
+            unlock_output(folder)
 
 
 def _fill(folder: Path, jobs: Sequence[Job], task, *, backend, scheduler, workers, resume,

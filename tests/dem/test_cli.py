@@ -462,7 +462,7 @@ def test_mesh_bad_input_one_line_exit_2_nothing_written(capsys, tmp_path, lola_c
 
 def test_enhance_options_are_the_config_plus_the_run_options():
     assert set(options_for("enhance")) == {*dem.EnhanceConfig.keys(), "output", "force",
-                                           "quiet"}
+                                           "quiet", "wait"}
 
 
 def test_enhance_parses_each_spec_and_checks_seed_and_folder_once(capsys, tmp_path, lola_tif,

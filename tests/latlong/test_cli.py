@@ -163,7 +163,7 @@ def test_every_option_has_a_config_key():
     parser = build_parser()
     build = parser._subparsers._group_actions[0].choices["build"]
     dests = {a.dest for a in build._actions} - {"help", "config"}
-    assert dests == set(OPTIONS)
+    assert dests == {*OPTIONS, "wait"}  # --wait: every command that has --force
 
 
 def test_info(run_cli, tmp_path):
