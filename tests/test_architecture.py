@@ -276,6 +276,29 @@ def test_importing_the_packages_loads_no_numba():
 
 
 @pytest.mark.parametrize("package", PACKAGES)
+def test_the_command_list_loads_no_command_and_shows_each_commands_help(package):
+    # `latlong --help` reads each command module's HELP from its source (issue 35: < 0.3 s)
+    import argparse
+    import importlib
+
+    code = (f"import sys; from {package}.cli import main\n"
+            f"try:\n    main(['--help'])\nexcept SystemExit:\n    pass\n"
+            f"print([m for m in sys.modules if m.startswith('{package}.cli.')"
+            f" and m.rsplit('.', 1)[1] not in ('kit', 'options', 'start', 'commands')])")
+    proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=ROOT, check=True)
+    assert proc.stdout.strip().splitlines()[-1] == "[]"
+    cli = importlib.import_module(f"{package}.cli")
+
+    def command_lines(parser) -> dict:
+        (sub,) = [a for a in parser._actions if isinstance(a, argparse._SubParsersAction)]
+        return {a.dest: a.help for a in sub._choices_actions}
+
+    full, listed = command_lines(cli.build_parser()), command_lines(cli.build_parser(["-h"]))
+    assert listed == full and len(full) >= 2
+
+
+@pytest.mark.parametrize("package", PACKAGES)
 def test_every_option_help_shows_its_default(package):
     import argparse
     import importlib

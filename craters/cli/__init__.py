@@ -11,11 +11,11 @@ This ``__init__`` imports nothing, so that :mod:`.start` loads before numpy and 
 from __future__ import annotations
 
 
-def build_parser():
+def build_parser(argv: list[str] | None = None):
     """The ``craters`` command's parser (:func:`craters.cli.commands.build_parser`)."""
     from .commands import build_parser
 
-    return build_parser()
+    return build_parser(argv)
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -6,23 +6,25 @@ from __future__ import annotations
 import sys
 
 from .kit import run_cli
-from .options import main_parser
+from .options import add_commands, main_parser
 
-__all__ = ["build_parser", "main"]
+__all__ = ["COMMANDS", "build_parser", "main"]
+
+#: The commands, in the order ``craters --help`` lists them, and their modules.
+COMMANDS = {"profile": "profile", "population": "population"}
 
 
-def build_parser():
-    """The ``craters`` argument parser with both commands."""
-    from . import population, profile
-
+def build_parser(argv: list[str] | None = None):
+    """The ``craters`` argument parser: both commands, or only the one ``argv`` names."""
     parser, sub = main_parser("craters", "Crater profiles and populations.")
-    profile.register(sub)
-    population.register(sub)
+    add_commands(sub, "craters.cli", COMMANDS, argv)
     return parser
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run ``craters`` with ``argv`` (default: the process's arguments); the exit code."""
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = build_parser(argv).parse_args(argv)
     return run_cli(lambda: args.func(args))
 
 

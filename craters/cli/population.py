@@ -194,8 +194,13 @@ def _plot_sfd(cat, layers, area: float, path) -> None:
     plt.close(fig)
 
 
+HELP = {
+    "population": "a crater catalog (CSV or craterstats .scc) from power laws or production "
+                  "functions at a model age",
+}
+
+
 def register(sub) -> None:
     """Register ``craters population``."""
     command(sub, "population", _population, OPTIONS, prog="craters",
-            help="a crater catalog (CSV or craterstats .scc) from power laws or production "
-            "functions at a model age")
+            help=HELP["population"])

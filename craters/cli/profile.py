@@ -107,7 +107,12 @@ def _plot_profiles(path, d: float, target, x, h, m) -> None:
     plt.close(fig)
 
 
+HELP = {
+    "profile": "a crater's radial profile as CSV and/or a plot",
+}
+
+
 def register(sub) -> None:
     """Register ``craters profile``."""
     command(sub, "profile", _profile, OPTIONS, prog="craters",
-            help="a crater's radial profile as CSV and/or a plot")
+            help=HELP["profile"])

@@ -40,11 +40,16 @@ def _batch(v: Values) -> int:
     return batch_summary(result, v.quiet)
 
 
+HELP = {
+    "batch": "build every variant of a `dem enhance` config (seeds x --vary) on "
+             "dask.distributed",
+}
+
+
 def register(sub) -> None:
     """Register ``dem batch``."""
     command(sub, "batch", _batch, OPTIONS, prog="dem",
-            help="build every variant of a `dem enhance` config (seeds x --vary) on "
-            "dask.distributed",
+            help=HELP["batch"],
             description="Build a `dem enhance` config for every seed and every combination "
             "of --vary values, one dask task per variant (a local cluster, or --scheduler), "
             "each variant's stack in FOLDER/NAME/, with FOLDER/index.csv (files, sha256, "

@@ -27,8 +27,13 @@ def _convert(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "convert": "convert a DEM (PDS3 .lbl/.img, GeoTIFF, Zarr, any raster GDAL reads) to a "
+               "cloud-optimised GeoTIFF or a Zarr store",
+}
+
+
 def register(sub) -> None:
     """Register ``dem convert``."""
     dem_command(sub, "convert", _convert, OPTIONS,
-                "convert a DEM (PDS3 .lbl/.img, GeoTIFF, Zarr, any raster GDAL reads) to a "
-                "cloud-optimised GeoTIFF or a Zarr store")
+                HELP["convert"])

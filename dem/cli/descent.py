@@ -39,8 +39,13 @@ def _descent(v: Values) -> int:
     return write_descent_run(frames, out, v, seed=scene.seed, lidar=camera["lidar"])
 
 
+HELP = {
+    "descent": "camera frames of a descent over a DEM site, craters and rocks made on demand for "
+               "each frame",
+}
+
+
 def register(sub) -> None:
     """Register ``dem descent``."""
     dem_command(sub, "descent", _descent, OPTIONS,
-                "camera frames of a descent over a DEM site, craters and rocks made on demand "
-                "for each frame")
+                HELP["descent"])

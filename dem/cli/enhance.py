@@ -55,7 +55,12 @@ def _enhance(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "enhance": "build a stack of layers around a site, each 2x finer, with craters per layer",
+}
+
+
 def register(sub) -> None:
     """Register ``dem enhance``."""
     dem_command(sub, "enhance", _enhance, OPTIONS,
-                "build a stack of layers around a site, each 2x finer, with craters per layer")
+                HELP["enhance"])

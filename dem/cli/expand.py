@@ -53,7 +53,12 @@ def _expand(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "expand": "double the resolution of a DEM (region) by random midpoint displacement",
+}
+
+
 def register(sub) -> None:
     """Register ``dem expand``."""
     dem_command(sub, "expand", _expand, OPTIONS,
-                "double the resolution of a DEM (region) by random midpoint displacement")
+                HELP["expand"])

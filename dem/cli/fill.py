@@ -62,7 +62,12 @@ def _fill(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "fill": "fill the unknown pixels of a DEM with fractal terrain, outside in",
+}
+
+
 def register(sub) -> None:
     """Register ``dem fill``."""
     dem_command(sub, "fill", _fill, OPTIONS,
-                "fill the unknown pixels of a DEM with fractal terrain, outside in")
+                HELP["fill"])

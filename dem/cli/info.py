@@ -98,7 +98,12 @@ def _crater_rows(dem) -> list[tuple[str, str]]:
     return [*rows, ("craters", text)]
 
 
+HELP = {
+    "info": "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)",
+}
+
+
 def register(sub) -> None:
     """Register ``dem info``."""
     dem_command(sub, "info", _info, {"input": INPUT, **READ},
-                "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)")
+                HELP["info"])

@@ -38,7 +38,12 @@ def _mesh(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "mesh": "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP",
+}
+
+
 def register(sub) -> None:
     """Register ``dem mesh``."""
     dem_command(sub, "mesh", _mesh, OPTIONS,
-                "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP")
+                HELP["mesh"])

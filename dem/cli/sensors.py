@@ -25,13 +25,19 @@ def _load(v):
     return DemSurface.read(v.model, progress=not v.quiet)
 
 
+HELP = {
+    "camera": "render camera frames (image, depth, range, normals, crater and boulder ids) of a "
+              "stack or a DEM, with a frames.json manifest",
+    "lidar": "simulate a LIDAR (flash or scanning) over a stack or a DEM: LAS 1.4 point "
+             "clouds, range images and lidar.json",
+}
+
+
 def register(sub) -> None:
     """Add ``camera`` and ``lidar`` to the sub-command parser."""
-    sensor_command(sub, "camera", "render camera frames (image, depth, range, normals, "
-                   "crater and boulder ids) of a stack or a DEM, with a frames.json manifest",
+    sensor_command(sub, "camera", HELP["camera"],
                    camera.camera_options(_MODEL, units=False, vertical=_VERTICAL),
                    camera.run_camera, _load, camera.GROUPS)
-    sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a stack or a DEM: "
-                   "LAS 1.4 point clouds, range images and lidar.json",
+    sensor_command(sub, "lidar", HELP["lidar"],
                    lidar.lidar_options(_MODEL, units=False, vertical=_VERTICAL),
                    lidar.run_lidar, _load, lidar.GROUPS)

@@ -41,7 +41,12 @@ def _slopes(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "slopes": "slope distributions of DEMs or stack layers, with comparisons",
+}
+
+
 def register(sub) -> None:
     """Register ``dem slopes``."""
     dem_command(sub, "slopes", _slopes, OPTIONS,
-                "slope distributions of DEMs or stack layers, with comparisons")
+                HELP["slopes"])

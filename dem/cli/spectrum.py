@@ -63,7 +63,12 @@ def _spectrum(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "spectrum": "radially averaged power spectra of DEMs or stack layers, with comparisons",
+}
+
+
 def register(sub) -> None:
     """Register ``dem spectrum``."""
     dem_command(sub, "spectrum", _spectrum, REPORT_OPTIONS,
-                "radially averaged power spectra of DEMs or stack layers, with comparisons")
+                HELP["spectrum"])

@@ -108,7 +108,12 @@ def _tile(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "tile": "a window of a DEM with craters made on demand, at any pixel size",
+}
+
+
 def register(sub) -> None:
     """Register ``dem tile``."""
     dem_command(sub, "tile", _tile, OPTIONS,
-                "a window of a DEM with craters made on demand, at any pixel size")
+                HELP["tile"])

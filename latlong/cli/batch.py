@@ -53,10 +53,15 @@ def _batch(v: Values) -> int:
     return batch_summary(result, v.quiet)
 
 
+HELP = {
+    "batch": "build every variant of a scene (seeds x --vary) on dask.distributed",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong batch``."""
     command(sub, "batch", _batch, OPTIONS, prog="latlong",
-            help="build every variant of a scene (seeds x --vary) on dask.distributed",
+            help=HELP["batch"],
             description="Build a scene file for every seed and every combination of --vary "
             "values, one dask task per variant (a local cluster, or --scheduler), and write "
             "each variant's outputs (the scene's, else .npz and the crater catalog) under its "

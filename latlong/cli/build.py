@@ -143,9 +143,14 @@ def _build(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "build": "generate a body and write meshes / catalogs / pictures",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong build``."""
     command(sub, "build", _build, OPTIONS, groups=GROUPS, config=True, prog="latlong",
-            help="generate a body and write meshes / catalogs / pictures",
+            help=HELP["build"],
             description="Generate a body (base shape, craters, boulders) or an implicit body "
             "and write it.")

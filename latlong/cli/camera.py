@@ -223,9 +223,14 @@ def _planet(v: Values, seq):
     return seq.planets(v.planet_albedo)
 
 
+HELP = {
+    "camera": "render camera frames (image, depth, range, normals) of a body or a mesh, with a "
+              "frames.json manifest",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong camera``."""
-    sensor_command(sub, "camera", "render camera frames (image, depth, range, normals) of a "
-                   "body or a mesh, with a frames.json manifest",
+    sensor_command(sub, "camera", HELP["camera"],
                    camera_options("a body .npz or a mesh file (.ply .obj .stl .vtp .vtk "
                                   ".glb)"), run_camera, load_model, GROUPS)

@@ -142,8 +142,13 @@ def write_descent_run(frames, out, v: Values, *, seed, lidar=None) -> int:
     return 0
 
 
+HELP = {
+    "descent": "camera frames of a descent from orbit to touchdown over terrain made on demand "
+               "for each frame",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong descent``."""
     command(sub, "descent", _descent, OPTIONS, groups=_GROUPS, config=True, prog="latlong",
-            help="camera frames of a descent from orbit to touchdown over terrain made on "
-            "demand for each frame")
+            help=HELP["descent"])

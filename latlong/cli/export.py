@@ -67,8 +67,13 @@ def _export(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "export": "renderer export: patched triangle strips (.glb, with a JSON manifest, nested "
+              "LODs) or a VTP with native strips",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong export``."""
     command(sub, "export", _export, OPTIONS, prog="latlong",
-            help="renderer export: patched triangle strips (.glb, with a JSON manifest, "
-            "nested LODs) or a VTP with native strips")
+            help=HELP["export"])

@@ -40,7 +40,12 @@ def _info(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "info": "describe a saved body (.npz)",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong info``."""
-    command(sub, "info", _info, {"model": MODEL}, help="describe a saved body (.npz)",
+    command(sub, "info", _info, {"model": MODEL}, help=HELP["info"],
             prog="latlong")

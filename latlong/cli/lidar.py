@@ -62,9 +62,14 @@ def run_lidar(v: Values, load) -> int:
     return 0
 
 
+HELP = {
+    "lidar": "simulate a LIDAR (flash or scanning) over a body or mesh: LAS 1.4 point clouds, "
+             "range images and lidar.json",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong lidar``."""
-    sensor_command(sub, "lidar", "simulate a LIDAR (flash or scanning) over a body or mesh: "
-                   "LAS 1.4 point clouds, range images and lidar.json",
+    sensor_command(sub, "lidar", HELP["lidar"],
                    lidar_options("a body .npz or a mesh file (PLY, OBJ, STL, VTP, VTK, GLB)"),
                    run_lidar, load_model, GROUPS)

@@ -17,7 +17,12 @@ def _presets(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "presets": "list the named scenes and their parameters",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong presets``."""
     command(sub, "presets", _presets, {}, prog="latlong",
-            help="list the named scenes and their parameters")
+            help=HELP["presets"])

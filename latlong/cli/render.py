@@ -30,7 +30,12 @@ def _render(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "render": "render a saved body to a PNG (off-screen)",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong render``."""
     command(sub, "render", _render, OPTIONS, groups={"render": "preview picture"},
-            prog="latlong", help="render a saved body to a PNG (off-screen)")
+            prog="latlong", help=HELP["render"])

@@ -108,8 +108,12 @@ def _slopes(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "slopes": "slope distributions (3-degree bins) of bodies and shape models, with comparisons",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong slopes``."""
     command(sub, "slopes", _slopes, OPTIONS, prog="latlong",
-            help="slope distributions (3-degree bins) of bodies and shape models, with "
-            "comparisons")
+            help=HELP["slopes"])

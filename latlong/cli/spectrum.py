@@ -69,7 +69,12 @@ def _spectrum(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "spectrum": "radius power spectra of bodies and shape models, with comparisons",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong spectrum``."""
     command(sub, "spectrum", _spectrum, OPTIONS, prog="latlong",
-            help="radius power spectra of bodies and shape models, with comparisons")
+            help=HELP["spectrum"])

@@ -92,7 +92,12 @@ def _tile(v: Values) -> int:
     return 0
 
 
+HELP = {
+    "tile": "a window of terrain on demand at any pixel size (GeoTIFF, mesh, picture)",
+}
+
+
 def register(sub) -> None:
     """Register ``latlong tile``."""
     command(sub, "tile", _tile, OPTIONS, groups=_GROUPS, config=True, prog="latlong",
-            help="a window of terrain on demand at any pixel size (GeoTIFF, mesh, picture)")
+            help=HELP["tile"])
