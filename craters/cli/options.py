@@ -60,6 +60,7 @@ import importlib
 import importlib.util
 import math
 from collections.abc import Callable, Iterator, Mapping
+from pathlib import Path
 
 from .._shared.files import load_toml
 from .._shared.outputs import waiting
@@ -466,10 +467,9 @@ def command_help(package: str, module: str) -> dict[str, str]:
     """The ``HELP`` table of the command module ``package.module`` ({command: its line in
     ``--help``}), read from its source: importing it would load its libraries."""
     spec = importlib.util.find_spec(f"{package}.{module}")
-    source = spec.loader.get_source(spec.name) if spec is not None and spec.loader else None
-    for node in ast.parse(source or "").body:
-        if isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] \
-                == ["HELP"]:
+    source = Path(spec.origin).read_text("utf-8") if spec and spec.origin else ""
+    for node in ast.parse(source).body:
+        if isinstance(node, ast.Assign) and ast.unparse(node.targets[0]) == "HELP":
             return ast.literal_eval(node.value)
     raise ImportError(f"{package}.{module} has no HELP table", name=f"{package}.{module}")
 
