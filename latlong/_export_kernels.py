@@ -12,7 +12,14 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from ._grid_kernels import _band_strip_kernel, _band_triangles_kernel, _lon_row, _ring_size
+from ._grid_kernels import (
+    _band_strip_kernel,
+    _band_triangles_kernel,
+    _lon_row,
+    _ring_part,
+    _ring_size,
+    _rings_of_range,
+)
 
 
 @njit(cache=True, nogil=True)
@@ -22,13 +29,9 @@ def _ply_vertex_kernel(m, ring_offsets, radii, radius_m, stretch, lon_table, lo,
     and height = float32(radius - radius_m); columns past 3 are left alone. The
     latitude's cosine and sine once per ring and the longitudes' from ``lon_table``
     (``_unit_of``'s values), or computed as the table's are when it is empty."""
-    r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
-    r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
+    r_first, r_last = _rings_of_range(ring_offsets, lo, hi)
     for r in range(r_first, r_last + 1):
-        o = ring_offsets[r]
-        n = ring_offsets[r + 1] - o
-        j0 = max(lo - o, 0)
-        j1 = min(hi - o, n)
+        o, n, j0, j1 = _ring_part(ring_offsets, lo, hi, r)
         lat = 0.5 * np.pi - r * (np.pi / (2 * m))
         c = np.cos(lat)
         sz = np.sin(lat)

@@ -7,6 +7,8 @@ from numba import njit, prange
 
 from craters.kernels import read_only_inputs
 
+from .geometry._ray_kernels import _moller_trumbore
+
 
 @njit(cache=True)
 def _ring_size(r, m):
@@ -279,37 +281,48 @@ def _unit_of(m, r, j, n):
     return c * np.cos(lon), c * np.sin(lon), np.sin(lat)
 
 
+@njit(cache=True, inline="always")
+def _rings_of_range(ring_offsets, lo, hi):
+    """First and last ring holding vertices ``lo .. hi - 1``."""
+    return (np.searchsorted(ring_offsets, lo, side="right") - 1,
+            np.searchsorted(ring_offsets, hi - 1, side="right") - 1)
+
+
+@njit(cache=True, inline="always")
+def _ring_part(ring_offsets, lo, hi, r):
+    """Ring ``r``'s share of vertices ``lo .. hi - 1``: (its first vertex, its size, the
+    first and the end index j on the ring)."""
+    o = ring_offsets[r]
+    n = ring_offsets[r + 1] - o
+    return o, n, max(lo - o, 0), min(hi - o, n)
+
+
+@njit(cache=True, inline="always")
+def _unit_ring(m, ring_offsets, lo, hi, r, out):
+    """Unit vectors of ring ``r``'s share of vertices lo..hi-1 into out (hi - lo, 3)."""
+    o, n, j0, j1 = _ring_part(ring_offsets, lo, hi, r)
+    for j in range(j0, j1):
+        x, y, z = _unit_of(m, r, j, n)
+        out[o + j - lo, 0] = x
+        out[o + j - lo, 1] = y
+        out[o + j - lo, 2] = z
+
+
 @njit(cache=True)
 def _unit_range_serial(m, ring_offsets, lo, hi, out):
     """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3) (one thread)."""
-    r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
-    r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
+    r_first, r_last = _rings_of_range(ring_offsets, lo, hi)
     for r in range(r_first, r_last + 1):
-        o = ring_offsets[r]
-        n = ring_offsets[r + 1] - o
-        for j in range(max(lo - o, 0), min(hi - o, n)):
-            x, y, z = _unit_of(m, r, j, n)
-            out[o + j - lo, 0] = x
-            out[o + j - lo, 1] = y
-            out[o + j - lo, 2] = z
+        _unit_ring(m, ring_offsets, lo, hi, r, out)
 
 
 @njit(cache=True, parallel=True)
 def _unit_range_kernel(m, ring_offsets, lo, hi, out):
     """Unit vectors of vertices lo..hi-1 into out (hi - lo, 3), rings in parallel (for
     large ranges: a parallel region costs far more than a small range's work)."""
-    r_first = np.searchsorted(ring_offsets, lo, side="right") - 1
-    r_last = np.searchsorted(ring_offsets, hi - 1, side="right") - 1
+    r_first, r_last = _rings_of_range(ring_offsets, lo, hi)
     for r in prange(r_first, r_last + 1):
-        o = ring_offsets[r]
-        n = ring_offsets[r + 1] - o
-        j0 = max(lo - o, 0)
-        j1 = min(hi - o, n)
-        for j in range(j0, j1):
-            x, y, z = _unit_of(m, r, j, n)
-            out[o + j - lo, 0] = x
-            out[o + j - lo, 1] = y
-            out[o + j - lo, 2] = z
+        _unit_ring(m, ring_offsets, lo, hi, r, out)
 
 
 @njit(cache=True)
@@ -345,22 +358,10 @@ def _ray_triangle(dx, dy, dz, a, b, c):
     two-sided: (u, v, t), the barycentric coordinates of the crossing (b and c weights)
     and its distance along d (in units of |d|); t = -1 when the ray is parallel to the
     triangle. The caller decides what counts as a hit (u, v, 1 - u - v >= 0, t > 0)."""
-    e1x, e1y, e1z = b[0] - a[0], b[1] - a[1], b[2] - a[2]
-    e2x, e2y, e2z = c[0] - a[0], c[1] - a[1], c[2] - a[2]
-    px = dy * e2z - dz * e2y
-    py = dz * e2x - dx * e2z
-    pz = dx * e2y - dy * e2x
-    det = e1x * px + e1y * py + e1z * pz
+    t, u, v, det = _moller_trumbore(0.0, 0.0, 0.0, dx, dy, dz, a[0], a[1], a[2], b[0], b[1],
+                                    b[2], c[0], c[1], c[2])
     if det == 0.0:
         return np.nan, np.nan, -1.0
-    inv = 1.0 / det
-    tx, ty, tz = -a[0], -a[1], -a[2]
-    u = (tx * px + ty * py + tz * pz) * inv
-    qx = ty * e1z - tz * e1y
-    qy = tz * e1x - tx * e1z
-    qz = tx * e1y - ty * e1x
-    v = (dx * qx + dy * qy + dz * qz) * inv
-    t = (e2x * qx + e2y * qy + e2z * qz) * inv
     return u, v, t
 
 

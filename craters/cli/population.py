@@ -22,6 +22,11 @@ from .options import FORCE, QUIET, Setting, Values, command, default_of
 from .profile import BODY
 from .report import save_figure
 
+HELP = {
+    "population": "a crater catalog (CSV or craterstats .scc) from power laws or production "
+                  "functions at a model age",
+}
+
 __all__ = ["register"]
 
 
@@ -189,15 +194,7 @@ def _plot_sfd(cat, layers, area: float, path) -> None:
     ax.set_title(f"Crater size-frequency distribution ({len(cat)} craters)")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    fig.tight_layout()
     save_figure(fig, path)
-    plt.close(fig)
-
-
-HELP = {
-    "population": "a crater catalog (CSV or craterstats .scc) from power laws or production "
-                  "functions at a model age",
-}
 
 
 def register(sub) -> None:

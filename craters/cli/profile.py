@@ -12,6 +12,10 @@ from .kit import CliError
 from .options import FORCE, QUIET, Setting, Values, command, default_of, shown_value
 from .report import save_figure
 
+HELP = {
+    "profile": "a crater's radial profile as CSV and/or a plot",
+}
+
 __all__ = ["BODY", "register"]
 
 #: The target body options of ``craters profile`` (``craters population`` has its own
@@ -102,14 +106,7 @@ def _plot_profiles(path, d: float, target, x, h, m) -> None:
     ax.set_title(f"Crater profile, D = {d:g} m on {target.name} ({m['morphology']}); "
                  f"topographic diffusion with age")
     ax.legend(fontsize=8)
-    fig.tight_layout()
     save_figure(fig, path)
-    plt.close(fig)
-
-
-HELP = {
-    "profile": "a crater's radial profile as CSV and/or a plot",
-}
 
 
 def register(sub) -> None:

@@ -29,9 +29,13 @@ def write_csv(path, comment: str, columns, rows) -> None:
 
 
 def save_figure(fig, path) -> None:
-    """Write a matplotlib figure as PNG (110 dpi), atomically."""
+    """Lay out a matplotlib figure, write it as PNG (110 dpi), atomically, and close it."""
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
 
 
 def series_colors(n: int) -> list:
@@ -95,9 +99,7 @@ def plot_slopes(path, results, *, xlabel: str, ylabel: str, title: str,
         ax.legend(fontsize=8)
         if full_range:
             ax.set_xlim(0, 90)
-    fig.tight_layout()
     save_figure(fig, path)
-    plt.close(fig)
 
 
 def plot_spectra(path, series, *, xlabel: str, ylabel: str, title: str, fmt: str = "-",
@@ -119,9 +121,7 @@ def plot_spectra(path, series, *, xlabel: str, ylabel: str, title: str, fmt: str
     ax.set_title(title)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
-    fig.tight_layout()
     save_figure(fig, path)
-    plt.close(fig)
 
 
 def slope_table(results) -> str:

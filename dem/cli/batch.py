@@ -15,6 +15,11 @@ from latlong.parallel.backends import CONNECT_TIMEOUT
 from ..batch import batch
 from .options import DEM
 
+HELP = {
+    "batch": "build every variant of a `dem enhance` config (seeds x --vary) on "
+             "dask.distributed",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -38,12 +43,6 @@ def _batch(v: Values) -> int:
     except (TypeError, ValueError) as exc:
         raise batch_error(exc, v, v["config"]) from None
     return batch_summary(result, v.quiet)
-
-
-HELP = {
-    "batch": "build every variant of a `dem enhance` config (seeds x --vary) on "
-             "dask.distributed",
-}
 
 
 def register(sub) -> None:

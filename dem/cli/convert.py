@@ -9,6 +9,11 @@ from ..core import crs_label
 from ..io import DEM_SUFFIXES, write
 from .options import DEM_OUTPUT, INPUT, READ, RUN, check_output, dem_command, read_input
 
+HELP = {
+    "convert": "convert a DEM (PDS3 .lbl/.img, GeoTIFF, Zarr, any raster GDAL reads) to a "
+               "cloud-optimised GeoTIFF or a Zarr store",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {"input": INPUT, "output": DEM_OUTPUT, **READ, **RUN}
@@ -25,12 +30,6 @@ def _convert(v: Values) -> int:
               f"{100 * dem.nan_fraction:.3g} % unknown")
         print(f"wrote {v['output']}")
     return 0
-
-
-HELP = {
-    "convert": "convert a DEM (PDS3 .lbl/.img, GeoTIFF, Zarr, any raster GDAL reads) to a "
-               "cloud-optimised GeoTIFF or a Zarr store",
-}
 
 
 def register(sub) -> None:

@@ -18,6 +18,11 @@ from latlong.cli.descent import (
 from .options import READ, RUN, dem_command
 from .tile import LAYERS, SITE, read_site, scene_of
 
+HELP = {
+    "descent": "camera frames of a descent over a DEM site, craters and rocks made on demand for "
+               "each frame",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {"input": SITE, **READ, **LAYERS, **DESCENT, **LIDAR, **RUN}
@@ -37,12 +42,6 @@ def _descent(v: Values) -> int:
     camera = camera_options(v)
     frames = dem_descent(dem, scene, v["lat_deg"], v["lon_deg"], alts, **camera)
     return write_descent_run(frames, out, v, seed=scene.seed, lidar=camera["lidar"])
-
-
-HELP = {
-    "descent": "camera frames of a descent over a DEM site, craters and rocks made on demand for "
-               "each frame",
-}
 
 
 def register(sub) -> None:

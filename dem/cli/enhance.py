@@ -13,6 +13,10 @@ from ..enhancefile import enhance_to_folder
 from ..stack import check_stack_folder
 from .options import DEM, RUN, dem_command, output
 
+HELP = {
+    "enhance": "build a stack of layers around a site, each 2x finer, with craters per layer",
+}
+
 __all__ = ["OPTIONS", "register"]
 
 OPTIONS = {"input": DEM["input"], "output": output(
@@ -53,11 +57,6 @@ def _enhance(v: Values) -> int:
                   "the finest layer or crossing a layer's border)")
         print(f"wrote {manifest}")
     return 0
-
-
-HELP = {
-    "enhance": "build a stack of layers around a site, each 2x finer, with craters per layer",
-}
 
 
 def register(sub) -> None:

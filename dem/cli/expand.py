@@ -11,6 +11,10 @@ from ..core import parse_region
 from ..expandfile import TILE_PX, expand_to_file
 from .options import DEM, DEM_OUTPUT, INPUT, READ, RUN, begin, dem_command, read_input, summary
 
+HELP = {
+    "expand": "double the resolution of a DEM (region) by random midpoint displacement",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -51,11 +55,6 @@ def _expand(v: Values) -> int:
     bar.close()
     summary(v, seed, dem.shape, made.shape, made.parameters)
     return 0
-
-
-HELP = {
-    "expand": "double the resolution of a DEM (region) by random midpoint displacement",
-}
 
 
 def register(sub) -> None:

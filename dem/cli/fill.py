@@ -12,6 +12,10 @@ from ..io import write
 from ..tiledfill import MEMORY_SHARE, fill_to_file, fits_whole, raster_shape
 from .options import DEM, DEM_OUTPUT, INPUT, READ, RUN, begin, dem_command, read_input, summary
 
+HELP = {
+    "fill": "fill the unknown pixels of a DEM with fractal terrain, outside in",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -60,11 +64,6 @@ def _fill(v: Values) -> int:
     bar.close()
     summary(v, seed, dem.shape, out.shape, out.history[-1]["parameters"])
     return 0
-
-
-HELP = {
-    "fill": "fill the unknown pixels of a DEM with fractal terrain, outside in",
-}
 
 
 def register(sub) -> None:

@@ -11,6 +11,10 @@ from ..fractal import fractal_fit
 from ..terrain import MATCHED_BAND_PX, spectral_fit
 from .options import INPUT, READ, dem_command, read_input
 
+HELP = {
+    "info": "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)",
+}
+
 __all__ = ["register"]
 
 #: ``dem info`` counts craters of up to this many pixels on DEMs up to this many pixels
@@ -96,11 +100,6 @@ def _crater_rows(dem) -> list[tuple[str, str]]:
                  f"D^{density.k:g} (D in m, per m^2), N(>{density.d_lo_m / 1e3:.4g} km) = "
                  f"{density.count / density.area_m2 * 1e6:.4g} per km^2")
     return [*rows, ("craters", text)]
-
-
-HELP = {
-    "info": "describe a DEM (size, CRS, pixel size, heights, fractal dimension, craters)",
-}
 
 
 def register(sub) -> None:

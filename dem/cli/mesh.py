@@ -13,6 +13,10 @@ from ..mesh import MESH_SUFFIXES, to_mesh
 from ..stack import read_stack
 from .options import INPUT, READ, RUN, check_output, dem_command, output, read_input
 
+HELP = {
+    "mesh": "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -36,11 +40,6 @@ def _mesh(v: Values) -> int:
         print(f"dem mesh: {n} layer(v), {staged_path(path).stat().st_size / 2**20:.1f} MiB")
         print(f"wrote {path}")
     return 0
-
-
-HELP = {
-    "mesh": "write the multi-resolution triangle mesh of a stack (or a DEM) as PLY or VTP",
-}
 
 
 def register(sub) -> None:

@@ -13,6 +13,13 @@ from __future__ import annotations
 from latlong.cli import camera, lidar
 from latlong.cli.sensor_options import sensor_command
 
+HELP = {
+    "camera": "render camera frames (image, depth, range, normals, crater and boulder ids) of a "
+              "stack or a DEM, with a frames.json manifest",
+    "lidar": "simulate a LIDAR (flash or scanning) over a stack or a DEM: LAS 1.4 point "
+             "clouds, range images and lidar.json",
+}
+
 __all__ = ["register"]
 
 _VERTICAL = (0.0, 0.0, 1.0)  # a site's up; sites are in metres (no --units)
@@ -23,14 +30,6 @@ def _load(v):
     from ..surface import DemSurface
 
     return DemSurface.read(v.model, progress=not v.quiet)
-
-
-HELP = {
-    "camera": "render camera frames (image, depth, range, normals, crater and boulder ids) of a "
-              "stack or a DEM, with a frames.json manifest",
-    "lidar": "simulate a LIDAR (flash or scanning) over a stack or a DEM: LAS 1.4 point "
-             "clouds, range images and lidar.json",
-}
 
 
 def register(sub) -> None:

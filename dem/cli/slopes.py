@@ -10,6 +10,10 @@ from craters.cli.report import plot_slopes, slope_csv, slope_table
 from ..terrain import slope_distribution
 from .options import REPORT_OPTIONS, dem_command, legend, report_inputs
 
+HELP = {
+    "slopes": "slope distributions of DEMs or stack layers, with comparisons",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {**REPORT_OPTIONS,
@@ -39,11 +43,6 @@ def _slopes(v: Values) -> int:
         print(slope_table(results))
     print_written(v)
     return 0
-
-
-HELP = {
-    "slopes": "slope distributions of DEMs or stack layers, with comparisons",
-}
 
 
 def register(sub) -> None:

@@ -13,6 +13,10 @@ from ..fractal import dimension_warning
 from ..terrain import power_spectrum, spectral_exponent
 from .options import REPORT_OPTIONS, dem_command, legend, report_inputs
 
+HELP = {
+    "spectrum": "radially averaged power spectra of DEMs or stack layers, with comparisons",
+}
+
 __all__ = ["register"]
 
 
@@ -61,11 +65,6 @@ def _spectrum(v: Values) -> int:
             print(note)
     print_written(v)
     return 0
-
-
-HELP = {
-    "spectrum": "radially averaged power spectra of DEMs or stack layers, with comparisons",
-}
 
 
 def register(sub) -> None:

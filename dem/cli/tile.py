@@ -16,6 +16,10 @@ from latlong.cli.tile import TILE_OUTPUTS, WINDOW
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
+HELP = {
+    "tile": "a window of a DEM with craters made on demand, at any pixel size",
+}
+
 __all__ = ["LAYERS", "SITE", "read_site", "register", "scene_of"]
 
 #: The layers made on demand over a DEM: craters, rocks, their seed.
@@ -106,11 +110,6 @@ def _tile(v: Values) -> int:
         for path in outs.values():
             print(f"wrote {path}")
     return 0
-
-
-HELP = {
-    "tile": "a window of a DEM with craters made on demand, at any pixel size",
-}
 
 
 def register(sub) -> None:

@@ -26,6 +26,10 @@ from ..outputs import OUTPUT_SETTINGS
 from ..scene import SETTINGS
 from .build import OPTIONS as BUILD_OPTIONS
 
+HELP = {
+    "batch": "build every variant of a scene (seeds x --vary) on dask.distributed",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -51,11 +55,6 @@ def _batch(v: Values) -> int:
     except (TypeError, ValueError) as exc:
         raise batch_error(exc, v, v.scene) from None
     return batch_summary(result, v.quiet)
-
-
-HELP = {
-    "batch": "build every variant of a scene (seeds x --vary) on dask.distributed",
-}
 
 
 def register(sub) -> None:

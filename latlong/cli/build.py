@@ -23,6 +23,10 @@ from latlong.scratch import drop_pages
 from ..outputs import OUTPUT_SETTINGS, Outputs, companions, output_kind, write_outputs
 from ..scene import SETTING_PARTS, SETTINGS
 
+HELP = {
+    "build": "generate a body and write meshes / catalogs / pictures",
+}
+
 __all__ = ["GROUPS", "OPTIONS", "register"]
 
 #: Every option of ``latlong build`` (the scene's settings, the outputs, --quiet,
@@ -141,11 +145,6 @@ def _build(v: Values) -> int:
             if staged_path(out).exists():  # a .glb's external buffer only past 4 GiB
                 print(wrote_line(out))
     return 0
-
-
-HELP = {
-    "build": "generate a body and write meshes / catalogs / pictures",
-}
 
 
 def register(sub) -> None:

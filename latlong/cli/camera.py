@@ -40,6 +40,11 @@ from .sensor_options import (
     wxh,
 )
 
+HELP = {
+    "camera": "render camera frames (image, depth, range, normals) of a body or a mesh, with a "
+              "frames.json manifest",
+}
+
 __all__ = ["GROUPS", "camera_options", "register", "run_camera"]
 
 #: The sections of the camera's options.
@@ -221,12 +226,6 @@ def _planet(v: Values, seq):
         raise CliError("--planet NAME takes the planet from the --spice kernels; without "
                        "them give --planet-direction X,Y,Z")
     return seq.planets(v.planet_albedo)
-
-
-HELP = {
-    "camera": "render camera frames (image, depth, range, normals) of a body or a mesh, with a "
-              "frames.json manifest",
-}
 
 
 def register(sub) -> None:

@@ -20,6 +20,11 @@ from ..scene import SETTINGS, Scene
 from .build import GROUPS
 from .tile import on_demand_options
 
+HELP = {
+    "descent": "camera frames of a descent from orbit to touchdown over terrain made on demand "
+               "for each frame",
+}
+
 __all__ = ["DESCENT", "LIDAR", "OPTIONS", "camera_options", "check_descent_folder",
            "lidar_settings", "register", "write_descent_run"]
 
@@ -140,12 +145,6 @@ def write_descent_run(frames, out, v: Values, *, seed, lidar=None) -> int:
     if not v["quiet"]:
         print(f"wrote {n} frames, {out / 'strip.png'}, {out / 'frames.json'}")
     return 0
-
-
-HELP = {
-    "descent": "camera frames of a descent from orbit to touchdown over terrain made on demand "
-               "for each frame",
-}
 
 
 def register(sub) -> None:

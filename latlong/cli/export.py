@@ -14,6 +14,11 @@ from latlong.gltf import LOD_LAYOUTS, level_path
 
 from .inputs import MODEL
 
+HELP = {
+    "export": "renderer export: patched triangle strips (.glb, with a JSON manifest, nested "
+              "LODs) or a VTP with native strips",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -65,12 +70,6 @@ def _export(v: Values) -> int:
     if not v["quiet"]:
         print(f"{wrote_line(out)}: {summary}")
     return 0
-
-
-HELP = {
-    "export": "renderer export: patched triangle strips (.glb, with a JSON manifest, nested "
-              "LODs) or a VTP with native strips",
-}
 
 
 def register(sub) -> None:

@@ -7,6 +7,10 @@ from latlong import load
 
 from .inputs import MODEL
 
+HELP = {
+    "info": "describe a saved body (.npz)",
+}
+
 __all__ = ["register"]
 
 
@@ -38,11 +42,6 @@ def _info(v: Values) -> int:
               f"{rocks['burial_frac'].min():.2f}..{rocks['burial_frac'].max():.2f} of their "
               f"height")
     return 0
-
-
-HELP = {
-    "info": "describe a saved body (.npz)",
-}
 
 
 def register(sub) -> None:

@@ -25,6 +25,11 @@ from .sensor_options import (
     wxh,
 )
 
+HELP = {
+    "lidar": "simulate a LIDAR (flash or scanning) over a body or mesh: LAS 1.4 point clouds, "
+             "range images and lidar.json",
+}
+
 __all__ = ["GROUPS", "lidar_options", "register", "run_lidar"]
 
 #: The sections of the LIDAR's options.
@@ -60,12 +65,6 @@ def run_lidar(v: Values, load) -> int:
         n = sum(f["n_returns"] for f in man["frames"])
         print(f"wrote {v.output}: {len(man['frames'])} frames, {n} returns (seed {seed})")
     return 0
-
-
-HELP = {
-    "lidar": "simulate a LIDAR (flash or scanning) over a body or mesh: LAS 1.4 point clouds, "
-             "range images and lidar.json",
-}
 
 
 def register(sub) -> None:

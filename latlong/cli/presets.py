@@ -6,6 +6,10 @@ from craters.cli.options import Values, command
 
 from ..presets import preset_table
 
+HELP = {
+    "presets": "list the named scenes and their parameters",
+}
+
 __all__ = ["register"]
 
 
@@ -15,11 +19,6 @@ def _presets(v: Values) -> int:
         for key, value in settings.items():
             print(f"    {key} = {value!r}")
     return 0
-
-
-HELP = {
-    "presets": "list the named scenes and their parameters",
-}
 
 
 def register(sub) -> None:

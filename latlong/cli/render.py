@@ -9,6 +9,10 @@ from latlong import PreviewSettings, load, render_preview
 
 from .inputs import MODEL
 
+HELP = {
+    "render": "render a saved body to a PNG (off-screen)",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -28,11 +32,6 @@ def _render(v: Values) -> int:
     if not v["quiet"]:
         print(wrote_line(v["output"]))
     return 0
-
-
-HELP = {
-    "render": "render a saved body to a PNG (off-screen)",
-}
 
 
 def register(sub) -> None:

@@ -21,6 +21,10 @@ from latlong import gravity, slope_summary, slopes_and_areas
 from ..slopes import SLOPE_BIN_DEG
 from .inputs import INPUTS, labels, load_input
 
+HELP = {
+    "slopes": "slope distributions (3-degree bins) of bodies and shape models, with comparisons",
+}
+
 __all__ = ["register"]
 
 
@@ -106,11 +110,6 @@ def _slopes(v: Values) -> int:
         print(slope_table(results))
     print_written(v)
     return 0
-
-
-HELP = {
-    "slopes": "slope distributions (3-degree bins) of bodies and shape models, with comparisons",
-}
 
 
 def register(sub) -> None:

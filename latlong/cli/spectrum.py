@@ -15,6 +15,10 @@ from latlong import radius_spectrum
 
 from .inputs import INPUTS, labels, load_input
 
+HELP = {
+    "spectrum": "radius power spectra of bodies and shape models, with comparisons",
+}
+
 __all__ = ["register"]
 
 OPTIONS = {
@@ -67,11 +71,6 @@ def _spectrum(v: Values) -> int:
             print(f"{label[:28]:<28} {r:13.4g} {rms:12.4g} {-beta:10.2f}")
     print_written(v)
     return 0
-
-
-HELP = {
-    "spectrum": "radius power spectra of bodies and shape models, with comparisons",
-}
 
 
 def register(sub) -> None:

@@ -17,6 +17,10 @@ from ..meshio.writers import MESH_SUFFIXES
 from ..scene import SETTING_PARTS, SETTINGS, Scene
 from .build import GROUPS
 
+HELP = {
+    "tile": "a window of terrain on demand at any pixel size (GeoTIFF, mesh, picture)",
+}
+
 __all__ = ["OPTIONS", "TILE_OUTPUTS", "WINDOW", "on_demand_options", "register"]
 
 #: A window of terrain on demand (``latlong tile``, ``dem tile``).
@@ -90,11 +94,6 @@ def _tile(v: Values) -> int:
         for path in outs.values():
             print(wrote_line(path))
     return 0
-
-
-HELP = {
-    "tile": "a window of terrain on demand at any pixel size (GeoTIFF, mesh, picture)",
-}
 
 
 def register(sub) -> None:
