@@ -55,7 +55,12 @@ def _local(fc, k, p0, p1, p2):
     xe = fc[k, E0] * p0 + fc[k, E1] * p1 + fc[k, E2] * p2
     xn = fc[k, N0] * p0 + fc[k, N1] * p1 + fc[k, N2] * p2
     s = np.sqrt(xe * xe + xn * xn)
-    dist = np.arctan2(s, c) * fc[k, RHO]
+    if s < 0.01 and c > 0.0:  # asin's series: the angle to ~1e-18 (relative), no arctan
+        s2 = s * s
+        dist = s * (1.0 + s2 * (1.0 / 6.0 + s2 * (3.0 / 40.0 + s2 * (5.0 / 112.0)))) \
+            * fc[k, RHO]
+    else:
+        dist = np.arctan2(s, c) * fc[k, RHO]
     if s > 0.0:
         return c, dist, dist * xe / s, dist * xn / s, xe, xn
     return c, dist, 0.0, 0.0, 0.0, 0.0

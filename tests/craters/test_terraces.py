@@ -54,14 +54,14 @@ def test_the_warp_kernel_matches_numpy(warp, rng):
         assert np.abs(got - x)[(x > 0.5) & (x < 0.75)].max() > 0.05
 
 
-def _wall_azimuthal_share(terraces: float) -> float:
+def _wall_azimuthal_share(terraces: float, seed: int) -> float:
     """Share of the wall's height variance (0.55 < r/R < 0.95) that runs around the crater
     (variance within rings of 1/60 R over the total) for a fresh 50 km lunar crater at
     250 m pixels; concentric terraces leave only the roughness overlay's."""
     n, pixel, d = 241, 250.0, 50_000.0
     cat = craters.make_catalog(x_m=[120 * pixel], y_m=[120 * pixel], diameter_m=[d],
                                degradation=[0.0])
-    h = craters.stamp_many(np.zeros((n, n)), pixel, cat, rng=7,
+    h = craters.stamp_many(np.zeros((n, n)), pixel, cat, rng=seed,
                            roughness=Roughness(terraces=terraces))
     yy, xx = np.mgrid[0:n, 0:n]
     x = np.hypot(xx - 120, yy - 120) * pixel / (d / 2)
@@ -73,8 +73,10 @@ def _wall_azimuthal_share(terraces: float) -> float:
 
 
 def test_terraces_of_a_complex_crater_are_not_concentric():
-    # measured: 0.012 concentric (the roughness overlay alone), 0.083 warped
-    concentric, warped = _wall_azimuthal_share(0.0), _wall_azimuthal_share(1.0)
+    # medians over five craters (one crater's share varies 0.04-0.10 with its seed);
+    # measured: 0.010 concentric (the roughness overlay alone), 0.065 warped
+    concentric = np.median([_wall_azimuthal_share(0.0, seed) for seed in range(1, 6)])
+    warped = np.median([_wall_azimuthal_share(1.0, seed) for seed in range(1, 6)])
     assert concentric < 0.02 and warped > 4 * concentric
 
 

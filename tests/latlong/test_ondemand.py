@@ -92,6 +92,20 @@ def test_bins_cover_the_layer_without_an_empty_top_bin():
 
 
 # ----------------------------------------------------------------------------- kernels
+@pytest.mark.parametrize("angle", [0.0, 1e-12, 3e-7, 1e-4, 0.0099, 0.0101, 0.3, 2.5])
+def test_the_distance_from_a_centre_is_the_arc(angle):
+    # below sin(angle) = 0.01 the kernel sums asin's series instead of calling arctan2
+    fc = np.zeros((1, K.N_COLS))
+    fc[0, K.C2], fc[0, K.E0], fc[0, K.N1], fc[0, K.RHO] = 1.0, 1.0, 1.0, 1000.0
+    az = 0.7
+    p = np.array([np.sin(angle) * np.cos(az), np.sin(angle) * np.sin(az), np.cos(angle)])
+    c, dist, x, y, east, north = K._local(fc, 0, *p)
+    want = np.arctan2(np.hypot(p[0], p[1]), p[2]) * 1000.0
+    assert dist == pytest.approx(want, rel=4e-16, abs=0.0)
+    assert (east, north) == (p[0], p[1])
+    assert np.hypot(x, y) == pytest.approx(dist, rel=4e-16, abs=0.0)
+
+
 def test_the_fit_operator_reproduces_a_quadric_exactly():
     x, y = STENCIL_XY[:, 0], STENCIL_XY[:, 1]
     coef = np.array([0.3, -1.2, 0.7, 2.0, -0.5, 1.5])
