@@ -12,8 +12,9 @@ from craters.local import bin_level, min_cell_angle
 from . import _cell_kernels as C
 from . import _field_kernels as K
 
-__all__ = ["block_level", "block_pairs", "cell_areas", "cells_of", "coarser", "in_sorted",
-           "neighbour_set", "neighbours", "reaching", "unique_inverse", "unique_sorted"]
+__all__ = ["GrowingRows", "block_level", "block_pairs", "cell_areas", "cells_of", "coarser",
+           "in_sorted", "neighbour_set", "neighbours", "reaching", "unique_inverse",
+           "unique_sorted"]
 
 
 def cells_of(units: np.ndarray, level: int) -> np.ndarray:
@@ -144,3 +145,36 @@ def cell_areas(base, level: int, cells: np.ndarray) -> np.ndarray:
     centres = cell_points(level, face, i, j, 0.5, 0.5)
     step = 0.25 * min_cell_angle(level)
     return cell_solid_angle(level, face, i, j) * base.area_factor(centres, step)
+
+
+class GrowingRows:
+    """Rows kept so far plus a scratch tail, in one buffer that doubles when full: the
+    records of the craters a query needs grow bin by bin, and concatenating them anew
+    for every bin copied the whole table some 40 times a tile."""
+
+    def __init__(self, width: int, dtype=np.float64):
+        self._buf = np.zeros((64, width) if width else 64, dtype=dtype)
+        self.n = 0
+
+    def _fit(self, n: int) -> None:
+        if n > len(self._buf):
+            grown = np.zeros((max(n, 2 * len(self._buf)),) + self._buf.shape[1:],
+                             dtype=self._buf.dtype)
+            grown[:self.n] = self._buf[:self.n]
+            self._buf = grown
+
+    def kept(self) -> np.ndarray:
+        """The rows kept (a view)."""
+        return self._buf[:self.n]
+
+    def with_tail(self, rows: np.ndarray) -> np.ndarray:
+        """The rows kept followed by ``rows`` (a view; the tail is scratch until
+        :meth:`keep`)."""
+        self._fit(self.n + len(rows))
+        self._buf[self.n:self.n + len(rows)] = rows
+        return self._buf[:self.n + len(rows)]
+
+    def keep(self, rows: np.ndarray) -> None:
+        """Append ``rows`` to the rows kept."""
+        self.with_tail(rows)
+        self.n += len(rows)

@@ -70,6 +70,7 @@ from ..scene import Scene
 from . import _field_kernels as K
 from .base import BaseField, base_field, per_scene, tangent_frame
 from .cellsets import (
+    GrowingRows,
     block_level,
     block_pairs,
     cell_areas,
@@ -223,8 +224,7 @@ class CraterField:
         owners_all: list[np.ndarray] = []
         deps_all: list[np.ndarray] = []
         n_have = 0
-        fc_have = np.zeros((0, K.N_COLS))
-        d_have = np.zeros(0)
+        fc_rows, d_rows = GrowingRows(K.N_COLS), GrowingRows(0)
         at_level = self._cells_by_level(units, d_min)
         for b in sorted(self.levels):
             if self._tops[b] <= d_min:
@@ -235,7 +235,7 @@ class CraterField:
             cand_cells = unique_sorted(neighbours(at_level[level]))
             q_cells = cand_cells
             # the cells around the centres of the needed smaller craters
-            own_cells = cells_of(fc_have[:, K.C0:K.C2 + 1], level)
+            own_cells = cells_of(fc_rows.kept()[:, K.C0:K.C2 + 1], level)
             set9 = neighbour_set(own_cells)  # the cells around them, distinct
             cand_cells = unique_sorted(np.concatenate([cand_cells, set9]))
             cand = self._draw(b, cand_cells, d_min)
@@ -246,8 +246,6 @@ class CraterField:
             # the query-rule craters are owners within this bin too
             first = np.flatnonzero(needed_mask)
             while True:
-                fc_all = np.concatenate([fc_have, cand.fc])
-                d_all = np.concatenate([d_have, cand.diameter_m])
                 owners = np.concatenate([owners, first + n_have])
                 first_cells = cells_of(cand.fc[first, K.C0:K.C2 + 1], level)
                 owner_cells = np.concatenate([owner_cells, first_cells])
@@ -258,9 +256,8 @@ class CraterField:
                     cand = _Craters.concat([cand, more])
                     needed_mask = np.concatenate([needed_mask, np.zeros(len(more), bool)])
                     cand_cells = unique_sorted(np.concatenate([cand_cells, extra]))
-                    fc_all = np.concatenate([fc_have, cand.fc])
-                    d_all = np.concatenate([d_have, cand.diameter_m])
-                o, d = _dep_pairs(owners, owner_cells, cand, n_have, fc_all, d_all)
+                o, d = _dep_pairs(owners, owner_cells, cand, n_have, fc_rows.with_tail(cand.fc),
+                                  d_rows.with_tail(cand.diameter_m))
                 owners_all.append(o)
                 deps_all.append(d)
                 hit = np.zeros(len(cand), bool)
@@ -279,8 +276,8 @@ class CraterField:
                 pairs[first_pair:] = _renumbered(pairs[first_pair:], keep, len(cand), n_have)
             kept = cand.take(keep)
             parts.append(kept)
-            fc_have = np.concatenate([fc_have, kept.fc])
-            d_have = np.concatenate([d_have, kept.diameter_m])
+            fc_rows.keep(kept.fc)
+            d_rows.keep(kept.diameter_m)
             n_have += len(keep)
         craters = _Craters.concat(parts) if parts else self._records(None, 0)
         if owners_all:

@@ -652,3 +652,51 @@ def test_a_crater_base_is_the_fit_of_its_older_larger_craters_with_their_roughne
                            atol=1e-6), k
         checked += 1
     assert checked == 12
+
+
+def _dep_pairs_reference(owners, owner_cell, lo, hi, cand, fc, diam):
+    """Every (owner, candidate) pair of the dependency kernel by brute force, in its order:
+    owners as given, candidates by neighbour cell t then position."""
+    pairs = []
+    for o, c in zip(owners, owner_cell, strict=True):
+        own = fc[o, K.RAD] / fc[o, K.RHO] * (1.0 + 1e-9)
+        for t in range(9):
+            for k in cand[lo[c, t]:hi[c, t]]:
+                d2 = np.sum((fc[k, 0:3] - fc[o, 0:3]) ** 2)
+                lim = np.sqrt(fc[k, K.CHORD2]) + 2.0 * np.sin(0.5 * own)
+                if diam[k] > diam[o] and (fc[k, K.FAR] + own >= np.pi or d2 <= lim * lim):
+                    pairs.append((o, k))
+    return np.array(pairs, dtype=np.int64).reshape(-1, 2)
+
+
+@pytest.mark.parametrize("spread", [1e-7, 1e-3, 0.3])
+def test_dependency_pairs_match_brute_force(spread, rng):
+    # owners clustered in three cells, candidates around them near and far, one reaching
+    # everywhere
+    n_own, n_cand = 300, 400
+    centre = np.array([0.3, -0.2, 0.9]) / np.linalg.norm([0.3, -0.2, 0.9])
+    u = centre + rng.normal(0.0, spread, (n_own + n_cand, 3))
+    u[n_own:] = centre + rng.normal(0.0, 20.0 * spread, (n_cand, 3))  # spread wider
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    fc = np.zeros((n_own + n_cand, K.N_COLS))
+    fc[:, 0:3] = u
+    fc[:, K.RHO] = 1000.0
+    fc[:, K.RAD] = 1000.0 * spread * rng.uniform(0.01, 0.5, n_own + n_cand)
+    fc[:, K.FAR] = np.minimum(3.0 * fc[:, K.RAD] / fc[:, K.RHO], np.pi)
+    fc[-1, K.FAR] = np.pi
+    fc[:, K.CHORD2] = (2.0 * np.sin(0.5 * fc[:, K.FAR])) ** 2
+    diam = 2.0 * fc[:, K.RAD]
+    diam[n_own:] += 1000.0 * spread  # candidates larger, but for a few
+    diam[n_own:n_own + 20] = 0.0
+    owners = rng.permutation(n_own).astype(np.int64)
+    owner_cell = rng.integers(0, 3, n_own).astype(np.int64)
+    cand = (np.arange(n_cand) + n_own).astype(np.int64)
+    edges = np.sort(rng.integers(0, n_cand, (3, 10)), axis=1)
+    lo, hi = edges[:, :9].copy(), edges[:, 1:].copy()
+    o, d = K._dep_kernel(owners, owner_cell, lo, hi, cand, fc, diam)
+    want = _dep_pairs_reference(owners, owner_cell, lo, hi, cand, fc, diam)
+    assert 0 < len(want) < len(owners) * 0.5 * n_cand
+    np.testing.assert_array_equal(np.stack([o, d], axis=1), want)
+    # and the cells' candidate lists left out the candidates no owner of theirs reaches
+    _, kept = K._cell_candidates(owners, owner_cell, lo, hi, cand, fc)
+    assert len(kept) < (hi - lo).sum()
