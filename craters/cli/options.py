@@ -18,9 +18,10 @@ How to declare a command's options
    a config file's value type). Ready-made: :data:`FORCE`, :data:`QUIET`,
    :data:`REPORT`, :func:`batch_options`. A library function's default is read from its
    signature, :func:`default_of`, not written again.
-3. One module a command registers its table, its ``--help`` line in ``HELP`` (a literal
-   dict, read from the source for the command list: :func:`command_help`)::
+3. One module a command registers its table, its ``--help`` line first in ``HELP`` (a
+   literal dict, read from the source for the command list: :func:`command_help`)::
 
+       HELP = {"render": "render a saved body"}
        OPTIONS = {"model": Setting(help="a .npz written by latlong build", flag="MODEL",
                                    required=True, run=True),
                   "output": Setting(help="PNG to write", flag="-o/--output",
@@ -30,8 +31,6 @@ How to declare a command's options
 
        def run(v: Values) -> int:      # v["width_px"] or v.width_px; v.given ...
            ...
-
-       HELP = {"render": "render a saved body"}
 
        def register(sub) -> None:
            command(sub, "render", run, OPTIONS, prog="latlong",

@@ -32,10 +32,12 @@ def save_figure(fig, path) -> None:
     """Lay out a matplotlib figure, write it as PNG (110 dpi), atomically, and close it."""
     import matplotlib.pyplot as plt
 
-    fig.tight_layout()
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=110, format="png")
-    plt.close(fig)
+    try:
+        fig.tight_layout()
+        with atomic_path(path) as tmp:
+            fig.savefig(tmp, dpi=110, format="png")
+    finally:
+        plt.close(fig)
 
 
 def series_colors(n: int) -> list:

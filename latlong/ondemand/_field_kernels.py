@@ -302,6 +302,19 @@ def _dep_scan(s, owners, owner_cell, c_start, c_list, fc, diam, out_owner, out_d
     return n
 
 
+@njit(cache=True, inline="always")
+def _may_reach_cell(fc, k, r, reach, own_max):
+    """Whether candidate ``k`` may pass :func:`_dep_scan`'s test for an owner of a cell
+    whose owners lie within ``reach`` (chord plus own chord) of its owner ``r``."""
+    if fc[k, FAR] + own_max >= np.pi:
+        return True
+    d0 = fc[k, C0] - fc[r, C0]
+    d1 = fc[k, C1] - fc[r, C1]
+    d2 = fc[k, C2] - fc[r, C2]
+    lim = (np.sqrt(fc[k, CHORD2]) + reach) * (1.0 + 1e-12)
+    return d0 * d0 + d1 * d1 + d2 * d2 <= lim * lim
+
+
 @njit(cache=True)
 def _cell_candidates(owners, owner_cell, lo, hi, cand_sorted, fc):
     """The candidates each owner cell's owners must test, in the order ``lo``/``hi``
@@ -311,7 +324,8 @@ def _cell_candidates(owners, owner_cell, lo, hi, cand_sorted, fc):
     chord_o, and |k - r| <= |k - o| + |o - r|, so the candidates with |k - r| >
     chord_k + max_o (chord_o + |o - r|) are none of them (kept with a margin of 1e-12
     for rounding: only a superset, the same pairs in the same order). In a coarse bin
-    ~10 000 owners in a few cells share a few hundred candidates, 1 % of them near."""
+    ~10 000 owners in a few cells share a few hundred candidates, 1 % of them near.
+    Every cell of ``lo`` holds an owner."""
     n_cell = lo.shape[0]
     ref = np.full(n_cell, -1, dtype=np.int64)
     reach = np.zeros(n_cell)
@@ -328,32 +342,23 @@ def _cell_candidates(owners, owner_cell, lo, hi, cand_sorted, fc):
         own, chord_own = _own_angle_chord(fc, o)
         reach[c] = max(reach[c], np.sqrt(d0 * d0 + d1 * d1 + d2 * d2) + chord_own)
         own_max[c] = max(own_max[c], own)
-    counts = np.zeros(n_cell + 1, dtype=np.int64)
-    for w in range(2):
-        c_list = np.empty(counts[n_cell] if w else 0, dtype=np.int64)
-        for c in range(n_cell):
-            at = counts[c]
-            n = 0
-            r = ref[c]
-            for t in range(9):
-                for q in range(lo[c, t], hi[c, t]):
-                    k = cand_sorted[q]
-                    keep = r < 0 or fc[k, FAR] + own_max[c] >= np.pi
-                    if not keep:
-                        d0 = fc[k, C0] - fc[r, C0]
-                        d1 = fc[k, C1] - fc[r, C1]
-                        d2 = fc[k, C2] - fc[r, C2]
-                        lim = (np.sqrt(fc[k, CHORD2]) + reach[c]) * (1.0 + 1e-12)
-                        keep = d0 * d0 + d1 * d1 + d2 * d2 <= lim * lim
-                    if keep:
-                        if w:
-                            c_list[at + n] = k
-                        n += 1
-            if not w:
-                counts[c + 1] = n
-        if not w:
-            counts = np.cumsum(counts)
-    return counts, c_list
+    starts = np.zeros(n_cell + 1, dtype=np.int64)
+    for c in range(n_cell):  # counted first, then written at the cells' offsets
+        n = 0
+        for t in range(9):
+            for q in range(lo[c, t], hi[c, t]):
+                n += _may_reach_cell(fc, cand_sorted[q], ref[c], reach[c], own_max[c])
+        starts[c + 1] = starts[c] + n
+    c_list = np.empty(starts[n_cell], dtype=np.int64)
+    for c in range(n_cell):
+        at = starts[c]
+        for t in range(9):
+            for q in range(lo[c, t], hi[c, t]):
+                k = cand_sorted[q]
+                if _may_reach_cell(fc, k, ref[c], reach[c], own_max[c]):
+                    c_list[at] = k
+                    at += 1
+    return starts, c_list
 
 
 @njit(cache=True, parallel=True)

@@ -223,13 +223,13 @@ class CraterField:
         parts: list[_Craters] = []
         owners_all: list[np.ndarray] = []
         deps_all: list[np.ndarray] = []
-        n_have = 0
-        fc_rows, d_rows = GrowingRows(K.N_COLS), GrowingRows(0)
+        fc_rows, d_rows = GrowingRows(K.N_COLS), GrowingRows(0)  # the craters kept
         at_level = self._cells_by_level(units, d_min)
         for b in sorted(self.levels):
             if self._tops[b] <= d_min:
                 continue
             level = self.levels[b]
+            n_have = fc_rows.n
             first_pair = len(owners_all)
             # the query rule: every crater of the cells around the points' cells
             cand_cells = unique_sorted(neighbours(at_level[level]))
@@ -278,7 +278,6 @@ class CraterField:
             parts.append(kept)
             fc_rows.keep(kept.fc)
             d_rows.keep(kept.diameter_m)
-            n_have += len(keep)
         craters = _Craters.concat(parts) if parts else self._records(None, 0)
         if owners_all:
             owner = np.concatenate(owners_all)
