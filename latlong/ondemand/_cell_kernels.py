@@ -10,7 +10,7 @@ from numba import njit, prange
 
 from craters.kernels import cell_id, face_point, face_uv, read_only_inputs
 
-from ._field_kernels import C0, C1, C2, COS_FAR, E0, N0
+from ._field_kernels import C0, C1, C2, E0, N0
 
 
 @read_only_inputs("out")
@@ -102,27 +102,28 @@ def _reach_kernel(centres, angles, level, occ, out):
 
 
 @njit(cache=True, parallel=True)
-def _cap_blocks_kernel(fc, craters, level, occ, cos_margin):
+def _cap_blocks_kernel(fc, angles, craters, level, occ, cos_margin):
     """Pairs (block, crater): the occupied blocks (sorted cell ids ``occ`` at ``level``)
-    that crater caps may reach (:func:`_cap_blocks_one`), crater by crater in the order
-    given. Craters in parallel, counted first, then written at their offsets."""
+    that crater caps (centre and frame in ``fc``, angular radius ``angles``) may reach
+    (:func:`_cap_blocks_one`), crater by crater in the order given. Craters in parallel,
+    counted first, then written at their offsets."""
     n_cr = craters.shape[0]
     counts = np.zeros(n_cr + 1, dtype=np.int64)
     none = np.empty(0, dtype=np.int64)
     for t in prange(n_cr):
-        counts[t + 1] = _cap_blocks_one(fc, craters[t], level, occ, cos_margin, none, none,
-                                        0, False)
+        counts[t + 1] = _cap_blocks_one(fc, angles, craters[t], level, occ, cos_margin, none,
+                                        none, 0, False)
     offsets = np.cumsum(counts)
     out_blk = np.empty(offsets[n_cr], dtype=np.int64)
     out_crater = np.empty(offsets[n_cr], dtype=np.int64)
     for t in prange(n_cr):
-        _cap_blocks_one(fc, craters[t], level, occ, cos_margin, out_blk, out_crater,
+        _cap_blocks_one(fc, angles, craters[t], level, occ, cos_margin, out_blk, out_crater,
                         offsets[t], True)
     return out_blk, out_crater
 
 
 @njit(cache=True)
-def _cap_blocks_one(fc, k, level, occ, cos_margin, out_blk, out_crater, at, write):
+def _cap_blocks_one(fc, angles, k, level, occ, cos_margin, out_blk, out_crater, at, write):
     """The occupied blocks crater k's cap may reach, written from ``at`` when ``write``;
     returns how many. A cap narrower than 0.3 rad is projected on each face it can touch
     and the blocks of its bounding box are looked up; a wider one is tested against every
@@ -132,8 +133,10 @@ def _cap_blocks_one(fc, k, level, occ, cos_margin, out_blk, out_crater, at, writ
     nside = 1 << level
     n_samples = 64
     bp = np.empty((n_samples + 1, 3))
-    cosf = fc[k, COS_FAR]
-    ang = np.arccos(min(1.0, max(-1.0, cosf)))
+    # the angle itself: its cosine rounds to 1 below ~1e-8 rad (2 cm on the Moon), which
+    # listed a centimetre crater in its centre's block only (steps along block edges)
+    ang = angles[k]
+    cosf = np.cos(ang)
     c = np.array([fc[k, C0], fc[k, C1], fc[k, C2]])
     if ang >= 0.3:
         # angle(c, block) <= ang + margin

@@ -111,15 +111,16 @@ def block_level(n: int, units: np.ndarray) -> int:
     return bin_level(width, 24)
 
 
-def block_pairs(records: np.ndarray, active: np.ndarray, level: int, occ: np.ndarray,
-                rank: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def block_pairs(records: np.ndarray, angles: np.ndarray, active: np.ndarray, level: int,
+                occ: np.ndarray, rank: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(start, list): for each occupied block (sorted cell ids ``occ`` at ``level``) the
-    ``active`` records (rows of ``records``: centre, east, north, reference radius, radius,
-    cos of the reach; :mod:`._field_kernels`) that may reach it, ordered by ``rank``;
-    block ``b``'s are ``list[start[b]:start[b + 1]]``."""
+    ``active`` records (rows of ``records``: centre, east, north; :mod:`._field_kernels`)
+    whose reach (``angles``, radians) may touch it, ordered by ``rank``; block ``b``'s are
+    ``list[start[b]:start[b + 1]]``."""
     margin = np.cos(2.0 * 2.0 ** (1 - level))  # a block's angular radius, bounded
-    ob, oc = C._cap_blocks_kernel(records, np.ascontiguousarray(active, dtype=np.int64), level,
-                                  occ, margin)
+    ob, oc = C._cap_blocks_kernel(records, np.ascontiguousarray(angles, dtype=np.float64),
+                                  np.ascontiguousarray(active, dtype=np.int64), level, occ,
+                                  margin)
     srt = np.lexsort((rank[oc], ob))
     return (np.searchsorted(ob[srt], np.arange(len(occ) + 1)).astype(np.int64),
             np.ascontiguousarray(oc[srt]))

@@ -419,7 +419,7 @@ class CraterField:
                          rank, diam, up, 20.0, 45.0, True)
         self._remember([keys[i] for i in new], fc[new])
         active = order[fc[order, K.ACTIVE] > 0]
-        blk_start, blk_list = block_pairs(fc, active, level, occ, rank)
+        blk_start, blk_list = block_pairs(fc, fc[:, K.FAR], active, level, occ, rank)
         out = np.empty(len(units))
         K._points_kernel(units, block_of, blk_start, blk_list, base, fc, tabs, rims, seeds,
                          rough, self.gain, ROUGHNESS_OCTAVES, self.xe, BLEND_EDGE, rank, diam, out)

@@ -132,7 +132,8 @@ class RockField:
         if not len(rc):
             return 0
         active = np.arange(len(rc), dtype=np.int64)
-        start, lst = block_pairs(rc, active, level, occ, active)
+        angles = 2.0 * np.arcsin(np.minimum(1.0, 0.5 * np.sqrt(rc[:, R.CHORD2])))
+        start, lst = block_pairs(rc, angles, active, level, occ, active)
         R._rocks_kernel(units, block_of, start, lst, rc, np.ascontiguousarray(got["seed"]),
                         out)
         return len(rc)
