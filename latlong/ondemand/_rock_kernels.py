@@ -51,16 +51,20 @@ def _rock_height(rc, seeds, k, p0, p1, p2):
     return z if z > 0.0 else 0.0
 
 
-@read_only_inputs("out")
+@read_only_inputs("out", "which")
 @njit(cache=True, parallel=True)
-def _rocks_kernel(points, block_of, blk_start, blk_list, rc, seeds, out):
-    """Adds to each point the tallest rock over it (of its block's rocks)."""
+def _rocks_kernel(points, block_of, blk_start, blk_list, rc, seeds, out, which):
+    """Adds to each point the tallest rock over it (of its block's rocks) and writes that
+    rock's row in ``which`` (-1 where no rock stands: the ground truth of the labels)."""
     for i in prange(points.shape[0]):
         blk = block_of[i]
         top = 0.0
+        best = -1
         for t in range(blk_start[blk], blk_start[blk + 1]):
-            h = _rock_height(rc, seeds, blk_list[t], points[i, 0], points[i, 1],
-                             points[i, 2])
+            k = blk_list[t]
+            h = _rock_height(rc, seeds, k, points[i, 0], points[i, 1], points[i, 2])
             if h > top:
                 top = h
+                best = k
         out[i] += top
+        which[i] = best

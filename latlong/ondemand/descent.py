@@ -76,6 +76,9 @@ class DescentFrame:
     crs_wkt: str = ""
     """The CRS of the positions (body-fixed Cartesian on the body's sphere), OGC WKT: the
     LAS files' CRS."""
+    rocks: np.ndarray | None = None
+    """The rocks that show in the frame's terrain (the row of a rock is its id in the
+    frame's ``boulder_id`` label image): :meth:`RockField.last_catalog`'s columns."""
 
 
 def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
@@ -86,13 +89,27 @@ def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
     return np.geomspace(start_m, stop_m, frames)
 
 
+def _rock_faces(field: CraterField, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+    """(each face's rock label, -1 on the ground; the catalog of the labelled rocks, row =
+    label) of the terrain of the field's last query: a face is a rock's where its three
+    vertices stand on that rock (the tallest at each, :attr:`RockField.last_which`)."""
+    rocks = field.rocks
+    which = rocks.last_which[faces] if rocks else np.full(faces.shape, -1)
+    on = (which[:, 0] >= 0) & (which[:, 0] == which[:, 1]) & (which[:, 0] == which[:, 2])
+    shown, label = np.unique(which[on, 0], return_inverse=True)
+    face_rock = np.full(len(faces), -1, dtype=np.int32)
+    face_rock[on] = label
+    return face_rock, rocks.last_catalog(shown) if rocks else None
+
+
 def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius):
-    """(vertices, faces, (craters, rocks), kind) of a frame's terrain."""
+    """(vertices, faces, (craters, rocks), kind, (face rock labels, rock catalog)) of a
+    frame's terrain."""
     if size_m <= 0.5 * site_radius:
         size_px = min(MAX_TILE_PX, max(1, int(round(size_m / pixel_m))))
         t = tile_of_field(field, lat_deg, lon_deg, size_px, pixel_m, 3.0)
         verts, faces = tile_mesh(t)
-        return verts, faces, (t.n_craters, t.n_rocks), "window"
+        return verts, faces, (t.n_craters, t.n_rocks), "window", _rock_faces(field, faces)
     if field.base.scene is None:
         raise ParameterError("altitudes_m", f"must keep the frames' ground within a window "
                              f"(footprint x {_MARGIN} <= half the site's radius) over a DEM")
@@ -102,7 +119,8 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
     d_min = 3.0 * grid.spacing(field.base.radius_m)
     radii = field.radii(units, d_min)
     counts = len(field.last["craters"]), len(field.rocks.last["diameter_m"])
-    return units * radii[:, None], grid.triangles(), counts, "body"
+    faces = grid.triangles()
+    return units * radii[:, None], faces, counts, "body", _rock_faces(field, faces)
 
 
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
@@ -160,8 +178,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     for i, h in enumerate(alts):
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
-        verts, faces, counts, kind = _terrain(field, lat_deg, lon_deg, _MARGIN * footprint,
-                                                 pixel, site_radius)
+        verts, faces, counts, kind, (face_rock, rocks) = _terrain(
+            field, lat_deg, lon_deg, _MARGIN * footprint, pixel, site_radius)
         catalog = field.last_catalog()  # the terrain's craters (oldest first)
         catalog = catalog[catalog["slope_factor"] > 0]  # those erased by slope show nothing
         # the altitude is above the terrain at the site as this frame's terrain has it
@@ -170,8 +188,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         # one frame per mesh: Embree's quick build pays (a medium BVH costs more than
         # the rays it saves on one frame)
         mesh = RayMesh(verts, faces, build_quality="low")
-        truth = SceneGeometry(verts, faces, np.full(len(faces), -1, dtype=np.int32),
-                              craters=catalog, source="terrain on demand")
+        truth = SceneGeometry(verts, faces, face_rock, craters=catalog, boulders=rocks,
+                              source="terrain on demand")
         albedo = ejecta_albedo(truth, contrast=bright_ejecta) * regolith_albedo(
             verts, seed=field.base.seed, contrast=mottling, pixel_m=pixel)
         frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth,
@@ -181,7 +199,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
             rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)
         n_craters, n_rocks = counts
         yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
-                           catalog, returns, crs_wkt)
+                           catalog, returns, crs_wkt, rocks)
 
 
 def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:
@@ -210,10 +228,11 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
     """Write the :class:`DescentFrame` s of ``frames`` (an iterable, e.g. :func:`descent`)
     into the new folder ``out`` (written whole or not at all,
     :func:`latlong.sensors.runs.run_folder`): per frame the camera's files (image, depth,
-    range, normals, the crater-id label image), the craters that show in the frame's
-    terrain ``craters_NNNN.csv`` (row = label id) and an 8-bit ``picture_NNNN.png``
-    exposed on its own lit pixels (the 99.5th percentile to white, as a descent camera's
-    auto-exposure would);
+    range, normals, the crater-id and boulder-id label images), the craters that show in
+    the frame's terrain ``craters_NNNN.csv`` (row = label id), its rocks that show
+    ``rocks_NNNN.csv`` (row = boulder label id; when there are any) and an 8-bit
+    ``picture_NNNN.png`` exposed on its own lit pixels (the 99.5th percentile to white, as
+    a descent camera's auto-exposure would);
     ``strip.png`` puts the pictures side by side; ``frames.json`` the intrinsics and per
     frame the altitude, ground pixel, exposure, terrain, craters, rocks, pose, sun and
     files; frames with LIDAR returns add ``lidar_NNNN.las`` (LAS 1.4 unless the settings
@@ -244,6 +263,9 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
                 Image.fromarray(pic).save(p, format="PNG")
             files["craters"] = f"craters_{i:04d}.csv"
             write_catalog(f.craters, tmp / files["craters"])
+            if f.rocks is not None and len(f.rocks):
+                files["rocks"] = f"rocks_{i:04d}.csv"
+                write_catalog(f.rocks, tmp / files["rocks"])
             pictures.append(pic)
             extra = {}
             if f.lidar is not None:

@@ -22,7 +22,9 @@ from __future__ import annotations
 import logging
 
 import numpy as np
+import numpy.lib.recfunctions as rfn
 
+from craters.catalog import make_catalog
 from craters.local import ROCK_FACETS, bin_bounds, bin_level, bins, draw_rock_cells
 
 from ..scene import Scene
@@ -56,6 +58,7 @@ class RockField:
                 self.levels[int(b)] = min(self.levels.get(int(b), 99),
                                           bin_level(_BIN_MARGIN * reach / base.min_radius_m))
         self.last = self.rocks(np.zeros((0, 3)), np.inf)
+        self.last_which = np.zeros(0, dtype=np.int64)  # each point's rock row, -1: none
 
     def __bool__(self) -> bool:
         return bool(self.layers)
@@ -129,11 +132,27 @@ class RockField:
         got = self.rocks(units, d_min)
         rc = np.ascontiguousarray(got["rc"])
         self.last = got
+        self.last_which = np.full(len(units), -1, dtype=np.int64)
         if not len(rc):
             return 0
         active = np.arange(len(rc), dtype=np.int64)
         angles = 2.0 * np.arcsin(np.minimum(1.0, 0.5 * np.sqrt(rc[:, R.CHORD2])))
         start, lst = block_pairs(rc, angles, active, level, occ, active)
         R._rocks_kernel(units, block_of, start, lst, rc, np.ascontiguousarray(got["seed"]),
-                        out)
+                        out, self.last_which)
         return len(rc)
+
+    def last_catalog(self, rows: np.ndarray | None = None) -> np.ndarray:
+        """The boulder catalog (:func:`craters.catalog.write_catalog`'s boulder columns)
+        of the rocks of the last :meth:`add` call, or of its ``rows``: centre (the
+        rock's foot direction), ``diameter_m``, ``height_m``, ``burial_frac``, ``id``."""
+        got = self.last
+        rows = np.arange(len(got["diameter_m"])) if rows is None else np.asarray(rows)
+        u = got["unit"][rows] if len(rows) else np.zeros((0, 3))
+        cat = make_catalog(lat_deg=np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0))),
+                           lon_deg=np.degrees(np.arctan2(u[:, 1], u[:, 0])),
+                           diameter_m=got["diameter_m"][rows],
+                           kind=np.full(len(rows), "boulder"),
+                           burial_frac=got["burial_frac"][rows],
+                           height_m=got["height_m"][rows], layer=got["layer"][rows])
+        return rfn.append_fields(cat, "id", got["id"][rows], usemask=False)

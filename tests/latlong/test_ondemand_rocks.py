@@ -85,11 +85,15 @@ def test_the_rock_kernel_matches_numpy(scene):
     rc = got["rc"]
     assert len(rc) > 20
     out = np.zeros(len(units))
+    which = np.zeros(len(units), dtype=np.int64)
     every = np.arange(len(rc), dtype=np.int64)
     R._rocks_kernel(units, np.zeros(len(units), np.int64), np.array([0, len(rc)]), every,
-                    rc, got["seed"], out)
-    ref = np.array([_rock_height_numpy(rc, got["seed"], p).max() for p in units])
+                    rc, got["seed"], out, which)
+    heights = np.array([_rock_height_numpy(rc, got["seed"], p) for p in units])
+    ref = heights.max(axis=1)
     assert np.allclose(out, ref, rtol=0, atol=1e-12)
+    # the tallest rock of each point (the labels' ground truth), -1 where none stands
+    assert np.array_equal(which, np.where(ref > 0, heights.argmax(axis=1), -1))
     assert (out > 0).mean() > 0.01
     # no rock stands higher than its unburied height (and its roughness)
     top = got["height_m"] * (1 - got["burial_frac"] + 0.5 * R.ROCK_ROUGHNESS)
@@ -128,3 +132,28 @@ def test_a_finer_resolution_changes_heights_only_where_added_craters_and_rocks_r
     changed = fine != coarse
     assert changed.any()
     assert not (changed & ~reach).any()
+
+
+def test_descent_frames_label_the_rocks_of_their_own_terrain(scene, tmp_path):
+    from craters.catalog import read_catalog
+    from latlong.ondemand.descent import descent, write_descent
+
+    frames = list(descent(scene, 10.0, 40.0, [40.0, 15.0], width_px=64))
+    stretch = np.sqrt(scene.boulders.shape.elongation)
+    for f in frames:
+        ids = f.frame.boulder_id
+        hit = ids >= 0
+        assert 0.001 < hit.mean() < 0.5 and ids.max() < len(f.rocks)
+        assert set(np.unique(ids[hit])) <= set(range(len(f.rocks)))
+        # each labelled pixel lies on the footprint of the rock it names (its long
+        # semi-axis, plus the two ground pixels a face on the rock may reach beyond it)
+        cat = f.rocks[ids[hit]]
+        u = units_of(cat["lat_deg"], cat["lon_deg"])
+        p = f.frame.position_m[hit]
+        cos = np.einsum("ij,ij->i", p, u) / np.linalg.norm(p, axis=1)
+        arc = np.linalg.norm(p, axis=1) * np.arccos(np.clip(cos, -1.0, 1.0))
+        assert (arc <= 0.5 * cat["diameter_m"] * stretch + 2 * f.ground_pixel_m).all()
+    assert write_descent(frames, tmp_path / "d", seed=5, site_lat_lon_deg=(10.0, 40.0)) == 2
+    back = read_catalog(tmp_path / "d" / "rocks_0001.csv")
+    assert len(back) == len(frames[1].rocks)
+    assert np.allclose(back["diameter_m"], frames[1].rocks["diameter_m"])
