@@ -23,7 +23,7 @@ import numpy as np
 
 from craters._shared import ParameterError
 from latlong import Scene
-from latlong.ondemand.base import BaseField
+from latlong.ondemand.base import BaseField, lat_lon_of
 from latlong.ondemand.field import CraterField
 from latlong.ondemand.tile import Tile, check_window, tile_of_field
 
@@ -65,7 +65,7 @@ class DemBase(BaseField):
         return (lat_deg - t.f) / t.e - 0.5, (lon - t.c) / t.a - 0.5
 
     def radius(self, unit) -> np.ndarray:
-        return self.radius_at(*_lat_lon(unit))
+        return self.radius_at(*lat_lon_of(unit))
 
     def radius_at(self, lat_deg: np.ndarray, lon_deg: np.ndarray) -> np.ndarray:
         """:meth:`radius` at latitudes and longitudes (degrees)."""
@@ -101,7 +101,7 @@ class StackBase(BaseField):
         self.dem = stack.layers[0]
 
     def radius(self, unit) -> np.ndarray:
-        lat, lon = _lat_lon(unit)
+        lat, lon = lat_lon_of(unit)
         r = self.levels[0].radius_at(lat, lon)  # refuses points outside the coarsest layer
         for level in self.levels[1:]:
             row, col = level._pixels(lat, lon)
@@ -114,13 +114,6 @@ class StackBase(BaseField):
                 r[inside] += w[inside] * (level.radius_at(lat[inside], lon[inside])
                                           - r[inside])
         return r
-
-
-def _lat_lon(unit) -> tuple[np.ndarray, np.ndarray]:
-    """Latitudes and longitudes (degrees) of directions ``unit`` (n, 3)."""
-    u = np.asarray(unit, dtype=np.float64).reshape(-1, 3)
-    return (np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0))),
-            np.degrees(np.arctan2(u[:, 1], u[:, 0])))
 
 
 def _raster_base(base: BaseField, seed: int, radius_m: float, min_radius_m: float) -> None:

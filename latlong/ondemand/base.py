@@ -217,6 +217,14 @@ def _normalized(v: np.ndarray) -> np.ndarray:
     return v / np.sqrt((v * v).sum(axis=1, keepdims=True))
 
 
+def lat_lon_of(units) -> tuple[np.ndarray, np.ndarray]:
+    """Latitudes and longitudes (degrees, longitude in [-180, 180]) of directions
+    ``units`` (n, 3): the inverse of :func:`latlong.ondemand.units_of`."""
+    u = np.asarray(units, dtype=np.float64).reshape(-1, 3)
+    return (np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0))),
+            np.degrees(np.arctan2(u[:, 1], u[:, 0])))
+
+
 def tangent_frame(u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """East and north unit vectors at directions ``u`` (x as east at the poles), by the
     stamping kernel's formulas (east = z x u, north = u x east)."""

@@ -89,14 +89,13 @@ def descent_altitudes(start_m: float, stop_m: float, frames: int) -> np.ndarray:
     return np.geomspace(start_m, stop_m, frames)
 
 
-def _rock_faces(field: CraterField, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+def _rock_faces(field: CraterField, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(each face's rock label, -1 on the ground; the catalog of the labelled rocks, row =
     label) of the terrain of the field's last query: a face is a rock's where two of its
     vertices stand on that rock (the tallest at each, :attr:`RockField.last_which`): the
     labelled area then matches the rocks' share of the vertices (all three left a quarter
     of a 5 mm-pixel tile's rock cover unlabelled, 0.23 % of the faces for 0.32 %)."""
-    rocks = field.rocks
-    a, b, c = (rocks.last_which[faces] if rocks else np.full(faces.shape, -1)).T
+    a, b, c = field.rocks.last_which[faces].T
     rock = np.where(b == c, b, -1)  # the rock two vertices share (-1: none)
     rock = np.where(a == c, a, rock)
     rock = np.where(a == b, a, rock)
@@ -104,7 +103,7 @@ def _rock_faces(field: CraterField, faces: np.ndarray) -> tuple[np.ndarray, np.n
     shown, label = np.unique(rock[on], return_inverse=True)
     face_rock = np.full(len(faces), -1, dtype=np.int32)
     face_rock[on] = label
-    return face_rock, rocks.last_catalog(shown) if rocks else None
+    return face_rock, field.rocks.last_catalog(shown)
 
 
 def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius):

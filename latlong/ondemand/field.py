@@ -68,7 +68,7 @@ from craters.stamp import (
 
 from ..scene import Scene
 from . import _field_kernels as K
-from .base import BaseField, base_field, per_scene, tangent_frame
+from .base import BaseField, base_field, lat_lon_of, per_scene, tangent_frame
 from .cellsets import (
     GrowingRows,
     block_level,
@@ -315,8 +315,7 @@ class CraterField:
         """:meth:`catalog` of the craters of the last :meth:`radii` call."""
         cr, fc = self.last["craters"], self.last["fc"]
         u = fc[:, K.C0:K.C2 + 1]
-        lat = np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0)))
-        lon = np.degrees(np.arctan2(u[:, 1], u[:, 0]))
+        lat, lon = lat_lon_of(u)
         kinds = np.array([la.kind for la in self.layers] or ["crater"])
         depth = fc[:, K.DEPTH] * fc[:, K.SCALE]
         with np.errstate(divide="ignore", invalid="ignore"):

@@ -29,7 +29,7 @@ from craters.local import ROCK_FACETS, bin_bounds, bin_level, bins, draw_rock_ce
 
 from ..scene import Scene
 from . import _rock_kernels as R
-from .base import BaseField, tangent_frame
+from .base import BaseField, lat_lon_of, tangent_frame
 from .cellsets import block_pairs, cell_areas, cells_of, coarser, neighbour_set, unique_sorted
 
 __all__ = ["RockField"]
@@ -91,12 +91,14 @@ class RockField:
             return {"rc": np.zeros((0, R.N_ROCK_COLS)), "diameter_m": np.zeros(0),
                     "seed": np.zeros(0, np.uint64),
                     "id": np.zeros(0, np.uint64), "layer": np.zeros(0, np.int64),
-                    "height_m": np.zeros(0), "burial_frac": np.zeros(0)}
+                    "height_m": np.zeros(0), "burial_frac": np.zeros(0),
+                    "unit": np.zeros((0, 3)), "reach_rad": np.zeros(0)}
         got = {k: np.concatenate([p[k] for p in parts]) for k in parts[0]}
-        got["rc"] = self._records(got)
+        got["rc"], got["reach_rad"] = self._records(got)
         return got
 
-    def _records(self, got: dict) -> np.ndarray:
+    def _records(self, got: dict) -> tuple[np.ndarray, np.ndarray]:
+        """(the rocks' kernel records, each rock's reach in radians)."""
         u = got["unit"]
         rc = np.zeros((len(u), R.N_ROCK_COLS))
         rc[:, 0:3] = u
@@ -122,7 +124,7 @@ class RockField:
         rc[:, R.F0 + 1::4][:, :R.N_FACETS] = np.sin(f[:, :, 0])
         rc[:, R.F0 + 2::4][:, :R.N_FACETS] = f[:, :, 1]
         rc[:, R.F0 + 3::4][:, :R.N_FACETS] = f[:, :, 2]
-        return rc
+        return rc, angle
 
     def add(self, units: np.ndarray, out: np.ndarray, d_min: float, level: int,
             occ: np.ndarray, block_of: np.ndarray) -> int:
@@ -136,8 +138,7 @@ class RockField:
         if not len(rc):
             return 0
         active = np.arange(len(rc), dtype=np.int64)
-        angles = 2.0 * np.arcsin(np.minimum(1.0, 0.5 * np.sqrt(rc[:, R.CHORD2])))
-        start, lst = block_pairs(rc, angles, active, level, occ, active)
+        start, lst = block_pairs(rc, got["reach_rad"], active, level, occ, active)
         R._rocks_kernel(units, block_of, start, lst, rc, np.ascontiguousarray(got["seed"]),
                         out, self.last_which)
         return len(rc)
@@ -148,10 +149,8 @@ class RockField:
         rock's foot direction), ``diameter_m``, ``height_m``, ``burial_frac``, ``id``."""
         got = self.last
         rows = np.arange(len(got["diameter_m"])) if rows is None else np.asarray(rows)
-        u = got["unit"][rows] if len(rows) else np.zeros((0, 3))
-        cat = make_catalog(lat_deg=np.degrees(np.arcsin(np.clip(u[:, 2], -1.0, 1.0))),
-                           lon_deg=np.degrees(np.arctan2(u[:, 1], u[:, 0])),
-                           diameter_m=got["diameter_m"][rows],
+        lat, lon = lat_lon_of(got["unit"][rows])
+        cat = make_catalog(lat_deg=lat, lon_deg=lon, diameter_m=got["diameter_m"][rows],
                            kind=np.full(len(rows), "boulder"),
                            burial_frac=got["burial_frac"][rows],
                            height_m=got["height_m"][rows], layer=got["layer"][rows])
