@@ -34,6 +34,7 @@ import numpy as np
 
 from ._diffusion_kernels import _blend_tables
 from ._shared import ParameterError
+from .exact import matmul
 from .morphology import EJECTA_EDGE, fresh_morphometry, fresh_profile
 from .targets import Target, get_target
 
@@ -135,9 +136,9 @@ def diffuse_profiles(profiles: np.ndarray, tau) -> np.ndarray:
     ``diffusion_nodes()``; the result is at the same nodes."""
     r, k, t, scale = _qdht(N_NODES, DOMAIN)
     tau = np.asarray(tau, dtype=np.float64).reshape(-1, 1)
-    spec = (profiles * scale) @ t.T
+    spec = matmul(profiles * scale, t.T)
     spec *= np.exp(-(k[None, :] ** 2) * tau)
-    return (spec @ t.T) / scale
+    return matmul(spec, t.T) / scale
 
 
 def diffusion_nodes() -> np.ndarray:
@@ -178,13 +179,13 @@ def _node_tables(target: Target, d_nodes: np.ndarray, tau_nodes: np.ndarray, xe:
     r, k, t, scale = _qdht(N_NODES, DOMAIN)
     fresh = fresh_profile(r, d_nodes, target, ejecta_edge=xe)            # (nd, N)
     fresh /= fresh_morphometry(d_nodes, target)["depth_m"][:, None]
-    spec = (fresh * scale) @ t.T                                          # (nd, N)
+    spec = matmul(fresh * scale, t.T)                                     # (nd, N)
     decay = np.exp(-np.outer(tau_nodes, k**2))                            # (nt, N)
     if rows_d is None:
         nd, nt = len(d_nodes), len(tau_nodes)
-        evolved = (spec[:, None, :] * decay[None]).reshape(nd * nt, -1) @ _to_table(xe)
+        evolved = matmul((spec[:, None, :] * decay[None]).reshape(nd * nt, -1), _to_table(xe))
         return evolved.reshape(nd, nt, -1).astype(np.float32)
-    return ((spec[rows_d] * decay[rows_tau]) @ _to_table(xe)).astype(np.float32)
+    return matmul(spec[rows_d] * decay[rows_tau], _to_table(xe)).astype(np.float32)
 
 
 class _Cache:

@@ -21,6 +21,7 @@ from craters._shared import (
     check_positive,
 )
 from craters._shared.files import check_regular_file
+from craters.exact import dot
 
 from .export import EXPORT_SUFFIXES, body_mesh_source, export_body
 from .geometry.meshes import polydata
@@ -371,7 +372,8 @@ def _area_mean(grid: LatLongGrid, radii: np.ndarray) -> float:
     The per-vertex areas of a block are made from the grid's :meth:`ring_areas` (no
     whole-grid array). A grid of at most one block (M <= 40) gets the very bits of the
     single ``np.dot`` used before; a larger one a result that no longer depends on the
-    BLAS thread count (the single dot's did).
+    BLAS thread count (the single dot's did). Each block's dot is :func:`craters.exact.dot`
+    (in index order): OpenBLAS's ``ddot`` kernel, and so its last bits, depend on the CPU.
     """
     areas, offs = grid.ring_areas(), grid.ring_offsets()
     num = den = 0.0
@@ -380,7 +382,7 @@ def _area_mean(grid: LatLongGrid, radii: np.ndarray) -> float:
         r0 = int(np.searchsorted(offs, s, side="right")) - 1
         r1 = int(np.searchsorted(offs, e - 1, side="right")) - 1
         w = np.repeat(areas[r0:r1 + 1], np.diff(np.clip(offs[r0:r1 + 2], s, e)))
-        num += float(np.dot(w, radii[s:e]))
+        num += dot(w, radii[s:e])
         den += float(w.sum())
     return num / den
 

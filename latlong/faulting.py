@@ -9,6 +9,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, normalize_rng, progress_bar
 from craters._shared.settings import check_declared, setting
+from craters.exact import dot
 
 from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid
@@ -39,7 +40,7 @@ def _check_grid(grid) -> LatLongGrid:
 def area_mean(grid: LatLongGrid, values) -> float:
     """Area-weighted mean of a per-vertex field over the sphere."""
     w = grid.vertex_areas()
-    return float(np.dot(w, values) / w.sum())
+    return dot(w, values) / float(w.sum())
 
 
 def apply_faults(grid: LatLongGrid, normals, heights, *, progress: bool = False) -> np.ndarray:

@@ -240,7 +240,8 @@ def gravity(body_or_mesh, density_kg_m3: float, period_h: float = math.inf, *,
                         f"got {type(body_or_mesh).__name__}")
     omega = 0.0 if math.isinf(period_h) else 2.0 * math.pi / (period_h * 3600.0)
     x = pos - centre
-    perp = x - np.outer(x @ axis, axis)
+    # x . axis written out (a matrix-vector product goes to OpenBLAS: CPU-dependent bits)
+    perp = x - np.outer(x[:, 0] * axis[0] + x[:, 1] * axis[1] + x[:, 2] * axis[2], axis)
     return GravityField(
         acceleration_m_s2=acc, potential_m2_s2=pot,
         effective_m_s2=acc + omega**2 * perp,

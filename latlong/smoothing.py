@@ -19,6 +19,7 @@ import math
 import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, check_range
+from craters.exact import dot
 
 from .grid import LatLongGrid
 
@@ -132,7 +133,7 @@ def heat_smooth(grid: LatLongGrid, values, sigma_rad: float) -> np.ndarray:
         f = _sample(mags[k + 1], f, LatLongGrid(mags[k]))
         f = _diffuse(mags[k], f, post[k])
     w = grid.vertex_areas()
-    f += (np.dot(w, f0) - np.dot(w, f)) / w.sum()
+    f += (dot(w, f0) - dot(w, f)) / float(w.sum())
     return f
 
 

@@ -123,7 +123,10 @@ def orientations(normals, azimuth_rad) -> np.ndarray:
     turn = np.zeros((k, 3, 3))
     turn[:, 0, 0], turn[:, 0, 1], turn[:, 1, 0], turn[:, 1, 1] = c, -s, s, c
     turn[:, 2, 2] = 1.0
-    return frame @ turn
+    # the product written out (a matmul goes to OpenBLAS, whose kernel, and so whose last
+    # bits, depend on the CPU: craters.exact)
+    return (frame[:, :, 0:1] * turn[:, 0:1, :] + frame[:, :, 1:2] * turn[:, 1:2, :]
+            + frame[:, :, 2:3] * turn[:, 2:3, :])
 
 
 def quaternions(rot) -> np.ndarray:

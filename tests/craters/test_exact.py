@@ -1,0 +1,82 @@
+"""craters.exact: products summed in a fixed order, so that their bytes do not depend on
+the CPU (issue 34). The kernels against pure-Python sums in the same order (IEEE float
+arithmetic, one rounding per operation: equal to the last bit), and the crater diffusion,
+which decides the bytes of every degraded crater, the same whatever kernels OpenBLAS picks
+(``OPENBLAS_CORETYPE``: the product it replaced changed with it)."""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from craters.exact import dot, matmul
+
+
+def _python_matmul(a, b):
+    out = np.empty((a.shape[0], b.shape[1]))
+    for i in range(a.shape[0]):
+        for j in range(b.shape[1]):
+            acc = 0.0
+            for k in range(a.shape[1]):
+                acc += float(a[i, k]) * float(b[k, j])
+            out[i, j] = acc
+    return out
+
+
+def test_matmul_is_the_in_order_sum_to_the_last_bit():
+    rng = np.random.default_rng(3)
+    a, b = rng.normal(size=(9, 31)), rng.normal(size=(31, 7)) * 1e3
+    got = matmul(a, b)
+    assert got.tobytes() == _python_matmul(a, b).tobytes()
+    np.testing.assert_allclose(got, a @ b, rtol=1e-12, atol=1e-9)
+    # rows and columns as 1-D arrays, as numpy's @ takes them
+    assert matmul(a[0], b).shape == (7,) and matmul(a, b[:, 0]).shape == (9,)
+    assert matmul(a[0], b[:, 0]).shape == ()
+
+
+def test_dot_is_the_in_order_sum():
+    rng = np.random.default_rng(4)
+    a, b = rng.normal(size=1001), rng.normal(size=1001)
+    acc = 0.0
+    for x, y in zip(a.tolist(), b.tolist(), strict=True):
+        acc += x * y
+    assert dot(a, b) == acc
+
+
+def test_bad_shapes_are_refused():
+    with pytest.raises(ValueError, match="do not multiply"):
+        matmul(np.ones((2, 3)), np.ones((2, 3)))
+    with pytest.raises(ValueError, match="differ"):
+        dot(np.ones(3), np.ones(4))
+
+
+_DIFFUSED = """
+import hashlib, numpy as np
+from craters.diffusion import diffuse_profiles, diffusion_nodes
+r = diffusion_nodes()
+h = np.where(r < 1.0, r * r - 1.0, 0.1 * r ** -3.0)
+print(hashlib.sha256(diffuse_profiles(np.stack([h, 0.5 * h]), [0.01, 0.2]).tobytes())
+      .hexdigest())
+"""
+
+
+def test_diffusion_does_not_depend_on_the_blas_kernels():
+    # Prescott: OpenBLAS's SSE3 kernels, which every x86-64 CPU runs
+    if os.uname().machine not in ("x86_64", "AMD64"):
+        pytest.skip("OPENBLAS_CORETYPE names x86-64 kernels; this machine is "
+                    f"{os.uname().machine} (the in-order tests above still run)")
+    digests = set()
+    for core in (None, "Prescott"):
+        env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"}
+        if core:
+            env["OPENBLAS_CORETYPE"] = core
+        done = subprocess.run([sys.executable, "-c", _DIFFUSED], env=env, capture_output=True,
+                              text=True, timeout=300, check=True)
+        digests.add(done.stdout.strip())
+    assert len(digests) == 1, digests
+    assert len(next(iter(digests))) == len(hashlib.sha256().hexdigest())
