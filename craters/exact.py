@@ -7,7 +7,10 @@ multiply-adds, so the same product differs in its last bits from one machine to 
 (forcing ``OPENBLAS_CORETYPE=Sandybridge`` on one AVX2 machine changed the bytes of 7 of
 the 29 golden outputs). These sum each element over the inner index in increasing order,
 without fused multiply-adds, in compiled loops: slower than BLAS for large matrices, used
-where a product decides output bytes.
+where a product decides output bytes. :func:`abs2` is the squared modulus of complex numbers
+as two products and a sum: numpy's ``abs`` of a complex array has SIMD loops that differ in
+the last bit between AVX2 and SSE (``NPY_DISABLE_CPU_FEATURES=X86_V3`` changed the bytes of
+both spectrum commands).
 
 Examples
 --------
@@ -23,7 +26,7 @@ import numpy as np
 
 from ._exact_kernels import _dot_kernel, _matmul_kernel
 
-__all__ = ["dot", "matmul"]
+__all__ = ["abs2", "dot", "matmul"]
 
 
 def matmul(a, b) -> np.ndarray:
@@ -50,3 +53,10 @@ def dot(a, b) -> float:
     if a.shape != b.shape:
         raise ValueError(f"dot: shapes {a.shape} and {b.shape} differ")
     return float(_dot_kernel(a, b))
+
+
+def abs2(z) -> np.ndarray:
+    """``|z|**2`` of a complex array as ``re*re + im*im`` (elementwise, IEEE, the same bits on
+    every CPU; no square root to undo)."""
+    z = np.asarray(z)
+    return z.real * z.real + z.imag * z.imag

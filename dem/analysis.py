@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from craters._shared import check_range
+from craters.exact import abs2
 
 from .core import Dem
 
@@ -73,6 +74,6 @@ def band_power(dem: Dem, lo_cycles_per_px: float = 0.25,
     coef = np.linalg.lstsq(design, z.ravel(), rcond=None)[0]
     resid = z - (design @ coef).reshape(z.shape)
     window = np.outer(np.hanning(rows), np.hanning(cols))
-    power = np.abs(np.fft.fft2(resid * window)) ** 2 / (window**2).sum() / z.size
+    power = abs2(np.fft.fft2(resid * window)) / (window**2).sum() / z.size
     f = np.hypot(np.fft.fftfreq(rows)[:, None], np.fft.fftfreq(cols)[None, :])
     return float(power[(f >= lo) & (f <= hi)].sum())

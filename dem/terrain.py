@@ -28,6 +28,7 @@ from craters._shared import (
     check_int,
     check_range,
 )
+from craters.exact import abs2
 from latlong.geometry.stats import area_slope_summary
 
 from .core import Dem
@@ -158,7 +159,7 @@ def power_spectrum(dem: Dem, n_bins: int | None = None) -> tuple[np.ndarray, np.
     coef = np.linalg.lstsq(design, z.ravel(), rcond=None)[0]
     resid = z - (design @ coef).reshape(z.shape)
     window = np.outer(np.hanning(rows), np.hanning(cols))
-    spec = np.abs(np.fft.fft2(resid * window)) ** 2 / (window**2).sum()
+    spec = abs2(np.fft.fft2(resid * window)) / (window**2).sum()
     spec *= dx * dy  # density: per unit area of the frequency plane (cycles/m)^2
     fy = np.fft.fftfreq(rows, d=dy)
     fx = np.fft.fftfreq(cols, d=dx)

@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from craters._shared import check_int, check_range
+from craters.exact import abs2
 
 from ._slope_kernels import _cap_average_kernel, _direction_cap_sum_kernel, _ring_prefix_kernel
 from .body import Body
@@ -252,5 +253,5 @@ def radius_spectrum(body: Body, l_max: int | None = None) -> tuple[np.ndarray, n
             ms = np.arange(mmax + 1)
             coeff[:, :mmax + 1] += plm[:, ms, k] * f[ms][None, :]
     coeff[0, 0] += mean_r * math.sqrt(4.0 * math.pi)
-    power = np.abs(coeff[:, 0]) ** 2 + 2.0 * (np.abs(coeff[:, 1:]) ** 2).sum(axis=1)
+    power = abs2(coeff[:, 0]) + 2.0 * abs2(coeff[:, 1:]).sum(axis=1)
     return np.arange(l_max + 1), power

@@ -43,6 +43,7 @@ from craters._shared import (
     parse_spec,
 )
 from craters._shared.files import check_regular_file
+from craters.exact import abs2
 
 from . import _kernels as _k
 from .grid import VoxelGrid
@@ -315,7 +316,7 @@ def power_spectrum(image, pixel_m: float):
     ny, nx = z.shape
     w = np.outer(np.hanning(ny), np.hanning(nx))
     f = np.fft.fft2((z - z.mean()) * w)
-    power = np.fft.fftshift(np.abs(f) ** 2) / (w**2).sum() / z.size
+    power = np.fft.fftshift(abs2(f)) / (w**2).sum() / z.size
     fx = np.fft.fftshift(np.fft.fftfreq(nx, pixel_m))
     fy = np.fft.fftshift(np.fft.fftfreq(ny, pixel_m))
     return power, fx, fy

@@ -14,7 +14,7 @@ import sys
 import numpy as np
 import pytest
 
-from craters.exact import dot, matmul
+from craters.exact import abs2, dot, matmul
 
 
 def _python_matmul(a, b):
@@ -25,6 +25,19 @@ def _python_matmul(a, b):
             for k in range(a.shape[1]):
                 acc += float(a[i, k]) * float(b[k, j])
             out[i, j] = acc
+    return out
+
+
+def _digests(script: str, variable: str, value: str) -> set[str]:
+    """What ``script`` prints in a fresh process without ``variable`` and with it set."""
+    out = set()
+    for setting in (None, value):
+        env = {k: v for k, v in os.environ.items() if k != variable}
+        if setting:
+            env[variable] = setting
+        done = subprocess.run([sys.executable, "-c", script], env=env, capture_output=True,
+                              text=True, timeout=300, check=True)
+        out.add(done.stdout.strip())
     return out
 
 
@@ -70,13 +83,34 @@ def test_diffusion_does_not_depend_on_the_blas_kernels():
     if os.uname().machine not in ("x86_64", "AMD64"):
         pytest.skip("OPENBLAS_CORETYPE names x86-64 kernels; this machine is "
                     f"{os.uname().machine} (the in-order tests above still run)")
-    digests = set()
-    for core in (None, "Prescott"):
-        env = {k: v for k, v in os.environ.items() if k != "OPENBLAS_CORETYPE"}
-        if core:
-            env["OPENBLAS_CORETYPE"] = core
-        done = subprocess.run([sys.executable, "-c", _DIFFUSED], env=env, capture_output=True,
-                              text=True, timeout=300, check=True)
-        digests.add(done.stdout.strip())
+    digests = _digests(_DIFFUSED, "OPENBLAS_CORETYPE", "Prescott")
     assert len(digests) == 1, digests
     assert len(next(iter(digests))) == len(hashlib.sha256().hexdigest())
+
+
+def test_abs2_is_re2_plus_im2():
+    rng = np.random.default_rng(5)
+    z = rng.normal(size=(33, 17)) + 1j * rng.normal(size=(33, 17))
+    got = abs2(z)
+    assert got.tobytes() == (z.real * z.real + z.imag * z.imag).tobytes()
+    np.testing.assert_allclose(got, np.abs(z) ** 2, rtol=1e-14)
+
+
+_SPECTRUM = """
+import hashlib, numpy as np
+from dem import Dem
+from dem.terrain import power_spectrum
+z = np.random.default_rng(2).standard_normal((96, 80)).cumsum(axis=0)
+print(hashlib.sha256(np.concatenate(power_spectrum(Dem(z, pixel_size_m=5.0))).tobytes())
+      .hexdigest())
+"""
+
+
+def test_the_dem_spectrum_does_not_depend_on_numpys_simd_loops():
+    # numpy's abs of complex numbers differs in the last bit between its AVX2 and SSE loops
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+
+    if "X86_V3" not in __cpu_dispatch__ or not __cpu_features__.get("X86_V3"):
+        pytest.skip("numpy has no AVX2 (X86_V3) loops to turn off on this machine")
+    digests = _digests(_SPECTRUM, "NPY_DISABLE_CPU_FEATURES", "X86_V3")
+    assert len(digests) == 1, digests
