@@ -68,13 +68,76 @@ def tiny_grid():
     return LatLongGrid(6)
 
 
+#: Set to 1 to run every command of :func:`run_entry_point` in a process of its own.
+SUBPROCESS_ENV = "CRATERFORM_TEST_SUBPROCESS"
+
+
 def run_entry_point(*args: str, env: dict | None = None, cwd=None) -> subprocess.CompletedProcess:
-    """Run a console script through ``python -m <package>`` (the real entry point)."""
+    """Run a command (``"latlong", "build", ...``) through its package's ``__main__.main``,
+    the code its console script and ``python -m`` run, and return what a process would.
+
+    With ``env`` (``NUMBA_NUM_THREADS`` and the like, read once per process) or
+    ``CRATERFORM_TEST_SUBPROCESS=1`` it runs as ``python -m <package>`` in a process of its
+    own; otherwise in this one (:func:`run_in_process`): a new process costs ~2 s here
+    loading numba's cached kernels, ~300 commands of the suite.
+    """
+    if env is None and os.environ.get(SUBPROCESS_ENV, "") in ("", "0"):
+        return run_in_process(*args, cwd=cwd)
     full_env = dict(os.environ)
     full_env.pop("CRATERFORM_DEBUG", None)
     full_env.update(env or {})
     return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True,
                           env=full_env, cwd=cwd, timeout=600)
+
+
+def run_in_process(package: str, *argv: str, cwd=None) -> subprocess.CompletedProcess:
+    """``python -m <package> <argv>`` in this process: stdout and stderr captured, the
+    logging and warning set-up of a new interpreter (``WARNING: ...`` lines on stderr,
+    Python's default warning filters), ``cwd`` for the run, ``SystemExit`` as the exit
+    code; signal handlers, the working folder and the root logger are restored after."""
+    import contextlib
+    import importlib
+    import io
+    import logging
+    import signal
+    import warnings
+
+    out, err = (io.TextIOWrapper(io.BytesIO(), encoding="utf-8", write_through=True)
+                for _ in range(2))
+    root = logging.getLogger()
+    saved = (root.handlers[:], root.level, os.getcwd(),
+             {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)},
+             os.environ.pop("CRATERFORM_DEBUG", None))
+    handler = logging.StreamHandler(err)
+    handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))
+    root.handlers[:] = [handler]
+    root.setLevel(logging.WARNING)
+    try:
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err), \
+                warnings.catch_warnings():
+            warnings.resetwarnings()  # a new interpreter's filters
+            for category in (DeprecationWarning, PendingDeprecationWarning, ImportWarning,
+                             ResourceWarning):
+                warnings.simplefilter("ignore", category)
+            if cwd is not None:
+                os.chdir(cwd)
+            try:
+                code = importlib.import_module(f"{package}.__main__").main(list(argv))
+            except SystemExit as stop:  # argparse: --help, usage errors
+                code = stop.code if isinstance(stop.code, int) else (stop.code is not None)
+                if isinstance(stop.code, str):
+                    sys.stderr.write(stop.code + "\n")
+    finally:
+        root.handlers[:], _, folder, handlers, debug = saved
+        root.setLevel(saved[1])
+        os.chdir(folder)
+        for sig, old in handlers.items():
+            signal.signal(sig, old)
+        if debug is not None:
+            os.environ["CRATERFORM_DEBUG"] = debug
+    return subprocess.CompletedProcess([sys.executable, "-m", package, *argv], int(code or 0),
+                                       out.buffer.getvalue().decode(),
+                                       err.buffer.getvalue().decode())
 
 
 @pytest.fixture
