@@ -18,8 +18,12 @@ docstrings can be followed in any order without one refusing to replace another'
 Sizes are made small by the substitutions of :data:`SMALLER` (each with its reason), and
 commands that need the network, services or the whole test suite are skipped by
 :data:`SKIPPED` (each with its reason); every entry of both must apply to some command.
-Every other command runs exactly as written; Python blocks run exactly as written (with
-``python -P``, so the packages under test are imported, not the copy's sources).
+Every other command runs exactly as written: a plain ``latlong``/``dem``/``craters`` line (no
+shell syntax: :func:`in_process_argv`) through the command's ``__main__.main`` in the test
+process (``run_cli`` of conftest: what its console script runs, without the ~2 s of a new
+process; ``CRATERFORM_TEST_SUBPROCESS=1`` runs it in bash instead), any other line in bash;
+Python blocks run exactly as written (with ``python -P``, so the packages under test are
+imported, not the copy's sources).
 """
 
 from __future__ import annotations
@@ -27,6 +31,7 @@ from __future__ import annotations
 import ast
 import os
 import re
+import shlex
 import shutil
 import subprocess
 import sys
@@ -180,6 +185,20 @@ def skipped(line: str) -> str | None:
     return None
 
 
+#: Characters with a meaning to bash beyond splitting words and quoting: a line holding any
+#: runs in bash.
+SHELL_SYNTAX = re.compile(r"[&|;<>$`*?~(){}\[\]\\!#]")
+
+
+def in_process_argv(line: str) -> list[str] | None:
+    """The words of ``line`` if it is one of the three commands with no shell syntax (bash
+    and ``shlex`` split it alike), else None (it runs in bash)."""
+    if SHELL_SYNTAX.search(line):
+        return None
+    words = shlex.split(line)
+    return words if words and words[0] in PACKAGES else None
+
+
 def _bash_lines() -> list[str]:
     return [line for source in SOURCES for language, body in blocks_of(source)
             if language == "bash" for line in commands(body)]
@@ -217,6 +236,12 @@ def test_parsing():
     assert smaller("latlong build --magnitude 400 -o a.npz") == \
         "latlong build --magnitude 24 -o a.npz"
     assert skipped("pip install \".[test]\" && python -m pytest -q")
+    assert in_process_argv("dem fill 'a b.tif' -o out/x.tif --seed=1") == [
+        "dem", "fill", "a b.tif", "-o", "out/x.tif", "--seed=1"]
+    for line in ("mkdir -p out && latlong info a.npz", "latlong info a.npz | head",
+                 "craters profile > out/p.txt", "latlong info $HOME/a.npz", "ls out/",
+                 "NUMBA_NUM_THREADS=1 latlong info a.npz", "latlong info out/*.npz"):
+        assert in_process_argv(line) is None, line
     # the three packages document their commands; none of the 43 commands of the
     # reference README was dropped on the way into the docstrings
     assert {"latlong", "dem", "craters"} <= set(SOURCES)
@@ -257,8 +282,12 @@ def test_every_substitution_and_skip_applies():
 
 def _run(command: list[str], cwd: Path, env: dict, what: str, **kw) -> None:
     start = time.perf_counter()
-    done = subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True,
-                          timeout=300, **kw)
+    _check(subprocess.run(command, cwd=cwd, env=env, capture_output=True, text=True,
+                          timeout=300, **kw), what, start)
+
+
+def _check(done: subprocess.CompletedProcess, what: str, start: float) -> None:
+    """The command ran to exit code 0 and printed no Python warning."""
     assert done.returncode == 0, (
         f"{what}\nafter {time.perf_counter() - start:.1f} s, "
         f"exit {done.returncode}\n{done.stderr[-3000:]}")
@@ -268,7 +297,7 @@ def _run(command: list[str], cwd: Path, env: dict, what: str, **kw) -> None:
 
 
 @pytest.mark.parametrize("source", SOURCES)
-def test_blocks_run_in_order(source, tmp_path):
+def test_blocks_run_in_order(source, tmp_path, run_cli):
     repo = tmp_path / "repo"
     repo.mkdir()
     _copy_repository(repo)
@@ -286,9 +315,14 @@ def test_blocks_run_in_order(source, tmp_path):
             if skipped(line):
                 continue
             command = smaller(without_comment(line))
-            _run(["bash", "-e", "-o", "pipefail", "-c", command], repo, env,
-                 f"{source} block {number}: {line!r}\nran as: {command!r}")
             ran += 1
+            what = f"{source} block {number}: {line!r}\nran as: {command!r}"
+            argv = in_process_argv(command)
+            if argv is not None:
+                start = time.perf_counter()
+                _check(run_cli(*argv, cwd=repo), what, start)
+                continue
+            _run(["bash", "-e", "-o", "pipefail", "-c", command], repo, env, what)
     assert ran
     stray = sorted(f for f in _files(repo) - before if not f.startswith(output_folder(source)))
     assert not stray, f"{source} wrote outside {output_folder(source)}: {stray[:20]}"
