@@ -5,9 +5,28 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
+
+
+def _children_import_these_packages() -> None:
+    """Every process a test starts imports the packages this one imports.
+
+    ``python -m pytest`` in a checkout puts the checkout first on ``sys.path``: the tests
+    import its sources, while a command started in another folder would import the
+    installed copy. Two copies of the same code: numba caches each copy's kernels apart,
+    and a cold CI run compiled them twice (~5 CPU minutes)."""
+    import latlong  # the lazy package: imports nothing heavy
+
+    root = str(Path(latlong.__file__).resolve().parents[1])
+    paths = [p for p in os.environ.get("PYTHONPATH", "").split(os.pathsep) if p]
+    if root not in paths:
+        os.environ["PYTHONPATH"] = os.pathsep.join([root, *paths])
+
+
+_children_import_these_packages()
 
 #: Test files that take longest on a cold CI run (seconds, 2 xdist workers, 2026-12-05), run
 #: first: pytest-xdist hands out whole files (``--dist loadfile``, so the two workers

@@ -67,8 +67,7 @@ def scene(tmp_path) -> Path:
 
 
 def _cli(*args, cwd=None) -> subprocess.CompletedProcess:
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join(
-        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    env = dict(os.environ)  # PYTHONPATH: the packages under test (conftest)
     env.pop("CRATERFORM_DEBUG", None)
     return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True,
                           env=env, cwd=cwd, timeout=300)
@@ -350,8 +349,7 @@ def test_dem_batch_equals_dem_enhance(tmp_path, scheduler, monkeypatch):
 def _separate_cluster(tmp_path: Path, n_workers: int = 2):
     """``dask scheduler`` and ``dask worker --nthreads 1`` processes on 127.0.0.1, the
     workers in another working folder than the client's."""
-    env = {**os.environ, "NUMBA_NUM_THREADS": "1", "PYTHONPATH": os.pathsep.join(
-        [str(ROOT), *filter(None, [os.environ.get("PYTHONPATH")])])}
+    env = {**os.environ, "NUMBA_NUM_THREADS": "1"}  # PYTHONPATH: set by conftest
     info = tmp_path / "scheduler.json"
     where = tmp_path / "workers"
     where.mkdir()
