@@ -124,9 +124,9 @@ def run_in_process(package: str, *argv: str, cwd=None) -> subprocess.CompletedPr
     out, err = (io.TextIOWrapper(io.BytesIO(), encoding="utf-8", write_through=True)
                 for _ in range(2))
     root = logging.getLogger()
-    saved = (root.handlers[:], root.level, os.getcwd(),
-             {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)},
-             os.environ.pop("CRATERFORM_DEBUG", None))
+    handlers, level, folder = root.handlers[:], root.level, os.getcwd()
+    signals = {s: signal.getsignal(s) for s in (signal.SIGINT, signal.SIGTERM)}
+    debug = os.environ.pop("CRATERFORM_DEBUG", None)
     handler = logging.StreamHandler(err)
     handler.setFormatter(logging.Formatter("%(levelname)s: %(message)s"))
     root.handlers[:] = [handler]
@@ -147,10 +147,10 @@ def run_in_process(package: str, *argv: str, cwd=None) -> subprocess.CompletedPr
                 if isinstance(stop.code, str):
                     sys.stderr.write(stop.code + "\n")
     finally:
-        root.handlers[:], _, folder, handlers, debug = saved
-        root.setLevel(saved[1])
+        root.handlers[:] = handlers
+        root.setLevel(level)
         os.chdir(folder)
-        for sig, old in handlers.items():
+        for sig, old in signals.items():
             signal.signal(sig, old)
         if debug is not None:
             os.environ["CRATERFORM_DEBUG"] = debug
