@@ -21,7 +21,7 @@ commands that need the network, services or the whole test suite are skipped by
 Every other command runs exactly as written: a plain ``latlong``/``dem``/``craters`` line (no
 shell syntax: :func:`in_process_argv`) through the command's ``__main__.main`` in the test
 process (``run_cli`` of conftest: what its console script runs, without the ~2 s of a new
-process; ``CRATERFORM_TEST_SUBPROCESS=1`` runs it in bash instead), any other line in bash;
+process; with ``CRATERFORM_TEST_SUBPROCESS=1`` in a process of its own), any other line in bash;
 Python blocks run exactly as written (with ``python -P``, so the packages under test are
 imported, not the copy's sources).
 """
