@@ -90,18 +90,17 @@ def _table_rows_kernel(tabs, x, xe, out):
 
 
 # --------------------------------------------------------------------------- noise
-@njit(cache=True, inline="always")
-def _hash2(seed, ix, iy):
-    """64 random bits of lattice point (ix, iy) under ``seed``: one splitmix64 finaliser
-    of the seed mixed with the point's key (a second finaliser of the key alone cost 6 %
-    of the on-demand field's time and changed no statistic the noise is used for)."""
-    k = np.uint64(ix) * GOLDEN ^ np.uint64(iy) * np.uint64(0xC2B2AE3D27D4EB4F)
-    return _mix64((seed ^ k) * GOLDEN)
+_KEY_Y = np.uint64(0xC2B2AE3D27D4EB4F)
 
 
 @njit(cache=True, inline="always")
-def _corner(seed, ix, iy, fx, fy):
-    g = np.int64(_hash2(seed, ix, iy) & np.uint64(7))
+def _corner(sx, ky, fx, fy):
+    """Gradient of the lattice point whose keys are ``sx`` (the seed xor the column's key
+    ``uint64(ix) * GOLDEN``) and ``ky`` (the row's, ``uint64(iy) * _KEY_Y``): 64 random bits
+    from one splitmix64 finaliser of the seed mixed with the point's key (a second
+    finaliser of the key alone cost 6 % of the on-demand field's time and changed no
+    statistic the noise is used for), dotted with (fx, fy)."""
+    g = np.int64(_mix64((sx ^ ky) * GOLDEN) & np.uint64(7))
     return _GRAD[g, 0] * fx + _GRAD[g, 1] * fy
 
 
@@ -118,10 +117,16 @@ def _noise2(seed, x, y):
     """2-D gradient noise in about [-0.8, 0.8], zero at integer lattice points."""
     ix, fx, u = _lattice_coord(x)
     iy, fy, v = _lattice_coord(y)
-    n00 = _corner(seed, ix, iy, fx, fy)
-    n10 = _corner(seed, ix + 1, iy, fx - 1.0, fy)
-    n01 = _corner(seed, ix, iy + 1, fx, fy - 1.0)
-    n11 = _corner(seed, ix + 1, iy + 1, fx - 1.0, fy - 1.0)
+    # the keys of ix + 1 and iy + 1 by one addition each: (i + 1) c = i c + c mod 2^64
+    kx = np.uint64(ix) * GOLDEN
+    s0 = seed ^ kx
+    s1 = seed ^ (kx + GOLDEN)
+    k0 = np.uint64(iy) * _KEY_Y
+    k1 = k0 + _KEY_Y
+    n00 = _corner(s0, k0, fx, fy)
+    n10 = _corner(s1, k0, fx - 1.0, fy)
+    n01 = _corner(s0, k1, fx, fy - 1.0)
+    n11 = _corner(s1, k1, fx - 1.0, fy - 1.0)
     a = n00 + u * (n10 - n00)
     b = n01 + u * (n11 - n01)
     return a + v * (b - a)

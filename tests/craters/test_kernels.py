@@ -233,3 +233,40 @@ def test_azimuth_table_is_periodic_linear_interpolation_at_any_angle(rng):
         want = np.interp(theta, samples, tab, period=2.0 * np.pi)
         assert K.table(tab, theta) == pytest.approx(want, abs=1e-12)
     assert K.table(tab, -np.pi) == tab[0]
+
+
+GRAD8 = [(1.0, 0.0), (0.70710678118654752, 0.70710678118654752), (0.0, 1.0),
+         (-0.70710678118654752, 0.70710678118654752), (-1.0, 0.0),
+         (-0.70710678118654752, -0.70710678118654752), (0.0, -1.0),
+         (0.70710678118654752, -0.70710678118654752)]
+
+
+def reference_noise2(seed: int, x: float, y: float) -> float:
+    """The roughness noise in Python integers: each corner's key from its own lattice
+    index (the kernel adds the key step instead of multiplying again)."""
+    ix, iy = int(np.floor(x)), int(np.floor(y))
+    fx, fy = x - np.floor(x), y - np.floor(y)
+
+    def corner(cx, cy, dx, dy):
+        key = ((cx * 0x9E3779B97F4A7C15) & MASK) ^ ((cy * 0xC2B2AE3D27D4EB4F) & MASK)
+        g = GRAD8[reference_mix64(((seed ^ key) * 0x9E3779B97F4A7C15) & MASK) & 7]
+        return g[0] * dx + g[1] * dy
+
+    u = fx * fx * fx * (fx * (fx * 6.0 - 15.0) + 10.0)
+    v = fy * fy * fy * (fy * (fy * 6.0 - 15.0) + 10.0)
+    n00, n10 = corner(ix, iy, fx, fy), corner(ix + 1, iy, fx - 1.0, fy)
+    n01, n11 = corner(ix, iy + 1, fx, fy - 1.0), corner(ix + 1, iy + 1, fx - 1.0, fy - 1.0)
+    a = n00 + u * (n10 - n00)
+    b = n01 + u * (n11 - n01)
+    return a + v * (b - a)
+
+
+def test_fbm2_matches_python_integers_bit_for_bit(rng):
+    # one octave is the noise itself (divided by a norm of 1); negative lattice indices
+    # and seeds with the top bit set included
+    for _ in range(300):
+        seed = int(rng.integers(0, 2**63)) * 2 + int(rng.integers(0, 2))
+        x, y = rng.uniform(-1e4, 1e4, 2)
+        got = K.fbm2(np.uint64(seed), x, y, 1.0, 1, 0.5)
+        assert got == reference_noise2(seed, x, y)
+
