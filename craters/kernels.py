@@ -15,7 +15,8 @@ Crater profile and stamping:
   at x outside the rim
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane
 * ``rim_offsets(h, cy, cx, pixel, R, rim_tab, p0, gx, gy, out)``: plane - terrain at the rim
-* ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
+* ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table;
+  ``azimuth(y, x)``: atan2 in plain arithmetic (:mod:`craters._angle_kernels`), for hot loops
 * ``slope_factor(slope, onset_deg, full_deg)``: the share of the relief kept on a slope
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
   spacing)`` and ``fbm2(seed, x, y, wavelength, octaves, gain)``: the roughness overlay
@@ -57,6 +58,7 @@ Cube-sphere cells (:mod:`craters.cells`):
   ``cell_id(level, face, u, v)``: the uint64 id of the cell holding (u, v)
 """
 
+from ._angle_kernels import _azimuth as azimuth
 from ._calls import read_only_inputs
 from ._counter_kernels import _cell_id as cell_id
 from ._counter_kernels import _face_point as face_point
@@ -89,9 +91,9 @@ from ._tilt_kernels import _TILT_MAX_COS as TILT_MAX_COS
 from ._tilt_kernels import TILT_MIN_DEG, tilted_coords, tilted_ejecta, tilted_root
 from ._tilt_kernels import _tilted_frame as tilted_frame
 
-__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "bilinear", "cell_id", "crater_rough",
-           "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8", "lattice_coord",
-           "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
+__all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "azimuth", "bilinear", "cell_id",
+           "crater_rough", "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8",
+           "lattice_coord", "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
            "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
            "slope_factor", "splitmix64", "table", "table_row_value", "table_value", "TILT_MAX_COS",
            "TILT_MIN_DEG",

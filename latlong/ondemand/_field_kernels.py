@@ -13,6 +13,7 @@ from numba import njit, prange
 from craters.kernels import (
     TILT_MAX_COS,
     TILT_MIN_DEG,
+    azimuth,
     fbm2,
     read_only_inputs,
     roughness_amp,
@@ -97,7 +98,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if fc[k, TILT_CZ] > 0.0:
         return _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y)
     radius = fc[k, RAD]
-    xr = dist / (radius * (1.0 + table(rims[k], np.arctan2(un, ue))))
+    xr = dist / (radius * (1.0 + table(rims[k], azimuth(un, ue))))
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]

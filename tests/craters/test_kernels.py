@@ -270,3 +270,29 @@ def test_fbm2_matches_python_integers_bit_for_bit(rng):
         got = K.fbm2(np.uint64(seed), x, y, 1.0, 1, 0.5)
         assert got == reference_noise2(seed, x, y)
 
+
+def test_azimuth_is_atan2_within_two_ulp(rng):
+    from craters._angle_kernels import _azimuth_kernel
+
+    for scale in (1.0, 1e-300, 1e300, 1e-9):
+        y = rng.normal(size=200_000) * scale
+        x = rng.normal(size=200_000) * scale
+        x[:500] = 0.0  # the axes
+        y[500:1000] = 0.0
+        y[1000:1500] = x[1000:1500]  # the diagonals
+        y[1500:2000] = -x[1500:2000]
+        got = np.empty_like(y)
+        _azimuth_kernel(y, x, got)
+        want = np.arctan2(y, x)
+        ulp = np.abs(got - want) / np.spacing(np.abs(want).clip(np.finfo(float).tiny))
+        assert ulp.max() <= 2.0, (scale, ulp.max())
+    t = np.linspace(-np.pi, np.pi, 100_001)  # every reduction's boundary crossed
+    got = np.empty_like(t)
+    _azimuth_kernel(np.sin(t), np.cos(t), got)
+    assert np.abs(got - np.arctan2(np.sin(t), np.cos(t))).max() <= 2 * np.spacing(np.pi)
+    special = np.array([[0.0, 0.0], [0.0, -0.0], [-0.0, 0.0], [1.0, 0.0], [-1.0, 0.0],
+                        [0.0, -1.0], [1e-320, 1.0], [1.0, 1e-320], [np.inf, 1.0]])
+    got = np.empty(len(special))
+    _azimuth_kernel(special[:, 0].copy(), special[:, 1].copy(), got)
+    assert got.tolist() == [0.0, 0.0, 0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-320,
+                            np.pi / 2, np.pi / 2]
