@@ -37,9 +37,9 @@ from ._shared import ParameterError, atomic_path, check_choice
 from ._shared.files import check_regular_file
 from .scc import read_scc, write_scc
 
-__all__ = ["BOULDER_FORMAT", "CATALOG_COLUMNS", "CATALOG_FORMAT", "catalog_dtype",
-           "is_boulder_catalog", "make_catalog", "read_catalog", "read_scc", "sort_oldest_first",
-           "write_catalog", "write_geojson", "write_scc"]
+__all__ = ["BOULDER_FORMAT", "CATALOG_COLUMNS", "CATALOG_FORMAT", "add_columns",
+           "catalog_dtype", "is_boulder_catalog", "make_catalog", "read_catalog", "read_scc",
+           "sort_oldest_first", "write_catalog", "write_geojson", "write_scc"]
 
 CATALOG_FORMAT = "craterform crater catalog v1"
 #: First line of a boulder catalog's CSV (a catalog with ``burial_frac``: the boulders of
@@ -142,6 +142,39 @@ def sort_oldest_first(cat: np.ndarray) -> np.ndarray:
         return cat
     order = np.argsort(-cat["age_gyr"], kind="stable")
     return cat[order]
+
+
+def add_columns(cat: np.ndarray, names, columns) -> np.ndarray:
+    """``cat`` with the columns ``columns`` appended under ``names`` (one name and column,
+    or sequences of them), each keeping its dtype: what
+    ``numpy.lib.recfunctions.append_fields(cat, names, columns, usemask=False)`` returns,
+    made column by column (``append_fields`` walks the records in Python: 0.8 s for a
+    descent frame's 25 000 craters).
+
+    Examples
+    --------
+    >>> cat = add_columns(make_catalog(x_m=[1.0], y_m=[0.0], diameter_m=[10.0]), "id",
+    ...                   np.array([7], dtype=np.uint64))
+    >>> cat.dtype.names[-2:], cat["id"].dtype.name
+    (('kind', 'id'), 'uint64')
+    """
+    if isinstance(names, str):
+        names, columns = [names], [columns]
+    cols = [np.asarray(c) for c in columns]
+    fields, old = cat.dtype.fields, cat.dtype.names
+    if fields is None or old is None:
+        raise TypeError("`cat` must be a structured numpy array (see make_catalog)")
+    if len(cols) != len(names) or any(c.shape != (len(cat),) for c in cols):
+        raise ValueError(f"add_columns needs one column of length {len(cat)} per name; "
+                         f"got {[c.shape for c in cols]} for {list(names)}")
+    dtype = [(n, fields[n][0]) for n in old] + [
+        (n, c.dtype) for n, c in zip(names, cols, strict=True)]
+    out = np.empty(len(cat), dtype=dtype)
+    for n in old:
+        out[n] = cat[n]
+    for n, c in zip(names, cols, strict=True):
+        out[n] = c
+    return out
 
 
 def _format(value) -> str:

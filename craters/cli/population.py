@@ -10,7 +10,7 @@ import math
 import numpy as np
 
 from .._shared import check_output_path
-from ..catalog import CATALOG_COLUMNS, write_catalog
+from ..catalog import CATALOG_COLUMNS, add_columns, write_catalog
 from ..chronology import CHRONOLOGY_SYSTEMS, equilibrium_density, get_chronology_system
 from ..layers import ModelAgeLayer, parse_layer_spec
 from ..morphology import morphology_class
@@ -149,10 +149,8 @@ def _population_target(args):
 
 def _with_morphology(cat, target):
     """The catalog with a ``morphology`` column: each crater's fresh class on ``target``."""
-    from numpy.lib import recfunctions
-
     kinds = morphology_class(cat["diameter_m"], target) if len(cat) else np.zeros(0, "U12")
-    return recfunctions.append_fields(cat, "morphology", kinds, usemask=False)
+    return add_columns(cat, "morphology", kinds)
 
 
 def _body_radius(args, layers) -> float | None:

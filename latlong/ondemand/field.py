@@ -53,11 +53,10 @@ from __future__ import annotations
 import dataclasses
 
 import numpy as np
-import numpy.lib.recfunctions as rfn
 
 from craters import CraterLayer, ModelAgeLayer
 from craters._shared import check_positive
-from craters.catalog import make_catalog
+from craters.catalog import add_columns, make_catalog
 from craters.local import bin_bounds, bin_level, bins, draw_cells
 from craters.morphology import EJECTA_EDGE
 from craters.stamp import (
@@ -326,11 +325,10 @@ class CraterField:
         # the centre on the ground the crater was made in (its base at the centre): the
         # position the sensors' labels measure a crater from
         centre = u * (fc[:, K.RHO] + fc[:, K.P0])[:, None]
-        cat = rfn.append_fields(cat, ("id", "rim_radius_m", "depth_m", "slope_factor",
-                                      "centre_x_m", "centre_y_m", "centre_z_m"),
-                                (cr.id, fc[:, K.RAD].copy(), depth, fc[:, K.SCALE].copy(),
-                                 centre[:, 0], centre[:, 1], centre[:, 2]),
-                                usemask=False)
+        cat = add_columns(cat, ("id", "rim_radius_m", "depth_m", "slope_factor",
+                                "centre_x_m", "centre_y_m", "centre_z_m"),
+                          (cr.id, fc[:, K.RAD], depth, fc[:, K.SCALE], centre[:, 0],
+                           centre[:, 1], centre[:, 2]))
         # oldest first: the composition's (age, id) order reversed
         return cat[np.lexsort((cr.id, cr.age_gyr))[::-1]]
 

@@ -22,9 +22,8 @@ from __future__ import annotations
 import logging
 
 import numpy as np
-import numpy.lib.recfunctions as rfn
 
-from craters.catalog import make_catalog
+from craters.catalog import add_columns, make_catalog
 from craters.local import ROCK_FACETS, bin_bounds, bin_level, bins, draw_rock_cells
 
 from ..scene import Scene
@@ -154,4 +153,4 @@ class RockField:
                            kind=np.full(len(rows), "boulder"),
                            burial_frac=got["burial_frac"][rows],
                            height_m=got["height_m"][rows], layer=got["layer"][rows])
-        return rfn.append_fields(cat, "id", got["id"][rows], usemask=False)
+        return add_columns(cat, "id", got["id"][rows])

@@ -25,6 +25,7 @@ import numpy as np
 
 import craters
 from craters._shared import ParameterError
+from craters.catalog import add_columns
 
 from ..geometry.meshes import TriangleMeshSurface
 from ..meshio.writers import MeshSource, array_source
@@ -200,8 +201,6 @@ def drape_catalog(catalog, mesh: RayMesh) -> np.ndarray:
     >>> drape_catalog(cat, plane)["centre_z_m"].tolist()
     [2.0, nan]
     """
-    import numpy.lib.recfunctions as rfn
-
     x = np.asarray(catalog["x_m"], dtype=np.float64)
     y = np.asarray(catalog["y_m"], dtype=np.float64)
     top = float(mesh.vertices[:, 2].max()) + 1.0
@@ -209,9 +208,8 @@ def drape_catalog(catalog, mesh: RayMesh) -> np.ndarray:
                           np.tile([0.0, 0.0, -1.0], (len(x), 1)))
     z = np.where(hits.hit, top - hits.t_m, np.nan)
     zero = np.zeros(len(x))
-    return np.asarray(rfn.append_fields(
-        catalog, ["centre_x_m", "centre_y_m", "centre_z_m", "normal_x", "normal_y",
-                  "normal_z"], [x, y, z, zero, zero, zero + 1.0], usemask=False))
+    return add_columns(catalog, ["centre_x_m", "centre_y_m", "centre_z_m", "normal_x",
+                                 "normal_y", "normal_z"], [x, y, z, zero, zero, zero + 1.0])
 
 
 def craters_catalog(path) -> np.ndarray:

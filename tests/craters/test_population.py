@@ -122,6 +122,28 @@ def test_geojson_is_rfc_7946(tmp_path):
         craters.write_geojson(cat, tmp_path / "x.geojson")
 
 
+def test_add_columns_is_append_fields_column_by_column(rng):
+    from numpy.lib import recfunctions
+
+    from craters.catalog import add_columns
+
+    n = 500
+    cat = craters.make_catalog(lat_deg=rng.uniform(-90, 90, n), lon_deg=rng.uniform(0, 9, n),
+                               diameter_m=rng.uniform(1, 9, n), layer=np.arange(n))
+    cols = (rng.integers(0, 2**63, n).astype(np.uint64), rng.normal(size=n),
+            np.full(n, "transitional"), np.arange(n, dtype=np.int32))
+    names = ("id", "depth_m", "morphology", "count")
+    for base, args in ((cat, (names, cols)), (cat, ("id", cols[0])),
+                       (cat[:0], ("id", cols[0][:0]))):
+        want = recfunctions.append_fields(base, *args, usemask=False)
+        got = add_columns(base, *args)
+        assert got.dtype == want.dtype and got.tobytes() == want.tobytes()
+    with pytest.raises(ValueError, match="length 500"):
+        add_columns(cat, ("a", "b"), (cols[1], cols[1][:3]))
+    with pytest.raises(TypeError, match="structured"):
+        add_columns(np.zeros(3), "a", np.zeros(3))
+
+
 def test_catalog_validation(tmp_path):
     with pytest.raises(ValueError, match="x_m, y_m or lat_deg"):
         craters.make_catalog(diameter_m=[1.0])
