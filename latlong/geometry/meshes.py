@@ -22,8 +22,20 @@ from craters._shared import ParameterError
 from ..meshio.writers import MeshSource, write_mesh
 from .normals import face_normals, tangent_frames, vertex_normals
 
-__all__ = ["CENTRES", "PlainMeshSurface", "TriangleMeshSurface", "area_centroid", "centre_point",
-           "mean_edge_m", "polydata", "surface_area_m2", "volume_centroid", "volume_m3"]
+__all__ = ["CENTRES", "PlainMeshSurface", "TriangleMeshSurface", "area_centroid", "bounds",
+           "centre_point", "mean_edge_m", "polydata", "surface_area_m2", "volume_centroid",
+           "volume_m3"]
+
+
+def bounds(points) -> tuple[np.ndarray, np.ndarray]:
+    """(lowest, highest) value of each column of ``points`` (n, k), n >= 1: the values of
+    ``points.min(axis=0)`` and ``points.max(axis=0)`` (NaN where a column holds one),
+    column by column - numpy reduces a narrow C-ordered array along axis 0 ~7x slower
+    (0.1 s for a descent frame's 2.9 M vertices)."""
+    p = np.asarray(points)
+    cols = range(p.shape[1])
+    return (np.array([p[:, k].min() for k in cols], dtype=p.dtype),
+            np.array([p[:, k].max() for k in cols], dtype=p.dtype))
 
 
 def _corners(vertices, faces):

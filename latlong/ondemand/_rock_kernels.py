@@ -68,3 +68,20 @@ def _rocks_kernel(points, block_of, blk_start, blk_list, rc, seeds, out, which):
                 best = k
         out[i] += top
         which[i] = best
+
+
+@read_only_inputs("out")
+@njit(cache=True, parallel=True)
+def _face_rocks_kernel(which, faces, out):
+    """Each face's rock: the rock (``which``, per vertex, -1 none) that at least two of
+    its corners stand on, else -1 (tests: against numpy)."""
+    for f in prange(faces.shape[0]):
+        a = which[faces[f, 0]]
+        b = which[faces[f, 1]]
+        c = which[faces[f, 2]]
+        r = b if b == c else -1
+        if a == c:
+            r = a
+        if a == b:
+            r = a
+        out[f] = r

@@ -63,6 +63,18 @@ def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
 
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
+def _cube_keys_kernel(verts, lo, cell, dims, out):
+    """The key ``i + dims0 (j + dims1 k)`` of each vertex's cube of :func:`_ejecta_kernel`'s
+    grid, (i, j, k) = floor((vertex - lo) / cell) (tests: against numpy)."""
+    for v in prange(verts.shape[0]):
+        i = np.int64(np.floor((verts[v, 0] - lo[0]) / cell))
+        j = np.int64(np.floor((verts[v, 1] - lo[1]) / cell))
+        k = np.int64(np.floor((verts[v, 2] - lo[2]) / cell))
+        out[v] = i + dims[0] * (j + dims[1] * k)
+
+
+@read_only_inputs("out")
+@njit(cache=True, parallel=True)
 def _ejecta_kernel(verts, order, keys, lo, cell, dims, centres, radii, gains, reach, n_threads,
                    out):
     """Brighten ``out`` (one factor per row of ``verts``, in place) by every crater c:

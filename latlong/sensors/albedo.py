@@ -32,7 +32,8 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
-from ._albedo_kernels import _ejecta_kernel, _mottle_kernel
+from ..geometry.meshes import bounds
+from ._albedo_kernels import _cube_keys_kernel, _ejecta_kernel, _mottle_kernel
 from .scene_geometry import SceneGeometry
 
 __all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "ejecta_albedo", "regolith_albedo"]
@@ -100,14 +101,17 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     # vertices (a k-d tree of the vertices took ~4 s a 1024^2 descent frame); at most 2^20
     # cubes along an axis, so that a cube's key fits an int64 (the cube size changes the
     # time, not the result)
-    lo = verts.min(axis=0)
-    cell = max(float(np.median(reach * radii[rows])), float((verts.max(axis=0) - lo).max())
+    verts = np.ascontiguousarray(verts, dtype=np.float64)
+    lo, hi = bounds(verts)
+    cell = max(float(np.median(reach * radii[rows])), float((hi - lo).max())
                / 2.0**20, 1e-9)
-    ijk = np.floor((verts - lo) / cell).astype(np.int64)
-    dims = ijk.max(axis=0) + 1
-    keys = ijk[:, 0] + dims[0] * (ijk[:, 1] + dims[1] * ijk[:, 2])
+    # the largest vertex's cube is the last along each axis (floor and the arithmetic
+    # before it are monotonic)
+    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+    keys = np.empty(len(verts), dtype=np.int64)
+    _cube_keys_kernel(verts, lo, cell, dims, keys)
     order = np.argsort(keys, kind="stable")
-    _ejecta_kernel(np.ascontiguousarray(verts, dtype=np.float64), order,
+    _ejecta_kernel(verts, order,
                    np.ascontiguousarray(keys[order]), lo, cell, dims,
                    np.ascontiguousarray(centres[rows]), np.ascontiguousarray(radii[rows]),
                    contrast * weight[rows], float(reach),

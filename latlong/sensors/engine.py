@@ -42,6 +42,7 @@ import numpy as np
 
 from craters._shared import ParameterError, ParameterTypeError
 
+from ..geometry.meshes import bounds
 from ..geometry.normals import triangle_normals
 from ..geometry.normals import vertex_normals as weighted_vertex_normals
 from ._engine_kernels import (
@@ -197,7 +198,7 @@ class RayMesh:
         if build_quality not in BUILD_QUALITIES:
             raise ParameterError("build_quality", f"must be one of {sorted(BUILD_QUALITIES)}; "
                                  f"got {build_quality!r}")
-        lo, hi = v.min(axis=0), v.max(axis=0)
+        lo, hi = bounds(v)
         centre = 0.5 * (lo + hi)
         self._vertices = v
         self._vertices.flags.writeable = False

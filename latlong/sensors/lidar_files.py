@@ -37,6 +37,7 @@ from craters._shared import (
     progress_bar,
 )
 
+from ..geometry.meshes import bounds
 from .engine import RayMesh
 from .lidar import LidarFrame, LidarSettings, lidar_frame
 from .poses import Poses
@@ -98,7 +99,7 @@ def write_las(frame: LidarFrame, path, *, point_source_id: int = 0,
                                                   "boulder catalog row, -1 none")])
     xyz = frame.position_m
     if len(xyz):
-        lo, hi = xyz.min(axis=0), xyz.max(axis=0)
+        lo, hi = bounds(xyz)
         offset = np.round((lo + hi) / 2.0)
         half = float(np.max(hi - lo)) / 2.0 + 1.0
     else:

@@ -163,3 +163,20 @@ def test_bright_ejecta_match_the_kd_tree_reference(rng):
     finally:
         numba.set_num_threads(threads)
     assert np.array_equal(one, got)
+
+
+def test_cube_keys_kernel_matches_numpy(rng):
+    from latlong.geometry.meshes import bounds
+    from latlong.sensors._albedo_kernels import _cube_keys_kernel
+
+    verts = rng.normal(scale=300.0, size=(20000, 3)) + [1.7e6, -2e5, 3e4]
+    lo, hi = bounds(verts)
+    np.testing.assert_array_equal(lo, verts.min(axis=0))
+    np.testing.assert_array_equal(hi, verts.max(axis=0))
+    for cell in (0.37, 7.0, 1e3):
+        ijk = np.floor((verts - lo) / cell).astype(np.int64)
+        dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+        np.testing.assert_array_equal(dims, ijk.max(axis=0) + 1)  # what albedo.py relies on
+        keys = np.empty(len(verts), dtype=np.int64)
+        _cube_keys_kernel(verts, lo, cell, dims, keys)
+        np.testing.assert_array_equal(keys, ijk[:, 0] + dims[0] * (ijk[:, 1] + dims[1] * ijk[:, 2]))

@@ -157,3 +157,16 @@ def test_descent_frames_label_the_rocks_of_their_own_terrain(scene, tmp_path):
     back = read_catalog(tmp_path / "d" / "rocks_0001.csv")
     assert len(back) == len(frames[1].rocks)
     assert np.allclose(back["diameter_m"], frames[1].rocks["diameter_m"])
+
+
+def test_face_rocks_kernel_matches_numpy(rng):
+    which = rng.integers(-1, 4, 5000)  # few rocks: ties of two and three corners are common
+    faces = rng.integers(0, len(which), (20000, 3))
+    a, b, c = which[faces].T
+    want = np.where(b == c, b, -1)
+    want = np.where(a == c, a, want)
+    want = np.where(a == b, a, want)
+    got = np.empty(len(faces), dtype=np.int64)
+    R._face_rocks_kernel(which, faces, got)
+    np.testing.assert_array_equal(got, want)
+    assert (got == -1).any() and (got >= 0).any()
