@@ -26,7 +26,7 @@ import numpy as np
 
 from ._exact_kernels import _dot_kernel, _matmul_kernel
 
-__all__ = ["abs2", "dot", "matmul"]
+__all__ = ["abs2", "dot", "matmul", "plane_residual"]
 
 
 def matmul(a, b) -> np.ndarray:
@@ -60,3 +60,24 @@ def abs2(z) -> np.ndarray:
     every CPU; no square root to undo)."""
     z = np.asarray(z)
     return z.real * z.real + z.imag * z.imag
+
+
+def plane_residual(z) -> np.ndarray:
+    """``z`` (rows, cols) minus its least-squares plane ``c0 + c1 col + c2 row`` over the
+    whole grid, in a fixed order: with the coordinates centred, the columns 1, col and row
+    of the design are orthogonal on a full grid, so the plane is the mean plus the two
+    projections (in-order sums, :func:`matmul`); numpy's ``lstsq`` gives the same plane to
+    rounding, but through LAPACK, whose kernels vary with the CPU (``OPENBLAS_CORETYPE``
+    changed the bytes of ``dem spectrum``)."""
+    z = np.asarray(z, dtype=np.float64)
+    if z.ndim != 2 or not z.size:
+        raise ValueError(f"plane_residual: needs a non-empty 2-D array; got shape {z.shape}")
+    rows, cols = z.shape
+    xc = np.arange(cols) - 0.5 * (cols - 1)  # half-integers: exact
+    yc = np.arange(rows) - 0.5 * (rows - 1)
+    row_sums = matmul(z, np.ones(cols))
+    mean = dot(row_sums, np.ones(rows)) / z.size
+    sxx, syy = dot(xc, xc), dot(yc, yc)
+    gx = dot(matmul(z, xc), np.ones(rows)) / (rows * sxx) if sxx > 0 else 0.0
+    gy = dot(row_sums, yc) / (cols * syy) if syy > 0 else 0.0
+    return z - ((mean + gx * xc)[None, :] + (gy * yc)[:, None])

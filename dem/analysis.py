@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from craters._shared import check_range
-from craters.exact import abs2
+from craters.exact import abs2, plane_residual
 
 from .core import Dem
 
@@ -69,10 +69,7 @@ def band_power(dem: Dem, lo_cycles_per_px: float = 0.25,
     if not dem.known.all():
         raise ValueError("`dem` has unknown (NaN) pixels; fill them first")
     rows, cols = z.shape
-    yy, xx = np.mgrid[0:rows, 0:cols]
-    design = np.column_stack([np.ones(z.size), xx.ravel(), yy.ravel()])
-    coef = np.linalg.lstsq(design, z.ravel(), rcond=None)[0]
-    resid = z - (design @ coef).reshape(z.shape)
+    resid = plane_residual(z)  # the same bytes on every CPU (craters.exact)
     window = np.outer(np.hanning(rows), np.hanning(cols))
     power = abs2(np.fft.fft2(resid * window)) / (window**2).sum() / z.size
     f = np.hypot(np.fft.fftfreq(rows)[:, None], np.fft.fftfreq(cols)[None, :])

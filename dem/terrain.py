@@ -28,7 +28,7 @@ from craters._shared import (
     check_int,
     check_range,
 )
-from craters.exact import abs2
+from craters.exact import abs2, plane_residual
 from latlong.geometry.stats import area_slope_summary
 
 from .core import Dem
@@ -154,10 +154,7 @@ def power_spectrum(dem: Dem, n_bins: int | None = None) -> tuple[np.ndarray, np.
         raise ParameterError("dem", f"must be at least 8 x 8 pixels; got {rows} x {cols}")
     width, dy = pixel_sizes_by_row(dem)
     dx = float(width.mean())
-    yy, xx = np.mgrid[0:rows, 0:cols]
-    design = np.column_stack([np.ones(z.size), xx.ravel(), yy.ravel()])
-    coef = np.linalg.lstsq(design, z.ravel(), rcond=None)[0]
-    resid = z - (design @ coef).reshape(z.shape)
+    resid = plane_residual(z)  # the same bytes on every CPU (craters.exact)
     window = np.outer(np.hanning(rows), np.hanning(cols))
     spec = abs2(np.fft.fft2(resid * window)) / (window**2).sum()
     spec *= dx * dy  # density: per unit area of the frequency plane (cycles/m)^2

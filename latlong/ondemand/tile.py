@@ -188,10 +188,8 @@ def write_tile(t: Tile, *, cog=None, mesh=None, picture=None) -> None:
     if picture:
         from PIL import Image
 
-        h = t.heights_m
-        yy, xx = np.mgrid[:h.shape[0], :h.shape[1]]
-        a = np.stack([np.ones(h.size), xx.ravel(), yy.ravel()], axis=1)
-        plane = a @ np.linalg.lstsq(a, h.ravel(), rcond=None)[0]
-        shade = hillshade(h - plane.reshape(h.shape), t.pixel_m)
+        from craters.exact import plane_residual
+
+        shade = hillshade(plane_residual(t.heights_m), t.pixel_m)
         with atomic_path(picture) as tmp:
             Image.fromarray((255.0 * shade).astype(np.uint8)).save(tmp, format="PNG")

@@ -14,7 +14,7 @@ import sys
 import numpy as np
 import pytest
 
-from craters.exact import abs2, dot, matmul
+from craters.exact import abs2, dot, matmul, plane_residual
 
 
 def _python_matmul(a, b):
@@ -78,12 +78,17 @@ print(hashlib.sha256(diffuse_profiles(np.stack([h, 0.5 * h]), [0.01, 0.2]).tobyt
 """
 
 
-def test_diffusion_does_not_depend_on_the_blas_kernels():
-    # Prescott: OpenBLAS's SSE3 kernels, which every x86-64 CPU runs
+def _blas_digests(script: str) -> set[str]:
+    """:func:`_digests` with OpenBLAS's kernels picked by the CPU and with Prescott's (its
+    SSE3 kernels, which every x86-64 CPU runs)."""
     if os.uname().machine not in ("x86_64", "AMD64"):
         pytest.skip("OPENBLAS_CORETYPE names x86-64 kernels; this machine is "
-                    f"{os.uname().machine} (the in-order tests above still run)")
-    digests = _digests(_DIFFUSED, "OPENBLAS_CORETYPE", "Prescott")
+                    f"{os.uname().machine} (the in-order tests still run)")
+    return _digests(script, "OPENBLAS_CORETYPE", "Prescott")
+
+
+def test_diffusion_does_not_depend_on_the_blas_kernels():
+    digests = _blas_digests(_DIFFUSED)
     assert len(digests) == 1, digests
     assert len(next(iter(digests))) == len(hashlib.sha256().hexdigest())
 
@@ -113,4 +118,24 @@ def test_the_dem_spectrum_does_not_depend_on_numpys_simd_loops():
     if "X86_V3" not in __cpu_dispatch__ or not __cpu_features__.get("X86_V3"):
         pytest.skip("numpy has no AVX2 (X86_V3) loops to turn off on this machine")
     digests = _digests(_SPECTRUM, "NPY_DISABLE_CPU_FEATURES", "X86_V3")
+    assert len(digests) == 1, digests
+
+
+def test_plane_residual_is_the_least_squares_plane_removed():
+    rng = np.random.default_rng(6)
+    for shape in ((33, 17), (1, 9), (8, 1), (1, 1), (64, 64)):
+        yy, xx = np.mgrid[0:shape[0], 0:shape[1]]
+        z = 5e3 + 3.0 * xx - 0.7 * yy + rng.normal(size=shape)
+        design = np.column_stack([np.ones(z.size), xx.ravel(), yy.ravel()])
+        want = z - (design @ np.linalg.lstsq(design, z.ravel(), rcond=None)[0]) \
+            .reshape(shape)
+        np.testing.assert_allclose(plane_residual(z), want, rtol=0, atol=1e-9)
+    with pytest.raises(ValueError, match="2-D"):
+        plane_residual(np.ones(3))
+
+
+def test_the_dem_spectrum_does_not_depend_on_the_blas_kernels():
+    # its plane fit went through LAPACK: under Prescott's kernels it hashed 4870209c...,
+    # under this machine's own 871b63c1... (2026-12-07, before craters.exact.plane_residual)
+    digests = _blas_digests(_SPECTRUM)
     assert len(digests) == 1, digests
