@@ -42,6 +42,8 @@ from __future__ import annotations
 import numpy as np
 
 from craters._shared import ParameterError
+from craters.exact import dot, matmul
+from craters.kernels import plane_solve
 
 from ..geometry.surface import Surface
 from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kernel
@@ -169,16 +171,29 @@ def rim_curves(catalog, surface=None, *, ids=None):
         rows = rows[(rows >= 0) & (rows < len(c))]
         for i, near in zip(rows, tree.query_ball_point(c[rows], 1.6 * r[rows]), strict=True):
             d = verts[np.asarray(near, dtype=np.int64)] - c[i]
-            h, x, y = d @ up[i], d @ e1[i], d @ e2[i]
+            h, x, y = matmul(d, np.stack([up[i], e1[i], e2[i]], axis=1)).T
             rho = np.hypot(x, y)
             for width in (0.05, 0.15):
                 ring = (np.abs(rho - r[i]) <= width * r[i]) & (np.abs(h) <= r[i])
                 if ring.sum() >= 8:
-                    fit = np.stack([np.ones(int(ring.sum())), x[ring], y[ring]], 1)
-                    a[i], tilt[i, 0], tilt[i, 1] = np.linalg.lstsq(fit, h[ring], rcond=None)[0]
-                    break
+                    ok, a_i, b_i, c_i = _plane_of(x[ring], y[ring], h[ring])
+                    if ok:
+                        a[i], tilt[i, 0], tilt[i, 1] = a_i, b_i, c_i
+                        break
     return (c + a[:, None] * up, r[:, None] * (e1 + tilt[:, :1] * up),
             r[:, None] * (e2 + tilt[:, 1:] * up))
+
+
+def _plane_of(x, y, h) -> tuple[bool, float, float, float]:
+    """(ok, a, b, c): the least-squares plane ``h = a + b x + c y`` of the points from their
+    sums in order and cofactors (``craters.kernels.plane_solve``): the same bits on every
+    CPU, where LAPACK's ``lstsq`` varies with the kernels OpenBLAS picks."""
+    one = np.ones(len(x))
+    s = (float(len(x)), dot(x, one), dot(y, one), dot(x, x), dot(y, y), dot(x, y),
+         dot(h, one), dot(h, x), dot(h, y))
+    big = max(s[3], s[4], 1.0)
+    ok, a, b, c = plane_solve(s, s[0] * big * big)
+    return bool(ok), float(a), float(b), float(c)
 
 
 class FittedRims:

@@ -139,3 +139,40 @@ def test_the_dem_spectrum_does_not_depend_on_the_blas_kernels():
     # under this machine's own 871b63c1... (2026-12-07, before craters.exact.plane_residual)
     digests = _blas_digests(_SPECTRUM)
     assert len(digests) == 1, digests
+
+
+_RIMS = """
+import hashlib, numpy as np, craters
+from latlong.sensors.labels import rim_curves
+rng = np.random.default_rng(7)
+xy = rng.uniform(-50, 50, (20000, 2))
+z = 0.13 * xy[:, 0] - 0.05 * xy[:, 1] + 0.3 * np.exp(-((np.hypot(*xy.T) - 10) / 2) ** 2)
+cat = craters.make_catalog(x_m=[0.0, 20.0], y_m=[0.0, -15.0], diameter_m=[20.0, 12.0],
+                           centre_x_m=[0.0, 20.0], centre_y_m=[0.0, -15.0],
+                           centre_z_m=[1e3, 1e3 + 3.35], normal_x=[0.0, 0.0],
+                           normal_y=[0.0, 0.0], normal_z=[1.0, 1.0])
+rims = rim_curves(cat, np.column_stack([xy, z + 1e3]))
+print(hashlib.sha256(np.concatenate([a.ravel() for a in rims]).tobytes()).hexdigest())
+"""
+
+
+def test_fitted_crater_rims_do_not_depend_on_the_blas_kernels():
+    # the labels' rim planes came from lstsq and d @ axis: two hashes (93eb3e9e... with this
+    # machine's kernels, 9fd0aa94... with Prescott's) before latlong.sensors.labels._plane_of
+    digests = _blas_digests(_RIMS)
+    assert len(digests) == 1, digests
+
+
+def test_the_rim_plane_is_the_least_squares_plane():
+    from latlong.sensors.labels import _plane_of
+
+    rng = np.random.default_rng(8)
+    t = rng.uniform(0, 2 * np.pi, 40)
+    x, y = 10 * np.cos(t), 10 * np.sin(t)
+    h = 2.0 + 0.1 * x - 0.3 * y + rng.normal(scale=0.01, size=40)
+    ok, a, b, c = _plane_of(x, y, h)
+    design = np.column_stack([np.ones(40), x, y])
+    assert ok
+    np.testing.assert_allclose([a, b, c], np.linalg.lstsq(design, h, rcond=None)[0],
+                               rtol=1e-12, atol=1e-12)
+    assert not _plane_of(np.arange(9.0), np.arange(9.0), np.ones(9))[0]  # collinear
