@@ -13,8 +13,8 @@ ADS bibcode, PMID) in ``venue``. A title that no record confirmed is kept but ma
 The table :data:`REFERENCES` is grouped by topic: the source papers (Martin et al.'s
 two, Li et al.'s two), crater shapes and their scaling, degradation, production and
 chronology, body radii, the asteroid presets (Eros, Itokawa, Bennu), gravity, terrain,
-implicit surfaces and meshes, randomness, and the sensors (ray tracing, cameras, stars,
-photometry, light between surfaces and from planets).
+implicit surfaces and meshes, numerics, randomness, and the sensors (ray tracing, cameras,
+stars, photometry, light between surfaces and from planets).
 
 Examples
 --------
@@ -368,6 +368,10 @@ REFERENCES = _entries(
     _R("max1999", ("Max, N.",), 1999,
        "Weights for computing vertex normals from facet normals",
        "Journal of Graphics Tools 4(2), 1-6", "10.1080/10867651.1999.10487501"),
+    # ---------------------------------------------------------------- numerics
+    _R("moshier1989", ("Moshier, S. L.",), 1989,
+       "Methods and Programs for Mathematical Functions",
+       "Ellis Horwood, Chichester (book; its programs are the Cephes library)"),
     # ---------------------------------------------------------------- randomness
     _R("salmon2011", ("Salmon, J. K.", "Moraes, M. A.", "Dror, R. O.", "Shaw, D. E."), 2011,
        "Parallel random numbers: as easy as 1, 2, 3",
