@@ -176,7 +176,7 @@ def rim_curves(catalog, surface=None, *, ids=None):
             for width in (0.05, 0.15):
                 ring = (np.abs(rho - r[i]) <= width * r[i]) & (np.abs(h) <= r[i])
                 if ring.sum() >= 8:
-                    ok, a_i, b_i, c_i = _plane_of(x[ring], y[ring], h[ring])
+                    ok, a_i, b_i, c_i = _plane_of(x[ring], y[ring], h[ring], r[i])
                     if ok:
                         a[i], tilt[i, 0], tilt[i, 1] = a_i, b_i, c_i
                         break
@@ -184,16 +184,19 @@ def rim_curves(catalog, surface=None, *, ids=None):
             r[:, None] * (e2 + tilt[:, 1:] * up))
 
 
-def _plane_of(x, y, h) -> tuple[bool, float, float, float]:
+def _plane_of(x, y, h, scale_m: float) -> tuple[bool, float, float, float]:
     """(ok, a, b, c): the least-squares plane ``h = a + b x + c y`` of the points from their
     sums in order and cofactors (``craters.kernels.plane_solve``): the same bits on every
-    CPU, where LAPACK's ``lstsq`` varies with the kernels OpenBLAS picks."""
-    one = np.ones(len(x))
-    s = (float(len(x)), dot(x, one), dot(y, one), dot(x, x), dot(y, y), dot(x, y),
-         dot(h, one), dot(h, x), dot(h, y))
+    CPU, where LAPACK's ``lstsq`` varies with the kernels OpenBLAS picks. x and y are
+    divided by ``scale_m`` (the rim radius) first, so the degeneracy test does not depend
+    on the crater's size (a 1 mm ring in metres would fail it)."""
+    u, v = x / scale_m, y / scale_m
+    one = np.ones(len(u))
+    s = (float(len(u)), dot(u, one), dot(v, one), dot(u, u), dot(v, v), dot(u, v),
+         dot(h, one), dot(h, u), dot(h, v))
     big = max(s[3], s[4], 1.0)
     ok, a, b, c = plane_solve(s, s[0] * big * big)
-    return bool(ok), float(a), float(b), float(c)
+    return bool(ok), float(a), float(b) / scale_m, float(c) / scale_m
 
 
 class FittedRims:

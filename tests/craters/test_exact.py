@@ -168,11 +168,12 @@ def test_the_rim_plane_is_the_least_squares_plane():
 
     rng = np.random.default_rng(8)
     t = rng.uniform(0, 2 * np.pi, 40)
-    x, y = 10 * np.cos(t), 10 * np.sin(t)
-    h = 2.0 + 0.1 * x - 0.3 * y + rng.normal(scale=0.01, size=40)
-    ok, a, b, c = _plane_of(x, y, h)
-    design = np.column_stack([np.ones(40), x, y])
-    assert ok
-    np.testing.assert_allclose([a, b, c], np.linalg.lstsq(design, h, rcond=None)[0],
-                               rtol=1e-12, atol=1e-12)
-    assert not _plane_of(np.arange(9.0), np.arange(9.0), np.ones(9))[0]  # collinear
+    for radius in (10.0, 1e-3):  # a 1 mm rim too: the last frames of a descent
+        x, y = radius * np.cos(t), radius * np.sin(t)
+        h = 2.0 + 0.1 * x - 0.3 * y + rng.normal(scale=0.001 * radius, size=40)
+        ok, a, b, c = _plane_of(x, y, h, radius)
+        design = np.column_stack([np.ones(40), x, y])
+        assert ok
+        np.testing.assert_allclose([a, b, c], np.linalg.lstsq(design, h, rcond=None)[0],
+                                   rtol=1e-9, atol=1e-12)
+    assert not _plane_of(np.arange(9.0), np.arange(9.0), np.ones(9), 1.0)[0]  # collinear
