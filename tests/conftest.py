@@ -102,11 +102,18 @@ def run_entry_point(*args: str, env: dict | None = None, cwd=None) -> subprocess
     """
     if env is None and os.environ.get(SUBPROCESS_ENV, "") in ("", "0"):
         return run_in_process(*args, cwd=cwd)
+    return run_process(*args, env=env, cwd=cwd)
+
+
+def run_process(*args: str, env: dict | None = None, cwd=None,
+                timeout: float = 600) -> subprocess.CompletedProcess:
+    """``python -m <args>`` in a process of its own, with this environment (but
+    ``CRATERFORM_DEBUG``) updated by ``env``."""
     full_env = dict(os.environ)
     full_env.pop("CRATERFORM_DEBUG", None)
     full_env.update(env or {})
     return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True,
-                          env=full_env, cwd=cwd, timeout=600)
+                          env=full_env, cwd=cwd, timeout=timeout)
 
 
 def run_in_process(package: str, *argv: str, cwd=None) -> subprocess.CompletedProcess:
@@ -162,6 +169,13 @@ def run_in_process(package: str, *argv: str, cwd=None) -> subprocess.CompletedPr
 @pytest.fixture
 def run_cli():
     return run_entry_point
+
+
+@pytest.fixture
+def run_module():
+    """:func:`run_process`: for commands that must run in a process of their own (those
+    that start dask workers or clients)."""
+    return run_process
 
 
 DATA = os.path.join(os.path.dirname(__file__), "data")

@@ -66,13 +66,6 @@ def scene(tmp_path) -> Path:
     return path
 
 
-def _cli(*args, cwd=None) -> subprocess.CompletedProcess:
-    env = dict(os.environ)  # PYTHONPATH: the packages under test (conftest)
-    env.pop("CRATERFORM_DEBUG", None)
-    return subprocess.run([sys.executable, "-m", *args], capture_output=True, text=True,
-                          env=env, cwd=cwd, timeout=300)
-
-
 def _shas(folder: Path, names) -> dict:
     return {n: sha256_file(folder / n) for n in names}
 
@@ -254,13 +247,14 @@ def test_resume_redoes_only_missing_and_corrupt(tmp_path, scene, scheduler):
     assert (changed.done, changed.skipped) == (3, 0)
 
 
-def test_failed_variant_is_recorded_and_the_others_kept(tmp_path, scene, scheduler):
+def test_failed_variant_is_recorded_and_the_others_kept(tmp_path, scene, scheduler, run_module):
     # a memory allowance far above the up-front estimate of TOO_MANY (4e9 GB), so the
     # variant is accepted and fails while it runs (the population's count limit)
     scene.write_text(SCENE + "max_memory_gb = 1e12\n")
     out = tmp_path / "batch"
-    proc = _cli("latlong", "batch", str(scene), "--seeds", "1-2", "--scheduler", scheduler,
-                "--vary", f"craters=c=0.5,k=-2,d_min_m=8,d_max_m=15;{TOO_MANY}", "-o", str(out))
+    proc = run_module("latlong", "batch", str(scene), "--seeds", "1-2", "--scheduler",
+                      scheduler, "--vary", f"craters=c=0.5,k=-2,d_min_m=8,d_max_m=15;{TOO_MANY}",
+                      "-o", str(out))
     assert proc.returncode == 1, proc.stderr
     last = proc.stderr.strip().splitlines()[-1]
     assert last.startswith("error: batch: 4 variants: 2 built, 0 kept, 2 failed")
@@ -307,20 +301,20 @@ def test_unreachable_scheduler_writes_nothing(tmp_path, scene, capsys):
     assert not out.exists()
 
 
-def test_errors_through_the_entry_point(tmp_path, scene):
+def test_errors_through_the_entry_point(tmp_path, scene, run_module):
     out = tmp_path / "batch"
     out.mkdir()
     (out / "index.csv").write_text("variant\n")
-    proc = _cli("latlong", "batch", str(scene), "--seeds", "1", "-o", str(out))
+    proc = run_module("latlong", "batch", str(scene), "--seeds", "1", "-o", str(out))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "holds a batch (index.csv): give --resume to finish it or --force" in proc.stderr
-    proc = _cli("dem", "batch", str(scene), "--seeds", "1", "-o", str(tmp_path / "d"))
+    proc = run_module("dem", "batch", str(scene), "--seeds", "1", "-o", str(tmp_path / "d"))
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "unknown config key(s) 'magnitude', 'preset'" in proc.stderr
     stack = tmp_path / "stack.toml"
     stack.write_text(STACK)
-    proc = _cli("dem", "batch", str(stack), "--seeds", "1", "--vary", "size=17,100",
-                "-o", str(tmp_path / "d"), cwd=ROOT)
+    proc = run_module("dem", "batch", str(stack), "--seeds", "1", "--vary", "size=17,100",
+                      "-o", str(tmp_path / "d"), cwd=ROOT)
     assert proc.returncode == 2 and proc.stderr.count("\n") == 1
     assert "--vary size=100: `size` must be 2^n + 1" in proc.stderr
 
@@ -382,7 +376,8 @@ def _separate_cluster(tmp_path: Path, n_workers: int = 2):
 
 
 @pytest.mark.slow
-def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monkeypatch):
+def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monkeypatch,
+                                                 run_module):
     local = tmp_path / "local"
     latlong.batch(scene, "1-2", vary={"magnitude": [16, 18]}, out=local, scheduler=scheduler)
     config = tmp_path / "stack.toml"
@@ -390,7 +385,7 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
     monkeypatch.chdir(ROOT)  # the config's input is relative to the working folder
     dem.batch(config, "1", out=tmp_path / "dem_local", scheduler=scheduler)
     expand = ("dem", "expand", str(LOLA), "--levels", "2", "--seed", "4", "-q")
-    proc = _cli(*expand, "-o", str(tmp_path / "here.tif"))
+    proc = run_module(*expand, "-o", str(tmp_path / "here.tif"))
     assert proc.returncode == 0, proc.stderr
     from latlong.ondemand.patches import build_patches
 
@@ -402,15 +397,16 @@ def test_separate_processes_give_the_same_bytes(tmp_path, scene, scheduler, monk
         assert there.radii_m.tobytes() == here.radii_m.tobytes()
         assert there.craters.tobytes() == here.craters.tobytes()
         # the tiles of one DEM as tasks on the separate workers: the same bytes
-        proc = _cli(*expand, "--scheduler", address, "-o", str(tmp_path / "there.tif"))
+        proc = run_module(*expand, "--scheduler", address, "-o", str(tmp_path / "there.tif"))
         assert proc.returncode == 0, proc.stderr
         assert sha256_file(tmp_path / "here.tif") == sha256_file(tmp_path / "there.tif")
-        proc = _cli("latlong", "batch", str(scene), "--seeds", "1-2", "--vary",
-                    "magnitude=16,18", "--scheduler", address, "-o", str(tmp_path / "remote"))
+        proc = run_module("latlong", "batch", str(scene), "--seeds", "1-2", "--vary",
+                          "magnitude=16,18", "--scheduler", address, "-o",
+                          str(tmp_path / "remote"))
         assert proc.returncode == 0, proc.stderr
         # the workers run in another folder: the input is read where the client sees it
-        proc = _cli("dem", "batch", str(config), "--seeds", "1", "--scheduler", address,
-                    "-o", str(tmp_path / "dem_remote"), cwd=ROOT)
+        proc = run_module("dem", "batch", str(config), "--seeds", "1", "--scheduler",
+                          address, "-o", str(tmp_path / "dem_remote"), cwd=ROOT)
         assert proc.returncode == 0, proc.stderr
     for a, b in (("local", "remote"), ("dem_local", "dem_remote")):
         rows_a = read_index(tmp_path / a / "index.csv")
