@@ -9,6 +9,7 @@ import numpy as np
 from craters.cells import cell_parts, cell_points, cell_solid_angle
 from craters.local import bin_level, min_cell_angle
 
+from ..parallel.backends import serial_below
 from . import _cell_kernels as C
 from . import _field_kernels as K
 
@@ -21,7 +22,8 @@ def cells_of(units: np.ndarray, level: int) -> np.ndarray:
     """Cell id (uint64) at ``level`` of each direction ``units`` (n, 3)."""
     out = np.empty(len(units), dtype=np.uint64)
     if len(units):
-        C._cells_kernel(np.ascontiguousarray(units, dtype=np.float64), level, out)
+        with serial_below(len(units)):
+            C._cells_kernel(np.ascontiguousarray(units, dtype=np.float64), level, out)
     return out
 
 
@@ -85,7 +87,8 @@ def neighbours(cells: np.ndarray, keep_shape: bool = False) -> np.ndarray:
     """The 9 cells around each cell (itself included), (n, 9) or flat."""
     out = np.empty((len(cells), 9), dtype=np.uint64)
     if len(cells):
-        C._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
+        with serial_below(len(cells)):
+            C._neighbourhood_kernel(np.ascontiguousarray(cells, dtype=np.uint64), out)
     return out if keep_shape else out.ravel()
 
 
@@ -133,8 +136,9 @@ def reaching(records: np.ndarray, level: int, occ: np.ndarray) -> np.ndarray:
     (:func:`block_pairs` may still list it: its block radius is a looser bound)."""
     out = np.zeros(len(records), dtype=bool)
     if len(records) and len(occ):
-        C._reach_kernel(np.ascontiguousarray(records[:, K.C0:K.C2 + 1]),
-                        np.ascontiguousarray(records[:, K.FAR]), level, occ, out)
+        with serial_below(len(records)):
+            C._reach_kernel(np.ascontiguousarray(records[:, K.C0:K.C2 + 1]),
+                            np.ascontiguousarray(records[:, K.FAR]), level, occ, out)
     return out
 
 

@@ -65,6 +65,7 @@ from craters.stamp import (
     stamping_profiles,
 )
 
+from ..parallel.backends import serial_below
 from ..scene import Scene
 from . import _field_kernels as K
 from .base import BaseField, base_field, lat_lon_of, per_scene, tangent_frame
@@ -463,8 +464,9 @@ def _dep_pairs(owners, owner_cells, cand: _Craters, n_have: int, fc_all, d_all):
     lo = np.where(found, starts[pos], 0).astype(np.int64)
     hi = np.where(found, ends[pos], 0).astype(np.int64)
     cand_idx = (order + n_have).astype(np.int64)
-    return K._dep_kernel(owners.astype(np.int64), owner_cell.astype(np.int64), lo, hi,
-                         cand_idx, fc_all, d_all)
+    with serial_below(len(owners)):
+        return K._dep_kernel(owners.astype(np.int64), owner_cell.astype(np.int64), lo, hi,
+                             cand_idx, fc_all, d_all)
 
 
 def _stencil_points(fc: np.ndarray) -> np.ndarray:

@@ -61,3 +61,36 @@ def test_every_crater_and_rock_reaching_a_point_is_listed_for_its_block(moon, mo
     units, block_of, start, lst, rc = seen["rocks"][:5]
     pairs, missed = _missed(units, block_of, start, lst, rc[:, 0:3], rc[:, R.CHORD2])
     assert pairs > 50 and missed == 0, (pairs, missed)
+
+
+def test_serial_below_runs_small_work_on_one_thread_and_restores_the_pool():
+    numba = pytest.importorskip("numba")
+    from latlong.parallel.backends import PARALLEL_MIN_ITEMS, serial_below
+
+    before = numba.get_num_threads()
+    with serial_below(10):
+        assert numba.get_num_threads() == 1
+    assert numba.get_num_threads() == before
+    with serial_below(PARALLEL_MIN_ITEMS):
+        assert numba.get_num_threads() == before
+    with pytest.raises(KeyError), serial_below(0, minimum=1):
+        raise KeyError("inside")
+    assert numba.get_num_threads() == before
+
+
+@pytest.mark.parametrize("minimum", [0, 10**9])
+def test_cell_set_work_gives_the_same_bytes_on_one_thread_or_all(moon, monkeypatch, minimum):
+    """The crater lookup's small kernels (cells, neighbourhoods, reach, dependency pairs)
+    run on the calling thread below ``PARALLEL_MIN_ITEMS`` items: the heights are the
+    same bytes with every one of them in parallel (minimum 0) or serial (10**9)."""
+    from latlong.ondemand.field import CraterField
+    from latlong.parallel import backends
+
+    half = np.degrees(0.5 / 1737400.0)
+    lat, lon = np.meshgrid(np.linspace(0.01 - half, 0.01 + half, 64),
+                           np.linspace(0.01 - half, 0.01 + half, 64))
+    units = units_of(lat.ravel(), lon.ravel())
+    want = CraterField(moon).radii(units, 0.002)
+    monkeypatch.setattr(backends, "PARALLEL_MIN_ITEMS", minimum)
+    got = CraterField(moon).radii(units, 0.002)
+    assert got.tobytes() == want.tobytes()
