@@ -7,8 +7,13 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
-import pytest
+from craters.cli.start import cap_numpy_simd  # imports nothing heavy
+
+# numpy's loops as the commands choose them (tests/test_golden_outputs.py): before numpy
+cap_numpy_simd()
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 
 
 def _children_import_these_packages() -> None:

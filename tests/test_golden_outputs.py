@@ -10,8 +10,10 @@ the commit that changes that file; regenerate it with::
     CRATERFORM_WRITE_GOLDEN=1 python -m pytest tests/test_golden_outputs.py
 
 Bytes depend on the platform as well as on the code: numpy picks SIMD implementations of
-``exp``, ``arcsin`` ... by the CPU's features (an AVX-512 machine and an AVX2 one differ in
-18 of the 29 steps), OpenBLAS its kernels, and VTK, GDAL and numba their versions. The file
+``exp``, ``arcsin`` ... by the CPU's features (an AVX-512 machine and an AVX2 one differed
+in 18 of the 29 steps; the commands and this suite now cap numpy's loops at AVX2,
+:func:`craters.cli.start.cap_numpy_simd`, so the record names no CPU features), OpenBLAS
+its kernels (the sums that decide bytes avoid it), and VTK, GDAL and numba their versions. The file
 holds one record per platform the hashes were made on (``records``: the platform and the
 steps' hashes); the comparison runs against this platform's record and is skipped with the
 difference to the nearest record named where there is none (the determinism tests still
@@ -173,7 +175,14 @@ def platform_fingerprint() -> dict:
     on, and the versions of the libraries that compute or write them."""
     from numpy._core._multiarray_umath import __cpu_features__
 
-    simd = sorted(k for k, v in __cpu_features__.items() if v and k.startswith(("AVX", "FMA")))
+    from craters.cli.start import NUMPY_SIMD_CAP
+
+    simd: str | list[str] = sorted(k for k, v in __cpu_features__.items()
+                                   if v and k.startswith(("AVX", "FMA")))
+    if os.environ.get("NPY_DISABLE_CPU_FEATURES") in NUMPY_SIMD_CAP.values():
+        # numpy capped at AVX2 before it loaded (conftest, as the commands): the loops of
+        # any x86-64 CPU give these bytes (AVX2 and SSE alike, tested), so no CPU list
+        simd = "numpy dispatch capped at X86_V3 (craters.cli.start.cap_numpy_simd)"
     return {"machine": platform.machine(), "simd": simd,
             **{lib: version(lib) for lib in ("numpy", "numba", "scipy", "vtk", "rasterio",
                                               "matplotlib", "pillow")}}

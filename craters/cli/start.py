@@ -7,6 +7,9 @@ problems of that start-up would show a traceback. This module and the packages' 
 before any of it loads: a Ctrl-C while the libraries load is ``error: interrupted`` and
 exit code 130 (as a Ctrl-C later in a run, :func:`craters.cli.kit.run_cli`), and a
 ``NUMBA_NUM_THREADS`` numba would refuse at import is one ``error:`` line and exit code 2.
+
+The start also caps numpy's SIMD dispatch at AVX2 (:func:`cap_numpy_simd`), so that a
+command writes the same bytes on any x86-64 CPU.
 """
 
 from __future__ import annotations
@@ -17,7 +20,40 @@ import signal
 import sys
 import threading
 
-__all__ = ["environment_problem", "start_command"]
+__all__ = ["NUMPY_SIMD_CAP", "cap_numpy_simd", "environment_problem", "start_command"]
+
+#: What ``NPY_DISABLE_CPU_FEATURES`` names (numpy >= 2.4 groups the x86 features in
+#: levels; earlier releases name them one by one): every dispatch target beyond AVX2.
+NUMPY_SIMD_CAP = {"2.4": "X86_V4 AVX512_ICL AVX512_SPR",
+                  "": ("AVX512F AVX512CD AVX512_KNL AVX512_KNM AVX512_SKX AVX512_CLX "
+                       "AVX512_CNL AVX512_ICL AVX512_SPR")}
+
+
+def cap_numpy_simd() -> str | None:
+    """Keep numpy's loops at AVX2 (X86_V3) and below in this process and the processes it
+    starts; what ``NPY_DISABLE_CPU_FEATURES`` is set to, or None where nothing was done.
+
+    numpy picks a loop for each CPU at import: its AVX-512 ``exp``/``log``, SVML's ``sin``,
+    ``cos``, ``arcsin`` ... and the AVX-512 sorts round or order differently from the AVX2
+    and SSE loops (an AVX-512 machine's golden outputs differed from an AVX2 one's in 17 of
+    29 steps, stop 50). The AVX2 and SSE loops give the project's outputs the same bytes
+    (the golden set under ``NPY_DISABLE_CPU_FEATURES=X86_V3``), numba's kernels do
+    without fast-math (``NUMBA_CPU_NAME=generic``: the same bytes) and the sums that
+    decide bytes avoid BLAS (:mod:`craters.exact`); with this cap an AVX-512 machine runs
+    the loops an AVX2 one runs. Only before numpy is imported (a library user sets the
+    variable before starting Python) and only where the variable is unset: set it, even
+    empty, to keep numpy's own choice."""
+    if "numpy" in sys.modules or "NPY_DISABLE_CPU_FEATURES" in os.environ:
+        return None
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        major, minor = (int(p) for p in version("numpy").split(".")[:2])
+    except (PackageNotFoundError, ValueError):
+        return None
+    names = NUMPY_SIMD_CAP["2.4" if (major, minor) >= (2, 4) else ""]
+    os.environ["NPY_DISABLE_CPU_FEATURES"] = names
+    return names
 
 
 def environment_problem() -> str | None:
@@ -58,6 +94,7 @@ def start_command(cli_module: str, argv: list[str] | None) -> int:
     if problem is not None:
         sys.stderr.write(f"error: {problem}\n")
         return 2
+    cap_numpy_simd()
     # a Ctrl-C while the libraries load is noted, not raised: a KeyboardInterrupt inside
     # the import machinery can be swallowed ("Exception ignored in ...") and the run go on.
     # One handler for the whole run (swapping handlers after loading left a window in
