@@ -485,3 +485,22 @@ def test_on_demand_patches_give_the_same_bytes_on_any_backend(scheduler):
         assert got.radii_m.tobytes() == one.radii_m.tobytes()
         assert got.craters.tobytes() == one.craters.tobytes()
     assert len(one.craters) > 100
+
+
+def test_workers_that_cap_numpy_otherwise_are_named(scheduler, caplog, monkeypatch):
+    """An existing cluster's workers whose numpy is not capped as this process's is
+    (``NPY_DISABLE_CPU_FEATURES``, :func:`craters.cli.start.cap_numpy_simd`) are named in
+    one warning: on an AVX-512 CPU their last bits may differ."""
+
+    def warned() -> list[str]:
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="latlong.parallel.backends"), \
+                open_backend(scheduler=scheduler):
+            pass
+        return [r.getMessage() for r in caplog.records
+                if "NPY_DISABLE_CPU_FEATURES" in r.getMessage()]
+
+    assert warned() == []  # the workers inherited this process's environment
+    monkeypatch.setenv("NPY_DISABLE_CPU_FEATURES", "X86_V3")
+    (message,) = warned()
+    assert message.startswith("2 of the workers of tcp://127.0.0.1:")

@@ -41,10 +41,14 @@ def cap_numpy_simd() -> str | None:
     without fast-math (``NUMBA_CPU_NAME=generic``: the same bytes) and the sums that
     decide bytes avoid BLAS (:mod:`craters.exact`); with this cap an AVX-512 machine runs
     the loops an AVX2 one runs. Only before numpy is imported (a library user sets the
-    variable before starting Python) and only where the variable is unset: set it, even
-    empty, to keep numpy's own choice."""
+    variable before starting Python), on x86-64, and only where the variable is unset: set
+    it, even empty, to keep numpy's own choice."""
     if "numpy" in sys.modules or "NPY_DISABLE_CPU_FEATURES" in os.environ:
         return None
+    import platform
+
+    if platform.machine().lower() not in ("x86_64", "amd64"):
+        return None  # the names are x86's (another architecture would warn of them)
     from importlib.metadata import PackageNotFoundError, version
 
     try:

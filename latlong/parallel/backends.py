@@ -306,4 +306,23 @@ def _connected(scheduler: str | None, workers: int | None, timeout_s: float):
         except (OSError, TimeoutError):
             raise ParameterError("scheduler", f"{scheduler} has no workers (waited "
                                  f"{_WORKERS_S} s)") from None
+        _check_numpy_cap(client, scheduler)
         yield client
+
+
+def _numpy_cap() -> str | None:
+    return os.environ.get("NPY_DISABLE_CPU_FEATURES")
+
+
+def _check_numpy_cap(client, scheduler: str) -> None:
+    """Warn when the workers of an existing cluster do not cap numpy's SIMD loops as this
+    process does (:func:`craters.cli.start.cap_numpy_simd`: a worker started by hand with
+    numpy's own choice may write other last bits on an AVX-512 CPU)."""
+    here = _numpy_cap()
+    differ = sorted(w for w, v in client.run(_numpy_cap).items() if v != here)
+    if differ:
+        logging.getLogger(__name__).warning(
+            "%d of the workers of %s run numpy with NPY_DISABLE_CPU_FEATURES other than "
+            "this process's %r (e.g. %s): on a CPU with AVX-512 their results may differ in "
+            "the last bits; start them with the same NPY_DISABLE_CPU_FEATURES",
+            len(differ), scheduler, here, differ[0])
