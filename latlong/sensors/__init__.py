@@ -87,7 +87,7 @@ the same engine and cast shadows. ``python examples/plot_descent_strip.py`` and
 ``plot_lidar_sweep.py`` draw frames and scans.
 """
 
-from .albedo import ejecta_albedo, regolith_albedo
+from .albedo import ejecta_albedo, regolith_albedo, regolith_normals
 from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
 from .camera_files import CameraSettings, camera_run
 from .engine import BUILD_QUALITIES, Hits, RayMesh
@@ -124,5 +124,6 @@ __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "crater_labels", "display_image", "drape_catalog", "ejecta_albedo", "expose",
            "exposure_for", "lidar_frame",
            "lidar_run", "quaternion_from_matrix", "quaternion_to_matrix", "radiance_factor",
-           "ray_scene", "read_poses", "reflectance_model", "regolith_albedo", "render",
+           "ray_scene", "read_poses", "reflectance_model", "regolith_albedo", "regolith_normals",
+           "render",
            "rim_curves", "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]

@@ -61,6 +61,74 @@ def _mottle_kernel(points, seed, wavelength_m, octaves, gain, out):
         out[i] = total
 
 
+@njit(cache=True, inline="always")
+def _value3_grad(seed, x, y, z):
+    """:func:`_value3` at (x, y, z) and its gradient (per lattice unit): the trilinear
+    blend differentiated through the quintic fades (30 f^2 (f - 1)^2)."""
+    ix, fx, u = lattice_coord(x)
+    iy, fy, v = lattice_coord(y)
+    iz, fz, w = lattice_coord(z)
+    du = 30.0 * fx * fx * (fx - 1.0) * (fx - 1.0)
+    dv = 30.0 * fy * fy * (fy - 1.0) * (fy - 1.0)
+    dw = 30.0 * fz * fz * (fz - 1.0) * (fz - 1.0)
+    c000 = _lattice(seed, ix, iy, iz)
+    c100 = _lattice(seed, ix + 1, iy, iz)
+    c010 = _lattice(seed, ix, iy + 1, iz)
+    c110 = _lattice(seed, ix + 1, iy + 1, iz)
+    c001 = _lattice(seed, ix, iy, iz + 1)
+    c101 = _lattice(seed, ix + 1, iy, iz + 1)
+    c011 = _lattice(seed, ix, iy + 1, iz + 1)
+    c111 = _lattice(seed, ix + 1, iy + 1, iz + 1)
+    x00 = c100 - c000
+    x10 = c110 - c010
+    x01 = c101 - c001
+    x11 = c111 - c011
+    a00 = c000 + u * x00
+    a10 = c010 + u * x10
+    a01 = c001 + u * x01
+    a11 = c011 + u * x11
+    b0 = a00 + v * (a10 - a00)
+    b1 = a01 + v * (a11 - a01)
+    gx = du * ((1.0 - w) * (x00 + v * (x10 - x00)) + w * (x01 + v * (x11 - x01)))
+    gy = dv * ((1.0 - w) * (a10 - a00) + w * (a11 - a01))
+    gz = dw * (b1 - b0)
+    return b0 + w * (b1 - b0), gx, gy, gz
+
+
+@read_only_inputs("out")
+@njit(cache=True, parallel=True)
+def _bump_kernel(points, normals, seed, wavelength_m, octaves, gain, amp_m, out):
+    """Each unit normal of ``normals`` tilted by the gradient of the height field
+    ``amp_m`` x fBm(points) (:func:`_mottle_kernel`'s octaves of :func:`_value3`, metres):
+    n - grad_t h, normalised (grad_t: the part of the gradient across n), into ``out``."""
+    for i in prange(points.shape[0]):
+        g0 = 0.0
+        g1 = 0.0
+        g2 = 0.0
+        amp = 1.0 - gain
+        inv = 1.0 / wavelength_m
+        for o in range(octaves):
+            s = seed + np.uint64(o) * _OCTAVE
+            _, dx, dy, dz = _value3_grad(s, points[i, 0] * inv, points[i, 1] * inv,
+                                         points[i, 2] * inv)
+            g0 += amp * inv * dx
+            g1 += amp * inv * dy
+            g2 += amp * inv * dz
+            amp *= gain
+            inv *= 2.0
+        n0 = normals[i, 0]
+        n1 = normals[i, 1]
+        n2 = normals[i, 2]
+        along = (g0 * n0 + g1 * n1 + g2 * n2)
+        m0 = n0 - amp_m * (g0 - along * n0)
+        m1 = n1 - amp_m * (g1 - along * n1)
+        m2 = n2 - amp_m * (g2 - along * n2)
+        norm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+        out[i, 0] = m0 / norm
+        out[i, 1] = m1 / norm
+        out[i, 2] = m2 / norm
+
+
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _cube_keys_kernel(verts, lo, cell, dims, out):

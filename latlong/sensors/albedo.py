@@ -19,10 +19,19 @@ the largest over the craters that reach the vertex; craters at or above
 position (value noise hashed from the lattice, octaves from ``wavelength_max_m`` halving
 down to two pixels, amplitudes 0.7^k: a frame shows the same coarse mottling as a coarser
 frame, plus finer detail), so ``contrast`` is the RMS of the log albedo at full detail.
-Its default, 0.1 (about +-10 %), is a choice for close-range pictures, not a published
-measurement: lunar surface photographs show bright rock fragments and dark patches on
-the soil at this level, and no small-scale albedo spectrum of the regolith is used here.
+Its default, 0.05 (about +-5 %), is set against LROC NAC pictures at 0.5 m a pixel (with
+the relief below the pixels, :func:`regolith_normals`; :mod:`latlong.ondemand.descent`'s
+notes): 0.1 put 0.18 / 0.22 of a frame's image power in its second and third finest
+octaves, the NAC crops hold 0.08-0.16 / 0.14-0.17; 0.05 gives 0.13 / 0.15. No published
+small-scale albedo spectrum of the regolith is used.
 Multiply the two factors for a frame's albedo.
+
+:func:`regolith_normals` is the relief below a frame's smallest stamped craters (3
+pixels), as shading: vertex normals tilted by the gradient of a 3-D fBm height field of the
+body-fixed position (octaves of 4 and 2 pixels, amplitude ratio 2^-H between them), scaled
+so that the RMS tangent of the tilt is ``tan(tilt_deg)``. Beside LROC NAC frames at 0.5 m a
+pixel the soil between stamped craters was smooth where the real regolith is granular;
+the geometry (depth, LIDAR ranges, labels) keeps the stamped terrain.
 """
 
 from __future__ import annotations
@@ -33,10 +42,11 @@ import numpy as np
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
 from ..geometry.meshes import bounds
-from ._albedo_kernels import _cube_keys_kernel, _ejecta_kernel, _mottle_kernel
+from ._albedo_kernels import _bump_kernel, _cube_keys_kernel, _ejecta_kernel, _mottle_kernel
 from .scene_geometry import SceneGeometry
 
-__all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "ejecta_albedo", "regolith_albedo"]
+__all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "RELIEF_TOP_PX", "VALUE_GRAD_RMS", "ejecta_albedo",
+           "regolith_albedo", "regolith_normals"]
 
 #: Octave gain of the regolith mottling (amplitude ratio of successive octaves).
 MOTTLE_GAIN = 0.7
@@ -45,6 +55,14 @@ MOTTLE_GAIN = 0.7
 #: ``contrast`` is the RMS of the log albedo.
 MOTTLE_RMS = 0.168
 _MOTTLE_SALT = 0x5DEECE66D2545F49
+#: Wavelength of the coarsest octave of :func:`regolith_normals`, pixels (craters from 3
+#: pixels are stamped; its octaves are 4 and 2 pixels).
+RELIEF_TOP_PX = 4.0
+#: RMS of the gradient across a random plane of one octave of the value noise at a unit
+#: wavelength (1.0807-1.0825 over three sets of 10^6 random points and planes;
+#: tests/latlong/test_albedo.py checks it).
+VALUE_GRAD_RMS = 1.081
+_RELIEF_SALT = 0x2545F4914F6CDD1D
 
 
 def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
@@ -119,7 +137,7 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     return out
 
 
-def regolith_albedo(points_m, *, seed: int, contrast: float = 0.1, pixel_m: float,
+def regolith_albedo(points_m, *, seed: int, contrast: float = 0.05, pixel_m: float,
                     wavelength_max_m: float = 2.0) -> np.ndarray:
     """(n,) float64 albedo factor of the regolith's mottling at ``points_m`` (n, 3),
     body-fixed metres (module notes), for a picture whose pixels are ``pixel_m`` on the
@@ -162,3 +180,54 @@ def regolith_albedo(points_m, *, seed: int, contrast: float = 0.1, pixel_m: floa
         return out
     _mottle_kernel(pts, np.uint64(seed ^ _MOTTLE_SALT), top, octaves, MOTTLE_GAIN, out)
     return np.exp((contrast / MOTTLE_RMS) * out)
+
+
+def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_deg: float,
+                     hurst: float = 0.76) -> np.ndarray:
+    """(n, 3) unit vertex normals ``normals`` at ``points_m`` tilted by the relief below a
+    picture's resolved craters (module notes): RMS tangent of the tilt ``tan(tilt_deg)``.
+
+    Parameters
+    ----------
+    points_m, normals : (n, 3) array_like
+        Vertex positions (body-fixed metres) and their unit normals.
+    seed : int
+        The relief's seed, [0, 2^63).
+    pixel_m : float
+        Ground pixel of the picture (> 0): the octaves are 4 and 2 pixels.
+    tilt_deg : float
+        RMS tilt of the normals (as the tangent's RMS), [0, 60) degrees; 0 returns the
+        normals as given.
+    hurst : float
+        Hurst exponent: the finer octave's amplitude is 2^-hurst of the coarser's, [0, 1].
+
+    Examples
+    --------
+    >>> n = regolith_normals([[0.0, 0.0, 1737e3]] * 2, [[0.0, 0.0, 1.0]] * 2, seed=1,
+    ...                      pixel_m=0.5, tilt_deg=7.0)
+    >>> n.shape, bool(np.allclose(np.linalg.norm(n, axis=1), 1.0))
+    ((2, 3), True)
+    """
+    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    nrm = np.ascontiguousarray(normals, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
+        raise ParameterError("points_m", f"must be finite (n, 3) positions; got shape "
+                                         f"{pts.shape}")
+    if nrm.shape != pts.shape or not np.isfinite(nrm).all():
+        raise ParameterError("normals", f"must be finite unit normals shaped like points_m "
+                                        f"{pts.shape}; got {nrm.shape}")
+    seed = check_int("seed", seed, 0, 2**63 - 1)
+    pixel = check_positive("pixel_m", pixel_m)
+    tilt = check_range("tilt_deg", tilt_deg, 0.0, 59.999)
+    gain = 2.0 ** -check_range("hurst", hurst, 0.0, 1.0)
+    if tilt == 0.0 or not len(pts):
+        return nrm.copy()
+    top = RELIEF_TOP_PX * pixel
+    octaves = 2
+    # RMS gradient (per metre) of the unit-amplitude fBm: independent octaves add in square
+    grad = VALUE_GRAD_RMS / top * float(np.sqrt(sum(((1.0 - gain) * gain**k * 2.0**k) ** 2
+                                                    for k in range(octaves))))
+    out = np.empty_like(nrm)
+    _bump_kernel(pts, nrm, np.uint64(seed ^ _RELIEF_SALT), top, octaves, gain,
+                 float(np.tan(np.radians(tilt))) / grad, out)
+    return out
