@@ -166,16 +166,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     frame's stamped craters, shown as shading (``latlong.sensors.regolith_normals``; 0:
     none), ``microrelief_hurst`` its Hurst exponent: the tilt at a pixel p metres wide is
     ``atan(tan(microrelief_deg) p^(H - 1))`` (module notes)."""
-    from ..sensors import (
-        Camera,
-        LidarSettings,
-        Pose,
-        ejecta_albedo,
-        lidar_frame,
-        regolith_albedo,
-        regolith_normals,
-        render,
-    )
+    from ..sensors import Camera, LidarSettings, Pose, lidar_frame, render
     from ..sensors.engine import RayMesh
     from ..sensors.lidar_files import body_fixed_wkt
     from ..sensors.scene_geometry import SceneGeometry
@@ -189,10 +180,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
                         f"{type(scene).__name__}")
     check_range("fov_deg", fov_deg, 1.0, 120.0)
     width_px = check_int("width_px", width_px, 16, 8192)
-    bright_ejecta = check_range("bright_ejecta", bright_ejecta, 0.0, 10.0)
-    mottling = check_range("mottling", mottling, 0.0, 2.0)
-    microrelief_deg = check_range("microrelief_deg", microrelief_deg, 0.0, 45.0)
-    microrelief_hurst = check_range("microrelief_hurst", microrelief_hurst, 0.0, 1.0)
+    shading = _Shading.checked(field.base.seed, bright_ejecta, mottling, microrelief_deg,
+                               microrelief_hurst)
     alts = np.asarray(altitudes_m, dtype=np.float64).ravel()
     if not len(alts) or not (np.isfinite(alts).all() and (alts > 0).all()):
         raise ParameterError("altitudes_m", "must be positive numbers")
@@ -225,13 +214,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         mesh = RayMesh(verts, faces, build_quality="low")
         truth = SceneGeometry(verts, faces, face_rock, craters=catalog, boulders=rocks,
                               source="terrain on demand")
-        albedo = ejecta_albedo(truth, contrast=bright_ejecta) * regolith_albedo(
-            verts, seed=field.base.seed, contrast=mottling, pixel_m=pixel)
-        tilt = math.degrees(math.atan(math.tan(math.radians(microrelief_deg))
-                                      * pixel ** (microrelief_hurst - 1.0)))
-        normals = regolith_normals(verts, mesh.vertex_normals, seed=field.base.seed,
-                                   pixel_m=pixel, tilt_deg=min(tilt, 59.0),
-                                   hurst=microrelief_hurst) if tilt > 0.0 else "smooth"
+        albedo, normals = shading.of(truth, mesh, pixel)
         frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth,
                        vertex_albedo=albedo, normals=normals)
         returns = None if lidar is None else lidar_frame(
@@ -240,6 +223,42 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         n_craters, n_rocks = counts
         yield DescentFrame(float(h), pixel, frame, int(n_craters), int(n_rocks), kind,
                            catalog, returns, crs_wkt, rocks)
+
+
+@dataclasses.dataclass(frozen=True)
+class _Shading:
+    """What a descent frame's pictures show beyond the terrain's geometry (module notes):
+    the albedo (bright ejecta times mottling) and the normals (the relief below the
+    pixels)."""
+
+    seed: int
+    bright_ejecta: float
+    mottling: float
+    microrelief_deg: float
+    microrelief_hurst: float
+
+    @classmethod
+    def checked(cls, seed: int, bright_ejecta: float, mottling: float,
+                microrelief_deg: float, microrelief_hurst: float) -> _Shading:
+        return cls(seed, check_range("bright_ejecta", bright_ejecta, 0.0, 10.0),
+                   check_range("mottling", mottling, 0.0, 2.0),
+                   check_range("microrelief_deg", microrelief_deg, 0.0, 45.0),
+                   check_range("microrelief_hurst", microrelief_hurst, 0.0, 1.0))
+
+    def of(self, truth, mesh, pixel_m: float):
+        """(vertex albedo, vertex normals or "smooth") of a frame's terrain ``truth`` (a
+        SceneGeometry) and its ray mesh, ``pixel_m`` on the ground."""
+        from ..sensors import ejecta_albedo, regolith_albedo, regolith_normals
+
+        albedo = ejecta_albedo(truth, contrast=self.bright_ejecta) * regolith_albedo(
+            truth.vertices, seed=self.seed, contrast=self.mottling, pixel_m=pixel_m)
+        tilt = math.degrees(math.atan(math.tan(math.radians(self.microrelief_deg))
+                                      * pixel_m ** (self.microrelief_hurst - 1.0)))
+        if tilt <= 0.0:
+            return albedo, "smooth"
+        return albedo, regolith_normals(truth.vertices, mesh.vertex_normals, seed=self.seed,
+                                        pixel_m=pixel_m, tilt_deg=min(tilt, 59.0),
+                                        hurst=self.microrelief_hurst)
 
 
 def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:
