@@ -97,32 +97,28 @@ def _value3_grad(seed, x, y, z):
 
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
-def _bump_kernel(points, normals, seed, wavelength_m, octaves, gain, amp_m, out):
+def _bump_kernel(points, normals, seeds, wavelengths_m, amps_m, out):
     """Each unit normal of ``normals`` tilted by the gradient of the height field
-    ``amp_m`` x fBm(points) (:func:`_mottle_kernel`'s octaves of :func:`_value3`, metres):
+    sum_k amps_m[k] :func:`_value3`(seeds[k], points / wavelengths_m[k]) (metres):
     n - grad_t h, normalised (grad_t: the part of the gradient across n), into ``out``."""
     for i in prange(points.shape[0]):
         g0 = 0.0
         g1 = 0.0
         g2 = 0.0
-        amp = 1.0 - gain
-        inv = 1.0 / wavelength_m
-        for o in range(octaves):
-            s = seed + np.uint64(o) * _OCTAVE
-            _, dx, dy, dz = _value3_grad(s, points[i, 0] * inv, points[i, 1] * inv,
+        for o in range(wavelengths_m.shape[0]):
+            inv = 1.0 / wavelengths_m[o]
+            _, dx, dy, dz = _value3_grad(seeds[o], points[i, 0] * inv, points[i, 1] * inv,
                                          points[i, 2] * inv)
-            g0 += amp * inv * dx
-            g1 += amp * inv * dy
-            g2 += amp * inv * dz
-            amp *= gain
-            inv *= 2.0
+            g0 += amps_m[o] * inv * dx
+            g1 += amps_m[o] * inv * dy
+            g2 += amps_m[o] * inv * dz
         n0 = normals[i, 0]
         n1 = normals[i, 1]
         n2 = normals[i, 2]
         along = (g0 * n0 + g1 * n1 + g2 * n2)
-        m0 = n0 - amp_m * (g0 - along * n0)
-        m1 = n1 - amp_m * (g1 - along * n1)
-        m2 = n2 - amp_m * (g2 - along * n2)
+        m0 = n0 - (g0 - along * n0)
+        m1 = n1 - (g1 - along * n1)
+        m2 = n2 - (g2 - along * n2)
         norm = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
         out[i, 0] = m0 / norm
         out[i, 1] = m1 / norm

@@ -28,10 +28,13 @@ Multiply the two factors for a frame's albedo.
 
 :func:`regolith_normals` is the relief below a frame's smallest stamped craters (3
 pixels), as shading: vertex normals tilted by the gradient of a 3-D fBm height field of the
-body-fixed position (octaves of 4 and 2 pixels, amplitude ratio 2^-H between them), scaled
-so that the RMS tangent of the tilt is ``tan(tilt_deg)``. Beside LROC NAC frames at 0.5 m a
-pixel the soil between stamped craters was smooth where the real regolith is granular;
-the geometry (depth, LIDAR ranges, labels) keeps the stamped terrain.
+body-fixed position on the fixed ladder of wavelengths 2^-k m, the octaves within a factor
+2 of 2.83 pixels weighted so that a frame shows the same texture at the same places as
+the frames before and after it (a descent's features stay put; with octaves tied to each
+frame's pixels, PnP between frames missed by up to 4.9 %), tilt ~ pixel^(H - 1). Beside
+LROC NAC frames at 0.5 m a pixel the soil between stamped craters was smooth where the
+real regolith is granular; the geometry (depth, LIDAR ranges, labels) keeps the stamped
+terrain.
 """
 
 from __future__ import annotations
@@ -45,8 +48,8 @@ from ..geometry.meshes import bounds
 from ._albedo_kernels import _bump_kernel, _cube_keys_kernel, _ejecta_kernel, _mottle_kernel
 from .scene_geometry import SceneGeometry
 
-__all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "RELIEF_TOP_PX", "VALUE_GRAD_RMS", "ejecta_albedo",
-           "regolith_albedo", "regolith_normals"]
+__all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "RELIEF_CENTRE_PX", "VALUE_GRAD_RMS", "ejecta_albedo",
+           "regolith_albedo", "regolith_normals", "relief_octaves"]
 
 #: Octave gain of the regolith mottling (amplitude ratio of successive octaves).
 MOTTLE_GAIN = 0.7
@@ -55,9 +58,9 @@ MOTTLE_GAIN = 0.7
 #: ``contrast`` is the RMS of the log albedo.
 MOTTLE_RMS = 0.168
 _MOTTLE_SALT = 0x5DEECE66D2545F49
-#: Wavelength of the coarsest octave of :func:`regolith_normals`, pixels (craters from 3
-#: pixels are stamped; its octaves are 4 and 2 pixels).
-RELIEF_TOP_PX = 4.0
+#: Centre of the wavelengths of :func:`regolith_normals`, pixels (craters from 3 pixels
+#: are stamped; its octaves lie within a factor 2 of 2^1.5 = 2.83 pixels).
+RELIEF_CENTRE_PX = 2.0 ** 1.5
 #: RMS of the gradient across a random plane of one octave of the value noise at a unit
 #: wavelength (1.0807-1.0825 over three sets of 10^6 random points and planes;
 #: tests/latlong/test_albedo.py checks it).
@@ -182,10 +185,33 @@ def regolith_albedo(points_m, *, seed: int, contrast: float = 0.05, pixel_m: flo
     return np.exp((contrast / MOTTLE_RMS) * out)
 
 
-def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_deg: float,
-                     hurst: float = 0.76) -> np.ndarray:
+def relief_octaves(pixel_m: float, tilt_1m_deg: float, hurst: float):
+    """The octaves of :func:`regolith_normals` for a picture of ``pixel_m`` pixels:
+    (wavelengths in metres, RMS tilt tangents, octave numbers k). The wavelengths are
+    the fixed ladder 2^-k m, so consecutive frames of a descent share their octaves (the
+    same texture at the same places); those within a factor 2 of RELIEF_CENTRE_PX pixels
+    are weighted cos(pi/2 log2(lambda / centre)) (their squares sum to 1 wherever the
+    centre falls), each with the tilt tan(tilt_1m_deg) (lambda / RELIEF_CENTRE_PX m)^(H-1)."""
+    centre = RELIEF_CENTRE_PX * pixel_m
+    k_lo = int(np.floor(-np.log2(2.0 * centre)))
+    ks, lams, tilts = [], [], []
+    for k in range(k_lo, k_lo + 3):
+        lam = 2.0 ** -k
+        x = np.log2(lam / centre)
+        if abs(x) >= 1.0:
+            continue
+        ks.append(k)
+        lams.append(lam)
+        tilts.append(np.cos(0.5 * np.pi * x) * np.tan(np.radians(tilt_1m_deg))
+                     * (lam / RELIEF_CENTRE_PX) ** (hurst - 1.0))
+    return np.array(lams), np.array(tilts), np.array(ks, dtype=np.int64)
+
+
+def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_1m_deg: float,
+                     hurst: float = 1.0) -> np.ndarray:
     """(n, 3) unit vertex normals ``normals`` at ``points_m`` tilted by the relief below a
-    picture's resolved craters (module notes): RMS tangent of the tilt ``tan(tilt_deg)``.
+    picture's resolved craters (module notes): about ``tan(tilt_1m_deg) p^(H - 1)`` RMS
+    tangent of the tilt at pixels p metres wide (:func:`relief_octaves`).
 
     Parameters
     ----------
@@ -194,17 +220,16 @@ def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_deg: 
     seed : int
         The relief's seed, [0, 2^63).
     pixel_m : float
-        Ground pixel of the picture (> 0): the octaves are 4 and 2 pixels.
-    tilt_deg : float
-        RMS tilt of the normals (as the tangent's RMS), [0, 60) degrees; 0 returns the
-        normals as given.
+        Ground pixel of the picture (> 0).
+    tilt_1m_deg : float
+        RMS tilt at 1 m pixels, [0, 45] degrees; 0 returns the normals as given.
     hurst : float
-        Hurst exponent: the finer octave's amplitude is 2^-hurst of the coarser's, [0, 1].
+        Hurst exponent of the relief, [0, 1] (1: the same tilt at every pixel size).
 
     Examples
     --------
     >>> n = regolith_normals([[0.0, 0.0, 1737e3]] * 2, [[0.0, 0.0, 1.0]] * 2, seed=1,
-    ...                      pixel_m=0.5, tilt_deg=7.0)
+    ...                      pixel_m=0.5, tilt_1m_deg=2.5)
     >>> n.shape, bool(np.allclose(np.linalg.norm(n, axis=1), 1.0))
     ((2, 3), True)
     """
@@ -218,16 +243,15 @@ def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_deg: 
                                         f"{pts.shape}; got {nrm.shape}")
     seed = check_int("seed", seed, 0, 2**63 - 1)
     pixel = check_positive("pixel_m", pixel_m)
-    tilt = check_range("tilt_deg", tilt_deg, 0.0, 59.999)
-    gain = 2.0 ** -check_range("hurst", hurst, 0.0, 1.0)
+    tilt = check_range("tilt_1m_deg", tilt_1m_deg, 0.0, 45.0)
+    hurst = check_range("hurst", hurst, 0.0, 1.0)
     if tilt == 0.0 or not len(pts):
         return nrm.copy()
-    top = RELIEF_TOP_PX * pixel
-    octaves = 2
-    # RMS gradient (per metre) of the unit-amplitude fBm: independent octaves add in square
-    grad = VALUE_GRAD_RMS / top * float(np.sqrt(sum(((1.0 - gain) * gain**k * 2.0**k) ** 2
-                                                    for k in range(octaves))))
+    lams, tilts, ks = relief_octaves(pixel, tilt, hurst)
+    # an octave's RMS tangential gradient is amp VALUE_GRAD_RMS / lambda
+    amps = tilts * lams / VALUE_GRAD_RMS
+    seeds = np.array([(seed ^ _RELIEF_SALT) + (int(k) + 1024) * 0x632BE59BD9B4E019 & (2**64 - 1)
+                      for k in ks], dtype=np.uint64)
     out = np.empty_like(nrm)
-    _bump_kernel(pts, nrm, np.uint64(seed ^ _RELIEF_SALT), top, octaves, gain,
-                 float(np.tan(np.radians(tilt))) / grad, out)
+    _bump_kernel(pts, nrm, seeds, np.ascontiguousarray(lams), np.ascontiguousarray(amps), out)
     return out
