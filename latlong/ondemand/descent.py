@@ -38,9 +38,9 @@ hold 0.037-0.083 of their image power (mean removed, Hann window) in the finest 
 spatial frequency and 0.080-0.163 in the next; a 1000^2 descent frame at 0.5 m (sun 30
 deg, the mare scene of ``tests/benchmarks/measure_ondemand.py``) without the relief
 0.015 / 0.056 (its soil smooth where the real regolith is granular), with 2.5 deg
-0.053 / 0.106 (with the mottling, 0.05: 0.047 / 0.127).
-Carrying the maria deviogram itself (2 deg at 17 m) down to 1 m gives 5.8 deg, which made
-0.147 / 0.230: a sandpaper texture that drowned the small craters.
+0.040 / 0.094 (with the mottling, 0.05: 0.037 / 0.120). Carrying the maria deviogram
+itself (2 deg at 17 m) down to 1 m gives 5.8 deg, which made 0.147 / 0.230: a sandpaper
+texture that drowned the small craters.
 """
 
 from __future__ import annotations
