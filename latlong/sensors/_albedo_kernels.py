@@ -25,20 +25,9 @@ def _lattice(seed, ix, iy, iz):
 
 @njit(cache=True)
 def _value3(seed, x, y, z):
-    """Trilinear value noise with quintic fades at (x, y, z) lattice units."""
-    ix, _, u = lattice_coord(x)
-    iy, _, v = lattice_coord(y)
-    iz, _, w = lattice_coord(z)
-    c = np.empty(8)
-    for k in range(8):
-        c[k] = _lattice(seed, ix + (k & 1), iy + ((k >> 1) & 1), iz + (k >> 2))
-    a0 = c[0] + u * (c[1] - c[0])
-    a1 = c[2] + u * (c[3] - c[2])
-    a2 = c[4] + u * (c[5] - c[4])
-    a3 = c[6] + u * (c[7] - c[6])
-    b0 = a0 + v * (a1 - a0)
-    b1 = a2 + v * (a3 - a2)
-    return b0 + w * (b1 - b0)
+    """Trilinear value noise with quintic fades at (x, y, z) lattice units (the value of
+    :func:`_value3_grad`; its unused gradient is compiled away)."""
+    return _value3_grad(seed, x, y, z)[0]
 
 
 @read_only_inputs("out")

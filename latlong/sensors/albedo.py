@@ -45,7 +45,13 @@ import numpy as np
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
 from ..geometry.meshes import bounds
-from ._albedo_kernels import _bump_kernel, _cube_keys_kernel, _ejecta_kernel, _mottle_kernel
+from ._albedo_kernels import (
+    _OCTAVE,
+    _bump_kernel,
+    _cube_keys_kernel,
+    _ejecta_kernel,
+    _mottle_kernel,
+)
 from .scene_geometry import SceneGeometry
 
 __all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "RELIEF_CENTRE_PX", "VALUE_GRAD_RMS", "ejecta_albedo",
@@ -66,6 +72,15 @@ RELIEF_CENTRE_PX = 2.0 ** 1.5
 #: tests/latlong/test_albedo.py checks it).
 VALUE_GRAD_RMS = 1.081
 _RELIEF_SALT = 0x2545F4914F6CDD1D
+
+
+def _positions(points_m) -> np.ndarray:
+    """``points_m`` as finite (n, 3) float64 positions (a one-line error otherwise)."""
+    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
+        raise ParameterError("points_m", f"must be finite (n, 3) positions; got shape "
+                                         f"{pts.shape}")
+    return pts
 
 
 def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
@@ -167,10 +182,7 @@ def regolith_albedo(points_m, *, seed: int, contrast: float = 0.05, pixel_m: flo
     >>> f.shape, bool(((f > 0.5) & (f < 2.0)).all())
     ((2,), True)
     """
-    pts = np.ascontiguousarray(points_m, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
-        raise ParameterError("points_m", f"must be finite (n, 3) positions; got shape "
-                                         f"{pts.shape}")
+    pts = _positions(points_m)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     contrast = check_range("contrast", contrast, 0.0, 2.0)
     pixel = check_positive("pixel_m", pixel_m)
@@ -233,11 +245,8 @@ def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_1m_de
     >>> n.shape, bool(np.allclose(np.linalg.norm(n, axis=1), 1.0))
     ((2, 3), True)
     """
-    pts = np.ascontiguousarray(points_m, dtype=np.float64)
+    pts = _positions(points_m)
     nrm = np.ascontiguousarray(normals, dtype=np.float64)
-    if pts.ndim != 2 or pts.shape[1] != 3 or not np.isfinite(pts).all():
-        raise ParameterError("points_m", f"must be finite (n, 3) positions; got shape "
-                                         f"{pts.shape}")
     if nrm.shape != pts.shape or not np.isfinite(nrm).all():
         raise ParameterError("normals", f"must be finite unit normals shaped like points_m "
                                         f"{pts.shape}; got {nrm.shape}")
@@ -250,7 +259,7 @@ def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_1m_de
     lams, tilts, ks = relief_octaves(pixel, tilt, hurst)
     # an octave's RMS tangential gradient is amp VALUE_GRAD_RMS / lambda
     amps = tilts * lams / VALUE_GRAD_RMS
-    seeds = np.array([(seed ^ _RELIEF_SALT) + (int(k) + 1024) * 0x632BE59BD9B4E019 & (2**64 - 1)
+    seeds = np.array([((seed ^ _RELIEF_SALT) + (int(k) + 1024) * int(_OCTAVE)) % 2**64
                       for k in ks], dtype=np.uint64)
     out = np.empty_like(nrm)
     _bump_kernel(pts, nrm, seeds, np.ascontiguousarray(lams), np.ascontiguousarray(amps), out)
