@@ -13,7 +13,14 @@ import numpy as np
 from craters._shared import about, check_int, human_bytes, physical_memory_bytes, progress_bar
 
 from .core import Dem
-from .expansion import BYTES_PER_PIXEL, HALO_PX, ExpansionPlan, expand_tile, plan_expansion
+from .expansion import (
+    BYTES_PER_PIXEL,
+    HALO_PX,
+    ExpansionPlan,
+    expand_tile,
+    expansion_extent,
+    plan_expansion,
+)
 
 __all__ = ["TILE_PX", "ExpandedFile", "expand_to_file"]
 
@@ -95,10 +102,10 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
 
     with about("tile_px"):
         tile_px = check_int("tile_px", TILE_PX if tile_px is None else tile_px, 3)
+    _check_disk(path, expansion_extent(dem, levels, region)[2])  # before any estimate
     choose_backend(backend, scheduler, workers, connect_timeout_s=connect_timeout_s)
     plan = plan_expansion(dem, levels, fractal_dimension, roughness, region, rng)
     t_in, t_out = _tile_sides(plan, tile_px)
-    _check_disk(path, plan)
     n = (plan.width - 1) // (t_in - 1)
     tags = dem.step_tags("dem.expand", plan.seed, plan.params, level=dem.level + plan.levels,
                          origin=plan.origin)
@@ -119,14 +126,14 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
     return ExpandedFile(out.path, (plan.side, plan.side), plan.seed, plan.params, len(tiles))
 
 
-def _check_disk(path, plan: ExpansionPlan) -> None:
-    """The free space for the output, before any work (a float32 pixel each): refused up
-    front (one-line ValueError) when the folder has no room for it."""
-    need = 4.0 * plan.side**2
+def _check_disk(path, side: int) -> None:
+    """The free space for a ``side``-square output, before any work (a float32 pixel
+    each): refused up front (one-line ValueError) when the folder has no room for it."""
+    need = 4.0 * side**2
     folder = Path(path).parent if str(Path(path).parent) else Path(".")
     free = shutil.disk_usage(folder).free
     if need > free:
-        raise ValueError(f"output {str(path)!r}: a float32 DEM of {plan.side} x {plan.side} "
+        raise ValueError(f"output {str(path)!r}: a float32 DEM of {side} x {side} "
                          f"pixels (deflate saves ~1 % of fractal terrain) is about "
                          f"{human_bytes(need)}; {str(folder)!r} has {human_bytes(free)} free; "
                          f"give fewer levels or a smaller region")

@@ -81,7 +81,6 @@ from typing import NamedTuple
 
 import numpy as np
 from affine import Affine
-from scipy.ndimage import median_filter
 
 from craters._shared import (
     ParameterError,
@@ -94,8 +93,6 @@ from craters._shared import (
     progress_bar,
 )
 
-from ._expand_kernels import _expand_kernel
-from ._rng_kernels import key_from_rng
 from .core import Dem
 from .fractal import MAX_ROUGHNESS, expansion_fit, local_msd
 
@@ -275,19 +272,28 @@ class ExpansionPlan(NamedTuple):
     origin: tuple[int, int]
 
 
+def expansion_extent(dem: Dem, levels, region) -> tuple[int, tuple[int, int, int], int]:
+    """(levels, (row_off, col_off, width) of the region, side of the output in pixels),
+    checked: what an output's size is known from before any estimate (``dem expand``
+    refuses an output too large for its disk before scipy and numba load, < 1 s)."""
+    with about("levels"):
+        levels = check_int("levels", levels, 1, 16)
+    r0, c0, width = _region(_check_dem(dem), region)
+    return levels, (r0, c0, width), (width - 1) * 2**levels + 1
+
+
 def plan_expansion(dem: Dem, levels, fractal_dimension, roughness, region, rng,
           relief: Dem | None = None) -> ExpansionPlan:
     """Check the arguments and make the estimates of the whole DEM (expand's parameters)."""
+    from ._rng_kernels import key_from_rng  # numba: loaded where it runs
+
     dem = _check_dem(dem)
-    with about("levels"):
-        levels = check_int("levels", levels, 1, 16)
-    r0, c0, width = _region(dem, region)
+    levels, (r0, c0, width), side = expansion_extent(dem, levels, region)
     block = dem.heights[r0:r0 + width, c0:c0 + width]
     unknown = int(np.isnan(block).sum())
     if unknown:
         raise ValueError(f"the region has {unknown} unknown (NaN) pixels; fill them first "
                          f"(dem.fill_gaps, `dem fill`)")
-    side = (width - 1) * 2**levels + 1
     if fractal_dimension is not None:
         with about("fractal_dimension"):
             fractal_dimension = check_range("fractal_dimension", fractal_dimension, 2.0, 3.0)
@@ -380,6 +386,8 @@ def local_relief(dem: Dem, *, median_px: int = 1) -> Dem:
     finite = np.isfinite(amp)
     amp[~finite] = float(np.sqrt(np.mean(amp[finite] ** 2))) if finite.any() else 0.0
     if median_px > 1:
+        from scipy.ndimage import median_filter  # loaded where it runs (expansion_extent)
+
         amp = median_filter(amp, median_px, mode="nearest")
     return dem.replace(heights=amp)
 
@@ -433,6 +441,8 @@ def _expand_region(z: np.ndarray, region, origin, level0: int, levels: int, key:
     grid ``amp_coarser`` levels above ``level0``, its pixel (0, 0) at lattice index
     ``amp_origin`` there. Returns the expanded region only.
     """
+    from ._expand_kernels import _expand_kernel  # numba: loaded where it runs
+
     r0, c0, width = region
     rows, cols = z.shape
     a_r, a_c = max(r0 - HALO_PX, 0), max(c0 - HALO_PX, 0)

@@ -207,6 +207,19 @@ def test_an_expansion_larger_than_the_disk_is_refused_up_front(capsys, tmp_path)
     assert list(tmp_path.iterdir()) == []
 
 
+def test_the_expansion_size_is_refused_before_numba_and_scipy_load(tmp_path):
+    # what keeps the refusal under a second (issue 34): numba (~0.3 s) and scipy.ndimage
+    # (~0.25 s) load where they run, after the output's size is checked
+    code = ("import sys\nfrom dem.__main__ import main\ntry:\n    main()\nexcept SystemExit:\n"
+            "    pass\nprint([m for m in ('numba', 'scipy.ndimage') if m in sys.modules])")
+    proc = subprocess.run([sys.executable, "-c", code, "expand", str(DATA / "ldem4_crop.lbl"),
+                           "-o", str(tmp_path / "big.tif"), "--levels", "12", "--seed", "1"],
+                          capture_output=True, text=True, cwd=tmp_path)
+    assert "1048577 x 1048577" in proc.stderr, proc.stderr
+    assert proc.stdout.strip() == "[]", proc.stdout
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_more_workers_than_the_machine_holds_are_refused(capsys, tmp_path):
     from latlong.parallel.backends import max_workers
 

@@ -21,7 +21,6 @@ from typing import cast
 
 import numpy as np
 
-from .._boulder_kernels import _noise_kernel
 from .._shared import check_int, check_range, normalize_rng
 
 __all__ = ["BoulderNode", "BoulderShape", "boulder", "boulder_faces", "boulder_meshes",
@@ -147,6 +146,10 @@ def _boulder_meshes(seeds, shape: BoulderShape):
     # the random numbers of boulder i come from its own seed: same seed, same boulder
     noise = np.empty((n, n_final - 12))
     if n:
+        # imported here: the boulder specs' parsers (every dem command's settings) load
+        # this module without numba
+        from .._boulder_kernels import _noise_kernel
+
         _noise_kernel(np.ascontiguousarray(seeds), noise)
     edge0 = np.linalg.norm(_ICO_V[0] - _ICO_V[1])
     count = 12
