@@ -4,13 +4,13 @@ bigger than memory, the same bytes as expanding the whole region (:mod:`dem.expa
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 from typing import NamedTuple
 
 import numpy as np
 
 from craters._shared import about, check_int, human_bytes, physical_memory_bytes, progress_bar
+from latlong.meshio.sizes import check_free_space
 
 from .core import Dem
 from .expansion import (
@@ -129,14 +129,9 @@ def expand_to_file(dem: Dem, path, levels: int = 1, fractal_dimension: float | N
 def _check_disk(path, side: int) -> None:
     """The free space for a ``side``-square output, before any work (a float32 pixel
     each): refused up front (one-line ValueError) when the folder has no room for it."""
-    need = 4.0 * side**2
-    folder = Path(path).parent if str(Path(path).parent) else Path(".")
-    free = shutil.disk_usage(folder).free
-    if need > free:
-        raise ValueError(f"output {str(path)!r}: a float32 DEM of {side} x {side} "
-                         f"pixels (deflate saves ~1 % of fractal terrain) is about "
-                         f"{human_bytes(need)}; {str(folder)!r} has {human_bytes(free)} free; "
-                         f"give fewer levels or a smaller region")
+    check_free_space([(path, 4.0 * side**2)],
+                     hint=f"a float32 DEM of {side} x {side} pixels (deflate saves ~1 % of "
+                     f"fractal terrain): give fewer levels or a smaller region")
 
 
 def _tile_sides(plan: ExpansionPlan, tile_px: int) -> tuple[int, int]:

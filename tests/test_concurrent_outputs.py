@@ -207,6 +207,69 @@ def test_an_expansion_larger_than_the_disk_is_refused_up_front(capsys, tmp_path)
     assert list(tmp_path.iterdir()) == []
 
 
+def _free_bytes(monkeypatch, free: int) -> None:
+    """The disk as the free-space checks see it: ``free`` bytes left."""
+    import shutil
+
+    import latlong.meshio.sizes
+
+    real = shutil.disk_usage
+
+    def usage(path):
+        total, used, _ = real(path)
+        return shutil._ntuple_diskusage(total, used, free)
+
+    monkeypatch.setattr(latlong.meshio.sizes.shutil, "disk_usage", usage)
+
+
+def test_a_build_larger_than_the_free_disk_is_refused_up_front(capsys, tmp_path, monkeypatch):
+    # M = 40: 9 602 vertices, a .ply of ~400 kB and an .stl of ~960 kB on a 1 MB disk
+    _free_bytes(monkeypatch, 1_000_000)
+    argv = ("build", "--magnitude", "40", "--base", "sphere", "--radius-m", "100")
+    code, _, err = run(capsys, "latlong", *argv, "-o", tmp_path / "a.ply",
+                       "-o", tmp_path / "a.stl")
+    assert_refused(code, err, "'", "a.ply", "a.stl", "needs about 1.3 MiB", "free",
+                   "--magnitude")
+    assert list(tmp_path.iterdir()) == []
+    code, _, err = run(capsys, "latlong", *argv, "-o", tmp_path / "a.ply")  # fits
+    assert code == 0, err
+    real = (tmp_path / "a.ply").stat().st_size
+    from latlong.meshio.sizes import mesh_file_bytes
+    assert abs(mesh_file_bytes("a.ply", 6 * 40**2 + 2) - real) < 0.02 * real
+
+
+def test_an_export_larger_than_the_free_disk_is_refused_up_front(capsys, tmp_path,
+                                                                 monkeypatch):
+    code, _, err = run(capsys, "latlong", "build", "--magnitude", "40", "--base", "sphere",
+                       "--radius-m", "100", "-o", tmp_path / "b.npz", "-q")
+    assert code == 0, err
+    _free_bytes(monkeypatch, 100_000)
+    code, _, err = run(capsys, "latlong", "export", tmp_path / "b.npz", "-o",
+                       tmp_path / "b.glb", "--lod", "2")
+    assert_refused(code, err, "b.glb", "needs about", "free", "--lod")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["b.npz"]
+
+
+def test_a_stack_larger_than_the_free_disk_is_refused_up_front(capsys, tmp_path,
+                                                               monkeypatch):
+    tif = tiny_tif(tmp_path / "tiny.tif")
+    _free_bytes(monkeypatch, 2_000)  # 2 layers of 17^2 pixels at 3.6 B: 2 081 B
+    code, _, err = run(capsys, "dem", *ENHANCE, tif, "-o", tmp_path / "site")
+    assert_refused(code, err, "site", "needs about 2.0 KiB", "2 layers of 17 x 17",
+                   "fewer layers")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["tiny.tif"]
+
+
+def test_frames_larger_than_the_free_disk_are_refused_up_front(capsys, tmp_path, monkeypatch):
+    _free_bytes(monkeypatch, 100_000)  # 4 frames of 64^2 px at >= 28 B a pixel: 459 kB
+    code, _, err = run(capsys, "latlong", "descent", "--preset", "fbm-cratered", "--lat-deg",
+                       "0", "--lon-deg", "0", "--frames", "4", "--size-px", "64", "-o",
+                       tmp_path / "d")
+    assert_refused(code, err, "-o/--output", "needs about 448.0 KiB", "4 frames of 64x64",
+                   "fewer frames")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_expansion_size_is_refused_before_numba_and_scipy_load(tmp_path):
     # what keeps the refusal under a second (issue 34): numba (~0.3 s) and scipy.ndimage
     # (~0.25 s) load where they run, after the output's size is checked

@@ -106,10 +106,13 @@ def _lidar_flag(name: str) -> str:
 
 def check_descent_folder(v: Values):
     """The checked output folder of a descent command (``-o``, ``--force``)."""
+    from latlong.sensors.camera_files import check_frames_disk
     from latlong.sensors.runs import check_output_folder
 
     try:
-        return check_output_folder(v["output"], force=v["force"])
+        out = check_output_folder(v["output"], force=v["force"])
+        check_frames_disk(out, v["size_px"], v["size_px"], v["frames"])
+        return out
     except ValueError as exc:
         raise CliError(f"-o/--output: {exc}") from None
 

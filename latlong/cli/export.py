@@ -11,6 +11,7 @@ from craters.cli.kit import CliError, check_not_input, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, default_of
 from latlong import export_glb, export_vtp_strips, load
 from latlong.gltf import LOD_LAYOUTS, level_path
+from latlong.meshio.sizes import EXPORT_BYTES_PER_VERTEX, check_free_space
 
 from .inputs import MODEL
 
@@ -59,6 +60,10 @@ def _export(v: Values) -> int:
     if body.magnitude % (2 ** v["lod"]):
         raise CliError(f"--lod {v['lod']} needs a magnitude divisible by {2 ** v['lod']}; "
                        f"{v['model']} has M = {body.magnitude}")
+    levels = range(v["lod"] + 1) if suffix == ".glb" else range(1)
+    vertices = sum(6 * (body.magnitude // 2**level) ** 2 + 2 for level in levels)
+    check_free_space([(out, EXPORT_BYTES_PER_VERTEX[suffix] * vertices)],
+                     hint="choose another folder, or fewer levels of detail (--lod)")
     if suffix == ".glb":
         man = export_glb(body, out, patch_k=v["patch_k"], lod=v["lod"], lods=v["lods"],
                          progress=not v["quiet"])

@@ -10,5 +10,6 @@
   reverse); a source may bring its own writer for a suffix (a lat/long body's ``.glb``).
 * :mod:`.boulders`: placed boulders merged after a surface's mesh; :mod:`.checks`:
   checks of mesh files before VTK reads them; :mod:`.chunks`: chunked, overlapped
-  writing.
+  writing; :mod:`.sizes`: the size of a body's file by suffix and the free-space check
+  every writer of large outputs makes before any work.
 """

@@ -49,6 +49,7 @@ from craters._shared import (
 )
 from craters._shared.settings import check_declared, setting
 
+from ..meshio.sizes import check_free_space
 from .albedo import ejecta_albedo
 from .camera import Camera
 from .datasets import optical_flow, parse_datasets, write_datasets, write_flow
@@ -217,6 +218,18 @@ def write_manifest(folder, document: dict) -> Path:
 #: Peak memory of a frame, bytes a pixel and band (measured: 1.48 GB for one band at 2048^2
 #: with the default outputs, 0.55 GB at 1024^2: ~300 bytes a pixel above the model).
 FRAME_BYTES_PER_PIXEL = 320
+
+
+#: Bytes a pixel a frame's files hold at the least: depth, range, crater-id and boulder-id
+#: (uncompressed 32-bit TIFF) and normals (3 float32 in .npy); the pictures compress.
+FRAME_FILE_BYTES_PER_PIXEL = 28
+
+
+def check_frames_disk(folder, width: int, height: int, n_frames: int) -> None:
+    """Refuse up front (one line) frames whose files cannot fit the disk of ``folder``."""
+    check_free_space([(folder, FRAME_FILE_BYTES_PER_PIXEL * width * height * n_frames)],
+                     hint=f"{n_frames} frames of {width}x{height} px: fewer frames, a smaller "
+                     f"--size or another folder")
 
 
 def check_frame_memory(width: int, height: int, bands: int = 1) -> None:
@@ -397,6 +410,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
     if frame_info is not None and len(frame_info) != len(poses):
         raise ParameterError("frame_info", f"must hold {len(poses)} dicts, one per pose")
     folder = check_output_folder(folder, force=force)
+    check_frames_disk(folder, settings.camera.width, settings.camera.height, len(poses))
     geometry, mesh = ray_scene(model, craters=craters, mesh=mesh)
     albedo = ejecta_albedo(geometry, contrast=settings.bright_ejecta) \
         if settings.bright_ejecta else None
