@@ -270,6 +270,25 @@ def test_frames_larger_than_the_free_disk_are_refused_up_front(capsys, tmp_path,
     assert list(tmp_path.iterdir()) == []
 
 
+def test_windows_and_descents_larger_than_the_memory_are_refused_up_front(capsys, tmp_path,
+                                                                          monkeypatch):
+    # a 16384^2 window (55 GB) was killed by the OOM killer on a 25 GB machine
+    import latlong.ondemand.tile
+
+    monkeypatch.setattr(latlong.ondemand.tile, "physical_memory_bytes", lambda: 2e9)
+    code, _, err = run(capsys, "latlong", "tile", "--preset", "fbm-cratered", "--radius-m",
+                       "100000", "--lat-deg", "0", "--lon-deg", "0", "--size-m", "409.6",
+                       "--pixel-m", "0.1", "-o", tmp_path / "t.tif")
+    assert_refused(code, err, "--size-m", "4096 x 4096 pixels", "3.5 GiB of memory",
+                   "1.9 GiB", "larger pixels")
+    code, _, err = run(capsys, "latlong", "descent", "--preset", "fbm-cratered", "--lat-deg",
+                       "0", "--lon-deg", "0", "--frames", "2", "--size-px", "2048", "-o",
+                       tmp_path / "d")
+    assert_refused(code, err, "--size-px", "2048 px frames over 3277 px of terrain",
+                   "a smaller frame")
+    assert list(tmp_path.iterdir()) == []
+
+
 def test_the_expansion_size_is_refused_before_numba_and_scipy_load(tmp_path):
     # what keeps the refusal under a second (issue 34): numba (~0.3 s) and scipy.ndimage
     # (~0.25 s) load where they run, after the output's size is checked

@@ -12,7 +12,7 @@ import sys
 
 from craters.cli.kit import CliError
 from craters.cli.options import Setting, Values
-from latlong.cli.tile import TILE_OUTPUTS, WINDOW
+from latlong.cli.tile import TILE_OUTPUTS, WINDOW, check_tile_disk
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
@@ -96,6 +96,7 @@ def _tile(v: Values) -> int:
                 raise CliError(f"--{key}: {exc}") from None
     if not outs:
         raise CliError("nothing to write: give -o/--output, --mesh or --picture")
+    check_tile_disk(v, outs)
     dem = read_site(v)
     scene = scene_of(dem, v)
     made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],

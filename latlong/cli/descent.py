@@ -105,10 +105,16 @@ def _lidar_flag(name: str) -> str:
 
 
 def check_descent_folder(v: Values):
-    """The checked output folder of a descent command (``-o``, ``--force``)."""
+    """The checked output folder of a descent command (``-o``, ``--force``), once the
+    frames' memory and files are known to fit."""
+    from latlong.ondemand.descent import check_descent_memory
     from latlong.sensors.camera_files import check_frames_disk
     from latlong.sensors.runs import check_output_folder
 
+    try:
+        check_descent_memory(v["size_px"])
+    except ParameterError as exc:
+        raise exc.renamed("size_px") from None
     try:
         out = check_output_folder(v["output"], force=v["force"])
         check_frames_disk(out, v["size_px"], v["size_px"], v["frames"])

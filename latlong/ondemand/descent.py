@@ -60,7 +60,7 @@ from . import units_of
 from ._rock_kernels import _face_rocks_kernel
 from .base import tangent_frame
 from .field import CraterField, crater_field
-from .tile import MAX_TILE_PX, tile_mesh, tile_of_field
+from .tile import MAX_TILE_PX, check_tile_memory, tile_mesh, tile_of_field
 
 if TYPE_CHECKING:
     from ..sensors import LidarFrame, LidarSettings
@@ -155,6 +155,16 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
     return units * radii[:, None], faces, counts, "body", _rock_faces(field, faces)
 
 
+def check_descent_memory(width_px: int) -> None:
+    """Refuse up front (one line naming ``width_px``) frames ``width_px`` wide that this
+    machine cannot hold with their terrain (the widest window, ``_MARGIN`` x the frame)."""
+    from ..sensors.camera_files import FRAME_BYTES_PER_PIXEL
+
+    window_px = min(MAX_TILE_PX, math.ceil(_MARGIN * width_px))
+    check_tile_memory(window_px, "width_px", f"{width_px} px frames over {window_px} px of "
+                      f"terrain", "a smaller frame", FRAME_BYTES_PER_PIXEL * width_px**2)
+
+
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
             fov_deg: float = 30.0, width_px: int = 512, sun_azimuth_deg: float = 90.0,
             sun_elevation_deg: float = 25.0, reflectance=None,
@@ -185,6 +195,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
                         f"{type(scene).__name__}")
     check_range("fov_deg", fov_deg, 1.0, 120.0)
     width_px = check_int("width_px", width_px, 16, 8192)
+    check_descent_memory(width_px)
     shading = _Shading.checked(field.base.seed, bright_ejecta, mottling, microrelief_deg,
                                microrelief_hurst)
     alts = np.asarray(altitudes_m, dtype=np.float64).ravel()
