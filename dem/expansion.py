@@ -386,7 +386,7 @@ def local_relief(dem: Dem, *, median_px: int = 1) -> Dem:
     finite = np.isfinite(amp)
     amp[~finite] = float(np.sqrt(np.mean(amp[finite] ** 2))) if finite.any() else 0.0
     if median_px > 1:
-        from scipy.ndimage import median_filter  # loaded where it runs (expansion_extent)
+        from scipy.ndimage import median_filter  # loaded where it runs: see expansion_extent
 
         amp = median_filter(amp, median_px, mode="nearest")
     return dem.replace(heights=amp)
