@@ -55,9 +55,10 @@ import numpy as np
 from rasterio.windows import Window
 
 import craters
-from craters._shared import ParameterError, human_bytes, physical_memory_bytes, progress_bar
+from craters._shared import ParameterError, progress_bar
 
 from .boulders import place_boulders
+from .budget import check_memory_need
 from .config import EnhanceConfig, SourceCraterLayer
 from .core import Dem
 from .craterdensity import CraterDensity, crater_density
@@ -278,10 +279,8 @@ def prepare(config, dem: Dem | None = None, *, layers_held: int | None = None) -
         raise TypeError(f"`dem` must be a Dem; got {type(dem).__name__}")
     held = cfg.layers * 2.5 if layers_held is None else layers_held
     need = held * cfg.size**2 * 8 + (2 * cfg.size + 8) ** 2 * 8 * 2.3
-    if need > 0.85 * physical_memory_bytes():
-        raise ValueError(f"{cfg.layers} layers of {cfg.size}^2 pixels need about "
-                         f"{human_bytes(need)} of memory; this machine has "
-                         f"{human_bytes(physical_memory_bytes())}")
+    check_memory_need(need, f"a stack of {cfg.layers} layers of {cfg.size}^2 pixels",
+                      share=0.85)
     base = dem if dem is not None else read(cfg.input, band=cfg.band,
                                             pixel_size_m=cfg.pixel_size_m,
                                             body_radius_m=cfg.body_radius_m, body=cfg.body,

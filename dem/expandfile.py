@@ -9,9 +9,10 @@ from typing import NamedTuple
 
 import numpy as np
 
-from craters._shared import about, check_int, human_bytes, physical_memory_bytes, progress_bar
+from craters._shared import about, check_int, progress_bar
 from latlong.meshio.sizes import check_free_space
 
+from .budget import check_memory_need
 from .core import Dem
 from .expansion import (
     BYTES_PER_PIXEL,
@@ -143,12 +144,9 @@ def _tile_sides(plan: ExpansionPlan, tile_px: int) -> tuple[int, int]:
                    ((tile_px - 1) // step).bit_length() - 1))
     t_in = 2**k + 1
     t_out = (t_in - 1) * step + 1
-    need = (t_out + 4 * HALO_PX) ** 2 * BYTES_PER_PIXEL
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
-        raise ValueError(f"one tile of {t_in} x {t_in} pixels expanded {plan.levels} levels "
-                         f"is {t_out} x {t_out} pixels and needs about {human_bytes(need)} of "
-                         f"memory; this machine has {human_bytes(have)}")
+    check_memory_need((t_out + 4 * HALO_PX) ** 2 * BYTES_PER_PIXEL,
+                      f"one tile of {t_in} x {t_in} pixels expanded {plan.levels} levels "
+                      f"({t_out} x {t_out} pixels)", share=0.85)
     return t_in, t_out
 
 

@@ -88,11 +88,10 @@ from craters._shared import (
     check_int,
     check_positive,
     check_range,
-    human_bytes,
-    physical_memory_bytes,
     progress_bar,
 )
 
+from .budget import check_memory_need
 from .core import Dem
 from .fractal import MAX_ROUGHNESS, expansion_fit, local_msd
 
@@ -236,13 +235,10 @@ def expand(dem: Dem, levels: int = 1, fractal_dimension: float | None = None,
     ((17, 17), (2.0, 2.0), True)
     """
     plan = plan_expansion(dem, levels, fractal_dimension, roughness, region, rng, relief)
-    need = (plan.side + 4 * HALO_PX) ** 2 * BYTES_PER_PIXEL
-    have = physical_memory_bytes()
-    if need > 0.85 * have:
-        raise ValueError(f"expanding {plan.width} x {plan.width} pixels {levels} levels gives "
-                         f"{plan.side} x {plan.side} pixels and needs about {human_bytes(need)} "
-                         f"of memory; this machine has {human_bytes(have)} (dem.expand_to_file "
-                         f"writes it tile by tile)")
+    check_memory_need((plan.side + 4 * HALO_PX) ** 2 * BYTES_PER_PIXEL,
+                      f"expanding {plan.width} x {plan.width} pixels {levels} levels (to "
+                      f"{plan.side} x {plan.side} pixels)",
+                      "dem.expand_to_file writes it tile by tile", share=0.85)
     heights = expand_tile(dem, plan, plan.r0, plan.c0, plan.width, progress=progress)
     return dem.with_step(heights, "dem.expand", plan.seed, plan.params,
                          transform=plan.transform, pixel_size_m=plan.pixel_size_m,

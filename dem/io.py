@@ -35,7 +35,7 @@ from craters._shared.files import check_regular_file
 
 from .core import LEVEL_TAG, ORIGIN_TAG, PIXEL_SIZE_TAG, RADIUS_TAG, Dem
 from .crscode import CRS_TAG, check_crs, crs_tags, restore_crs
-from .pdsimage import read_pds
+from .pdsimage import check_read_memory, read_pds
 from .zarrio import (
     ZARR_OPTIONS,
     ZARR_SUFFIXES,
@@ -250,6 +250,7 @@ def _read_gdal(path: Path, band: int, win=None):
                 if np.dtype(ds.dtypes[band - 1]).kind == "c":
                     raise ValueError(f"{str(path)!r}: band {band} holds complex numbers "
                                      f"({ds.dtypes[band - 1]}); heights must be real")
+                check_read_memory(path, *((ds.height, ds.width) if win is None else win[2:]))
                 if win is None:
                     data = ds.read(band, masked=True)
                 else:

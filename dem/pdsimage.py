@@ -49,6 +49,7 @@ from ._pds import (
     parse_label,
     sample_constant,
 )
+from .budget import check_memory_need
 
 __all__ = ["read_pds"]
 
@@ -85,6 +86,20 @@ class _Image(NamedTuple):
         return self.prefix + self.samples * self.bits // 8 + self.suffix
 
 
+#: Memory a pixel of a raster read takes at its peak: the float64 heights and the float64
+#: copy the NoData fill makes (the file's own samples and mask are smaller and freed).
+READ_BYTES_PER_PIXEL = 16
+
+
+def check_read_memory(path, rows: int, cols: int) -> None:
+    """Refuse up front (one line naming the file) a read of ``rows`` x ``cols`` pixels that
+    this machine's memory cannot hold (:func:`dem.read`, GDAL rasters and PDS3 images)."""
+    check_memory_need(READ_BYTES_PER_PIXEL * float(rows) * float(cols),
+                      f"reading {str(path)!r} ({rows} x {cols} pixels)",
+                      "crop it first (gdal_translate -srcwin) or read a window "
+                      "(dem.read(..., window=...))")
+
+
 def read_pds(path: Path, band: int, win=None):
     """Heights, transform, CRS, tags and body radius (m, or None) of a PDS3 image.
 
@@ -110,6 +125,7 @@ def read_pds(path: Path, band: int, win=None):
             raise ValueError(f"`window` (row_off, col_off, rows, cols) = {tuple(win)} is not "
                              f"inside {str(path)!r} ({layout.lines} x {layout.samples} "
                              f"pixels)")
+    check_read_memory(path, n_lines, n_samples)
     proj, _ = find_object(label, "IMAGE_MAP_PROJECTION")
     dtype = np.dtype(f"{layout.kind}{layout.bits // 8}")
     raw, gdal_transform, gdal_crs = _read_with_gdal(

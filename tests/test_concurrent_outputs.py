@@ -289,6 +289,42 @@ def test_windows_and_descents_larger_than_the_memory_are_refused_up_front(capsys
     assert list(tmp_path.iterdir()) == []
 
 
+def _sparse_tif(path: Path, side: int) -> Path:
+    """A ``side``-square float32 GeoTIFF of which one block holds data (a few kB on disk)."""
+    import numpy as np
+    import rasterio
+    from affine import Affine
+
+    with rasterio.open(path, "w", driver="GTiff", width=side, height=side, count=1,
+                       dtype="float32", crs="EPSG:32633", tiled=True, blockxsize=256,
+                       blockysize=256, sparse_ok=True, nodata=np.nan,
+                       transform=Affine(1.0, 0, 500000.0, 0, -1.0, 4000000.0)) as ds:
+        ds.write(np.zeros((256, 256), np.float32), 1, window=((0, 256), (0, 256)))
+    return path
+
+
+def test_a_raster_larger_than_the_memory_is_refused_before_reading(capsys, tmp_path,
+                                                                    monkeypatch):
+    # was numpy's "Unable to allocate 149. GiB for an array with shape (1, 200000, 200000)"
+    import dem.budget
+
+    tif = _sparse_tif(tmp_path / "big.tif", 10000)
+    monkeypatch.setattr(dem.budget, "physical_memory_bytes", lambda: 1e9)
+    for argv in (("info", tif), ("slopes", tif, "--csv", tmp_path / "s.csv")):
+        code, _, err = run(capsys, "dem", *argv)
+        assert_refused(code, err, "big.tif", "10000 x 10000 pixels", "1.5 GiB of memory",
+                       "crop it first")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.tif"]
+
+
+def test_a_fill_larger_than_the_free_disk_is_refused_up_front(capsys, tmp_path, monkeypatch):
+    tif = _sparse_tif(tmp_path / "big.tif", 10000)
+    _free_bytes(monkeypatch, 100_000_000)  # the filled DEM: 10^8 float32 pixels
+    code, _, err = run(capsys, "dem", "fill", tif, "-o", tmp_path / "f.tif", "--seed", "1")
+    assert_refused(code, err, "f.tif", "needs about 381.5 MiB", "10000 x 10000 pixels")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["big.tif"]
+
+
 def test_the_expansion_size_is_refused_before_numba_and_scipy_load(tmp_path):
     # what keeps the refusal under a second (issue 34): numba (~0.3 s) and scipy.ndimage
     # (~0.25 s) load where they run, after the output's size is checked

@@ -5,6 +5,7 @@ by tile from the file (the same bytes)."""
 from __future__ import annotations
 
 from craters.cli.options import Setting, Values, default_of
+from latlong.meshio.sizes import check_free_space
 
 from ..frame import crater_target
 from ..gaps import fill_gaps
@@ -40,6 +41,9 @@ def _fill(v: Values) -> int:
     seed, show, bar = begin(v, "fill")
     head = read_input(v, window=(0, 0, 1, 1), allow_unknown=True)
     shape_in = raster_shape(v["input"])
+    check_free_space([(v["output"], 4.0 * shape_in[0] * shape_in[1])],  # float32 heights
+                     hint=f"the filled DEM has {shape_in[0]} x {shape_in[1]} pixels: another "
+                     f"folder")
     if not fits_whole(shape_in, v["max_memory_gb"]):
         # bigger than memory: tile by tile from the file (the same bytes)
         bar.close()
