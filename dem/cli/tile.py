@@ -12,7 +12,7 @@ import sys
 
 from craters.cli.kit import CliError
 from craters.cli.options import Setting, Values
-from latlong.cli.tile import TILE_OUTPUTS, WINDOW, check_tile_disk
+from latlong.cli.tile import TILE_OUTPUTS, WINDOW, check_outputs
 
 from .options import INPUT, READ, RUN, dem_command, read_input
 
@@ -80,23 +80,11 @@ def scene_of(dem, v: Values):
 
 
 def _tile(v: Values) -> int:
-    from craters._shared import check_output_path
-    from latlong.meshio.writers import MESH_SUFFIXES
     from latlong.ondemand.tile import write_tile
 
     from ..ondemand import dem_tile
 
-    outs = {}
-    for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
-                          ("picture", (".png",))):
-        if v[key]:
-            try:
-                outs[key] = check_output_path(v[key], force=v["force"], suffixes=suffixes)
-            except ValueError as exc:
-                raise CliError(f"--{key}: {exc}") from None
-    if not outs:
-        raise CliError("nothing to write: give -o/--output, --mesh or --picture")
-    check_tile_disk(v, outs)
+    outs = check_outputs(v)
     dem = read_site(v)
     scene = scene_of(dem, v)
     made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],

@@ -64,14 +64,20 @@ OPTIONS = on_demand_options("tile", {**WINDOW, **TILE_OUTPUTS})
 _GROUPS = {"tile": "window and outputs", **GROUPS}
 
 
-def check_outputs(v: Values) -> list[tuple[str, Path]]:
-    outs = []
+def check_outputs(v: Values) -> dict[str, Path]:
+    """The outputs of a window command (``latlong tile``, ``dem tile``) by key, checked
+    before any work: suffixes, nothing overwritten without ``--force``, room on the disk."""
+    outs = {}
     for key, suffixes in (("output", (".tif", ".tiff")), ("mesh", MESH_SUFFIXES),
                           ("picture", (".png",))):
         if v[key]:
-            outs.append((key, check_output_path(v[key], force=v["force"], suffixes=suffixes)))
+            try:
+                outs[key] = check_output_path(v[key], force=v["force"], suffixes=suffixes)
+            except ValueError as exc:
+                raise CliError(f"--{key}: {exc}") from None
     if not outs:
         raise CliError("nothing to write: give -o/--output, --mesh or --picture")
+    check_tile_disk(v, outs)
     return outs
 
 
@@ -90,8 +96,7 @@ def _tile(v: Values) -> int:
 
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
-    outs = dict(check_outputs(v))
-    check_tile_disk(v, outs)
+    outs = check_outputs(v)
     made = tile(scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"], pixel_m=v["pixel_m"],
                 min_crater_px=v["min_crater_px"])
     write_tile(made, cog=outs.get("output"), mesh=outs.get("mesh"),
