@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from craters._shared import temp_folder
-from latlong.meshio.sizes import check_free_space
+from latlong.meshio.sizes import GEOTIFF_BYTES_PER_PIXEL, check_free_space
 
 from .enhance import finish, layer_step, layers_of, prepare, stack_info
 from .io import WindowWriter, read
@@ -70,9 +70,8 @@ def enhance_to_folder(config, folder, *, dem=None, progress: bool = False
     """
     run = prepare(config, dem, layers_held=LAYERS_HELD)
     folder = Path(folder)
-    # the layers, before any work: float32 GeoTIFFs, deflated to 3.70 B a pixel in a 4-layer
-    # stack of 257^2 over the LOLA crop (2026-12-07), counted at 3.6 (a run that fits runs)
-    check_free_space([(folder, 3.6 * run.cfg.layers * run.cfg.size**2)],
+    # the layers' GeoTIFFs, before any work
+    check_free_space([(folder, GEOTIFF_BYTES_PER_PIXEL * run.cfg.layers * run.cfg.size**2)],
                      hint=f"{run.cfg.layers} layers of {run.cfg.size} x {run.cfg.size} "
                      f"pixels: give fewer layers, a smaller size or another folder")
     work = temp_folder(folder)

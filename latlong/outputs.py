@@ -28,6 +28,7 @@ from craters._shared.outputs import claim
 from craters._shared.settings import by_key, check_declared, setting
 
 from .body import EXPORT_SUFFIXES
+from .grid import LatLongGrid
 from .meshio.sizes import check_free_space, mesh_file_bytes
 from .meshio.writers import MESH_SUFFIXES
 from .preview import render_preview
@@ -158,7 +159,7 @@ class Outputs:
                                          f"which exists; use --force to overwrite")
                 claim(extra, force=force)
         if paths and kind == "latlong":  # a lat/long body's size is known from M
-            n = 6 * scene.body.magnitude**2 + 2
+            n = LatLongGrid(scene.body.magnitude).n_vertices
             check_free_space([(o, mesh_file_bytes(o, n)) for o in self.output],
                              hint="give a smaller --magnitude, fewer or binary outputs, or "
                              "another folder")

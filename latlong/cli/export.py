@@ -9,7 +9,7 @@ from pathlib import Path
 from craters._shared import check_output_path
 from craters.cli.kit import CliError, check_not_input, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, default_of
-from latlong import export_glb, export_vtp_strips, load
+from latlong import LatLongGrid, export_glb, export_vtp_strips, load
 from latlong.gltf import LOD_LAYOUTS, level_path
 from latlong.meshio.sizes import EXPORT_BYTES_PER_VERTEX, check_free_space
 
@@ -61,7 +61,7 @@ def _export(v: Values) -> int:
         raise CliError(f"--lod {v['lod']} needs a magnitude divisible by {2 ** v['lod']}; "
                        f"{v['model']} has M = {body.magnitude}")
     levels = range(v["lod"] + 1) if suffix == ".glb" else range(1)
-    vertices = sum(6 * (body.magnitude // 2**level) ** 2 + 2 for level in levels)
+    vertices = sum(LatLongGrid(body.magnitude // 2**level).n_vertices for level in levels)
     check_free_space([(out, EXPORT_BYTES_PER_VERTEX[suffix] * vertices)],
                      hint="choose another folder, or fewer levels of detail (--lod)")
     if suffix == ".glb":

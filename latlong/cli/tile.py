@@ -13,7 +13,7 @@ from craters._shared import check_output_path
 from craters.cli.kit import CliError, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys
 
-from ..meshio.sizes import check_free_space, mesh_file_bytes
+from ..meshio.sizes import GEOTIFF_BYTES_PER_PIXEL, check_free_space, mesh_file_bytes
 from ..meshio.writers import MESH_SUFFIXES
 from ..scene import SETTING_PARTS, SETTINGS, Scene
 from .build import GROUPS
@@ -82,10 +82,10 @@ def check_outputs(v: Values) -> dict[str, Path]:
 
 
 def check_tile_disk(v: Values, outs: dict) -> None:
-    """Refuse up front a window whose files do not fit the disk: the GeoTIFF (3.6 B a pixel,
-    as a stack's layers) and the mesh (a vertex a pixel, :mod:`latlong.meshio.sizes`)."""
+    """Refuse up front a window whose files do not fit the disk: the GeoTIFF and the mesh
+    (a vertex a pixel; :mod:`latlong.meshio.sizes`)."""
     n = max(1, round(v["size_m"] / v["pixel_m"])) ** 2
-    needs = [(outs["output"], 3.6 * n)] if outs.get("output") else []
+    needs = [(outs["output"], GEOTIFF_BYTES_PER_PIXEL * n)] if outs.get("output") else []
     if outs.get("mesh"):
         needs.append((outs["mesh"], mesh_file_bytes(outs["mesh"], n)))
     check_free_space(needs, hint="a larger --pixel-m, a smaller --size-m or another folder")

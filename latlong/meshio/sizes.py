@@ -19,8 +19,8 @@ from pathlib import Path
 
 from craters._shared import human_bytes
 
-__all__ = ["BYTES_PER_VERTEX", "EXPORT_BYTES_PER_VERTEX", "check_free_space",
-           "mesh_file_bytes"]
+__all__ = ["BYTES_PER_VERTEX", "EXPORT_BYTES_PER_VERTEX", "GEOTIFF_BYTES_PER_PIXEL",
+           "check_free_space", "mesh_file_bytes"]
 
 #: File bytes per vertex of a lat/long body by suffix (2 triangles a vertex; the .glb's
 #: manifest included; .obj: its text at about 81 B, counted at 60 so that a body that
@@ -31,6 +31,11 @@ BYTES_PER_VERTEX = {".npz": 8.0, ".ply": 42.0, ".obj": 60.0, ".stl": 100.0, ".vt
 #: ... of ``latlong export``'s files: the patched-strip .glb with its manifest (each level
 #: of detail counted with its own vertices), the triangle-strip .vtp.
 EXPORT_BYTES_PER_VERTEX = {".glb": 34.0, ".vtp": 56.0}
+
+#: ... of a float32 height GeoTIFF as the project writes it (deflate, floating-point
+#: predictor), a pixel: a 4-layer stack of 257^2 over the LOLA crop measured 3.70 B
+#: (2026-12-07), counted at 3.6 so that a run that fits runs.
+GEOTIFF_BYTES_PER_PIXEL = 3.6
 
 
 def mesh_file_bytes(path, n_vertices: int) -> float:

@@ -108,23 +108,16 @@ def nac(folder: Path) -> float:
 def ours(sun_elevation_deg: float, threshold: float) -> None:
     import measure_ondemand as mo
 
-    from latlong.ondemand import units_of
-    from latlong.ondemand.base import tangent_frame
     from latlong.ondemand.descent import descent
 
     site = (0.01, 0.01)
     alt = 0.5 * SIZE_PX * PIXEL_M / np.tan(np.radians(15.0))  # a 30 deg field of view
     (f,) = list(descent(mo.scene(), *site, [alt], width_px=SIZE_PX, fov_deg=30.0,
                         sun_azimuth_deg=270.0, sun_elevation_deg=sun_elevation_deg))
-    u0 = units_of([site[0]], [site[1]])
-    east, north = (v[0] for v in tangent_frame(u0))
     cat = f.craters
-    c = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
-    r = np.linalg.norm(c, axis=1)
-    w = c / r[:, None] - u0[0]
+    centres = np.stack([cat["centre_x_m"], cat["centre_y_m"], cat["centre_z_m"]], 1)
+    col, row = f.frame.camera.project(centres, f.frame.pose)[0].T  # pixel coordinates
     px = f.ground_pixel_m
-    col = 0.5 * SIZE_PX + (w @ east) * r / px  # the camera looks down, north up
-    row = 0.5 * SIZE_PX - (w @ north) * r / px
     d_px = cat["diameter_m"] / px
     sel = (d_px >= MIN_PX) & (col >= 0) & (col < SIZE_PX) & (row >= 0) & (row < SIZE_PX)
     con, bright = crater_stats(f.frame.reflectance.astype(np.float64), col[sel], row[sel],
