@@ -33,8 +33,8 @@ BYTES_PER_VERTEX = {".npz": 8.0, ".ply": 42.0, ".obj": 60.0, ".stl": 100.0, ".vt
 EXPORT_BYTES_PER_VERTEX = {".glb": 34.0, ".vtp": 56.0}
 
 #: ... of a float32 height GeoTIFF as the project writes it (deflate, floating-point
-#: predictor), a pixel: a 4-layer stack of 257^2 over the LOLA crop measured 3.70 B
-#: (2026-12-07), counted at 3.6 so that a run that fits runs.
+#: predictor), a pixel: a 4-layer stack of 257^2 over the LOLA crop measured 3.70 bytes
+#: a pixel on 2026-12-07, counted at 3.6 so that a run that fits runs.
 GEOTIFF_BYTES_PER_PIXEL = 3.6
 
 
