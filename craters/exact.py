@@ -24,8 +24,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._exact_kernels import _dot_kernel, _matmul_kernel
-
 __all__ = ["abs2", "dot", "matmul", "plane_residual"]
 
 
@@ -38,6 +36,8 @@ def matmul(a, b) -> np.ndarray:
     if a2.ndim != 2 or b2.ndim != 2 or a2.shape[1] != b2.shape[0]:
         raise ValueError(f"matmul: shapes {a.shape} and {b.shape} do not multiply")
     out = np.empty((a2.shape[0], b2.shape[1]))
+    from ._exact_kernels import _matmul_kernel  # numba loads here
+
     _matmul_kernel(np.ascontiguousarray(a2), np.ascontiguousarray(b2), out)
     if a.ndim == 1:
         out = out[0]
@@ -52,6 +52,8 @@ def dot(a, b) -> float:
     b = np.ascontiguousarray(b, dtype=np.float64).ravel()
     if a.shape != b.shape:
         raise ValueError(f"dot: shapes {a.shape} and {b.shape} differ")
+    from ._exact_kernels import _dot_kernel  # numba loads here
+
     return float(_dot_kernel(a, b))
 
 

@@ -25,7 +25,8 @@ from craters._shared import ParameterError
 from latlong import Scene
 from latlong.ondemand.base import BaseField, lat_lon_of
 from latlong.ondemand.field import CraterField
-from latlong.ondemand.tile import Tile, check_window, tile_of_field
+from latlong.ondemand.tile import Tile, tile_of_field
+from latlong.ondemand.window import check_window
 
 from .core import Dem
 from .stack import Stack

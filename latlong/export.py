@@ -23,8 +23,6 @@ from pathlib import Path
 
 import numpy as np
 
-from ._export_kernels import _ply_face_kernel, _ply_vertex_kernel
-from ._grid_kernels import lon_table
 from .gltf import export_glb
 from .meshio.boulders import BoulderMeshes, mesh_fields
 from .meshio.chunks import ordered_chunks
@@ -117,12 +115,15 @@ def _write_glb(body, path, progress: bool) -> None:
 def _vertex_records(body, rocks, rock_heights, dtype):
     """The PLY writer's fast path (:attr:`MeshSource.vertex_records`): the body's records
     straight from a kernel, chunks made on worker threads, then the boulders'."""
+    from ._export_kernels import _ply_vertex_kernel  # numba loads here
     grid = body.grid
     n = grid.n_vertices
     radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
     stretch = np.array(body.stretch, dtype=np.float64)
     # the longitude table (8 B a vertex) up to _TABLE_BYTES; past it the kernel
     # computes the same cosines and sines itself (3.2 GB saved at M = 8192)
+    from ._grid_kernels import lon_table  # numba loads here
+
     table = lon_table(grid.magnitude, grid.ring_offsets()) \
         if 8 * n <= _TABLE_BYTES else np.empty((0, 2))
 
@@ -145,6 +146,7 @@ def _vertex_records(body, rocks, rock_heights, dtype):
 def _face_records(grid, rocks, dtype):
     """The PLY writer's fast path (:attr:`MeshSource.face_records`): the body's triangles
     packed by a kernel on worker threads, then the boulders'."""
+    from ._export_kernels import _ply_face_kernel  # numba loads here
     ro, bo = grid.ring_offsets(), grid.band_offsets()
     chunks = list(_band_chunks(grid))
     size = max((int(bo[hi] - bo[lo]) for lo, hi in chunks), default=0)

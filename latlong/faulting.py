@@ -9,9 +9,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, normalize_rng, progress_bar
 from craters._shared.settings import check_declared, setting
-from craters.exact import dot
 
-from ._fault_kernels import _apply_faults_kernel
 from .grid import LatLongGrid
 from .smoothing import check_smooth_width, smooth
 
@@ -40,6 +38,8 @@ def _check_grid(grid) -> LatLongGrid:
 def area_mean(grid: LatLongGrid, values) -> float:
     """Area-weighted mean of a per-vertex field over the sphere."""
     w = grid.vertex_areas()
+    from craters.exact import dot
+
     return dot(w, values) / float(w.sum())
 
 
@@ -97,6 +97,8 @@ def apply_faults(grid: LatLongGrid, normals, heights, *, progress: bool = False)
     n = normals.shape[0]
     chunk = _CHUNK if progress else n
     bar = progress_bar(range(0, n, chunk), enabled=progress, desc="faults")
+    from ._fault_kernels import _apply_faults_kernel  # numba loads here
+
     for s in bar:
         e = min(s + chunk, n)
         _apply_faults_kernel(offs, ring_cos, ring_sin, unit, normals[s:e], lon0[s:e],

@@ -4,20 +4,10 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from craters._shared import check_int
 
-from ._grid_kernels import (
-    _interpolate_kernel,
-    _surface_radius_kernel,
-    _triangles_kernel,
-    _triangles_serial,
-    _unit_index_kernel,
-    _unit_range_kernel,
-    _unit_range_serial,
-)
 from .geometry.normals import lat_long_vertex_normals
 
 __all__ = ["BUILD_BASE_BYTES", "BUILD_BYTES_PER_VERTEX", "BUILD_BYTES_PER_VERTEX_THREAD",
@@ -44,7 +34,11 @@ def build_bytes_per_vertex(threads: int | None = None) -> float:
     """Peak memory of a build per grid vertex with ``threads`` stamping threads (default
     numba's current count): :data:`BUILD_BYTES_PER_VERTEX` + ``threads`` x
     :data:`BUILD_BYTES_PER_VERTEX_THREAD` (11 B with 2 threads)."""
-    threads = numba.get_num_threads() if threads is None else int(threads)
+    if threads is None:
+        import numba
+
+        threads = numba.get_num_threads()
+    threads = int(threads)
     return BUILD_BYTES_PER_VERTEX + threads * BUILD_BYTES_PER_VERTEX_THREAD
 
 
@@ -229,6 +223,7 @@ class LatLongGrid:
 
     def unit_vectors_range(self, lo: int = 0, hi: int | None = None) -> np.ndarray:
         """Unit vectors of vertices ``lo .. hi - 1`` (from the cache if it exists)."""
+        from ._grid_kernels import _unit_range_kernel, _unit_range_serial  # numba loads here
         hi = self.n_vertices if hi is None else min(int(hi), self.n_vertices)
         lo = max(0, int(lo))
         cached = self._cache.get("unit")
@@ -243,6 +238,7 @@ class LatLongGrid:
 
     def unit_vectors_of(self, idx) -> np.ndarray:
         """Unit vectors of the vertices ``idx`` (any shape of indices), shape (..., 3)."""
+        from ._grid_kernels import _unit_index_kernel  # numba loads here
         idx = np.asarray(idx, dtype=np.int64)
         flat = np.ascontiguousarray(idx.ravel())
         if flat.size and (flat.min() < 0 or flat.max() >= self.n_vertices):
@@ -296,6 +292,7 @@ class LatLongGrid:
         Band ``b`` joins ring ``b`` and ring ``b + 1``. Returns int64 (T, 3) vertex
         indices, counter-clockwise seen from outside.
         """
+        from ._grid_kernels import _triangles_kernel, _triangles_serial  # numba loads here
         nb = 2 * self._m
         band_hi = nb if band_hi is None else int(band_hi)
         band_lo = int(band_lo)
@@ -369,6 +366,7 @@ class LatLongGrid:
         Linear along each ring (with wrap-around) and linear between the two rings that
         bracket the colatitude; exact at the grid's own vertices.
         """
+        from ._grid_kernels import _interpolate_kernel  # numba loads here
         return self._sample(_interpolate_kernel, "values", values, colatitudes, longitudes)
 
     def surface_radii(self, radii, colatitudes, longitudes) -> np.ndarray:
@@ -381,6 +379,7 @@ class LatLongGrid:
         neighbouring vertices). For a stretched body pass the direction of ``p / stretch``:
         stretching maps the rays from the centre and the triangles onto themselves.
         """
+        from ._grid_kernels import _surface_radius_kernel  # numba loads here
         return self._sample(_surface_radius_kernel, "radii", radii, colatitudes, longitudes)
 
     def vertex_normals(self, radii, stretch=(1.0, 1.0, 1.0), *,

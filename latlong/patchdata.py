@@ -19,8 +19,6 @@ import numpy as np
 
 from craters._shared import progress_bar
 
-from ._export_kernels import _patch_kernel
-from ._window_kernels import _window_normals_kernel, _window_positions_kernel
 from .meshio.chunks import ordered_chunks
 
 __all__ = ["WINDOW_VERTICES", "leaf_metadata", "write_leaf_data"]
@@ -66,6 +64,7 @@ def _windows(ring_offsets: np.ndarray, table: tuple):
 
 
 def _window_positions(grid, radii, stretch, r0: int, r1: int) -> np.ndarray:
+    from ._window_kernels import _window_positions_kernel  # numba loads here
     offs = grid.ring_offsets()
     pos = np.empty((int(offs[r1 + 1] - offs[r0]), 3), dtype=np.float32)
     _window_positions_kernel(grid.magnitude, offs, radii, stretch, r0, r1, pos)
@@ -75,6 +74,7 @@ def _window_positions(grid, radii, stretch, r0: int, r1: int) -> np.ndarray:
 def leaf_metadata(grid, radii, stretch, leaves: tuple) -> tuple[np.ndarray, np.ndarray]:
     """(meta, bounds) of every leaf (:func:`~latlong._export_kernels._patch_kernel`'s
     first pass: strip length, vertices, triangles; float32 bounds, centre, radius)."""
+    from ._export_kernels import _patch_kernel  # numba loads here
     radii = np.ascontiguousarray(radii, dtype=np.float64)
     stretch = np.array(stretch, dtype=np.float64)
     offs = grid.ring_offsets()
@@ -106,6 +106,8 @@ def write_leaf_data(grid, radii, stretch, leaves: tuple, at: np.ndarray, nbytes:
     """Write every leaf's data (positions, normals, indices: ``nbytes[i]`` bytes at the
     level offset ``at[i, 0]``; ``at[i] = -1`` for leaves without a patch) into ``fh`` from
     its current position; leaves ``fh`` positioned after the level's data."""
+    from ._export_kernels import _patch_kernel  # numba loads here
+    from ._window_kernels import _window_normals_kernel  # numba loads here
     radii = np.ascontiguousarray(radii, dtype=np.float64)
     stretch = np.array(stretch, dtype=np.float64)
     offs = grid.ring_offsets()

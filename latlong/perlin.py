@@ -17,7 +17,6 @@ from craters._shared import (
 )
 from craters._shared.settings import check_declared, declared, setting
 
-from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
 from .grid import LatLongGrid
 
 __all__ = ["FBM_PRESETS", "FbmParams", "fbm3", "perlin_fbm", "random_rotation"]
@@ -98,6 +97,9 @@ def fbm3(x, y, z, octaves: int = 1, persistence: float = 0.5, lacunarity: float 
 
 def _run_fbm3(xs, ys, zs, octaves, persistence, lacunarity, base, out):
     """Pick the fast kernel when every |coordinate| <= FAST_LIMIT (same results)."""
+    # numba loads here (a scene is described without it: `latlong tile` checks first)
+    from ._perlin_kernels import FAST_LIMIT, GRAD3, PERM, _fbm3_fast_kernel, _fbm3_kernel
+
     fast = xs.size == 0 or max(np.abs(a).max() for a in (xs, ys, zs)) <= FAST_LIMIT
     kernel = _fbm3_fast_kernel if fast else _fbm3_kernel
     kernel(xs, ys, zs, octaves, np.float32(persistence), np.float32(lacunarity), base,

@@ -25,7 +25,6 @@ import numpy as np
 from craters._shared import ParameterError, atomic_path, check_finite
 from craters._shared.settings import check_declared, setting
 
-from ._preview_kernels import _extent_kernel
 from .geometry.surface import Resamplable, Surface
 
 __all__ = ["PreviewSettings", "VIEW_DIRECTIONS", "camera_frame", "preview_view",
@@ -127,6 +126,7 @@ def preview_view(vertices, view, width_px: int, height_px: int,
     (:func:`camera_frame`): the centre of the bounding box at the centre of the picture
     and, unless ``camera_distance_m`` is given, the silhouette filling it with an 8 %
     margin (vertical field of view :data:`VIEW_ANGLE_DEG`)."""
+    from ._preview_kernels import _extent_kernel  # numba loads here
     from .sensors import Camera, Pose
 
     v, right, up = (np.ascontiguousarray(a, dtype=np.float64) for a in view)

@@ -24,7 +24,6 @@ import numpy as np
 
 from craters._shared import ParameterError, check_choice, check_int
 
-from ._shape_kernels import _brute_force_kernel, _raycast_kernel
 from .body import Body
 from .geometry.meshes import PlainMeshSurface, centre_point, polydata
 from .geometry.surface import Surface
@@ -159,6 +158,8 @@ def cast_radii(model: ShapeModel, grid: LatLongGrid, *, brute_force: bool = Fals
     tmin = np.zeros(n)
     tmax = np.zeros(n)
     unit = grid.unit_vectors()
+    from ._shape_kernels import _brute_force_kernel, _raycast_kernel  # numba loads here
+
     if brute_force:
         _brute_force_kernel(unit, verts, faces, count, tmin, tmax)
     else:

@@ -27,7 +27,6 @@ import numpy as np
 
 from craters._shared import check_int
 
-from ._grid_kernels import _band_strip_kernel
 from .grid import LatLongGrid
 
 __all__ = ["Patch", "band_strip", "join_strips", "patch_bounds", "patch_tree",
@@ -50,6 +49,7 @@ def strip_triangles(strip: np.ndarray, *, keep_degenerate: bool = False) -> np.n
 
 def band_strip(grid: LatLongGrid, band: int, lo: int = 0, hi: int | None = None) -> np.ndarray:
     """The strip of band ``band`` (its triangles ``lo .. hi - 1`` in longitude order)."""
+    from ._grid_kernels import _band_strip_kernel  # numba loads here
     m = grid.magnitude
     n_tri = int(grid.band_offsets()[band + 1] - grid.band_offsets()[band])
     hi = n_tri if hi is None else min(int(hi), n_tri)

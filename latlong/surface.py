@@ -12,7 +12,6 @@ import numpy as np
 
 from craters._shared import check_int, normalize_rng
 
-from ._surface_kernels import band_triangle_areas, band_triangle_areas_serial, sample_in_bands
 from .body import Body
 
 __all__ = ["band_areas", "sample_surface_points", "surface_positions"]
@@ -28,6 +27,10 @@ def _triangle_areas(body: Body, band_lo: int, band_hi: int) -> np.ndarray:
     :meth:`LatLongGrid.band_triangles` order: the bits of
     ``0.5 * norm(cross(p1 - p0, p2 - p0))`` over :meth:`Body.vertices` (a numba kernel,
     bands in parallel when there are many; tests compare it with that expression)."""
+    from ._surface_kernels import (  # numba loads here
+        band_triangle_areas,
+        band_triangle_areas_serial,
+    )
     g = body.grid
     bo = g.band_offsets()
     out = np.empty(int(bo[band_hi] - bo[band_lo]))
@@ -71,6 +74,7 @@ def sample_surface_points(body: Body, areas: np.ndarray, n: int,
     For callers that already hold the band areas (one computation per body); the
     stream of ``rng`` draws is the same whatever the body.
     """
+    from ._surface_kernels import sample_in_bands  # numba loads here
     total, a, b, band, resid = _draws(areas, n, rng)
     p = np.empty((n, 3))
     order = np.argsort(band, kind="stable")

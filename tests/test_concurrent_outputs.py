@@ -273,9 +273,9 @@ def test_frames_larger_than_the_free_disk_are_refused_up_front(capsys, tmp_path,
 def test_windows_and_descents_larger_than_the_memory_are_refused_up_front(capsys, tmp_path,
                                                                           monkeypatch):
     # a 16384^2 window (55 GB) was killed by the OOM killer on a 25 GB machine
-    import latlong.ondemand.tile
+    import latlong.ondemand.window
 
-    monkeypatch.setattr(latlong.ondemand.tile, "physical_memory_bytes", lambda: 2e9)
+    monkeypatch.setattr(latlong.ondemand.window, "physical_memory_bytes", lambda: 2e9)
     code, _, err = run(capsys, "latlong", "tile", "--preset", "fbm-cratered", "--radius-m",
                        "100000", "--lat-deg", "0", "--lon-deg", "0", "--size-m", "409.6",
                        "--pixel-m", "0.1", "-o", tmp_path / "t.tif")
@@ -335,6 +335,32 @@ def test_the_expansion_size_is_refused_before_numba_and_scipy_load(tmp_path):
                           capture_output=True, text=True, cwd=tmp_path)
     assert "1048577 x 1048577" in proc.stderr, proc.stderr
     assert proc.stdout.strip() == "[]", proc.stdout
+    assert list(tmp_path.iterdir()) == []
+
+
+_LAYER = "c=0.08,k=-2,d_min_m=1,d_max_m=1000"
+
+
+@pytest.mark.parametrize("argv", [
+    ("latlong", "tile", "--preset", "fbm-cratered", "--lat-deg", "0", "--lon-deg", "0",
+     "--size-m", "16384", "--pixel-m", "1", "-o", "big.tif"),
+    ("latlong", "descent", "--preset", "fbm-cratered", "--lat-deg", "0", "--lon-deg", "0",
+     "--size-px", "6000", "-o", "frames"),
+    ("dem", "tile", str(DATA / "ldem4_crop.lbl"), "--craters", _LAYER, "--lat-deg", "0",
+     "--lon-deg", "0", "--size-m", "16384", "--pixel-m", "1", "-o", "big.tif"),
+    ("dem", "descent", str(DATA / "ldem4_crop.lbl"), "--craters", _LAYER, "--lat-deg", "0",
+     "--lon-deg", "0", "--size-px", "6000", "-o", "frames"),
+], ids=["latlong-tile", "latlong-descent", "dem-tile", "dem-descent"])
+def test_windows_and_descents_are_refused_before_numba_loads(tmp_path, argv):
+    # what keeps these refusals under a second (issue 34; 1.3-1.6 s when the command
+    # modules loaded the terrain's kernels first): numba loads where the terrain is made
+    package, *args = argv
+    code = (f"import sys\nfrom {package}.__main__ import main\ntry:\n    main()\n"
+            "except SystemExit:\n    pass\nprint('numba' in sys.modules)")
+    proc = subprocess.run([sys.executable, "-c", code, *args], capture_output=True, text=True,
+                          cwd=tmp_path)
+    assert "of memory; this machine has" in proc.stderr, proc.stderr
+    assert proc.stdout.strip() == "False", proc.stdout
     assert list(tmp_path.iterdir()) == []
 
 

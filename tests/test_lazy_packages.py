@@ -15,7 +15,7 @@ import pytest
 from craters._shared.lazy import lazy_names
 
 ROOT = Path(__file__).resolve().parents[1]
-LAZY = ("latlong", "dem", "craters", "craters._shared")
+LAZY = ("latlong", "dem", "craters", "craters._shared", "latlong.ondemand", "latlong.sensors")
 
 
 def _names(package: str) -> dict[str, tuple[str, str]]:

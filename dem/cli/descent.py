@@ -29,13 +29,13 @@ OPTIONS = {"input": SITE, **READ, **LAYERS, **DESCENT, **LIDAR, **RUN}
 
 
 def _descent(v: Values) -> int:
+    if v["stop_m"] > v["start_m"]:
+        raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
+    out = check_descent_folder(v)  # before the terrain's kernels (numba) load
     from latlong.ondemand.descent import descent_altitudes
 
     from ..ondemand import dem_descent
 
-    if v["stop_m"] > v["start_m"]:
-        raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
-    out = check_descent_folder(v)
     dem = read_site(v)
     scene = scene_of(dem, v)
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])

@@ -80,11 +80,15 @@ def scene_of(dem, v: Values):
 
 
 def _tile(v: Values) -> int:
+    from latlong.ondemand.window import check_window
+
+    # the window's size first, before the DEM is read and the terrain's kernels load
+    check_window(v["lat_deg"], v["size_m"], v["pixel_m"], v["min_crater_px"])
+    outs = check_outputs(v)
     from latlong.ondemand.tile import write_tile
 
     from ..ondemand import dem_tile
 
-    outs = check_outputs(v)
     dem = read_site(v)
     scene = scene_of(dem, v)
     made = dem_tile(dem, scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"],

@@ -16,7 +16,7 @@ import numpy as np
 from craters._shared import progress_bar, staged_path
 from craters.cli.kit import CliError, wrote_line
 from craters.cli.options import FORCE, QUIET, Setting, Values, command, declared_keys, flag_of
-from latlong import LatLongGrid, Scene, build
+from latlong import LatLongGrid, Scene
 from latlong.parallel.backends import CONNECT_TIMEOUT
 from latlong.scratch import drop_pages
 
@@ -135,6 +135,8 @@ def _build(v: Values) -> int:
                              out=None if scratch is None else disk_radii(n, scratch))
         patch_bar.close()
     else:
+        from latlong.build import build  # numba and the science load where they run
+
         made = build(scene, progress=show, scratch_dir=scratch)
     bar.update()
     write_outputs(made, scene, outputs, progress=show, done=bar.update)

@@ -73,11 +73,11 @@ _GROUPS = {"descent": "descent and outputs", "lidar": "LIDAR (with --lidar)", **
 
 
 def _descent(v: Values) -> int:
-    from ..ondemand.descent import descent, descent_altitudes
-
     if v["stop_m"] > v["start_m"]:
         raise CliError(f"--stop-m ({v['stop_m']:g}) must be at most --start-m ({v['start_m']:g})")
-    out = check_descent_folder(v)
+    out = check_descent_folder(v)  # before the terrain's kernels (numba) load
+    from ..ondemand.descent import descent, descent_altitudes
+
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
     alts = descent_altitudes(v["start_m"], v["stop_m"], v["frames"])
@@ -107,7 +107,7 @@ def _lidar_flag(name: str) -> str:
 def check_descent_folder(v: Values):
     """The checked output folder of a descent command (``-o``, ``--force``), once the
     frames' memory and files are known to fit."""
-    from latlong.ondemand.descent import check_descent_memory
+    from latlong.ondemand.window import check_descent_memory
     from latlong.sensors.camera_files import check_frames_disk
     from latlong.sensors.runs import check_output_folder
 

@@ -92,11 +92,15 @@ def check_tile_disk(v: Values, outs: dict) -> None:
 
 
 def _tile(v: Values) -> int:
-    from ..ondemand.tile import tile, write_tile
+    from ..ondemand.window import check_window
 
+    # the window's size first: a window this machine cannot hold is refused before the
+    # terrain's kernels (numba) load
+    check_window(v["lat_deg"], v["size_m"], v["pixel_m"], v["min_crater_px"])
     scene = Scene.from_settings({**{k: v[k] for k in SETTINGS if k in v.given},
                                  "on_demand": True})
     outs = check_outputs(v)
+    from ..ondemand.tile import tile, write_tile
     made = tile(scene, v["lat_deg"], v["lon_deg"], size_m=v["size_m"], pixel_m=v["pixel_m"],
                 min_crater_px=v["min_crater_px"])
     write_tile(made, cog=outs.get("output"), mesh=outs.get("mesh"),

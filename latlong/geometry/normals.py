@@ -33,15 +33,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._normal_kernels import (
-    _angle_normals_kernel,
-    _area_normals_kernel,
-    _max_normals_kernel,
-    _normalize_rows_kernel,
-    _normals_from_radii_kernel,
-    _scatter_add_kernel,
-)
-
 __all__ = ["ORDERS", "WEIGHTINGS", "face_normals", "lat_long_vertex_normals", "tangent_frames",
            "triangle_normals", "unit_rows", "vertex_areas", "vertex_normal_sums",
            "vertex_normals", "vertex_normals_and_areas"]
@@ -134,6 +125,11 @@ def vertex_normal_sums(vertices, faces, weighting: str = "area", *,
     float64 (module notes; ``"area"``: area vectors, m^2). ``order`` defaults to the
     weighting's :data:`DEFAULT_ORDER`; the max weighting has unit normals only
     (:func:`vertex_normals`)."""
+    from ._normal_kernels import (  # numba loads here
+        _angle_normals_kernel,
+        _area_normals_kernel,
+        _scatter_add_kernel,
+    )
     order = _check(weighting, order)
     if weighting == "max":
         raise ValueError("`weighting` 'max' has no sums here: use vertex_normals")
@@ -172,6 +168,7 @@ def vertex_normals(vertices, faces, weighting: str = "area", *,
     >>> vertex_normals(v, f, "area")[3].round(3).tolist()
     [0.0, 0.0, 1.0]
     """
+    from ._normal_kernels import _max_normals_kernel  # numba loads here
     v = np.asarray(vertices, dtype=np.float64)
     if v.ndim == 3:
         return np.stack([vertex_normals(x, faces, weighting, order=order) for x in v])
@@ -186,6 +183,7 @@ def vertex_normals(vertices, faces, weighting: str = "area", *,
 def vertex_areas(vertices, faces) -> np.ndarray:
     """Area of every vertex, m^2: a third of each incident facet's (summed per corner
     column, in facet order)."""
+    from ._normal_kernels import _scatter_add_kernel  # numba loads here
     v = np.asarray(vertices, dtype=np.float64)
     f = np.asarray(faces, dtype=np.int64)
     third = np.linalg.norm(0.5 * face_normals(v, f), axis=1) / 3.0
@@ -200,6 +198,7 @@ def vertex_areas(vertices, faces) -> np.ndarray:
 def vertex_normals_and_areas(vertices, face_chunks) -> tuple[np.ndarray, np.ndarray]:
     """Unit area-weighted vertex normals (V, 3) and vertex areas (V,) m^2 of a mesh whose
     faces come in chunks (a body's bands), summed facet after facet (``"faces"``)."""
+    from ._normal_kernels import _area_normals_kernel  # numba loads here
     v = np.ascontiguousarray(vertices, dtype=np.float64)
     acc = np.zeros_like(v)
     area = np.zeros(len(v))
@@ -219,6 +218,10 @@ def lat_long_vertex_normals(grid, radii, stretch=(1.0, 1.0, 1.0), *,
     ``lon_table`` - ``latlong._grid_kernels.lon_table(M, ring_offsets)`` - to reuse one)
     and normalised in place."""
     from .._grid_kernels import lon_table as make_lon_table
+    from ._normal_kernels import (  # numba loads here
+        _normalize_rows_kernel,
+        _normals_from_radii_kernel,
+    )
 
     if weighting not in ("area", "angle"):
         raise ValueError(f"`weighting` must be 'area' or 'angle'; got {weighting!r}")

@@ -56,11 +56,13 @@ from craters._shared import ParameterError, check_int, check_range
 
 from ..grid import LatLongGrid
 from ..scene import Scene
-from . import units_of
 from ._rock_kernels import _face_rocks_kernel
 from .base import tangent_frame
 from .field import CraterField, crater_field
-from .tile import MAX_TILE_PX, check_tile_memory, tile_mesh, tile_of_field
+from .points import units_of
+from .tile import tile_mesh, tile_of_field
+from .window import DESCENT_MARGIN as _MARGIN
+from .window import MAX_TILE_PX, check_descent_memory
 
 if TYPE_CHECKING:
     from ..sensors import LidarFrame, LidarSettings
@@ -69,7 +71,6 @@ if TYPE_CHECKING:
 __all__ = ["MICRORELIEF_DEG", "MICRORELIEF_HURST", "DescentFrame", "descent",
            "descent_altitudes", "display", "write_descent"]
 
-_MARGIN = 1.6
 _MAX_MAGNITUDE = 1500
 #: Hurst exponent of the relief below the pixels (1: the same tilt at every scale; module
 #: notes).
@@ -153,16 +154,6 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
     counts = len(field.last["craters"]), len(field.rocks.last["diameter_m"])
     faces = grid.triangles()
     return units * radii[:, None], faces, counts, "body", _rock_faces(field, faces)
-
-
-def check_descent_memory(width_px: int) -> None:
-    """Refuse up front (one line naming ``width_px``) frames ``width_px`` wide that this
-    machine cannot hold with their terrain (the widest window, ``_MARGIN`` x the frame)."""
-    from ..sensors.camera_files import FRAME_BYTES_PER_PIXEL
-
-    window_px = min(MAX_TILE_PX, math.ceil(_MARGIN * width_px))
-    check_tile_memory(window_px, "width_px", f"{width_px} px frames over {window_px} px of "
-                      f"terrain", "a smaller frame", FRAME_BYTES_PER_PIXEL * width_px**2)
 
 
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,

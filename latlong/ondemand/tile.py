@@ -16,31 +16,17 @@ from pathlib import Path
 
 import numpy as np
 
-from craters._shared import (
-    ParameterError,
-    atomic_path,
-    check_positive,
-    check_range,
-    human_bytes,
-    physical_memory_bytes,
-)
+from craters._shared import ParameterError, atomic_path
 
 from ..scene import Scene
-from . import _cell_kernels, units_of
+from . import _cell_kernels
 from .base import tangent_frame
 from .field import CraterField, crater_field
+from .points import units_of
+from .window import MAX_TILE_PX, check_window
 
 __all__ = ["MAX_TILE_PX", "Tile", "hillshade", "tile", "tile_mesh", "tile_of_field",
            "write_cog", "write_tile"]
-
-#: Largest tile side in pixels (a 16384^2 float64 tile is 2 GiB).
-MAX_TILE_PX = 16384
-#: Peak memory of a window a pixel, and its base, bytes: ``latlong tile`` with a GeoTIFF,
-#: a .ply mesh and a picture peaked at 1.15 GB at 2048^2 and 3.73 GB at 4096^2 pixels
-#: (``/usr/bin/time -v``, fbm-cratered, 0.1 m pixels, 2026-12-07): 205 B a pixel over
-#: 0.3 GB. A 16384^2 window (55 GB) was killed by the kernel's OOM killer here.
-TILE_BYTES_PER_PIXEL = 205.0
-TILE_BASE_BYTES = 0.3e9
 
 
 @dataclasses.dataclass(frozen=True)
@@ -98,32 +84,6 @@ def tile(scene: Scene, lat_deg: float, lon_deg: float, *, size_m: float, pixel_m
     size_px, pixel_m, min_crater_px = check_window(lat_deg, size_m, pixel_m, min_crater_px)
     return tile_of_field(crater_field(scene), lat_deg, lon_deg, size_px, pixel_m,
                          min_crater_px)
-
-
-def check_tile_memory(size_px: int, name: str, what: str, change: str,
-                      extra_bytes: float = 0.0) -> None:
-    """Refuse up front (one line naming ``name``) a window of ``size_px`` pixels a side (plus
-    ``extra_bytes``, e.g. a camera frame) that this machine's memory cannot hold."""
-    need = TILE_BASE_BYTES + TILE_BYTES_PER_PIXEL * size_px**2 + extra_bytes
-    have = physical_memory_bytes()
-    if need > 0.8 * have:
-        raise ParameterError(name, f"{what}, which need about {human_bytes(need)} of memory; "
-                             f"this machine has {human_bytes(have)}: {change}")
-
-
-def check_window(lat_deg, size_m, pixel_m, min_crater_px) -> tuple[int, float, float]:
-    """(pixels a side, pixel size, smallest crater in pixels) of a window, checked."""
-    check_range("lat_deg", lat_deg, -90.0, 90.0)
-    pixel_m = check_positive("pixel_m", pixel_m)
-    size_m = check_positive("size_m", size_m)
-    min_crater_px = check_range("min_crater_px", min_crater_px, 1.0, 1000.0)
-    size_px = int(round(size_m / pixel_m))
-    if not 1 <= size_px <= MAX_TILE_PX:
-        raise ParameterError("size_m", f"must give 1 to {MAX_TILE_PX} pixels of {pixel_m:g} m; "
-                             f"got {size_m:g} m ({size_px} pixels)")
-    check_tile_memory(size_px, "size_m", f"gives {size_px} x {size_px} pixels of {pixel_m:g} m",
-                      "a smaller window or larger pixels")
-    return size_px, pixel_m, min_crater_px
 
 
 def tile_of_field(field: CraterField, lat_deg: float, lon_deg: float, size_px: int,

@@ -87,34 +87,39 @@ the same engine and cast shadows. ``python examples/plot_descent_strip.py`` and
 ``plot_lidar_sweep.py`` draw frames and scans.
 """
 
-from .albedo import ejecta_albedo, regolith_albedo, regolith_normals
-from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
-from .camera_files import CameraSettings, camera_run
-from .engine import BUILD_QUALITIES, Hits, RayMesh
-from .labels import ELLIPSE_DTYPE, boulder_labels, crater_labels, rim_curves, rim_ellipses
-from .lidar import LIDAR_PATTERNS, LidarFrame, LidarSettings, beam_pattern, lidar_frame
-from .lidar_files import LIDAR_FORMAT, lidar_run, write_las
-from .photometry import (
-    HAPKE_PRESETS,
-    REFLECTANCES,
-    Hapke,
-    Lambert,
-    LommelSeeliger,
-    LunarLambert,
-    radiance_factor,
-    reflectance_model,
-)
-from .planetshine import Planet
-from .poses import Poses, read_poses
-from .render import SUN_RADIUS_1AU_DEG, Frame, Sun, camera_inside, render
-from .scene_geometry import (
-    SceneGeometry,
-    drape_catalog,
-    ray_scene,
-    scene_geometry,
-    scene_mesh,
-)
-from .sensor import Sensor, display_image, expose, exposure_for
+from typing import TYPE_CHECKING
+
+from craters._shared.lazy import lazy_package
+
+if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_package)
+    from .albedo import ejecta_albedo, regolith_albedo, regolith_normals
+    from .camera import Camera, Pose, quaternion_from_matrix, quaternion_to_matrix
+    from .camera_files import CameraSettings, camera_run
+    from .engine import BUILD_QUALITIES, Hits, RayMesh
+    from .labels import ELLIPSE_DTYPE, boulder_labels, crater_labels, rim_curves, rim_ellipses
+    from .lidar import LIDAR_PATTERNS, LidarFrame, LidarSettings, beam_pattern, lidar_frame
+    from .lidar_files import LIDAR_FORMAT, lidar_run, write_las
+    from .photometry import (
+        HAPKE_PRESETS,
+        REFLECTANCES,
+        Hapke,
+        Lambert,
+        LommelSeeliger,
+        LunarLambert,
+        radiance_factor,
+        reflectance_model,
+    )
+    from .planetshine import Planet
+    from .poses import Poses, read_poses
+    from .render import SUN_RADIUS_1AU_DEG, Frame, Sun, camera_inside, render
+    from .scene_geometry import (
+        SceneGeometry,
+        drape_catalog,
+        ray_scene,
+        scene_geometry,
+        scene_mesh,
+    )
+    from .sensor import Sensor, display_image, expose, exposure_for
 
 __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "LIDAR_PATTERNS", "REFLECTANCES", "SUN_RADIUS_1AU_DEG", "Camera", "CameraSettings",
@@ -127,3 +132,4 @@ __all__ = ["BUILD_QUALITIES", "ELLIPSE_DTYPE", "HAPKE_PRESETS", "LIDAR_FORMAT",
            "ray_scene", "read_poses", "reflectance_model", "regolith_albedo", "regolith_normals",
            "render",
            "rim_curves", "rim_ellipses", "scene_geometry", "scene_mesh", "write_las"]
+lazy_package(__name__)

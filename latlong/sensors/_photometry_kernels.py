@@ -13,7 +13,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-LAMBERT, LOMMEL_SEELIGER, LUNAR_LAMBERT, HAPKE = 0, 1, 2, 3
+from ._photometry_codes import LAMBERT, LOMMEL_SEELIGER, LUNAR_LAMBERT
 
 
 @njit(cache=True, inline="always")

@@ -39,19 +39,11 @@ terrain.
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
 from ..geometry.meshes import bounds
-from ._albedo_kernels import (
-    _OCTAVE,
-    _bump_kernel,
-    _cube_keys_kernel,
-    _ejecta_kernel,
-    _mottle_kernel,
-)
 from .scene_geometry import SceneGeometry
 
 __all__ = ["MOTTLE_GAIN", "MOTTLE_RMS", "RELIEF_CENTRE_PX", "VALUE_GRAD_RMS", "ejecta_albedo",
@@ -109,6 +101,7 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     >>> ejecta_albedo(geo, contrast=0.5).round(4).tolist()
     [1.5, 1.0625, 1.0]
     """
+    from ._albedo_kernels import _cube_keys_kernel, _ejecta_kernel  # numba loads here
     if not isinstance(geometry, SceneGeometry):
         raise TypeError(f"`geometry` must be a SceneGeometry; got {type(geometry).__name__}")
     contrast = check_range("contrast", contrast, 0.0, 10.0)
@@ -145,6 +138,8 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     # before it are monotonic)
     dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
     keys = np.empty(len(verts), dtype=np.int64)
+    import numba
+
     _cube_keys_kernel(verts, lo, cell, dims, keys)
     order = np.argsort(keys, kind="stable")
     _ejecta_kernel(verts, order,
@@ -182,6 +177,7 @@ def regolith_albedo(points_m, *, seed: int, contrast: float = 0.05, pixel_m: flo
     >>> f.shape, bool(((f > 0.5) & (f < 2.0)).all())
     ((2,), True)
     """
+    from ._albedo_kernels import _mottle_kernel  # numba loads here
     pts = _positions(points_m)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     contrast = check_range("contrast", contrast, 0.0, 2.0)
@@ -245,6 +241,7 @@ def regolith_normals(points_m, normals, *, seed: int, pixel_m: float, tilt_1m_de
     >>> n.shape, bool(np.allclose(np.linalg.norm(n, axis=1), 1.0))
     ((2, 3), True)
     """
+    from ._albedo_kernels import _OCTAVE, _bump_kernel  # numba loads here
     pts = _positions(points_m)
     nrm = np.ascontiguousarray(normals, dtype=np.float64)
     if nrm.shape != pts.shape or not np.isfinite(nrm).all():

@@ -40,8 +40,6 @@ import numpy as np
 
 from craters._shared import ParameterError, check_finite, check_int, check_positive
 
-from ._camera_kernels import _distort, _pixel_rays_kernel, _undistort_kernel
-
 __all__ = ["Camera", "Pose", "quaternion_from_matrix", "quaternion_to_matrix", "unit_direction",
            "unit_quaternions"]
 
@@ -278,6 +276,7 @@ class Camera:
     def undistort(self, xd, yd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Normalised undistorted (x, y) of distorted normalised points, and where the
         inversion converged."""
+        from ._camera_kernels import _undistort_kernel  # numba loads here
         xd = np.ascontiguousarray(xd, dtype=np.float64).ravel()
         yd = np.ascontiguousarray(yd, dtype=np.float64).ravel()
         if not self.distorted:
@@ -289,6 +288,7 @@ class Camera:
 
     def distort(self, x, y) -> tuple[np.ndarray, np.ndarray]:
         """Distorted normalised coordinates of undistorted ones (OpenCV's model)."""
+        from ._camera_kernels import _distort  # numba loads here
         x = np.asarray(x, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
         xd, yd = _distort(x, y, *self.distortion)[:2]
@@ -297,6 +297,7 @@ class Camera:
     def rays(self, pose: Pose) -> tuple[np.ndarray, np.ndarray]:
         """The camera centre (3,) and the (height, width, 3) unit body-frame directions
         through the pixel centres (NaN where the distortion cannot be inverted)."""
+        from ._camera_kernels import _pixel_rays_kernel  # numba loads here
         if not isinstance(pose, Pose):
             raise TypeError(f"`pose` must be a Pose; got {type(pose).__name__}")
         d = np.empty((self.height, self.width, 3))

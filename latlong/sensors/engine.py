@@ -45,12 +45,6 @@ from craters._shared import ParameterError, ParameterTypeError
 from ..geometry.meshes import bounds
 from ..geometry.normals import triangle_normals
 from ..geometry.normals import vertex_normals as weighted_vertex_normals
-from ._engine_kernels import (
-    _intersect_kernel,
-    _occluded_kernel,
-    _shift_kernel,
-    _unit_kernel,
-)
 
 __all__ = ["BUILD_QUALITIES", "Hits", "RayMesh"]
 
@@ -136,6 +130,7 @@ def _embree():
 def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
     """Float64 origins ((1, 3) when one origin serves all rays, else (k, 3)) and unit
     directions (k, 3)."""
+    from ._engine_kernels import _unit_kernel  # numba loads here
     d = np.ascontiguousarray(directions, dtype=np.float64)
     o = np.ascontiguousarray(origins, dtype=np.float64)
     if d.ndim != 2 or d.shape[1] != 3:
@@ -181,6 +176,7 @@ class RayMesh:
     """
 
     def __init__(self, vertices, faces, *, build_quality: str = "medium"):
+        from ._engine_kernels import _shift_kernel  # numba loads here
         v = np.ascontiguousarray(vertices, dtype=np.float64)
         f = np.asarray(faces)
         if v.ndim != 2 or v.shape[1] != 3 or not len(v):
@@ -302,6 +298,7 @@ class RayMesh:
         ``directions`` need not be unit vectors (they are normalised; distances are in
         metres); ``origins`` is (k, 3) or one (3,) origin for all rays.
         """
+        from ._engine_kernels import _intersect_kernel  # numba loads here
         o, d = _rays(origins, directions)
         k = len(d)
         t_out = np.empty(k)
@@ -316,6 +313,7 @@ class RayMesh:
     def occluded(self, origins, directions, t_max, *, t_min=0.0) -> np.ndarray:
         """(k,) bool: something lies on the ray between ``t_min`` and ``t_max`` metres
         (shadow rays; ``t_min`` keeps a ray from hitting the face it starts on)."""
+        from ._engine_kernels import _occluded_kernel  # numba loads here
         o, d = _rays(origins, directions)
         k = len(d)
         out = np.empty(k, dtype=np.bool_)

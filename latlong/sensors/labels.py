@@ -43,10 +43,8 @@ import numpy as np
 
 from craters._shared import ParameterError
 from craters.exact import dot, matmul
-from craters.kernels import plane_solve
 
 from ..geometry.surface import Surface
-from ._label_kernels import _bin_points_kernel, _finite_box_kernel, _label_kernel
 from .camera import quaternion_to_matrix
 
 __all__ = ["ELLIPSE_DTYPE", "FittedRims", "boulder_labels", "crater_labels", "rim_curves",
@@ -101,6 +99,11 @@ def crater_labels(points, catalog) -> np.ndarray:
     >>> crater_labels([[100.0, 0, 0], [99.0, 4.5, 0], [100.0, 30, 0]], cat).tolist()
     [0, 1, -1]
     """
+    from ._label_kernels import (  # numba loads here
+        _bin_points_kernel,
+        _finite_box_kernel,
+        _label_kernel,
+    )
     p = np.asarray(points, dtype=np.float64).reshape(-1, 3)
     out = np.full(len(p), -1, dtype=np.int64)
     if catalog is None or not len(catalog) or not len(p):
@@ -195,6 +198,8 @@ def _plane_of(x, y, h, scale_m: float) -> tuple[bool, float, float, float]:
     s = (float(len(u)), dot(u, one), dot(v, one), dot(u, u), dot(v, v), dot(u, v),
          dot(h, one), dot(h, u), dot(h, v))
     big = max(s[3], s[4], 1.0)
+    from craters.kernels import plane_solve  # numba loads here
+
     ok, a, b, c = plane_solve(s, s[0] * big * big)
     return bool(ok), float(a), float(b) / scale_m, float(c) / scale_m
 

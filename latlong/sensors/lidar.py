@@ -42,7 +42,6 @@ import numpy as np
 from craters._shared import ParameterError, check_int, check_range, normalize_rng
 from craters._shared.settings import check_declared, setting
 
-from ._lidar_kernels import _returns_kernel
 from .camera import quaternion_to_matrix
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
@@ -328,6 +327,7 @@ def _trace_beams(mesh: RayMesh, settings: LidarSettings, origin, rot, axes_s, ax
                  *, labelled: bool) -> _Traced:
     """Cast every sub-ray of every beam (in chunks of about ``_SUBRAYS_PER_CHUNK``) and
     group the hits into returns (:func:`_returns_kernel`)."""
+    from ._lidar_kernels import _returns_kernel  # numba loads here
     sub, weight = footprint_rays(settings.rays_per_beam, settings.divergence_mrad)
     nr = len(weight)
     spacing = 1e-3 * settings.divergence_mrad / np.sqrt(nr)

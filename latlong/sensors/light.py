@@ -13,8 +13,6 @@ import numpy as np
 
 from craters._shared import ParameterError, check_range
 
-from ._bounce_kernels import SECOND_BOUNCE, _bounce_light_kernel, _bounce_rays_kernel
-from ._render_kernels import _shade_kernel, _shadow_rays_kernel, _surface_kernel
 from .camera import unit_direction
 from .engine import RayMesh
 from .photometry import radiance_factor
@@ -77,6 +75,7 @@ def sunlit(mesh, pos, ng, facing, sun: Sun | Planet, samples: int, seed: int,
            stream: int = 0) -> np.ndarray:
     """Lit fraction per hit: facet faces the light and the shadow ray is free (samples
     over the light's disk from the counter streams ``stream`` + sample)."""
+    from ._render_kernels import _shadow_rays_kernel  # numba loads here
     lit = np.zeros(len(pos))
     cand = np.flatnonzero(facing)
     if not len(cand):
@@ -99,6 +98,7 @@ def sunlit(mesh, pos, ng, facing, sun: Sun | Planet, samples: int, seed: int,
 
 def shade(models, cosines, lit, albedo) -> np.ndarray:
     """(n, bands) I/F: each model at the cosines x lit fraction x albedo factor."""
+    from ._render_kernels import _shade_kernel  # numba loads here
     out = np.empty((len(cosines), len(models)))
     column = np.empty(len(cosines))
     for b, model in enumerate(models):
@@ -113,6 +113,7 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
     (n, 3) by the sunlit surface it sees (``samples`` cosine-weighted rays a point) and,
     with ``bounces`` 2, by the light that surface received once from the rest (one ray
     on from each hit)."""
+    from ._bounce_kernels import SECOND_BOUNCE, _bounce_rays_kernel  # numba loads here
     centre, radius_m = mesh.bounding_sphere
     floor = 1e-3 * SHADOW_OFFSET * radius_m
     n = len(pos)
@@ -165,6 +166,7 @@ def _seen_light(mesh: RayMesh, models, d, face, q, nq, hits, vertex_albedo, sun:
                 seed: int) -> tuple[np.ndarray, np.ndarray]:
     """((n, bands) direct I/F of each secondary hit seen back along its ray (0 for a
     miss), (n,) the albedo factor at the hits)."""
+    from ._bounce_kernels import _bounce_light_kernel  # numba loads here
     facing = (face >= 0) & (nq @ sun.direction > 0.0)
     lit = sunlit(mesh, q, nq, facing, sun, 0, seed)
     va = vertex_albedo_at(mesh, vertex_albedo, hits)
@@ -181,6 +183,7 @@ def planet_light(mesh: RayMesh, models, origin, dirs, hits, vnormals, planet: Pl
                  sun: Sun, albedo, samples: int, seed: int) -> np.ndarray:
     """(n, bands) I/F the planet's light adds at each pixel (:mod:`.planetshine`): each
     model lit from the planet, its cast shadows, times its irradiance ratio."""
+    from ._render_kernels import _surface_kernel  # numba loads here
     n = len(hits.face)
     pos, ng, ns, cosines = (np.empty((n, 3)) for _ in range(4))
     facing = np.empty(n, dtype=np.bool_)

@@ -52,13 +52,7 @@ import numpy as np
 
 from craters._shared import ParameterError, check_finite, check_range
 
-from ._photometry_kernels import (
-    HAPKE,
-    LAMBERT,
-    LOMMEL_SEELIGER,
-    LUNAR_LAMBERT,
-    _radiance_factor_kernel,
-)
+from ._photometry_codes import HAPKE, LAMBERT, LOMMEL_SEELIGER, LUNAR_LAMBERT
 
 __all__ = ["HAPKE_PRESETS", "REFLECTANCES", "Hapke", "Lambert", "LommelSeeliger",
            "LunarLambert", "Photometry", "radiance_factor", "reflectance_model", "with_albedo"]
@@ -206,6 +200,7 @@ def with_albedo(model: Photometry, albedo: float) -> Photometry:
 
 def radiance_factor(model: Photometry, cos_i, cos_e, cos_g) -> np.ndarray:
     """I/F for arrays of cos i, cos e and cos g (broadcast; flattened result)."""
+    from ._photometry_kernels import _radiance_factor_kernel  # numba loads here
     if not isinstance(model, Lambert | LommelSeeliger | LunarLambert | Hapke):
         raise TypeError(f"`model` must be a reflectance model; got {type(model).__name__}")
     mu0, mu, cg = (np.ascontiguousarray(a, dtype=np.float64).ravel()

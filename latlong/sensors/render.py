@@ -46,7 +46,6 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int
 
-from ._render_kernels import _ground_truth_kernel, _surface_kernel
 from .camera import Camera, Pose
 from .engine import RayMesh
 from .labels import boulder_labels, crater_labels
@@ -217,6 +216,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     exposure is taken for all bands (the shutter is one) and the sensor noise differs
     between them.
     """
+    from ._render_kernels import _ground_truth_kernel, _surface_kernel  # numba loads here
     if not isinstance(camera, Camera):
         raise TypeError(f"`camera` must be a Camera; got {type(camera).__name__}")
     if not isinstance(pose, Pose):

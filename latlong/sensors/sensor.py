@@ -34,8 +34,6 @@ import numpy as np
 
 from craters._shared import ParameterError, check_int, check_positive, check_range
 
-from ._render_kernels import _sensor_kernel
-
 __all__ = ["DEFAULT_EXPOSURE_S", "Sensor", "display_image", "expose", "exposure_for"]
 
 #: Exposure of a frame with no lit pixel under auto-exposure, seconds.
@@ -154,6 +152,7 @@ def expose(reflectance, sensor: Sensor | None = None, *, seed: int = 0) -> np.nd
     """The image a :class:`Sensor` records of an (H, W) I/F image (NaN counts as 0), at
     :func:`exposure_for` of it; an (H, W, bands) image band by band (the PSF within each
     band; the noise keyed by the pixel and the band)."""
+    from ._render_kernels import _sensor_kernel  # numba loads here
     img, sensor = _checked(reflectance, sensor)
     seed = check_int("seed", seed, 0, 2**63 - 1)
     if sensor.exposure_s is None:
