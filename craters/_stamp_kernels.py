@@ -247,6 +247,22 @@ def _table(tab, theta):
 
 
 @njit(cache=True, inline="always")
+def _table_row(tabs, k, theta):
+    """:func:`_table` of the row ``tabs[k]``, read in place (as :func:`_table_row_value`:
+    no row view, whose reference counts are atomic in a parallel loop)."""
+    n = tabs.shape[1]
+    t = (theta + np.pi) * (n / (2.0 * np.pi))
+    k0 = int(np.floor(t))
+    w = t - k0
+    if k0 < 0 or k0 >= n:
+        k0 = k0 % n
+    k1 = k0 + 1
+    if k1 == n:
+        k1 = 0
+    return tabs[k, k0] + w * (tabs[k, k1] - tabs[k, k0])
+
+
+@njit(cache=True, inline="always")
 def _roughness_amp(x, xe, a_bowl, a_wall, a_ejecta):
     """Piecewise-linear overlay amplitude: bowl, wall, ejecta fading to 0 at xe."""
     if x <= 0.5:

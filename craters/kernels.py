@@ -15,7 +15,8 @@ Crater profile and stamping:
   at x outside the rim
 * ``fit_plane(h, cy, cx, r_px, pixel)`` -> (p0, gx, gy, n): least-squares plane
 * ``rim_offsets(h, cy, cx, pixel, R, rim_tab, p0, gx, gy, out)``: plane - terrain at the rim
-* ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table;
+* ``table(tab, theta)``: periodic interpolation of a 64-sample azimuth table
+  (``table_row(tabs, k, theta)`` of row k, read in place);
   ``azimuth(y, x)``: atan2 in plain arithmetic (:mod:`craters._angle_kernels`), for hot loops
 * ``slope_factor(slope, onset_deg, full_deg)``: the share of the relief kept on a slope
 * ``roughness_amp(x, x_e, a_bowl, a_wall, a_ejecta)``, ``roughness_octaves(wavelength,
@@ -84,6 +85,7 @@ from ._stamp_kernels import _roughness_amp as roughness_amp
 from ._stamp_kernels import _roughness_octaves as roughness_octaves
 from ._stamp_kernels import _slope_factor as slope_factor
 from ._stamp_kernels import _table as table
+from ._stamp_kernels import _table_row as table_row
 from ._stamp_kernels import _table_row_value as table_row_value
 from ._stamp_kernels import _table_value as table_value
 from ._stamp_kernels import _warp_x as warp_x
@@ -95,6 +97,7 @@ __all__ = ["DC8", "DR8", "GOLDEN", "N_RIM", "PLANE_SUMS0", "azimuth", "bilinear"
            "crater_rough", "face_point", "face_uv", "fbm2", "fit_plane", "hash_normal", "idw8",
            "lattice_coord", "lcsn_height", "mix64", "outer_weight", "plane_solve", "plane_sums_add",
            "read_only_inputs", "rim_offsets", "roughness_amp", "roughness_octaves",
-           "slope_factor", "splitmix64", "table", "table_row_value", "table_value", "TILT_MAX_COS",
+           "slope_factor", "splitmix64", "table", "table_row", "table_row_value", "table_value",
+           "TILT_MAX_COS",
            "TILT_MIN_DEG",
            "tilted_coords", "tilted_ejecta", "tilted_frame", "tilted_root", "warp_x"]

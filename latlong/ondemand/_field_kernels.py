@@ -18,7 +18,7 @@ from craters.kernels import (
     read_only_inputs,
     roughness_amp,
     slope_factor,
-    table,
+    table_row,
     table_row_value,
     tilted_coords,
     tilted_ejecta,
@@ -98,7 +98,7 @@ def _step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, p0, p1, p2):
     if fc[k, TILT_CZ] > 0.0:
         return _tilted_step(fc, k, tabs, rims, seeds, rough, gain, octaves, xe, xb, x, y)
     radius = fc[k, RAD]
-    xr = dist / (radius * (1.0 + table(rims[k], azimuth(un, ue))))
+    xr = dist / (radius * (1.0 + table_row(rims, k, azimuth(un, ue))))
     if not xr < xe:
         return False, 1.0, 0.0
     scale = fc[k, SCALE]

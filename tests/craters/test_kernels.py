@@ -211,6 +211,32 @@ def test_table_row_value_is_table_value_of_the_row(rng):
     assert by_view.tobytes() == in_place.tobytes()
 
 
+def test_azimuth_table_row_is_the_periodic_interpolation_of_the_row(rng):
+    from numba import njit
+
+    from craters._stamp_kernels import _table, _table_row
+
+    @njit
+    def both(tabs, theta, by_view, in_place):
+        for c in range(tabs.shape[0]):
+            for i in range(theta.shape[0]):
+                by_view[c, i] = _table(tabs[c], theta[i])
+                in_place[c, i] = _table_row(tabs, c, theta[i])
+
+    tabs = rng.normal(size=(3, 64))
+    theta = np.concatenate([rng.uniform(-np.pi, np.pi, 500), [-np.pi, 0.0, np.pi - 1e-12,
+                                                              np.pi, 4.0, -4.0]])
+    by_view, in_place = np.empty((3, len(theta))), np.empty((3, len(theta)))
+    both(tabs, theta, by_view, in_place)
+    assert by_view.tobytes() == in_place.tobytes()
+    # numpy: linear between the 64 samples at -pi + 2 pi k / 64, periodic
+    grid = -np.pi + 2.0 * np.pi * np.arange(65) / 64.0
+    for c in range(3):
+        want = np.interp(np.mod(theta + np.pi, 2.0 * np.pi) - np.pi, grid,
+                         np.append(tabs[c], tabs[c, 0]))
+        np.testing.assert_allclose(in_place[c], want, rtol=0, atol=1e-12)
+
+
 @pytest.mark.parametrize(("wavelength", "spacing"), [(1.0, 1.0), (8.0, 1.0), (9.0, 1.0),
                                                      (1e6, 1.0), (100.0, 3.0)])
 def test_roughness_octaves(wavelength, spacing):
