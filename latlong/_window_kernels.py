@@ -16,23 +16,28 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
+from craters.kernels import read_only_inputs
+
 from .geometry._normal_kernels import _band_area_vectors
 
 
+@read_only_inputs("out")
 @njit(cache=True, parallel=True)
-def _window_normals_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out, angle):
+def _window_normals_kernel(m, ring_offsets, radii, stretch, no_table, r_lo, r_hi, out, angle):
     """Unit area-weighted (``angle``: angle-weighted) normals (float32) of the vertices of
     rings ``r_lo .. r_hi`` into ``out`` (their count, 3): those of the whole-body kernel,
     bit for bit. The bands
     touching those rings (``r_lo - 1 .. r_hi``) are streamed as the whole-body kernel
     streams them, even bands first, into an accumulator over rings ``r_lo - 1 .. r_hi + 1``
-    (the outer two rings only receive part of their bands and are dropped)."""
+    (the outer two rings only receive part of their bands and are dropped). ``no_table``:
+    an empty (0, 2) array (the longitudes computed, the table's values), passed read-only
+    so that :func:`_band_area_vectors` compiles once for this kernel and the whole-body
+    one."""
     two_m = 2 * m
     a = max(r_lo - 1, 0)
     b = min(r_hi + 1, two_m)
     base = ring_offsets[a]
     acc = np.zeros((ring_offsets[b + 1] - base, 3), dtype=np.float32)
-    no_table = np.empty((0, 2))  # longitudes computed, the table's values
     band_lo = max(r_lo - 1, 0)
     band_hi = min(r_hi, two_m - 1)
     for parity in range(2):

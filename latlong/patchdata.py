@@ -26,6 +26,8 @@ __all__ = ["WINDOW_VERTICES", "leaf_metadata", "write_leaf_data"]
 #: Vertices of a ring window (its float32 positions and normals: 24 B each, plus a
 #: float32 accumulator of 12 B while the normals are made).
 WINDOW_VERTICES = 1 << 22
+#: No longitude table: the window kernel computes the cosines and sines itself.
+_NO_TABLE = np.empty((0, 2))
 #: Bytes of leaf data made per task of the writing pass.
 GROUP_BYTES = 1 << 25
 #: Leaves per task of the metadata pass.
@@ -131,7 +133,8 @@ def write_leaf_data(grid, radii, stretch, leaves: tuple, at: np.ndarray, nbytes:
             pos = _window_positions(grid, radii, stretch, r0, r1)
             nrm = np.empty_like(pos)
             # angle-weighted: the camera's shading normals, and Mitsuba's and Blender's
-            _window_normals_kernel(grid.magnitude, offs, radii, stretch, r0, r1, nrm, True)
+            _window_normals_kernel(grid.magnitude, offs, radii, stretch, _NO_TABLE, r0, r1,
+                                   nrm, True)
             groups = _groups(nb_s, a, b)
             big = max(int(nb_s[g0:g1].sum()) for g0, g1 in groups)
 

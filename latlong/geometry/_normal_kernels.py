@@ -225,8 +225,10 @@ def _normals_from_radii_kernel(m, ring_offsets, band_offsets, radii, stretch, lo
             band = 2 * hb + parity
             if band >= n_bands:
                 continue
-            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc, 0,
-                               angle)
+            # base: ring_offsets[0] (0) as an int64, not a literal 0, as the window
+            # kernel's: one compile of _band_area_vectors for both
+            _band_area_vectors(m, ring_offsets, radii, stretch, lon_table, band, acc,
+                               ring_offsets[0], angle)
 
 
 @njit(cache=True, parallel=True)
