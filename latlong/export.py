@@ -116,14 +116,14 @@ def _vertex_records(body, rocks, rock_heights, dtype):
     """The PLY writer's fast path (:attr:`MeshSource.vertex_records`): the body's records
     straight from a kernel, chunks made on worker threads, then the boulders'."""
     from ._export_kernels import _ply_vertex_kernel  # numba loads here
+    from ._grid_kernels import lon_table
+
     grid = body.grid
     n = grid.n_vertices
     radii = np.ascontiguousarray(body.radii_m, dtype=np.float64)
     stretch = np.array(body.stretch, dtype=np.float64)
     # the longitude table (8 B a vertex) up to _TABLE_BYTES; past it the kernel
     # computes the same cosines and sines itself (3.2 GB saved at M = 8192)
-    from ._grid_kernels import lon_table  # numba loads here
-
     table = lon_table(grid.magnitude, grid.ring_offsets()) \
         if 8 * n <= _TABLE_BYTES else np.empty((0, 2))
 

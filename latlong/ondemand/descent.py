@@ -61,8 +61,7 @@ from .base import tangent_frame
 from .field import CraterField, crater_field
 from .points import units_of
 from .tile import tile_mesh, tile_of_field
-from .window import DESCENT_MARGIN as _MARGIN
-from .window import MAX_TILE_PX, check_descent_memory
+from .window import DESCENT_MARGIN, MAX_TILE_PX, check_descent_memory
 
 if TYPE_CHECKING:
     from ..sensors import LidarFrame, LidarSettings
@@ -145,7 +144,7 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
         return verts, faces, (t.n_craters, t.n_rocks), "window", _rock_faces(field, faces)
     if field.base.scene is None:
         raise ParameterError("altitudes_m", f"must keep the frames' ground within a window "
-                             f"(footprint x {_MARGIN} <= half the site's radius) over a DEM")
+                             f"(footprint x {DESCENT_MARGIN} <= half the site's radius) over a DEM")
     m = int(min(_MAX_MAGNITUDE, max(16, math.ceil(math.pi * field.base.radius_m / (2 * pixel_m)))))
     grid = LatLongGrid(m)
     units = grid.unit_vectors()
@@ -210,7 +209,7 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
         footprint = 2.0 * h * tan_half
         pixel = footprint / width_px
         verts, faces, counts, kind, (face_rock, rocks) = _terrain(
-            field, lat_deg, lon_deg, _MARGIN * footprint, pixel, site_radius)
+            field, lat_deg, lon_deg, DESCENT_MARGIN * footprint, pixel, site_radius)
         catalog = field.last_catalog()  # the terrain's craters (oldest first)
         catalog = catalog[catalog["slope_factor"] > 0]  # those erased by slope show nothing
         # the altitude is above the terrain at the site as this frame's terrain has it
@@ -268,16 +267,16 @@ class _Shading:
 
 def _check_lidar_inside(lidar: LidarSettings, fov_deg: float) -> None:
     """Refuse a LIDAR whose beams (with their divergence) leave the frames' terrain window
-    (``_MARGIN`` camera footprints wide): they would see its edge, not the ground."""
+    (``DESCENT_MARGIN`` camera footprints wide): they would see its edge, not the ground."""
     from ..sensors import beam_pattern
 
     axes, _ = beam_pattern(lidar)
     half = np.arctan(np.max(np.abs(axes[:, :2]), axis=1) / axes[:, 2]).max() \
         + 0.5e-3 * lidar.divergence_mrad
-    limit = math.atan(_MARGIN * math.tan(math.radians(fov_deg) / 2.0))
+    limit = math.atan(DESCENT_MARGIN * math.tan(math.radians(fov_deg) / 2.0))
     if not (axes[:, 2] > 0).all() or half > limit:
         raise ParameterError("lidar", f"beams must stay within {math.degrees(limit):.4g} deg "
-                             f"of the axis (the terrain window: {_MARGIN} x the camera's "
+                             f"of the axis (the terrain window: {DESCENT_MARGIN} x the camera's "
                              f"footprint at {{}} {fov_deg:g}); the LIDAR's reach "
                              f"{math.degrees(half):.4g} deg", see=("fov_deg",))
 

@@ -101,7 +101,10 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     >>> ejecta_albedo(geo, contrast=0.5).round(4).tolist()
     [1.5, 1.0625, 1.0]
     """
+    import numba
+
     from ._albedo_kernels import _cube_keys_kernel, _ejecta_kernel  # numba loads here
+
     if not isinstance(geometry, SceneGeometry):
         raise TypeError(f"`geometry` must be a SceneGeometry; got {type(geometry).__name__}")
     contrast = check_range("contrast", contrast, 0.0, 10.0)
@@ -138,8 +141,6 @@ def ejecta_albedo(geometry: SceneGeometry, *, contrast: float = 0.5,
     # before it are monotonic)
     dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
     keys = np.empty(len(verts), dtype=np.int64)
-    import numba
-
     _cube_keys_kernel(verts, lo, cell, dims, keys)
     order = np.argsort(keys, kind="stable")
     _ejecta_kernel(verts, order,
