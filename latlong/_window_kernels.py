@@ -21,6 +21,16 @@ from craters.kernels import read_only_inputs
 from .geometry._normal_kernels import _band_area_vectors
 
 
+@njit(cache=True, inline="always")
+def _zigzag(t, n):
+    """The ``t``-th of ``0 .. n - 1`` taken from both ends in turn (0, n - 1, 1, n - 2 ...).
+    numba gives each thread one contiguous block of a ``prange``, and a window's rings grow
+    (or shrink) along it: without this one thread had about three times the other's work
+    (an M = 1400 export's window normals 2.15 s against 1.60 s for the whole-body kernel
+    over the same bands)."""
+    return t // 2 if t % 2 == 0 else n - 1 - t // 2
+
+
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _window_normals_kernel(m, ring_offsets, radii, stretch, no_table, r_lo, r_hi, out, angle):
@@ -44,9 +54,9 @@ def _window_normals_kernel(m, ring_offsets, radii, stretch, no_table, r_lo, r_hi
         first = band_lo + ((parity - band_lo) % 2)
         # (a conditional expression as prange's bound made numba run the loop serially)
         count = max((band_hi - first) // 2 + 1, 0)
-        for hb in prange(count):
-            _band_area_vectors(m, ring_offsets, radii, stretch, no_table, first + 2 * hb, acc,
-                               base, angle)
+        for hb in prange(count):  # bands of one parity share no ring: any order, same sums
+            _band_area_vectors(m, ring_offsets, radii, stretch, no_table,
+                               first + 2 * _zigzag(hb, count), acc, base, angle)
     skip = ring_offsets[r_lo] - base
     for i in prange(out.shape[0]):
         x = np.float64(acc[skip + i, 0])
@@ -67,7 +77,9 @@ def _window_positions_kernel(m, ring_offsets, radii, stretch, r_lo, r_hi, out):
     :func:`~latlong._export_kernels._glb_positions_kernel`'s values (``(u * r) * s``
     rounded once), the longitudes' cosines and sines computed as the table's are."""
     base = ring_offsets[r_lo]
-    for r in prange(r_lo, r_hi + 1):
+    n_rings = r_hi - r_lo + 1
+    for t in prange(n_rings):
+        r = r_lo + _zigzag(t, n_rings)
         o = ring_offsets[r]
         n = ring_offsets[r + 1] - o
         lat = 0.5 * np.pi - r * (np.pi / (2 * m))
