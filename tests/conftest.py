@@ -40,9 +40,12 @@ _children_import_these_packages()
 #: order of the run depends on it.
 LONGEST_FIRST = (
     "tests/test_readme_commands.py",     # 262 s
+    # beside the README from the start: it compiles the on-demand field's kernels (~45 s)
+    # and caches them before the README's tile and descent commands need them (the two
+    # workers compiled them both at once when this file came after test_cli.py)
+    "tests/dem/test_ondemand.py",        # 114
     "tests/test_types.py",               # 39 (mypy, one thread)
     "tests/latlong/test_cli.py",         # 134
-    "tests/dem/test_ondemand.py",        # 114
     "tests/latlong/test_boulders.py",    # 113
     "tests/latlong/test_gravity.py",     # 75
     "tests/latlong/test_gabor.py",       # 71
