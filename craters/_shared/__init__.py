@@ -36,7 +36,6 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
     from .validation import (
         ParameterError,
         ParameterTypeError,
-        RngLike,
         about,
         check_choice,
         check_finite,
@@ -47,7 +46,7 @@ if TYPE_CHECKING:  # at run time each name is imported on first use (lazy_packag
         parameter_of,
     )
 
-__all__ = ["ParameterError", "ParameterTypeError", "RngLike", "about",
+__all__ = ["ParameterError", "ParameterTypeError", "about",
            "atomic_path", "check_choice", "check_finite", "check_int", "check_output_path",
            "check_outside_folder",
            "check_parent_folder", "check_positive", "check_range", "check_suffix", "human_bytes",
