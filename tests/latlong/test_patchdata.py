@@ -99,14 +99,15 @@ def test_every_prange_of_the_window_normals_is_a_parallel_loop():
 
     from numba import njit
 
+    from craters._calls import read_only
+
     kernel = _window_normals_kernel
     fresh = njit(parallel=True)(kernel.py_func)
     m = 3
     g = LatLongGrid(m)
     out = np.empty((g.n_vertices, 3), np.float32)
-    inputs = [np.full(g.n_vertices, 10.0), np.ones(3), np.empty((0, 2))]
-    for a in inputs:  # read-only, as the kernel's wrapper passes them: no other compile
-        a.setflags(write=False)
+    # read-only, as the kernel's wrapper passes them (craters._calls.read_only_inputs)
+    inputs = [read_only(a) for a in (np.full(g.n_vertices, 10.0), np.ones(3), np.empty((0, 2)))]
     args = (m, g.ring_offsets(), *inputs, 0, 2 * m, out)
     fresh(*args, True)
     diagnostics = next(iter(fresh.overloads.values())).metadata["parfor_diagnostics"]
