@@ -128,6 +128,7 @@ def camera_options(model_help: str, *, units: bool = True, vertical=None) -> dic
         "soft_shadow_samples": into("light", own["soft_shadow_samples"]),
         "bounces": into("light", own["bounces"]),
         "bounce_samples": into("light", own["bounce_samples"]),
+        "bounce_filter_px": into("light", own["bounce_filter_px"]),
         "blur_samples": into("sensor", own["blur_samples"]),
         "line_time_s": into("sensor", own["line_time_s"]),
         "stars": into("light", own["stars"]),

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit, prange
 
 from craters.kernels import read_only_inputs, splitmix64
@@ -68,3 +69,64 @@ def _bounce_light_kernel(code, params, dirs, face, face_normals, albedo_w, sun, 
             continue
         cos_g = -(d0 * sun[0] + d1 * sun[1] + d2 * sun[2]) / dn
         out[k] = _radiance_factor(code, params, cos_i, cos_e, cos_g) * albedo_w[k] * lit[k]
+
+
+#: The geometric weights of :func:`_bounce_filter_kernel` (:func:`.light.filter_bounced`):
+#: a neighbour counts by (n_p . n_q)^(2^NORMAL_POWER_LOG2) = (n_p . n_q)^32 and by
+#: (1 - sin^2 / PLANE_SIN2)^2, 0 beyond, sin the elevation of the neighbour above the
+#: point's tangent plane seen from the point (0 for one plane; ~10 deg cuts it off).
+NORMAL_POWER_LOG2 = 5
+PLANE_SIN2 = 0.03
+
+
+@read_only_inputs("out")
+@njit(cache=True, parallel=True)
+def _bounce_filter_kernel(light, seen, pos, nrm, radius, out):
+    """Cross-bilateral mean of ``light`` (h, w, bands) over the seen pixels within
+    ``radius`` pixels of each seen pixel (unseen pixels copied): weights the spatial
+    Gaussian exp(-(di^2 + dj^2) / (2 sigma^2)) of sigma radius / 2 times the geometric
+    weights above, from the points ``pos`` and shading normals ``nrm`` (h, w, 3). Each
+    pixel's sums in a fixed order (rows, then columns of its window): the same bytes on
+    any thread count."""
+    h, w, nb = light.shape
+    side = 2 * radius + 1
+    spatial = np.empty((side, side))
+    inv_2s2 = 2.0 / (radius * radius)  # 1 / (2 sigma^2), sigma = radius / 2
+    for a in range(side):
+        for b in range(side):
+            spatial[a, b] = math.exp(-((a - radius) ** 2 + (b - radius) ** 2) * inv_2s2)
+    for i in prange(h):
+        acc = np.zeros(nb)
+        for j in range(w):
+            if not seen[i, j]:
+                for b in range(nb):
+                    out[i, j, b] = light[i, j, b]
+                continue
+            for b in range(nb):
+                acc[b] = 0.0
+            total = 0.0
+            px, py, pz = pos[i, j, 0], pos[i, j, 1], pos[i, j, 2]
+            nx, ny, nz = nrm[i, j, 0], nrm[i, j, 1], nrm[i, j, 2]
+            for ii in range(max(0, i - radius), min(h, i + radius + 1)):
+                for jj in range(max(0, j - radius), min(w, j + radius + 1)):
+                    if not seen[ii, jj]:
+                        continue
+                    c = nx * nrm[ii, jj, 0] + ny * nrm[ii, jj, 1] + nz * nrm[ii, jj, 2]
+                    if not c > 0.0:
+                        continue
+                    dx, dy, dz = pos[ii, jj, 0] - px, pos[ii, jj, 1] - py, pos[ii, jj, 2] - pz
+                    d2 = dx * dx + dy * dy + dz * dz
+                    e = nx * dx + ny * dy + nz * dz
+                    t = 1.0
+                    if d2 > 0.0:
+                        t = 1.0 - e * e / (d2 * PLANE_SIN2)
+                        if not t > 0.0:
+                            continue
+                    for _ in range(NORMAL_POWER_LOG2):
+                        c = c * c
+                    wt = spatial[ii - i + radius, jj - j + radius] * c * (t * t)
+                    total += wt
+                    for b in range(nb):
+                        acc[b] += wt * light[ii, jj, b]
+            for b in range(nb):
+                out[i, j, b] = acc[b] / total

@@ -19,7 +19,7 @@ and how its frames are written is one :class:`CameraSettings` record.
   ``Z``, the albedo seen in float32 ``Y`` (``albedo_NNNN.exr``, always with exr), label
   images in a uint32 channel ``id`` (4294967295, the bits of -1, where none).
 * :func:`manifest`: the ``frames.json`` document: ``{"intrinsics": {fx, fy, cx, cy, width,
-  height}, "frames": [{"time_s", "position_m", "quaternion_wxyz", "sun_direction",
+  height}, "frames": [{"time_s", "position_m", "quaternion_wxyz", "sun_direction", "seed",
   "files": {"image", "depth", "range", "normals", "crater_id", "boulder_id", ...}}]}``,
   file names relative to the folder (``crater_id`` / ``boulder_id`` null when the model
   has no catalogs), and per frame the projected rim ellipses of the craters seen, plus
@@ -256,13 +256,18 @@ class CameraSettings:
     soft_shadow_samples: int = setting(0, "shadow rays per pixel over the solar disk (0: hard "
                                        "shadows)", range=(0, 1024))
     """Shadow rays per pixel over the solar disk, [0, 1024] (0: hard shadows)."""
-    bounces: int = setting(0, "bounces of light between surfaces (1: crater floors in shadow "
+    bounces: int = setting(1, "bounces of light between surfaces (1: crater floors in shadow "
                            "lit by the sunlit walls; 2: and by what those walls received; "
                            "0: direct sunlight only)", range=(0, 2))
     """Bounces of light between surfaces, 0, 1 or 2 (:func:`~latlong.sensors.render.render`)."""
-    bounce_samples: int = setting(16, "rays a pixel for the bounced light (its noise falls as "
+    bounce_samples: int = setting(8, "rays a pixel for the bounced light (its noise falls as "
                                   "1 / sqrt of this)", range=(1, 4096))
     """Cosine-weighted rays a pixel for the bounced light, [1, 4096]."""
+    bounce_filter_px: int = setting(8, "smooth the bounced light over this many pixels around "
+                                    "each, on the same surface (0: each pixel's own rays)",
+                                    unit="px", range=(0, 64))
+    """Radius of the bounced light's smoothing, pixels, [0, 64]
+    (:func:`~latlong.sensors.light.filter_bounced`; 0: none)."""
     blur_samples: int = setting(0, "motion blur: instants sampled over each frame's exposure "
                                 "along the trajectory (0: a sharp frame)", range=(0, 256))
     """Motion blur: instants over the exposure, [0, 256] (:mod:`~latlong.sensors.motion`;
@@ -273,8 +278,10 @@ class CameraSettings:
     stars: bool = setting(False, "stars (Yale Bright Star Catalogue, V <= 6) where no "
                           "surface is seen; J2000 = the body frame unless SPICE says")
     """Stars where no surface is seen (:mod:`~latlong.sensors.stars`)."""
-    seed: int = setting(0, "seed of the noise and of the sun-disk samples", range=(0, 2**63 - 1))
-    """Key of the sensor noise and of the sun-disk samples, [0, 2^63 - 1]."""
+    seed: int = setting(0, "seed of the noise, the sun-disk samples and the bounce rays (new "
+                        "draws in each frame)", range=(0, 2**63 - 1))
+    """Key of the sensor noise, the sun-disk samples and the bounce rays, [0, 2^63 - 1]; frame
+    k draws with :func:`frame_seed` (seed, k), recorded as the frame's ``seed``."""
     bright_ejecta: float = setting(0.0, "albedo contrast of fresh craters' ejecta (0.5 = 50 % "
                                    "brighter at the rim, fading as (r/R)^-3 and with "
                                    "degradation; needs a crater catalog; 0: off)",
@@ -330,6 +337,7 @@ class CameraSettings:
                 "sun_angular_radius_deg": sun.angular_radius_deg,
                 "soft_shadow_samples": self.soft_shadow_samples, "seed": self.seed,
                 "bounces": self.bounces, "bounce_samples": self.bounce_samples,
+                "bounce_filter_px": self.bounce_filter_px,
                 "blur_samples": self.blur_samples, "line_time_s": self.line_time_s,
                 "stars": self.stars, "bands": parse_bands(self.bands),
                 "sensor": {f.name: getattr(self.sensor, f.name)
@@ -359,6 +367,16 @@ def parse_bands(spec: str) -> dict[str, float]:
     return out
 
 
+def frame_seed(seed: int, k: int) -> int:
+    """The counter key of frame ``k`` of a run of ``seed``: each frame its own sensor noise,
+    sun-disk samples and bounce rays (a real detector's noise is new in every exposure; one
+    key for all frames would repeat one pattern at fixed pixels, which a feature tracker
+    follows), the same for the same (seed, k) on any machine (numpy's SeedSequence hash,
+    as the LIDAR's frames)."""
+    state = np.random.SeedSequence([int(seed), int(k)]).generate_state(1, np.uint64)[0]
+    return int(state) >> 1
+
+
 def _per_pose(planet, n: int) -> list[Planet | None]:
     """One :class:`Planet` (or None) per pose."""
     if planet is None or isinstance(planet, Planet):
@@ -376,6 +394,27 @@ def _planet_entry(planet: Planet, sun: Sun) -> dict:
             "geometric_albedo": planet.geometric_albedo,
             "phase_deg": planet.phase_deg(sun.direction),
             "irradiance_ratio": planet.irradiance_ratio(sun.direction)}
+
+
+def _frame(mesh: RayMesh, geometry, settings: CameraSettings, bands, albedo, poses: Poses,
+           k: int, sun: Sun, planet: Planet | None, seed: int, body_to_j2000) -> Frame:
+    """Frame ``k`` of a camera run (its key ``seed``; ``bands`` the run's band models):
+    rendered over its exposure, with stars when asked."""
+
+    def render_at(camera, pose):
+        return render(mesh, camera, pose, sun, reflectance=None if bands else settings.reflectance,
+                      bands=bands, sensor=settings.sensor,
+                      soft_shadow_samples=settings.soft_shadow_samples, seed=seed,
+                      ground_truth=geometry, vertex_albedo=albedo, bounces=settings.bounces,
+                      bounce_samples=settings.bounce_samples,
+                      bounce_filter_px=settings.bounce_filter_px, planet=planet)
+
+    frame = timed_frame(render_at, poses, k, settings.camera, settings.sensor,
+                        blur_samples=settings.blur_samples, line_time_s=settings.line_time_s,
+                        seed=seed)
+    if settings.stars:
+        frame = with_stars(frame, settings.sensor, seed=seed, body_to_j2000=body_to_j2000)
+    return frame
 
 
 def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, craters=None,
@@ -423,22 +462,9 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
         flow = "flow" in settings.datasets.split(",")
         previous = None
         for k in progress_bar(range(len(poses)), enabled=progress, desc="frames"):
-            def render_at(camera, pose, sun=suns[k], planet=planets[k]):
-                return render(mesh, camera, pose, sun,
-                              reflectance=None if bands else settings.reflectance, bands=bands,
-                              sensor=settings.sensor,
-                              soft_shadow_samples=settings.soft_shadow_samples,
-                              seed=settings.seed, ground_truth=geometry,
-                              vertex_albedo=albedo, bounces=settings.bounces,
-                              bounce_samples=settings.bounce_samples, planet=planet)
-
-            frame = timed_frame(render_at, poses, k, settings.camera, settings.sensor,
-                                blur_samples=settings.blur_samples,
-                                line_time_s=settings.line_time_s, seed=settings.seed)
-            if settings.stars:
-                frame = with_stars(frame, settings.sensor, seed=settings.seed,
-                                   body_to_j2000=None if body_to_j2000 is None
-                                   else body_to_j2000[k])
+            seed = frame_seed(settings.seed, k)
+            frame = _frame(mesh, geometry, settings, bands, albedo, poses, k, suns[k],
+                           planets[k], seed, None if body_to_j2000 is None else body_to_j2000[k])
             files = write_frame(tmp, k, frame, depth_format=settings.depth_format,
                                 extra=settings.all_ground_truth)
             if flow and previous is not None:  # the flow from the frame before to this one
@@ -447,6 +473,7 @@ def camera_run(model, settings: CameraSettings, poses: Poses, sun, folder, *, cr
                 entries[-1]["files"]["flow"] = name
             previous = frame if flow else None
             entries.append(frame_entry(frame, files, craters=geometry.craters, rims=rims))
+            entries[-1]["seed"] = seed  # render(..., seed=) of this frame (frame_seed)
             if frame_info is not None:
                 entries[-1].update(frame_info[k])
             if planets[k] is not None:

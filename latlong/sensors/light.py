@@ -18,8 +18,8 @@ from .engine import RayMesh
 from .photometry import radiance_factor
 from .planetshine import Planet
 
-__all__ = ["PLANET_STREAM", "SHADOW_OFFSET", "SUN_RADIUS_1AU_DEG", "Sun", "indirect",
-           "planet_light", "shade", "sunlit", "vertex_albedo_at"]
+__all__ = ["PLANET_STREAM", "SHADOW_OFFSET", "SUN_RADIUS_1AU_DEG", "Sun", "filter_bounced",
+           "indirect", "planet_light", "shade", "sunlit", "vertex_albedo_at"]
 
 #: Angular radius of the sun seen from 1 au, degrees (696 000 km / 1 au).
 SUN_RADIUS_1AU_DEG = math.degrees(math.asin(6.957e8 / 1.495978707e11))
@@ -108,11 +108,13 @@ def shade(models, cosines, lit, albedo) -> np.ndarray:
 
 
 def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun,
-             samples: int, seed: int, bounces: int = 1) -> np.ndarray:
+             samples: int, seed: int, bounces: int = 1, smooth=None) -> np.ndarray:
     """Bounced light (:mod:`.render`'s notes): (n, bands) I/F added at each point ``pos``
     (n, 3) by the sunlit surface it sees (``samples`` cosine-weighted rays a point) and,
     with ``bounces`` 2, by the light that surface received once from the rest (one ray
-    on from each hit)."""
+    on from each hit). ``smooth`` (optional) maps the light received, (n, bands) as a
+    white Lambertian surface would send it back, to a smoothed estimate
+    (:func:`filter_bounced`) before each point's albedo multiplies it."""
     from ._bounce_kernels import SECOND_BOUNCE, _bounce_rays_kernel  # numba loads here
     centre, radius_m = mesh.bounding_sphere
     floor = 1e-3 * SHADOW_OFFSET * radius_m
@@ -145,9 +147,36 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         for b in range(len(models)):
             total[front, b] += normal_albedo[b] * va[front] * light2[:, b]
     out = np.empty_like(total)
+    if smooth is not None:
+        received = smooth(total / samples)
+        for b in range(len(models)):
+            out[:, b] = normal_albedo[b] * albedo * received[:, b]
+        return out
     for b in range(len(models)):
         out[:, b] = normal_albedo[b] * albedo * total[:, b] / samples
     return out
+
+
+def filter_bounced(received: np.ndarray, seen: np.ndarray, pos: np.ndarray, ns: np.ndarray,
+                   radius_px: int) -> np.ndarray:
+    """The bounced light ``received`` by the seen pixels, (n_seen, bands), smoothed across
+    the image (h, w) = ``seen.shape``: a cross-bilateral mean within ``radius_px`` pixels
+    whose weights keep to one surface (a neighbour counts less the more its shading
+    normal turns away, ``ns`` (h, w, 3), and the farther it lies off the point's tangent
+    plane, ``pos`` (h, w, 3): a crater rim in front of a floor is not averaged into it).
+    Light bounced from the surroundings changes over metres, not from pixel to pixel,
+    while the Monte Carlo noise of a few rays a pixel does: the mean over ~radius^2
+    pixels removes most of it. The direct light and its shadow edges are not touched."""
+    from ._bounce_kernels import _bounce_filter_kernel  # numba loads here
+    h, w = seen.shape
+    nb = received.shape[1]
+    light = np.zeros((h * w, nb))
+    light[seen.ravel()] = received
+    out = np.empty((h, w, nb))
+    _bounce_filter_kernel(light.reshape(h, w, nb), np.ascontiguousarray(seen),
+                          np.ascontiguousarray(pos, dtype=np.float64),
+                          np.ascontiguousarray(ns, dtype=np.float64), int(radius_px), out)
+    return out.reshape(h * w, nb)[seen.ravel()]
 
 
 def _secondary_hits(mesh: RayMesh, o, d, above):

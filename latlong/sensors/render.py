@@ -27,7 +27,13 @@ its albedo as a Lambertian surface, is added to what it sends back. A spherical 
 gets its closed form (every further bounce is the last times albedo x the bowl's share
 of the sphere: Ingersoll, Svitek & Murray 1992) within 3 % for one bounce and 4 % for
 the second; a crater's shadowed floor Mitsuba 3's path tracer within 3.5 % for one
-bounce (``tests/benchmarks/compare_bounce_mitsuba.py``). The sky sends nothing but,
+bounce (``tests/benchmarks/compare_bounce_mitsuba.py``). ``bounce_filter_px`` > 0
+smooths the bounced light over that many pixels around each, on the same surface
+(:func:`~.light.filter_bounced`: bounced light changes over metres, the noise of a few
+rays from pixel to pixel); a few rays a pixel then do the work of hundreds. ``render``'s
+default is the sun's direct light alone (``bounces=0``); camera runs
+(:class:`~.camera_files.CameraSettings`, ``latlong camera``) default to one bounce of 8
+rays a pixel smoothed over 8 pixels. The sky sends nothing but,
 with ``planet``, a planet's light (:mod:`.planetshine`): shaded and shadowed as the
 sun's, scaled by its irradiance ratio.
 
@@ -52,6 +58,7 @@ from .labels import boulder_labels, crater_labels
 from .light import (
     SUN_RADIUS_1AU_DEG,
     Sun,
+    filter_bounced,
     indirect,
     planet_light,
     shade,
@@ -193,8 +200,8 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
            soft_shadow_samples: int = 0, seed: int = 0,
            ground_truth: SceneGeometry | None = None, bounces: int = 0,
-           bounce_samples: int = 16, planet: Planet | None = None,
-           bands: Mapping[str, object] | None = None) -> Frame:
+           bounce_samples: int = 8, bounce_filter_px: int = 8,
+           planet: Planet | None = None, bands: Mapping[str, object] | None = None) -> Frame:
     """Render one frame of ``model`` seen by ``camera`` at ``pose``, lit by ``sun`` (a
     :class:`Sun` or a direction towards it). See the module notes.
 
@@ -207,9 +214,9 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     ``normals`` is ``"smooth"``, ``"face"`` or an (n, 3) array of vertex normals to blend
     (e.g. a sphere's exact radial directions); ``vertex_albedo`` an optional (n,) factor
     per vertex; ``seed`` keys the sun-disk samples and the sensor noise. With ground
-    truth the frame has the crater-id and boulder-id label images. ``bounces`` 1 adds
-    the light the surface sends to itself once (``bounce_samples`` rays a pixel), 2 that
-    light bounced once more (0: the sun's direct light only). ``planet`` adds a
+    truth the frame has the crater-id and boulder-id label images. ``bounces``,
+    ``bounce_samples``, ``bounce_filter_px``: light bounced between surfaces (module
+    notes; 0 here, 1 in camera runs). ``planet`` adds a
     :class:`~latlong.sensors.planetshine.Planet`'s light (its disk sampled like the sun's
     with ``soft_shadow_samples``). ``bands`` (instead of ``reflectance``) makes a
     multi-band camera: {name: reflectance model} in band order; the rays are shared, one
@@ -231,6 +238,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
     samples = check_int("soft_shadow_samples", soft_shadow_samples, 0, 1024)
     light = {"bounces": check_int("bounces", bounces, 0, 2),
              "bounce_samples": check_int("bounce_samples", bounce_samples, 1, 4096),
+             "bounce_filter_px": check_int("bounce_filter_px", bounce_filter_px, 0, 64),
              "seed": check_int("seed", seed, 0, 2**63 - 1), "planet": planet,
              "planet_samples": samples, "vertex_albedo": vertex_albedo}
     mesh, ground_truth = traced_model(model, ground_truth)
@@ -248,7 +256,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
                  samples if sun.angular_radius_deg > 0.0 else 0, light["seed"])
     albedo = vertex_albedo_at(mesh, vertex_albedo, hits)
     refl = _reflectance(mesh, models, (origin, dirs, hits, vnormals), (pos, ng, ns, cosines),
-                        lit, albedo, sun, **light)
+                        lit, albedo, sun, image_shape=(h, w), **light)
     shape = (h, w) if not names else (h, w, len(names))
     refl = refl[:, 0].reshape(h, w) if not names else refl.reshape(shape)
     depth, rng_m, lit32 = (np.empty(n, dtype=np.float32) for _ in range(3))
@@ -271,16 +279,24 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
 
 
 def _reflectance(mesh: RayMesh, models, rays, surface, lit, albedo, sun: Sun, *,
-                 bounces: int, bounce_samples: int, seed: int, planet: Planet | None,
-                 planet_samples: int, vertex_albedo) -> np.ndarray:
+                 bounces: int, bounce_samples: int, bounce_filter_px: int, seed: int,
+                 planet: Planet | None, planet_samples: int, vertex_albedo,
+                 image_shape: tuple[int, int]) -> np.ndarray:
     """(n, bands) I/F of the pixels: the sun's light, bounced light and planetshine."""
     origin, dirs, hits, vnormals = rays
     pos, ng, ns, cosines = surface
     refl = shade(models, cosines, lit, albedo)
     if bounces:
         seen = hits.face >= 0
+        smooth = None
+        if bounce_filter_px:
+            def smooth(received):
+                return filter_bounced(received, seen.reshape(image_shape),
+                                      pos.reshape(*image_shape, 3),
+                                      ns.reshape(*image_shape, 3), bounce_filter_px)
         refl[seen] += indirect(mesh, models, pos[seen], ng[seen], ns[seen], albedo[seen],
-                               vertex_albedo, sun, bounce_samples, seed, bounces)
+                               vertex_albedo, sun, bounce_samples, seed, bounces,
+                               smooth=smooth)
     if planet is not None:
         refl += planet_light(mesh, models, origin, dirs, hits, vnormals, planet, sun, albedo,
                              planet_samples, seed)

@@ -12,7 +12,8 @@ and ``--spp`` independent samples a pixel; craterform with ``--spp`` bounce rays
 pixel. Shadowed floor pixels: inside 0.8 radii with no direct light in either renderer.
 
 Usage: ``python tests/benchmarks/compare_bounce_mitsuba.py [--size 96] [--spp 4096]
-[--bounces 1]``
+[--bounces 1] [--our-spp N] [--filter-px R]`` (``--our-spp 16 --filter-px 4``: the
+camera's defaults against Mitsuba's ``--spp``)
 (needs ``pip install mitsuba``).
 """
 
@@ -87,7 +88,12 @@ def main() -> int:
     ap.add_argument("--size", type=int, default=96)
     ap.add_argument("--spp", type=int, default=4096)
     ap.add_argument("--bounces", type=int, choices=(1, 2), default=1)
+    ap.add_argument("--our-spp", type=int, default=None,
+                    help="craterform's bounce rays a pixel (default: --spp)")
+    ap.add_argument("--filter-px", type=int, default=0,
+                    help="craterform's bounce_filter_px (the camera's default: 4)")
     args = ap.parse_args()
+    our_spp = args.spp if args.our_spp is None else args.our_spp
     v, f = crater_mesh()
     mesh = RayMesh(v, f)
     el = np.radians(ELEVATION_DEG)
@@ -100,8 +106,9 @@ def main() -> int:
     direct = render(mesh, cam, pose, sun, **kw).reflectance
     t1 = time.perf_counter()
     # more than render's 4096 rays a pixel: the mean of renders with other seeds
-    runs = [render(mesh, cam, pose, sun, bounces=args.bounces, bounce_samples=min(args.spp, 4096),
-                   seed=s, **kw) for s in range(max(1, args.spp // 4096))]
+    runs = [render(mesh, cam, pose, sun, bounces=args.bounces, bounce_samples=min(our_spp, 4096),
+                   bounce_filter_px=args.filter_px, seed=s, **kw)
+            for s in range(max(1, our_spp // 4096))]
     ours = runs[0]
     bounced = np.mean([fr.reflectance for fr in runs], axis=0)
     t2 = time.perf_counter()
@@ -126,7 +133,8 @@ def main() -> int:
           " (Mitsuba)")
     print(f"median relative difference {np.median(np.abs(rel)):.4f}, median signed "
           f"{np.median(rel):+.4f}, 90th percentile {np.percentile(np.abs(rel), 90):.4f}")
-    print(f"times: craterform direct {t1 - t0:.2f} s, bounce ({args.spp} rays a pixel) "
+    print(f"times: craterform direct {t1 - t0:.2f} s, bounce ({our_spp} rays a pixel, "
+          f"filter {args.filter_px} px) "
           f"{t2 - t1:.2f} s; Mitsuba direct {t4 - t3:.2f} s, path depth {2 + args.bounces} "
           f"({args.spp} spp) "
           f"{t5 - t4:.2f} s")
