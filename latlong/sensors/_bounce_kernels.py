@@ -20,14 +20,14 @@ SECOND_BOUNCE = 1 << 32
 
 
 @njit(cache=True, parallel=True)
-def _bounce_rays_kernel(pos, ng, ns, offset, centre, floor, seed, sample, out_o, out_d,
+def _bounce_rays_kernel(pos, ng, ns, ids, offset, centre, floor, seed, sample, out_o, out_d,
                         above):
     """Cosine-weighted directions about the shading normal ``ns`` (sample ``sample`` of
-    each point, counter-based on (seed, sample, point)), origins lifted along the
-    geometric normal as the shadow rays' are; ``above``: the direction leaves the facet
-    (a direction below it carries no light)."""
+    each point, counter-based on (seed, sample, the point's id ``ids[i]``)), origins
+    lifted along the geometric normal as the shadow rays' are; ``above``: the direction
+    leaves the facet (a direction below it carries no light)."""
     for i in prange(pos.shape[0]):
-        h = _key(seed, BOUNCE_STREAM + sample, i)
+        h = _key(seed, BOUNCE_STREAM + sample, ids[i])
         u1 = _uniform(h)
         u2 = _uniform(splitmix64(h))
         r = math.sqrt(u1)
@@ -81,13 +81,14 @@ PLANE_SIN2 = 0.03
 
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
-def _bounce_filter_kernel(light, seen, pos, nrm, radius, out):
+def _bounce_filter_kernel(light, seen, pos, nrm, rays, radius, out):
     """Cross-bilateral mean of ``light`` (h, w, bands) over the seen pixels within
     ``radius`` pixels of each seen pixel (unseen pixels copied): weights the spatial
     Gaussian exp(-(di^2 + dj^2) / (2 sigma^2)) of sigma radius / 2 times the geometric
-    weights above, from the points ``pos`` and shading normals ``nrm`` (h, w, 3). Each
-    pixel's sums in a fixed order (rows, then columns of its window): the same bytes on
-    any thread count."""
+    weights above, from the points ``pos`` and shading normals ``nrm`` (h, w, 3), times
+    the neighbour's ``rays`` (h, w: the rays its estimate averages). Each pixel's sums in
+    a fixed order (rows, then columns of its window): the same bytes on any thread
+    count."""
     h, w, nb = light.shape
     side = 2 * radius + 1
     spatial = np.empty((side, side))
@@ -124,7 +125,7 @@ def _bounce_filter_kernel(light, seen, pos, nrm, radius, out):
                             continue
                     for _ in range(NORMAL_POWER_LOG2):
                         c = c * c
-                    wt = spatial[ii - i + radius, jj - j + radius] * c * (t * t)
+                    wt = spatial[ii - i + radius, jj - j + radius] * c * (t * t) * rays[ii, jj]
                     total += wt
                     for b in range(nb):
                         acc[b] += wt * light[ii, jj, b]

@@ -261,8 +261,10 @@ class CameraSettings:
                            "0: direct sunlight only)", range=(0, 2))
     """Bounces of light between surfaces, 0, 1 or 2 (:func:`~latlong.sensors.render.render`)."""
     bounce_samples: int = setting(8, "rays a pixel for the bounced light (its noise falls as "
-                                  "1 / sqrt of this)", range=(1, 4096))
-    """Cosine-weighted rays a pixel for the bounced light, [1, 4096]."""
+                                  "1 / sqrt of this; a quarter in full sun when smoothed)",
+                                  range=(1, 4096))
+    """Cosine-weighted rays a pixel for the bounced light, [1, 4096] (with
+    ``bounce_filter_px`` > 0, a quarter of them for fully sunlit pixels)."""
     bounce_filter_px: int = setting(8, "smooth the bounced light over this many pixels around "
                                     "each, on the same surface (0: each pixel's own rays)",
                                     unit="px", range=(0, 64))

@@ -108,29 +108,40 @@ def shade(models, cosines, lit, albedo) -> np.ndarray:
 
 
 def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun,
-             samples: int, seed: int, bounces: int = 1, smooth=None) -> np.ndarray:
+             samples: int, seed: int, bounces: int = 1, smooth=None,
+             sunlit_full=None) -> np.ndarray:
     """Bounced light (:mod:`.render`'s notes): (n, bands) I/F added at each point ``pos``
     (n, 3) by the sunlit surface it sees (``samples`` cosine-weighted rays a point) and,
     with ``bounces`` 2, by the light that surface received once from the rest (one ray
     on from each hit). ``smooth`` (optional) maps the light received, (n, bands) as a
-    white Lambertian surface would send it back, to a smoothed estimate
-    (:func:`filter_bounced`) before each point's albedo multiplies it."""
+    white Lambertian surface would send it back, and the rays a point's estimate averages
+    (n,) to a smoothed estimate (:func:`filter_bounced`) before each point's albedo
+    multiplies it; with it, the points ``sunlit_full`` marks (n,) trace a quarter of the
+    rays (their bounced light is a few per cent of their direct light: its noise, smoothed,
+    is not seen), the others all."""
     from ._bounce_kernels import SECOND_BOUNCE, _bounce_rays_kernel  # numba loads here
     centre, radius_m = mesh.bounding_sphere
-    floor = 1e-3 * SHADOW_OFFSET * radius_m
     n = len(pos)
-    p, g, h = (np.ascontiguousarray(a) for a in (pos, ng, ns))
-    o, d = np.empty((n, 3)), np.empty((n, 3))
-    above = np.empty(n, dtype=np.bool_)
+    rays = np.full(n, samples, dtype=np.int64)
+    if smooth is not None and sunlit_full is not None:
+        rays[np.asarray(sunlit_full, dtype=np.bool_)] = max(1, samples // 4)
     total = np.zeros((n, len(models)))
     # the receiving points as Lambertian surfaces of each model's normal albedo
     normal_albedo = [float(radiance_factor(m, 1.0, 1.0, 1.0)[0]) for m in models]
+    active = np.arange(n)
     for k in range(samples):
-        _bounce_rays_kernel(p, g, h, SHADOW_OFFSET, centre, floor, seed, k, o, d, above)
+        if len(active) and rays[active].min() <= k:
+            active = np.flatnonzero(rays > k)  # the points still tracing at sample k
+        p, g, h = (np.ascontiguousarray(a if len(active) == n else a[active])
+                   for a in (pos, ng, ns))
+        o, d = np.empty((len(active), 3)), np.empty((len(active), 3))
+        above = np.empty(len(active), dtype=np.bool_)
+        _bounce_rays_kernel(p, g, h, active, SHADOW_OFFSET, centre, 1e-3 * SHADOW_OFFSET *
+                            radius_m, seed, k, o, d, above)
         face, q, nq, hits = _secondary_hits(mesh, o, d, above)
         light, va = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun,
                                 seed)
-        total += light
+        total[active] += light
         front = np.flatnonzero((face >= 0) & (np.einsum("ij,ij->i", nq, d) < 0.0))
         if bounces < 2 or not len(front):
             continue
@@ -139,16 +150,17 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         q2, n2 = np.ascontiguousarray(q[front]), np.ascontiguousarray(nq[front])
         o2, d2 = np.empty_like(q2), np.empty_like(q2)
         above2 = np.empty(len(front), dtype=np.bool_)
-        _bounce_rays_kernel(q2, n2, n2, SHADOW_OFFSET, centre, floor, seed,
-                            SECOND_BOUNCE + k, o2, d2, above2)
+        _bounce_rays_kernel(q2, n2, n2, np.arange(len(front)), SHADOW_OFFSET, centre,
+                            1e-3 * SHADOW_OFFSET * radius_m, seed, SECOND_BOUNCE + k, o2, d2,
+                            above2)
         face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
         light2, _ = _seen_light(mesh, models, d2, face2, r2, nr2, hits2, vertex_albedo, sun,
                                 seed)
         for b in range(len(models)):
-            total[front, b] += normal_albedo[b] * va[front] * light2[:, b]
+            total[active[front], b] += normal_albedo[b] * va[front] * light2[:, b]
     out = np.empty_like(total)
     if smooth is not None:
-        received = smooth(total / samples)
+        received = smooth(total / rays[:, None], rays)
         for b in range(len(models)):
             out[:, b] = normal_albedo[b] * albedo * received[:, b]
         return out
@@ -158,24 +170,29 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
 
 
 def filter_bounced(received: np.ndarray, seen: np.ndarray, pos: np.ndarray, ns: np.ndarray,
-                   radius_px: int) -> np.ndarray:
+                   radius_px: int, rays=None) -> np.ndarray:
     """The bounced light ``received`` by the seen pixels, (n_seen, bands), smoothed across
     the image (h, w) = ``seen.shape``: a cross-bilateral mean within ``radius_px`` pixels
     whose weights keep to one surface (a neighbour counts less the more its shading
     normal turns away, ``ns`` (h, w, 3), and the farther it lies off the point's tangent
-    plane, ``pos`` (h, w, 3): a crater rim in front of a floor is not averaged into it).
-    Light bounced from the surroundings changes over metres, not from pixel to pixel,
-    while the Monte Carlo noise of a few rays a pixel does: the mean over ~radius^2
-    pixels removes most of it. The direct light and its shadow edges are not touched."""
+    plane, ``pos`` (h, w, 3): a crater rim in front of a floor is not averaged into it)
+    and count each neighbour's ``rays`` (n_seen,: the rays its estimate averages; all 1
+    by default). Light bounced from the surroundings changes over metres, not from pixel
+    to pixel, while the Monte Carlo noise of a few rays a pixel does: the mean over
+    ~radius^2 pixels removes most of it. The direct light and its shadow edges are not
+    touched."""
     from ._bounce_kernels import _bounce_filter_kernel  # numba loads here
     h, w = seen.shape
     nb = received.shape[1]
     light = np.zeros((h * w, nb))
     light[seen.ravel()] = received
+    weight = np.zeros(h * w)
+    weight[seen.ravel()] = 1.0 if rays is None else rays
     out = np.empty((h, w, nb))
     _bounce_filter_kernel(light.reshape(h, w, nb), np.ascontiguousarray(seen),
                           np.ascontiguousarray(pos, dtype=np.float64),
-                          np.ascontiguousarray(ns, dtype=np.float64), int(radius_px), out)
+                          np.ascontiguousarray(ns, dtype=np.float64), weight.reshape(h, w),
+                          int(radius_px), out)
     return out.reshape(h * w, nb)[seen.ravel()]
 
 

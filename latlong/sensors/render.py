@@ -30,10 +30,12 @@ the second; a crater's shadowed floor Mitsuba 3's path tracer within 3.5 % for o
 bounce (``tests/benchmarks/compare_bounce_mitsuba.py``). ``bounce_filter_px`` > 0
 smooths the bounced light over that many pixels around each, on the same surface
 (:func:`~.light.filter_bounced`: bounced light changes over metres, the noise of a few
-rays from pixel to pixel); a few rays a pixel then do the work of hundreds. ``render``'s
-default is the sun's direct light alone (``bounces=0``); camera runs
-(:class:`~.camera_files.CameraSettings`, ``latlong camera``) default to one bounce of 8
-rays a pixel smoothed over 8 pixels. The sky sends nothing but,
+rays from pixel to pixel), and fully sunlit pixels then trace a quarter of the rays
+(their bounced light is a few per cent of their direct light); a few rays a pixel then
+do the work of hundreds. ``render``'s default is the sun's direct light alone
+(``bounces=0``); camera runs (:class:`~.camera_files.CameraSettings`, ``latlong
+camera``) default to one bounce of 8 rays a pixel (2 in sunlight) smoothed over 8
+pixels. The sky sends nothing but,
 with ``planet``, a planet's light (:mod:`.planetshine`): shaded and shadowed as the
 sun's, scaled by its irradiance ratio.
 
@@ -290,13 +292,13 @@ def _reflectance(mesh: RayMesh, models, rays, surface, lit, albedo, sun: Sun, *,
         seen = hits.face >= 0
         smooth = None
         if bounce_filter_px:
-            def smooth(received):
+            def smooth(received, rays):
                 return filter_bounced(received, seen.reshape(image_shape),
                                       pos.reshape(*image_shape, 3),
-                                      ns.reshape(*image_shape, 3), bounce_filter_px)
+                                      ns.reshape(*image_shape, 3), bounce_filter_px, rays)
         refl[seen] += indirect(mesh, models, pos[seen], ng[seen], ns[seen], albedo[seen],
                                vertex_albedo, sun, bounce_samples, seed, bounces,
-                               smooth=smooth)
+                               smooth=smooth, sunlit_full=lit[seen] >= 1.0)
     if planet is not None:
         refl += planet_light(mesh, models, origin, dirs, hits, vnormals, planet, sun, albedo,
                              planet_samples, seed)
