@@ -45,6 +45,9 @@ DESCENT = {
                                unit="deg", range="finite", run=True),
     "sun_elevation_deg": Setting(25.0, "sun elevation above the site's horizon", unit="deg",
                                  range=(0.5, 90.0), run=True),
+    "bounces": Setting(0, "bounces of light between surfaces (1: shadowed crater floors lit "
+                       "by their sunlit walls, ~4 s more a 1024^2 frame; 0: direct sunlight "
+                       "only)", range=(0, 2), run=True),
     "output": Setting(help="output folder", flag="-o/--output", required=True, run=True),
 }
 
@@ -127,7 +130,7 @@ def camera_options(v: Values) -> dict:
     """The camera keywords of :func:`latlong.ondemand.descent.descent` from the options."""
     return {"fov_deg": v["fov_deg"], "width_px": v["size_px"],
             "sun_azimuth_deg": v["sun_azimuth_deg"], "sun_elevation_deg": v["sun_elevation_deg"],
-            "lidar": lidar_settings(v), "lidar_seed": v["lidar_seed"]}
+            "lidar": lidar_settings(v), "lidar_seed": v["lidar_seed"], "bounces": v["bounces"]}
 
 
 def write_descent_run(frames, out, v: Values, *, seed, lidar=None) -> int:
@@ -145,7 +148,8 @@ def write_descent_run(frames, out, v: Values, *, seed, lidar=None) -> int:
 
     try:
         n = write_descent(frames, out, seed=seed, site_lat_lon_deg=(v["lat_deg"], v["lon_deg"]),
-                          report=report, lidar=lidar, lidar_seed=v["lidar_seed"])
+                          report=report, lidar=lidar, lidar_seed=v["lidar_seed"],
+                          bounces=v["bounces"])
     except ParameterError as exc:
         if exc.name != "lidar":  # the LIDAR's reach beyond the terrain window
             raise

@@ -155,13 +155,24 @@ def _terrain(field: CraterField, lat_deg, lon_deg, size_m, pixel_m, site_radius)
     return units * radii[:, None], faces, counts, "body", _rock_faces(field, faces)
 
 
+def _field_of(scene: Scene | CraterField) -> CraterField:
+    """The crater field of a scene, or the field itself (e.g. over a DEM, dem.ondemand)."""
+    if isinstance(scene, Scene):
+        return crater_field(scene)
+    if isinstance(scene, CraterField):
+        return scene
+    raise TypeError(f"`scene` must be a latlong.Scene or a CraterField; got "
+                    f"{type(scene).__name__}")
+
+
 def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitudes_m, *,
             fov_deg: float = 30.0, width_px: int = 512, sun_azimuth_deg: float = 90.0,
             sun_elevation_deg: float = 25.0, reflectance=None,
             lidar: LidarSettings | None = None, lidar_seed: int = 0,
             bright_ejecta: float = 0.5, mottling: float = 0.05,
             microrelief_deg: float = MICRORELIEF_DEG,
-            microrelief_hurst: float = MICRORELIEF_HURST) -> Iterator[DescentFrame]:
+            microrelief_hurst: float = MICRORELIEF_HURST,
+            bounces: int = 0) -> Iterator[DescentFrame]:
     """Frames of a vertical descent over (lat, lon) at ``altitudes_m`` (module notes) of a
     scene, or of a crater field (any base, e.g. a DEM's), square pictures ``width_px``
     wide, the sun at ``sun_azimuth_deg`` (clockwise from north) and ``sun_elevation_deg``
@@ -170,21 +181,21 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
     contrasts; ``microrelief_deg`` the RMS tilt at a 1 m pixel of the relief below each
     frame's stamped craters, shown as shading (``latlong.sensors.regolith_normals``; 0:
     none), ``microrelief_hurst`` its Hurst exponent: the tilt at a pixel p metres wide is
-    ``atan(tan(microrelief_deg) p^(H - 1))`` (module notes)."""
+    ``atan(tan(microrelief_deg) p^(H - 1))`` (module notes); ``bounces`` 1 or 2 lights
+    the shadows with the light the terrain sends itself (the camera's defaults of
+    :class:`~latlong.sensors.CameraSettings`: 8 rays a pixel smoothed over 8 pixels, new
+    rays in each frame; 0, the default: the sun's direct light only, ~4 s less a 1024^2
+    frame)."""
     from ..sensors import Camera, LidarSettings, Pose, lidar_frame, render
+    from ..sensors.camera_files import frame_seed
     from ..sensors.engine import RayMesh
     from ..sensors.lidar_files import body_fixed_wkt
     from ..sensors.scene_geometry import SceneGeometry
 
-    if isinstance(scene, Scene):
-        field = crater_field(scene)
-    elif isinstance(scene, CraterField):  # e.g. over a DEM (dem.ondemand)
-        field = scene
-    else:
-        raise TypeError(f"`scene` must be a latlong.Scene or a CraterField; got "
-                        f"{type(scene).__name__}")
+    field = _field_of(scene)
     check_range("fov_deg", fov_deg, 1.0, 120.0)
     width_px = check_int("width_px", width_px, 16, 8192)
+    bounces = check_int("bounces", bounces, 0, 2)
     check_descent_memory(width_px)
     shading = _Shading.checked(field.base.seed, bright_ejecta, mottling, microrelief_deg,
                                microrelief_hurst)
@@ -222,7 +233,8 @@ def descent(scene: Scene | CraterField, lat_deg: float, lon_deg: float, altitude
                               source="terrain on demand")
         albedo, normals = shading.of(truth, mesh, pixel)
         frame = render(mesh, camera, pose, sun, reflectance=reflectance, ground_truth=truth,
-                       vertex_albedo=albedo, normals=normals)
+                       vertex_albedo=albedo, normals=normals, bounces=bounces,
+                       seed=frame_seed(shading.seed, i))
         returns = None if lidar is None else lidar_frame(
             mesh, lidar, pose.position_m, pose.quaternion_wxyz,
             rng=np.random.default_rng([lidar_seed, i]), ground_truth=truth)
@@ -287,7 +299,7 @@ def display(reflectance: np.ndarray, scale: float) -> np.ndarray:
 
 
 def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=None,
-                  lidar_seed=None) -> int:
+                  lidar_seed=None, bounces: int = 0) -> int:
     """Write the :class:`DescentFrame` s of ``frames`` (an iterable, e.g. :func:`descent`)
     into the new folder ``out`` (written whole or not at all,
     :func:`latlong.sensors.runs.run_folder`): per frame the camera's files (image, depth,
@@ -301,7 +313,8 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
     files; frames with LIDAR returns add ``lidar_NNNN.las`` (LAS 1.4 unless the settings
     say 1.2, ``.laz`` with ``laz``; crater labels as extra bytes) and
     ``lidar_range_NNNN.npy`` (first-return range image), and the manifest the LIDAR's
-    settings ``lidar`` and ``lidar_seed``. ``report(i, frame)`` is
+    settings ``lidar`` and ``lidar_seed``; ``bounces``, the frames' (:func:`descent`), is
+    recorded in the manifest. ``report(i, frame)`` is
     called as frames are written. Returns the number of frames."""
     from PIL import Image
 
@@ -359,6 +372,7 @@ def write_descent(frames, out, *, seed, site_lat_lon_deg, report=None, lidar=Non
                                                 "lidar_intrinsics": lidar.intrinsics(),
                                                 "lidar_seed": lidar_seed}
         write_manifest(tmp, {"intrinsics": f.frame.camera.intrinsics(), "seed": seed,
+                             "bounces": int(bounces),
                              "site_lat_lon_deg": [float(x) for x in site_lat_lon_deg],
                              **lidar_keys, "frames": entries})
     return len(entries)

@@ -265,9 +265,9 @@ class CameraSettings:
                                   range=(1, 4096))
     """Cosine-weighted rays a pixel for the bounced light, [1, 4096] (with
     ``bounce_filter_px`` > 0, a quarter of them for fully sunlit pixels)."""
-    bounce_filter_px: int = setting(8, "smooth the bounced light over this many pixels around "
-                                    "each, on the same surface (0: each pixel's own rays)",
-                                    unit="px", range=(0, 64))
+    bounce_filter_px: int = setting(8, "radius of the bounced light's smoothing on the same "
+                                    "surface (0: each pixel's own rays)", unit="px",
+                                    range=(0, 64))
     """Radius of the bounced light's smoothing, pixels, [0, 64]
     (:func:`~latlong.sensors.light.filter_bounced`; 0: none)."""
     blur_samples: int = setting(0, "motion blur: instants sampled over each frame's exposure "

@@ -453,6 +453,27 @@ def test_descent_frames_label_the_craters_of_their_own_terrain(scene):
     assert len(frames[0].craters) > 20
 
 
+def test_descent_frames_light_their_shadows_with_bounced_light_when_asked(scene):
+    from latlong.ondemand.descent import descent
+
+    alts = [60.0, 20.0]
+    direct = list(descent(scene, 10.0, 40.0, alts, width_px=64, sun_elevation_deg=8.0))
+    lit = list(descent(scene, 10.0, 40.0, alts, width_px=64, sun_elevation_deg=8.0,
+                       bounces=1))
+    for a, b in zip(direct, lit, strict=True):
+        np.testing.assert_array_equal(a.frame.depth_m, b.frame.depth_m)  # the same terrain
+        seen = a.frame.face >= 0
+        shadow = seen & (a.frame.sunlit == 0)
+        assert shadow.mean() > 0.01
+        assert (a.frame.reflectance[shadow] == 0).all()
+        # the terrain lights its own shadows (where lit ground rises above a shadowed point's
+        # horizon: ~40 % of them on this 100 m convex body at 8 deg sun), and adds to the rest
+        assert (b.frame.reflectance[shadow] > 0).mean() > 0.2
+        assert (b.frame.reflectance[seen] >= a.frame.reflectance[seen]).all()
+    with pytest.raises(ValueError, match="bounces"):
+        next(descent(scene, 10.0, 40.0, alts, width_px=64, bounces=3))
+
+
 def test_descent_lidar_sees_the_frames_terrain_as_the_camera_does(scene):
     from latlong.ondemand.descent import descent
     from latlong.sensors import LidarSettings
