@@ -121,6 +121,7 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
     is not seen), the others all."""
     from ._bounce_kernels import SECOND_BOUNCE, _bounce_rays_kernel  # numba loads here
     centre, radius_m = mesh.bounding_sphere
+    floor = 1e-3 * SHADOW_OFFSET * radius_m
     n = len(pos)
     rays = np.full(n, samples, dtype=np.int64)
     if smooth is not None and sunlit_full is not None:
@@ -136,8 +137,8 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
                    for a in (pos, ng, ns))
         o, d = np.empty((len(active), 3)), np.empty((len(active), 3))
         above = np.empty(len(active), dtype=np.bool_)
-        _bounce_rays_kernel(p, g, h, active, SHADOW_OFFSET, centre, 1e-3 * SHADOW_OFFSET *
-                            radius_m, seed, k, o, d, above)
+        _bounce_rays_kernel(p, g, h, active, SHADOW_OFFSET, centre, floor, seed, k, o, d,
+                            above)
         face, q, nq, hits = _secondary_hits(mesh, o, d, above)
         light, va = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun,
                                 seed)
@@ -150,9 +151,8 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         q2, n2 = np.ascontiguousarray(q[front]), np.ascontiguousarray(nq[front])
         o2, d2 = np.empty_like(q2), np.empty_like(q2)
         above2 = np.empty(len(front), dtype=np.bool_)
-        _bounce_rays_kernel(q2, n2, n2, np.arange(len(front)), SHADOW_OFFSET, centre,
-                            1e-3 * SHADOW_OFFSET * radius_m, seed, SECOND_BOUNCE + k, o2, d2,
-                            above2)
+        _bounce_rays_kernel(q2, n2, n2, np.arange(len(front)), SHADOW_OFFSET, centre, floor,
+                            seed, SECOND_BOUNCE + k, o2, d2, above2)
         face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
         light2, _ = _seen_light(mesh, models, d2, face2, r2, nr2, hits2, vertex_albedo, sun,
                                 seed)
@@ -176,7 +176,7 @@ def filter_bounced(received: np.ndarray, seen: np.ndarray, pos: np.ndarray, ns: 
     whose weights keep to one surface (a neighbour counts less the more its shading
     normal turns away, ``ns`` (h, w, 3), and the farther it lies off the point's tangent
     plane, ``pos`` (h, w, 3): a crater rim in front of a floor is not averaged into it)
-    and count each neighbour's ``rays`` (n_seen,: the rays its estimate averages; all 1
+    and count each neighbour's ``rays`` ((n_seen,): the rays its estimate averages; all 1
     by default). Light bounced from the surroundings changes over metres, not from pixel
     to pixel, while the Monte Carlo noise of a few rays a pixel does: the mean over
     ~radius^2 pixels removes most of it. The direct light and its shadow edges are not
