@@ -28,6 +28,13 @@ HELP = {
 __all__ = ["DESCENT", "LIDAR", "OPTIONS", "camera_options", "check_descent_folder",
            "lidar_settings", "register", "write_descent_run"]
 
+def _camera_setting(key: str) -> Setting:
+    """A setting of :class:`~latlong.sensors.CameraSettings` (declared there once)."""
+    from latlong.sensors import CameraSettings
+
+    return declared_keys(CameraSettings)[key]
+
+
 DESCENT = {
     "lat_deg": Setting(help="latitude of the landing site", unit="deg", range=(-90.0, 90.0),
                        kind=float, required=True, run=True),
@@ -45,9 +52,8 @@ DESCENT = {
                                unit="deg", range="finite", run=True),
     "sun_elevation_deg": Setting(25.0, "sun elevation above the site's horizon", unit="deg",
                                  range=(0.5, 90.0), run=True),
-    "bounces": Setting(0, "bounces of light between surfaces (1: shadowed crater floors lit "
-                       "by their sunlit walls, ~4 s more a 1024^2 frame; 0: direct sunlight "
-                       "only)", range=(0, 2), run=True),
+    # the camera's setting, off by default: ~4 s more a 1024^2 frame
+    "bounces": dataclasses.replace(_camera_setting("bounces"), default=0, run=True),
     "output": Setting(help="output folder", flag="-o/--output", required=True, run=True),
 }
 

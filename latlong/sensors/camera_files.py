@@ -59,7 +59,7 @@ from .motion import timed_frame
 from .photometry import REFLECTANCES, LommelSeeliger, Photometry, with_albedo
 from .planetshine import Planet
 from .poses import Poses
-from .render import Frame, Sun, band_name_ok, render
+from .render import BOUNCE_FILTER_PX, BOUNCE_SAMPLES, Frame, Sun, band_name_ok, render
 from .runs import check_output_folder, run_folder
 from .scene_geometry import ray_scene
 from .sensor import Sensor, display_image
@@ -260,14 +260,14 @@ class CameraSettings:
                            "lit by the sunlit walls; 2: and by what those walls received; "
                            "0: direct sunlight only)", range=(0, 2))
     """Bounces of light between surfaces, 0, 1 or 2 (:func:`~latlong.sensors.render.render`)."""
-    bounce_samples: int = setting(8, "rays a pixel for the bounced light (its noise falls as "
-                                  "1 / sqrt of this; a quarter in full sun when smoothed)",
-                                  range=(1, 4096))
+    bounce_samples: int = setting(BOUNCE_SAMPLES, "rays a pixel for the bounced light (its "
+                                  "noise falls as 1 / sqrt of this; a quarter in full sun "
+                                  "when smoothed)", range=(1, 4096))
     """Cosine-weighted rays a pixel for the bounced light, [1, 4096] (with
     ``bounce_filter_px`` > 0, a quarter of them for fully sunlit pixels)."""
-    bounce_filter_px: int = setting(8, "radius of the bounced light's smoothing on the same "
-                                    "surface (0: each pixel's own rays)", unit="px",
-                                    range=(0, 64))
+    bounce_filter_px: int = setting(BOUNCE_FILTER_PX, "radius of the bounced light's "
+                                    "smoothing on the same surface (0: each pixel's own "
+                                    "rays)", unit="px", range=(0, 64))
     """Radius of the bounced light's smoothing, pixels, [0, 64]
     (:func:`~latlong.sensors.light.filter_bounced`; 0: none)."""
     blur_samples: int = setting(0, "motion blur: instants sampled over each frame's exposure "

@@ -130,13 +130,15 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
     # the receiving points as Lambertian surfaces of each model's normal albedo
     normal_albedo = [float(radiance_factor(m, 1.0, 1.0, 1.0)[0]) for m in models]
     active = np.arange(n)
+    p, g, h = (np.ascontiguousarray(a) for a in (pos, ng, ns))
+    o, d = np.empty((n, 3)), np.empty((n, 3))
+    above = np.empty(n, dtype=np.bool_)
+    fewest = int(rays.min()) if n else samples
     for k in range(samples):
-        if len(active) and rays[active].min() <= k:
-            active = np.flatnonzero(rays > k)  # the points still tracing at sample k
-        p, g, h = (np.ascontiguousarray(a if len(active) == n else a[active])
-                   for a in (pos, ng, ns))
-        o, d = np.empty((len(active), 3)), np.empty((len(active), 3))
-        above = np.empty(len(active), dtype=np.bool_)
+        if k == fewest:  # the sunlit points have traced theirs: the others go on
+            active = np.flatnonzero(rays > k)
+            p, g, h = (np.ascontiguousarray(a[active]) for a in (pos, ng, ns))
+            o, d, above = o[:len(active)], d[:len(active)], above[:len(active)]
         _bounce_rays_kernel(p, g, h, active, SHADOW_OFFSET, centre, floor, seed, k, o, d,
                             above)
         face, q, nq, hits = _secondary_hits(mesh, o, d, above)

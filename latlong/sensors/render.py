@@ -72,7 +72,13 @@ from .planetshine import Planet
 from .scene_geometry import SceneGeometry, traced_model
 from .sensor import Sensor, expose, exposure_for
 
-__all__ = ["SUN_RADIUS_1AU_DEG", "Frame", "Sun", "camera_inside", "render"]
+__all__ = ["BOUNCE_FILTER_PX", "BOUNCE_SAMPLES", "SUN_RADIUS_1AU_DEG", "Frame", "Sun",
+           "camera_inside", "render"]
+
+#: Bounce rays a pixel and the radius of their smoothing, pixels, unless asked otherwise
+#: (:func:`render` and :class:`~.camera_files.CameraSettings` alike).
+BOUNCE_SAMPLES = 8
+BOUNCE_FILTER_PX = 8
 
 
 
@@ -202,7 +208,7 @@ def render(model, camera: Camera, pose: Pose, sun, *, reflectance=None,
            sensor: Sensor | None = None, normals="smooth", vertex_albedo=None,
            soft_shadow_samples: int = 0, seed: int = 0,
            ground_truth: SceneGeometry | None = None, bounces: int = 0,
-           bounce_samples: int = 8, bounce_filter_px: int = 8,
+           bounce_samples: int = BOUNCE_SAMPLES, bounce_filter_px: int = BOUNCE_FILTER_PX,
            planet: Planet | None = None, bands: Mapping[str, object] | None = None) -> Frame:
     """Render one frame of ``model`` seen by ``camera`` at ``pose``, lit by ``sun`` (a
     :class:`Sun` or a direction towards it). See the module notes.
