@@ -390,6 +390,13 @@ REFERENCES = _entries(
     _R("frisvad2012", ("Frisvad, J. R.",), 2012,
        "Building an orthonormal basis from a 3D unit vector without normalization",
        "Journal of Graphics Tools 16(3), 151-159 (DOI not confirmed)"),
+    _R("dammertz2010", ("Dammertz, H.", "Sewtz, D.", "Hanika, J.", "Lensch, H. P. A."), 2010,
+       "Edge-avoiding À-Trous wavelet transform for fast global illumination filtering",
+       "Proceedings of High Performance Graphics 2010, 67-75 (DOI not confirmed)"),
+    _R("knutsson1993", ("Knutsson, H.", "Westin, C.-F."), 1993,
+       "Normalized and differential convolution: methods for interpolation and filtering "
+       "of incomplete and uncertain data", "Proceedings of the IEEE Conference on Computer "
+       "Vision and Pattern Recognition 1993, 515-523 (DOI not confirmed)"),
     _R("ingersoll1992", ("Ingersoll, A. P.", "Svitek, T.", "Murray, B. C."), 1992,
        "Stability of polar frosts in spherical bowl-shaped craters on the Moon, Mercury, "
        "and Mars", "Icarus 100(1), 40-47 (DOI not confirmed)"),

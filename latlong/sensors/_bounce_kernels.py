@@ -71,63 +71,97 @@ def _bounce_light_kernel(code, params, dirs, face, face_normals, albedo_w, sun, 
         out[k] = _radiance_factor(code, params, cos_i, cos_e, cos_g) * albedo_w[k] * lit[k]
 
 
-#: The geometric weights of :func:`_bounce_filter_kernel` (:func:`.light.filter_bounced`):
+#: The geometric weights of :func:`_atrous_pass_kernel` (:func:`.light.filter_bounced`):
 #: a neighbour counts by (n_p . n_q)^(2^NORMAL_POWER_LOG2) = (n_p . n_q)^32 and by
 #: (1 - sin^2 / PLANE_SIN2)^2, 0 beyond, sin the elevation of the neighbour above the
 #: point's tangent plane seen from the point (0 for one plane; ~10 deg cuts it off).
 NORMAL_POWER_LOG2 = 5
 PLANE_SIN2 = 0.03
+#: The cubic B-spline's taps (1, 4, 6, 4, 1) / 16 of each a-trous pass (Dammertz et al.
+#: 2010): a pass with taps ``step`` pixels apart has variance step^2 px^2 per axis.
+B3_TAPS = np.array([1.0, 4.0, 6.0, 4.0, 1.0]) / 16.0
 
 
-@read_only_inputs("out")
+def atrous_steps(radius: int) -> list[int]:
+    """The a-trous passes' tap spacings for a smoothing ``radius`` in pixels: 1, 2, 4 ...
+    up to the largest power of two <= radius / 2 (at least one pass): their variances add
+    to ~(radius / 2)^2 (8 px: 1 + 4 + 16 = 21, sigma 4.6 px), the Gaussian of sigma
+    radius / 2 that they stand for, reaching 2 (1 + 2 + 4 ...) px."""
+    steps = [1]
+    while 2 * steps[-1] <= radius / 2:
+        steps.append(2 * steps[-1])
+    return steps
+
+
+@njit(cache=True, inline="always")
+def _geometric_weight(pos, nrm, i, j, ii, jj):
+    """The weight of neighbour (ii, jj) for pixel (i, j) on one surface (module notes):
+    0 when its normal turns away or it lies off the pixel's tangent plane."""
+    nx, ny, nz = nrm[i, j, 0], nrm[i, j, 1], nrm[i, j, 2]
+    c = nx * nrm[ii, jj, 0] + ny * nrm[ii, jj, 1] + nz * nrm[ii, jj, 2]
+    if not c > 0.0:
+        return 0.0
+    dx = pos[ii, jj, 0] - pos[i, j, 0]
+    dy = pos[ii, jj, 1] - pos[i, j, 1]
+    dz = pos[ii, jj, 2] - pos[i, j, 2]
+    d2 = dx * dx + dy * dy + dz * dz
+    t = 1.0
+    if d2 > 0.0:
+        e = nx * dx + ny * dy + nz * dz
+        t = 1.0 - e * e / (d2 * PLANE_SIN2)
+        if not t > 0.0:
+            return 0.0
+    for _ in range(NORMAL_POWER_LOG2):
+        c = c * c
+    return c * (t * t)
+
+
+@read_only_inputs("out_num", "out_den")
 @njit(cache=True, parallel=True)
-def _bounce_filter_kernel(light, seen, pos, nrm, rays, radius, out):
-    """Cross-bilateral mean of ``light`` (h, w, bands) over the seen pixels within
-    ``radius`` pixels of each seen pixel (unseen pixels copied): weights the spatial
-    Gaussian exp(-(di^2 + dj^2) / (2 sigma^2)) of sigma radius / 2 times the geometric
-    weights above, from the points ``pos`` and shading normals ``nrm`` (h, w, 3), times
-    the neighbour's ``rays`` (h, w: the rays its estimate averages). Each pixel's sums in
-    a fixed order (rows, then columns of its window): the same bytes on any thread
-    count."""
-    h, w, nb = light.shape
-    side = 2 * radius + 1
-    spatial = np.empty((side, side))
-    inv_2s2 = 2.0 / (radius * radius)  # 1 / (2 sigma^2), sigma = radius / 2
-    for a in range(side):
-        for b in range(side):
-            spatial[a, b] = math.exp(-((a - radius) ** 2 + (b - radius) ** 2) * inv_2s2)
+def _atrous_pass_kernel(num, den, seen, pos, nrm, taps, step, out_num, out_den):
+    """One pass of the edge-avoiding a-trous filter (Dammertz, Sewtz, Hanika & Lensch
+    2010, "Edge-avoiding a-trous wavelet transform for fast global illumination
+    filtering", HPG): each seen pixel's ``num`` (h, w, bands) and ``den`` (h, w) become
+    their means over the 5 x 5 seen pixels ``step`` apart around it, weighted by the
+    B-spline ``taps`` (5,) times the geometric weights (:func:`_geometric_weight`).
+    ``num`` = rays x light and ``den`` = rays carried through every pass make
+    ``num / den`` a mean that counts each estimate by its rays (normalised convolution,
+    Knutsson & Westin 1993). Unseen pixels are copied. Each pixel's sums in a fixed
+    order (rows, then columns): the same bytes on any thread count."""
+    h, w, nb = num.shape
     for i in prange(h):
         acc = np.zeros(nb)
         for j in range(w):
             if not seen[i, j]:
                 for b in range(nb):
-                    out[i, j, b] = light[i, j, b]
+                    out_num[i, j, b] = num[i, j, b]
+                out_den[i, j] = den[i, j]
                 continue
             for b in range(nb):
                 acc[b] = 0.0
             total = 0.0
-            px, py, pz = pos[i, j, 0], pos[i, j, 1], pos[i, j, 2]
-            nx, ny, nz = nrm[i, j, 0], nrm[i, j, 1], nrm[i, j, 2]
-            for ii in range(max(0, i - radius), min(h, i + radius + 1)):
-                for jj in range(max(0, j - radius), min(w, j + radius + 1)):
-                    if not seen[ii, jj]:
+            d_acc = 0.0
+            for a in range(5):
+                ii = i + (a - 2) * step
+                if ii < 0 or ii >= h:
+                    continue
+                for c in range(5):
+                    jj = j + (c - 2) * step
+                    if jj < 0 or jj >= w or not seen[ii, jj]:
                         continue
-                    c = nx * nrm[ii, jj, 0] + ny * nrm[ii, jj, 1] + nz * nrm[ii, jj, 2]
-                    if not c > 0.0:
+                    g = _geometric_weight(pos, nrm, i, j, ii, jj)
+                    if g == 0.0:
                         continue
-                    dx, dy, dz = pos[ii, jj, 0] - px, pos[ii, jj, 1] - py, pos[ii, jj, 2] - pz
-                    d2 = dx * dx + dy * dy + dz * dz
-                    e = nx * dx + ny * dy + nz * dz
-                    t = 1.0
-                    if d2 > 0.0:
-                        t = 1.0 - e * e / (d2 * PLANE_SIN2)
-                        if not t > 0.0:
-                            continue
-                    for _ in range(NORMAL_POWER_LOG2):
-                        c = c * c
-                    wt = spatial[ii - i + radius, jj - j + radius] * c * (t * t) * rays[ii, jj]
+                    wt = taps[a] * taps[c] * g
                     total += wt
+                    d_acc += wt * den[ii, jj]
                     for b in range(nb):
-                        acc[b] += wt * light[ii, jj, b]
+                        acc[b] += wt * num[ii, jj, b]
+            if not total > 0.0:  # a zero normal: not even the pixel itself counts
+                for b in range(nb):
+                    out_num[i, j, b] = num[i, j, b]
+                out_den[i, j] = den[i, j]
+                continue
             for b in range(nb):
-                out[i, j, b] = acc[b] / total
+                out_num[i, j, b] = acc[b] / total
+            out_den[i, j] = d_acc / total

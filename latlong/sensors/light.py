@@ -145,8 +145,10 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         light, va = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun,
                                 seed)
         total[active] += light
+        if bounces < 2:
+            continue
         front = np.flatnonzero((face >= 0) & (np.einsum("ij,ij->i", nq, d) < 0.0))
-        if bounces < 2 or not len(front):
+        if not len(front):
             continue
         # one ray on from each front-facing hit: its own once-bounced light, received as
         # a Lambertian surface of its albedo (the second counter stream of the sample)
@@ -174,37 +176,44 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
 def filter_bounced(received: np.ndarray, seen: np.ndarray, pos: np.ndarray, ns: np.ndarray,
                    radius_px: int, rays=None) -> np.ndarray:
     """The bounced light ``received`` by the seen pixels, (n_seen, bands), smoothed across
-    the image (h, w) = ``seen.shape``: a cross-bilateral mean within ``radius_px`` pixels
-    whose weights keep to one surface (a neighbour counts less the more its shading
-    normal turns away, ``ns`` (h, w, 3), and the farther it lies off the point's tangent
-    plane, ``pos`` (h, w, 3): a crater rim in front of a floor is not averaged into it)
-    and count each neighbour's ``rays`` ((n_seen,): the rays its estimate averages; all 1
-    by default). Light bounced from the surroundings changes over metres, not from pixel
-    to pixel, while the Monte Carlo noise of a few rays a pixel does: the mean over
-    ~radius^2 pixels removes most of it. The direct light and its shadow edges are not
-    touched."""
-    from ._bounce_kernels import _bounce_filter_kernel  # numba loads here
+    the image (h, w) = ``seen.shape`` over about ``radius_px`` pixels on the same surface:
+    an edge-avoiding a-trous filter (Dammertz et al. 2010; passes of 5 x 5 taps 1, 2, 4
+    ... px apart, :func:`~._bounce_kernels.atrous_steps`: a Gaussian of sigma ~radius / 2
+    in 75 taps a pixel at 8 px instead of 289) whose weights keep to one surface (a
+    neighbour counts less the more its shading normal turns away, ``ns`` (h, w, 3), and
+    the farther it lies off the point's tangent plane, ``pos`` (h, w, 3): a crater rim
+    in front of a floor is not averaged into it) and count each estimate by its ``rays``
+    ((n_seen,): the rays it averages; all 1 by default). Light bounced from the
+    surroundings changes over metres, not from pixel to pixel, while the Monte Carlo
+    noise of a few rays a pixel does: the mean over ~radius^2 pixels removes most of it.
+    The direct light and its shadow edges are not touched."""
+    from ._bounce_kernels import B3_TAPS, _atrous_pass_kernel, atrous_steps  # numba loads
     h, w = seen.shape
     nb = received.shape[1]
-    light = np.zeros((h * w, nb))
-    light[seen.ravel()] = received
-    weight = np.zeros(h * w)
-    weight[seen.ravel()] = 1.0 if rays is None else rays
-    out = np.empty((h, w, nb))
-    _bounce_filter_kernel(light.reshape(h, w, nb), np.ascontiguousarray(seen),
-                          np.ascontiguousarray(pos, dtype=np.float64),
-                          np.ascontiguousarray(ns, dtype=np.float64), weight.reshape(h, w),
-                          int(radius_px), out)
-    return out.reshape(h * w, nb)[seen.ravel()]
+    flat = seen.ravel()
+    weight = np.ones(len(received)) if rays is None else np.asarray(rays, dtype=np.float64)
+    num = np.zeros((h * w, nb))
+    num[flat] = received * weight[:, None]
+    den = np.ones(h * w)
+    den[flat] = weight
+    num, den = num.reshape(h, w, nb), den.reshape(h, w)
+    seen_c = np.ascontiguousarray(seen)
+    p = np.ascontiguousarray(pos, dtype=np.float64)
+    n = np.ascontiguousarray(ns, dtype=np.float64)
+    out_num, out_den = np.empty_like(num), np.empty_like(den)
+    for step in atrous_steps(int(radius_px)):
+        _atrous_pass_kernel(num, den, seen_c, p, n, B3_TAPS, step, out_num, out_den)
+        num, out_num = out_num, num
+        den, out_den = out_den, den
+    return (num / den[..., None]).reshape(h * w, nb)[flat]
 
 
 def _secondary_hits(mesh: RayMesh, o, d, above):
     """(face or -1, hit points, their facet normals (0 on a miss), hits) of rays that
     leave their facet (``above``)."""
-    hits = mesh.intersect(o, d)
+    hits, q = mesh.intersect_points(o, d)
     face = np.where(above, hits.face, -1)
     seen = face >= 0
-    q = hits.points(o, d)
     nq = np.zeros((len(face), 3))
     nq[seen] = mesh.face_normals[face[seen]]
     return face, q, nq, hits

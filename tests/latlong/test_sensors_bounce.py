@@ -12,12 +12,15 @@ import pytest
 from latlong import LatLongGrid
 from latlong.sensors import Camera, Lambert, LommelSeeliger, Pose, RayMesh, radiance_factor
 from latlong.sensors._bounce_kernels import (
+    B3_TAPS,
     NORMAL_POWER_LOG2,
     PLANE_SIN2,
-    _bounce_filter_kernel,
+    _atrous_pass_kernel,
     _bounce_light_kernel,
     _bounce_rays_kernel,
+    atrous_steps,
 )
+from latlong.sensors.light import filter_bounced
 from latlong.sensors.render import render
 
 R = 100.0
@@ -149,30 +152,53 @@ def test_bounce_light_kernel_is_the_model_seen_back_along_the_ray():
     assert ok.sum() > 500 and (~ok).sum() > 500
 
 
-def filter_reference(light, seen, pos, nrm, rays, radius):
-    """:func:`_bounce_filter_kernel` in numpy: the window's taps one offset at a time (rows,
+def pass_reference(num, den, seen, pos, nrm, step):
+    """:func:`_atrous_pass_kernel` in numpy: the 5 x 5 taps one offset at a time (rows,
     then columns: the kernel's order of the sums)."""
-    h, w, _ = light.shape
-    acc = np.zeros(light.shape)
+    h, w, _ = num.shape
+    acc = np.zeros(num.shape)
+    d_acc = np.zeros((h, w))
     total = np.zeros((h, w))
-    for di in range(-radius, radius + 1):
-        for dj in range(-radius, radius + 1):
+    for a in range(5):
+        for c in range(5):
+            di, dj = (a - 2) * step, (c - 2) * step
             i0, i1, j0, j1 = max(0, -di), min(h, h - di), max(0, -dj), min(w, w - dj)
+            if i0 >= i1 or j0 >= j1:
+                continue
             p = (slice(i0, i1), slice(j0, j1))
             q = (slice(i0 + di, i1 + di), slice(j0 + dj, j1 + dj))
-            c = (nrm[p] * nrm[q]).sum(axis=-1)
-            ok = seen[q] & (c > 0.0)
-            c = np.where(ok, c, 0.0) ** (2**NORMAL_POWER_LOG2)
+            cos = (nrm[p] * nrm[q]).sum(axis=-1)
+            ok = seen[q] & (cos > 0.0)
+            cos = np.where(ok, cos, 0.0) ** (2**NORMAL_POWER_LOG2)
             d = pos[q] - pos[p]
             d2 = (d * d).sum(axis=-1)
             e = (nrm[p] * d).sum(axis=-1)
             t = np.where(d2 > 0.0, 1.0 - e * e / (np.where(d2 > 0.0, d2, 1.0) * PLANE_SIN2), 1.0)
             ok &= t > 0.0
-            spatial = np.exp(-(di * di + dj * dj) * (2.0 / radius**2))
-            wt = np.where(ok, spatial * c * t * t * rays[q], 0.0)
+            wt = np.where(ok, B3_TAPS[a] * B3_TAPS[c] * cos * t * t, 0.0)
             total[p] += wt
-            acc[p] += wt[..., None] * light[q]
-    return np.where(seen[..., None], acc / np.where(total > 0, total, 1.0)[..., None], light)
+            d_acc[p] += wt * den[q]
+            acc[p] += wt[..., None] * num[q]
+    keep = seen & (total > 0)
+    safe = np.where(keep, total, 1.0)
+    return (np.where(keep[..., None], acc / safe[..., None], num),
+            np.where(keep, d_acc / safe, den))
+
+
+def filter_reference(light, seen, pos, nrm, rays, radius):
+    """:func:`filter_bounced` in numpy on an image: the a-trous passes of rays x light and
+    rays, their ratio at the end."""
+    num, den = light * rays[..., None], rays.copy()
+    for step in atrous_steps(radius):
+        num, den = pass_reference(num, den, seen, pos, nrm, step)
+    return num / den[..., None]
+
+
+def filtered(light, seen, pos, nrm, rays, radius):
+    """:func:`filter_bounced` as an image (unseen pixels 0)."""
+    out = np.zeros(light.shape)
+    out[seen] = filter_bounced(light[seen], seen, pos, nrm, radius, rays[seen])
+    return out
 
 
 def two_planes(h=40, w=48, step_m=5.0):
@@ -186,22 +212,44 @@ def two_planes(h=40, w=48, step_m=5.0):
     return pos, nrm
 
 
-def test_bounce_filter_kernel_matches_numpy():
+def test_atrous_steps_stand_for_a_gaussian_of_half_the_radius():
+    assert atrous_steps(1) == atrous_steps(3) == [1]
+    assert atrous_steps(4) == [1, 2]
+    assert atrous_steps(8) == [1, 2, 4]
+    assert atrous_steps(64) == [1, 2, 4, 8, 16, 32]
+    for radius in (2, 4, 8, 16, 32, 64):  # variances add: sigma within 16 % of radius / 2
+        sigma = np.sqrt(sum(s * s for s in atrous_steps(radius)))
+        assert abs(sigma / (radius / 2) - 1.0) < 0.16, radius
+    # the cubic B-spline's variance is 1 px^2 per axis at step 1
+    x = np.arange(-2, 3)
+    assert B3_TAPS.sum() == 1.0 and np.isclose((B3_TAPS * x * x).sum(), 1.0)
+
+
+def test_atrous_pass_kernel_matches_numpy():
     rng = np.random.default_rng(4)
-    h, w, nb, radius = 23, 31, 2, 3
+    h, w, nb = 23, 31, 2
     pos, nrm = two_planes(h, w)
     pos += rng.normal(scale=0.2, size=pos.shape)
     nrm = nrm + rng.normal(scale=0.3, size=nrm.shape)
     nrm /= np.linalg.norm(nrm, axis=-1, keepdims=True)
     nrm[3, 4] = -nrm[3, 4]  # a normal turned away: no weight either way
+    nrm[5, 6] = 0.0  # a zero normal: not even its own weight, kept as it was
     seen = rng.random((h, w)) > 0.15
-    light = rng.uniform(0.0, 1.0, (h, w, nb))
-    rays = rng.choice([2.0, 8.0], (h, w))
-    out = np.empty_like(light)
-    _bounce_filter_kernel(light, seen, pos, nrm, rays, radius, out)
-    np.testing.assert_allclose(out, filter_reference(light, seen, pos, nrm, rays, radius),
+    num = rng.uniform(0.0, 1.0, (h, w, nb))
+    den = rng.choice([2.0, 8.0], (h, w))
+    for step in (1, 2, 4, 8):
+        out_num, out_den = np.empty_like(num), np.empty_like(den)
+        _atrous_pass_kernel(num, den, seen, pos, nrm, B3_TAPS, step, out_num, out_den)
+        want_num, want_den = pass_reference(num, den, seen, pos, nrm, step)
+        np.testing.assert_allclose(out_num, want_num, rtol=1e-12, atol=0)
+        np.testing.assert_allclose(out_den, want_den, rtol=1e-12, atol=0)
+        np.testing.assert_array_equal(out_num[~seen], num[~seen])  # unseen as they were
+        assert out_num[5, 6, 0] == num[5, 6, 0] or not seen[5, 6]
+    rays = den
+    light = num / rays[..., None]
+    np.testing.assert_allclose(filtered(light, seen, pos, nrm, rays, 8)[seen],
+                               filter_reference(light, seen, pos, nrm, rays, 8)[seen],
                                rtol=1e-12, atol=0)
-    np.testing.assert_array_equal(out[~seen], light[~seen])  # unseen pixels as they were
 
 
 def test_bounce_filter_averages_the_noise_within_a_surface_not_across_a_cliff():
@@ -213,22 +261,29 @@ def test_bounce_filter_averages_the_noise_within_a_surface_not_across_a_cliff():
     light = (level * (1.0 + 0.3 * rng.standard_normal((h, w))))[..., None]
     seen = np.ones((h, w), dtype=np.bool_)
     ones = np.ones((h, w))
-    out = np.empty_like(light)
-    _bounce_filter_kernel(light, seen, pos, nrm, ones, 4, out)
+    out = filtered(light, seen, pos, nrm, ones, 4)
     inner = (slice(6, -6), slice(6, w // 2 - 6))
-    # the noise falls by about the window's effective size (sigma 2 px: 4 pi sigma^2 ~ 50)
+    # the noise falls by about the window's effective size (sigma ~2 px: 4 pi sigma^2 ~ 60)
     assert out[inner].std() < 0.2 * light[inner].std()
     assert abs(out[inner].mean() / light[inner].mean() - 1.0) < 0.02
     # next to the cliff each side keeps its own level: the lower plane lies 5 m off the
     # upper one's tangent plane (sin^2 ~ 1: no weight)
     np.testing.assert_allclose(out[6:-6, w // 2 - 1, 0].mean(), 1.0, atol=0.05)
     np.testing.assert_allclose(out[6:-6, w // 2, 0].mean(), 0.2, atol=0.01)
+    # an estimate of more rays counts more: a pixel of 8 rays among pixels of 1 pulls the
+    # mean towards itself 8 times as hard as one of 1 ray would
+    rays = ones.copy()
+    spike = np.zeros((h, w, 1))
+    spike[20, 10] = 1.0
+    one_ray = filtered(spike, seen, pos, nrm, rays, 4)
+    rays[20, 10] = 8.0
+    eight = filtered(spike, seen, pos, nrm, rays, 4)
+    assert eight[20, 12, 0] > 4.0 * one_ray[20, 12, 0]
     # one thread or two: the same bytes
     threads = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
-        one = np.empty_like(light)
-        _bounce_filter_kernel(light, seen, pos, nrm, ones, 4, one)
+        one = filtered(light, seen, pos, nrm, ones, 4)
     finally:
         numba.set_num_threads(threads)
     np.testing.assert_array_equal(one, out)
