@@ -99,6 +99,8 @@ def crater_labels(points, catalog) -> np.ndarray:
     >>> crater_labels([[100.0, 0, 0], [99.0, 4.5, 0], [100.0, 30, 0]], cat).tolist()
     [0, 1, -1]
     """
+    import numba
+
     from ._label_kernels import (  # numba loads here
         _bin_points_kernel,
         _finite_box_kernel,
@@ -132,7 +134,7 @@ def crater_labels(points, catalog) -> np.ndarray:
     _label_kernel(q, lo, h, dims, offsets, order, np.ascontiguousarray(c[rows]),
                   np.ascontiguousarray(r[rows]),
                   np.ascontiguousarray(normals[rows]) if use else np.zeros((len(rows), 3)),
-                  use, sub)
+                  use, numba.get_num_threads(), sub)
     out[ok] = np.where(sub >= 0, rows[np.maximum(sub, 0)], -1)
     return out
 

@@ -241,3 +241,12 @@ def test_crater_labels_kernel_matches_reference(with_normals, rng):
     np.testing.assert_array_equal(got, ref)
     assert (got >= 0).sum() > 1000 and (got[:5] == -1).all()
 
+    # the threads test rows in turn and keep each point's last: the same on one thread
+    import numba
+    threads = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = crater_labels(p, cat)
+    finally:
+        numba.set_num_threads(threads)
+    np.testing.assert_array_equal(one, got)
