@@ -243,7 +243,9 @@ def surface_tree(surface):
 def _surface_vertices(surface) -> np.ndarray:
     if isinstance(surface, Surface):  # a SceneGeometry ...: the boulders' left out
         vertices, faces = surface.mesh()
-        return vertices[np.unique(faces)]
+        used = np.zeros(len(vertices), dtype=np.bool_)
+        used[faces.ravel()] = True  # the rows np.unique(faces) gives, in its order
+        return vertices[used]
     verts = np.asarray(surface, dtype=np.float64)
     if verts.ndim != 2 or verts.shape[1] != 3:
         raise ParameterError("surface", f"must be a SceneGeometry or (n, 3) vertices; got "
