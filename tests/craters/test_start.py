@@ -1,5 +1,6 @@
 """The commands' start (:mod:`craters.cli.start`): numpy's SIMD dispatch capped at AVX2
-before numpy loads, so that a command writes the same bytes on any x86-64 CPU."""
+before numpy loads, so that a command writes the same bytes on any x86-64 CPU; and numba's
+threads told to sleep soon after they run out of work (``import craters``)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ import sys
 
 import pytest
 
+import craters
 from craters.cli.start import NUMPY_SIMD_CAP
 
 CAP = ("import os; from craters.cli.start import cap_numpy_simd; got = cap_numpy_simd(); "
@@ -52,3 +54,12 @@ def test_an_unknown_feature_name_would_fail_the_check():
     :func:`_python`, so the first test fails when numpy renames its levels."""
     with pytest.raises(AssertionError, match="ImportWarning"):
         _python("import numpy", NPY_DISABLE_CPU_FEATURES="NO_SUCH_FEATURE")
+
+
+@pytest.mark.parametrize("given, want", [({}, craters.THREAD_SPIN_COUNT),
+                                         ({"GOMP_SPINCOUNT": "50"}, "50"),
+                                         ({"OMP_WAIT_POLICY": "active"}, "None")])
+def test_numba_threads_spin_briefly_unless_the_environment_says(given, want):
+    env = {"GOMP_SPINCOUNT": None, "OMP_WAIT_POLICY": None} | given
+    code = "import os, latlong; print(os.environ.get('GOMP_SPINCOUNT')); print()"
+    assert _python(code, **env)[0] == want
