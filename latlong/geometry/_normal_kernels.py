@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit, prange
 
-from craters.kernels import read_only_inputs
+from craters.kernels import azimuth, read_only_inputs
 
 from .._grid_kernels import _lon_row, _ring_positions, _ring_size
 
@@ -49,34 +49,26 @@ def _add_triangle_normal(pos, a, b, c, out):
 
 
 @njit(cache=True, inline="always")
-def _corner_angle(dot, la, lb):
-    """The angle between two edges of lengths ``la``, ``lb`` whose dot product is ``dot``
-    (0 for a degenerate edge)."""
-    if not (la > 0.0 and lb > 0.0):
-        return 0.0
-    return np.arccos(min(1.0, max(-1.0, dot / (la * lb))))
-
-
-@njit(cache=True, inline="always")
 def _add_triangle_angle_normal(pos, a, b, c, out):
     """Add triangle (a, b, c)'s unit normal times its angle at each corner to that
     corner's row of ``out`` (the ``"angle"`` weighting: Mitsuba's and Blender's smooth
-    normals); a degenerate triangle adds nothing."""
+    normals); a degenerate triangle adds nothing. The angle between two edges is
+    atan2(|cross|, dot), and the cross product of any corner's two edges has the length
+    of the facet's: one square root a triangle, an arc tangent in plain arithmetic
+    (:func:`craters.kernels.azimuth`) and no arc cosine, which also keeps its accuracy
+    at angles near 0 and pi (acos of a rounded cosine does not)."""
     e1x, e1y, e1z, e2x, e2y, e2z = _triangle_edges(pos, a, b, c)  # b - a, c - a
     cx, cy, cz = e1y * e2z - e1z * e2y, e1z * e2x - e1x * e2z, e1x * e2y - e1y * e2x
     norm = np.sqrt(cx * cx + cy * cy + cz * cz)
-    if not norm > 0.0:
+    if not norm > 0.0:  # also every triangle with an edge of length 0
         return
     fx, fy, fz = e2x - e1x, e2y - e1y, e2z - e1z  # c - b
-    l1 = np.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
-    l2 = np.sqrt(e2x * e2x + e2y * e2y + e2z * e2z)
-    l3 = np.sqrt(fx * fx + fy * fy + fz * fz)
     d12 = e1x * e2x + e1y * e2y + e1z * e2z
     d13 = e1x * fx + e1y * fy + e1z * fz
     d23 = e2x * fx + e2y * fy + e2z * fz
     nx, ny, nz = cx / norm, cy / norm, cz / norm
-    for v, ang in ((a, _corner_angle(d12, l1, l2)), (b, _corner_angle(-d13, l1, l3)),
-                   (c, _corner_angle(d23, l2, l3))):
+    for v, ang in ((a, azimuth(norm, d12)), (b, azimuth(norm, -d13)),
+                   (c, azimuth(norm, d23))):
         out[v, 0] += ang * nx
         out[v, 1] += ang * ny
         out[v, 2] += ang * nz

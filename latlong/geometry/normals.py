@@ -109,12 +109,10 @@ def _corner_weights(v: np.ndarray, f: np.ndarray, weighting: str) -> list[np.nda
     norm = np.linalg.norm(cross, axis=1, keepdims=True)
     unit = np.where(norm > 0, cross / np.where(norm > 0, norm, 1.0), 0.0)
     out = []
-    for k in range(3):
+    for k in range(3):  # the corner's angle atan2(|cross|, dot): |cross| is the facet's
         u = corners[(k + 1) % 3] - corners[k]
         w = corners[(k + 2) % 3] - corners[k]
-        cosang = np.einsum("ij,ij->i", u, w) / np.maximum(
-            np.linalg.norm(u, axis=1) * np.linalg.norm(w, axis=1), 1e-300)
-        angle = np.arccos(np.clip(cosang, -1.0, 1.0))
+        angle = np.arctan2(norm[:, 0], np.einsum("ij,ij->i", u, w))
         out.append(np.stack([angle * unit[:, d] for d in range(3)], axis=1))
     return out
 
