@@ -40,7 +40,8 @@ from ._counter_kernels import (
 )
 
 __all__ = ["MAX_POISSON_MEAN", "philox4x64", "poisson_from_uniform", "portable_exp",
-           "portable_log", "power_law_from_uniform", "uniform_from_words"]
+           "portable_geomspace", "portable_log", "power_law_from_uniform",
+           "uniform_from_words"]
 
 _U53 = 2.0 ** -53
 #: Largest Poisson mean drawn by inversion (its cost grows with the mean; a cell hierarchy
@@ -129,6 +130,25 @@ def portable_log(x) -> np.ndarray:
     (0.0, 1.0)
     """
     return _elementwise(_log_kernel, x)
+
+
+def portable_geomspace(start: float, stop: float, num: int) -> np.ndarray:
+    """``num`` numbers from ``start`` to ``stop`` (both > 0, kept exactly) evenly spaced
+    in their logarithm, as ``np.geomspace``, the same bytes on every machine
+    (:func:`portable_exp` and :func:`portable_log`; numpy's own goes through its SIMD
+    ``log10``/``power`` loops, whose last bits differ between AVX2 and SSE).
+
+    Examples
+    --------
+    >>> portable_geomspace(1.0, 1000.0, 4).round(12).tolist()
+    [1.0, 10.0, 100.0, 1000.0]
+    """
+    out = start * portable_exp(np.linspace(0.0, 1.0, num)
+                               * float(portable_log(stop / start)))
+    if num:
+        out[0] = start
+        out[-1] = stop
+    return out
 
 
 def _uniforms(u) -> np.ndarray:

@@ -164,7 +164,9 @@ def power_spectrum(dem: Dem, n_bins: int | None = None) -> tuple[np.ndarray, np.
     f_min, f_max = 1.0 / (min(rows * dy, cols * dx)), 0.5 / max(dx, dy)
     n_bins = check_int("n_bins", n_bins if n_bins is not None else
                        max(8, int(2 * math.log2(min(rows, cols)) * 4)), 2, 10_000)
-    edges = np.geomspace(f_min, f_max, n_bins + 1)
+    from craters.counter import portable_geomspace  # numba loads here
+
+    edges = portable_geomspace(f_min, f_max, n_bins + 1)  # the same bytes on every CPU
     which = np.digitize(f.ravel(), edges) - 1
     valid = (which >= 0) & (which < n_bins)
     sums = np.bincount(which[valid], weights=spec.ravel()[valid], minlength=n_bins)
