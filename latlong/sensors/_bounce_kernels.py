@@ -48,6 +48,37 @@ def _bounce_rays_kernel(pos, ng, ns, ids, offset, centre, floor, seed, sample, o
         above[i] = ng[i, 0] * dx + ng[i, 1] * dy + ng[i, 2] * dz > 0.0
 
 
+@read_only_inputs("face", "q", "nq", "facing")
+@njit(cache=True, parallel=True)
+def _secondary_kernel(origins, dirs, t, hit_face, above, face_normals, sun, face, q, nq,
+                      facing):
+    """What the bounce rays hit, in one pass (the numpy steps it replaced, with the same
+    values): ``face`` the face hit (``hit_face``) where the ray leaves its facet
+    (``above``), else -1; ``q`` the hit point o + t u, u the unit direction as
+    :meth:`.engine.RayMesh.intersect` makes it (NaN where nothing is hit); ``nq`` the
+    face's normal (0 without a face); ``facing`` the face turns towards the ``sun``."""
+    for i in prange(dirs.shape[0]):
+        x, y, z = dirs[i, 0], dirs[i, 1], dirs[i, 2]
+        norm = np.sqrt(x * x + y * y + z * z)
+        f = hit_face[i]
+        if f >= 0:
+            q[i, 0] = origins[i, 0] + t[i] * (x / norm)
+            q[i, 1] = origins[i, 1] + t[i] * (y / norm)
+            q[i, 2] = origins[i, 2] + t[i] * (z / norm)
+        else:
+            q[i, 0] = q[i, 1] = q[i, 2] = np.nan
+        if not above[i]:
+            f = -1
+        face[i] = f
+        if f < 0:
+            nq[i, 0] = nq[i, 1] = nq[i, 2] = 0.0
+            facing[i] = False
+            continue
+        n0, n1, n2 = face_normals[f, 0], face_normals[f, 1], face_normals[f, 2]
+        nq[i, 0], nq[i, 1], nq[i, 2] = n0, n1, n2
+        facing[i] = (n0 * sun[0] + n1 * sun[1]) + n2 * sun[2] > 0.0
+
+
 @read_only_inputs("out")
 @njit(cache=True, parallel=True)
 def _bounce_light_kernel(code, params, dirs, face, face_normals, albedo_w, sun, lit, out):

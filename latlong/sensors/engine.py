@@ -81,15 +81,11 @@ class Hits:
 
     def points(self, origins, directions) -> np.ndarray:
         """(k, 3) hit points o + t d (NaN on a miss) for the rays that were cast."""
-        return _hit_points(*_rays(origins, directions), self)
-
-
-def _hit_points(o, d, hits: Hits) -> np.ndarray:
-    """:meth:`Hits.points` of float64 origins and unit directions (:func:`_rays`)."""
-    with np.errstate(invalid="ignore"):
-        p = o + hits.t_m[:, None] * d
-    p[~hits.hit] = np.nan
-    return p
+        o, d = _rays(origins, directions)
+        with np.errstate(invalid="ignore"):
+            p = o + self.t_m[:, None] * d
+        p[~self.hit] = np.nan
+        return p
 
 
 @functools.cache
@@ -302,18 +298,8 @@ class RayMesh:
         ``directions`` need not be unit vectors (they are normalised; distances are in
         metres); ``origins`` is (k, 3) or one (3,) origin for all rays.
         """
-        return self._intersect_unit(*_rays(origins, directions), t_max)
-
-    def intersect_points(self, origins, directions, t_max=np.inf) -> tuple[Hits, np.ndarray]:
-        """:meth:`intersect` and the hit points (:meth:`Hits.points`: the same values) in
-        one pass over the rays (the directions normalised once)."""
-        o, d = _rays(origins, directions)
-        hits = self._intersect_unit(o, d, t_max)
-        return hits, _hit_points(o, d, hits)
-
-    def _intersect_unit(self, o, d, t_max) -> Hits:
-        """:meth:`intersect` of float64 origins and unit directions (:func:`_rays`)."""
         from ._engine_kernels import _intersect_kernel  # numba loads here
+        o, d = _rays(origins, directions)
         k = len(d)
         t_out = np.empty(k)
         face = np.empty(k, dtype=np.int64)

@@ -141,9 +141,9 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
             o, d, above = o[:len(active)], d[:len(active)], above[:len(active)]
         _bounce_rays_kernel(p, g, h, active, SHADOW_OFFSET, centre, floor, seed, k, o, d,
                             above)
-        face, q, nq, hits = _secondary_hits(mesh, o, d, above)
-        light, va = _seen_light(mesh, models, d, face, q, nq, hits, vertex_albedo, sun,
-                                seed)
+        face, q, nq, facing, hits = _secondary_hits(mesh, o, d, above, sun)
+        light, va = _seen_light(mesh, models, d, face, q, nq, facing, hits, vertex_albedo,
+                                sun, seed)
         total[active] += light
         if bounces < 2:
             continue
@@ -157,9 +157,9 @@ def indirect(mesh: RayMesh, models, pos, ng, ns, albedo, vertex_albedo, sun: Sun
         above2 = np.empty(len(front), dtype=np.bool_)
         _bounce_rays_kernel(q2, n2, n2, np.arange(len(front)), SHADOW_OFFSET, centre, floor,
                             seed, SECOND_BOUNCE + k, o2, d2, above2)
-        face2, r2, nr2, hits2 = _secondary_hits(mesh, o2, d2, above2)
-        light2, _ = _seen_light(mesh, models, d2, face2, r2, nr2, hits2, vertex_albedo, sun,
-                                seed)
+        face2, r2, nr2, facing2, hits2 = _secondary_hits(mesh, o2, d2, above2, sun)
+        light2, _ = _seen_light(mesh, models, d2, face2, r2, nr2, facing2, hits2,
+                                vertex_albedo, sun, seed)
         for b in range(len(models)):
             total[active[front], b] += normal_albedo[b] * va[front] * light2[:, b]
     out = np.empty_like(total)
@@ -208,23 +208,26 @@ def filter_bounced(received: np.ndarray, seen: np.ndarray, pos: np.ndarray, ns: 
     return (num / den[..., None]).reshape(h * w, nb)[flat]
 
 
-def _secondary_hits(mesh: RayMesh, o, d, above):
-    """(face or -1, hit points, their facet normals (0 on a miss), hits) of rays that
-    leave their facet (``above``)."""
-    hits, q = mesh.intersect_points(o, d)
-    face = np.where(above, hits.face, -1)
-    seen = face >= 0
-    nq = np.zeros((len(face), 3))
-    nq[seen] = mesh.face_normals[face[seen]]
-    return face, q, nq, hits
+def _secondary_hits(mesh: RayMesh, o, d, above, sun: Sun):
+    """(face or -1, hit points, their facet normals (0 on a miss), facets facing the sun,
+    hits) of rays that leave their facet (``above``)."""
+    from ._bounce_kernels import _secondary_kernel  # numba loads here
+    hits = mesh.intersect(o, d)
+    n = len(hits.face)
+    face, facing = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.bool_)
+    q, nq = np.empty((n, 3)), np.empty((n, 3))
+    _secondary_kernel(np.ascontiguousarray(o, dtype=np.float64),
+                      np.ascontiguousarray(d, dtype=np.float64), hits.t_m, hits.face,
+                      np.ascontiguousarray(above), mesh.face_normals, sun.direction, face, q,
+                      nq, facing)
+    return face, q, nq, facing, hits
 
 
-def _seen_light(mesh: RayMesh, models, d, face, q, nq, hits, vertex_albedo, sun: Sun,
-                seed: int) -> tuple[np.ndarray, np.ndarray]:
+def _seen_light(mesh: RayMesh, models, d, face, q, nq, facing, hits, vertex_albedo,
+                sun: Sun, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """((n, bands) direct I/F of each secondary hit seen back along its ray (0 for a
     miss), (n,) the albedo factor at the hits)."""
     from ._bounce_kernels import _bounce_light_kernel  # numba loads here
-    facing = (face >= 0) & (nq @ sun.direction > 0.0)
     lit = sunlit(mesh, q, nq, facing, sun, 0, seed)
     va = vertex_albedo_at(mesh, vertex_albedo, hits)
     out = np.empty((len(face), len(models)))

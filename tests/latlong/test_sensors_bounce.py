@@ -18,6 +18,7 @@ from latlong.sensors._bounce_kernels import (
     _atrous_pass_kernel,
     _bounce_light_kernel,
     _bounce_rays_kernel,
+    _secondary_kernel,
     atrous_steps,
 )
 from latlong.sensors.light import filter_bounced
@@ -150,6 +151,30 @@ def test_bounce_light_kernel_is_the_model_seen_back_along_the_ray():
                                         cos_g) * albedo * lit, 0.0)
     np.testing.assert_allclose(out, want, rtol=1e-12, atol=0)
     assert ok.sum() > 500 and (~ok).sum() > 500
+
+
+def test_secondary_kernel_is_the_numpy_steps_it_replaced(bowl):
+    rng = np.random.default_rng(7)
+    n = 4000
+    o = rng.normal(scale=30.0, size=(n, 3))
+    d = rng.normal(size=(n, 3)) * rng.uniform(0.5, 2.0, (n, 1))  # not unit: as given
+    hits = bowl.intersect(o, d)
+    above = rng.random(n) > 0.2
+    sun = SUN
+    face, q, nq = np.empty(n, np.int64), np.empty((n, 3)), np.empty((n, 3))
+    facing = np.empty(n, np.bool_)
+    _secondary_kernel(o, d, hits.t_m, hits.face, above, bowl.face_normals, sun, face, q, nq,
+                      facing)
+    want_face = np.where(above, hits.face, -1)
+    want_nq = np.zeros((n, 3))
+    want_nq[want_face >= 0] = bowl.face_normals[want_face[want_face >= 0]]
+    assert (hits.face >= 0).sum() > 1000 and (want_face >= 0).sum() < (hits.face >= 0).sum()
+    np.testing.assert_array_equal(face, want_face)
+    np.testing.assert_array_equal(q, hits.points(o, d))  # NaN where nothing is hit
+    np.testing.assert_array_equal(nq, want_nq)
+    dots = (want_nq[:, 0] * sun[0] + want_nq[:, 1] * sun[1]) + want_nq[:, 2] * sun[2]
+    np.testing.assert_array_equal(facing, (want_face >= 0) & (dots > 0.0))
+    assert facing.any() and not facing.all()
 
 
 def pass_reference(num, den, seen, pos, nrm, step):
