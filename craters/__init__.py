@@ -122,11 +122,11 @@ from ._shared.lazy import lazy_package
 THREAD_SPIN_COUNT = "1000"
 
 
-def _short_thread_spins() -> bool:
+def _short_thread_spins() -> None:
     """Let numba's OpenMP threads (its default threading layer on Linux) sleep soon after
     they run out of work: ``GOMP_SPINCOUNT`` = :data:`THREAD_SPIN_COUNT` in this process
-    and the processes it starts, unless ``GOMP_SPINCOUNT`` or ``OMP_WAIT_POLICY`` is set;
-    True where it was set. ``craters`` is imported before any kernel runs (``latlong``
+    and the processes it starts, unless ``GOMP_SPINCOUNT`` or ``OMP_WAIT_POLICY`` is set.
+    ``craters`` is imported before any kernel runs (``latlong``
     and ``dem`` import it), and libgomp reads the variable when numba starts its threads.
 
     A thread that finished its share of a parallel loop spins ~300 000 times by default,
@@ -137,10 +137,8 @@ def _short_thread_spins() -> bool:
     with libgomp's default and x1.05-1.13 with 1000 spins (10 repetitions a run), M = 1000
     x1.02-1.03 and x1.34-1.35; alone, M = 330 x1.58-1.68 and x1.87-2.29, M = 1000
     x1.96-2.04 and x1.81-1.92. No result depends on it."""
-    if "GOMP_SPINCOUNT" in os.environ or "OMP_WAIT_POLICY" in os.environ:
-        return False
-    os.environ["GOMP_SPINCOUNT"] = THREAD_SPIN_COUNT
-    return True
+    if "GOMP_SPINCOUNT" not in os.environ and "OMP_WAIT_POLICY" not in os.environ:
+        os.environ["GOMP_SPINCOUNT"] = THREAD_SPIN_COUNT
 
 
 _short_thread_spins()

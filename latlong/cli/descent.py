@@ -52,7 +52,7 @@ DESCENT = {
                                unit="deg", range="finite", run=True),
     "sun_elevation_deg": Setting(25.0, "sun elevation above the site's horizon", unit="deg",
                                  range=(0.5, 90.0), run=True),
-    # the camera's setting, off by default: ~4 s more a 1024^2 frame
+    # the camera's setting, off by default: ~2.5 s more a 1024^2 frame
     "bounces": dataclasses.replace(_camera_setting("bounces"), default=0, run=True),
     "output": Setting(help="output folder", flag="-o/--output", required=True, run=True),
 }
