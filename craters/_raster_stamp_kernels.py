@@ -158,4 +158,4 @@ def _stamp_many_kernel(h, pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, se
     for c in range(cx.shape[0]):
         _stamp_one(h, c, pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds, xe,
                    slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
-                   out_erased, delta, True)
+                   out_erased, delta, np.bool_(True))

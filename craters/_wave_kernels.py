@@ -83,7 +83,7 @@ def _stamp_waves_kernel(order, starts, alone, n_threads, h, pixel, cx, cy, diam,
         while s < e and (alone[order[s]] or e - s == 1):
             _stamp_one(h, order[s], pixel, cx, cy, diam, tabs, depths, warps, rim_tabs, seeds,
                        xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale, out_slope,
-                       out_erased, delta, True)
+                       out_erased, delta, np.bool_(True))
             s += 1
         nt = min(n_threads, e - s)
         for t in prange(nt):  # thread t takes every nt-th crater (costliest first)
@@ -91,4 +91,4 @@ def _stamp_waves_kernel(order, starts, alone, n_threads, h, pixel, cx, cy, diam,
             for k in range(s + t, e, nt):
                 _stamp_one(h, order[k], pixel, cx, cy, diam, tabs, depths, warps, rim_tabs,
                            seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain, out_scale,
-                           out_slope, out_erased, scratch, False)
+                           out_slope, out_erased, scratch, np.bool_(False))

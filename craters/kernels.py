@@ -52,6 +52,10 @@ Calling kernels from Python:
 
 * ``read_only_inputs(*outputs)``: a kernel's decorator (outside ``njit``) passing every
   array argument but its outputs read-only, so it compiles once
+* from numba code, flags and counts go to a compiled (not inlined) kernel as
+  ``np.bool_(...)`` and ``np.int64(...)``: a constant ``True`` or ``0`` is a literal type
+  of its own, and numba compiles the callee once per literal (``_stamp_one`` ~10 s a
+  time; ``tests/test_kernel_signatures.py`` checks the source)
 
 Cube-sphere cells (:mod:`craters.cells`):
 

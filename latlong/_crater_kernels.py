@@ -356,9 +356,10 @@ def _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, d
         cand = _scan_all(unit, uc0, uc1, uc2, np.cos(ang))
         cnt = cand.shape[0]
     else:
-        cnt = _gather_kernel(m, ring_offsets, colat, lo, ang, np.empty(0, np.int64), True)
+        cnt = _gather_kernel(m, ring_offsets, colat, lo, ang, np.empty(0, np.int64),
+                             np.bool_(True))
         cand = np.empty(cnt, np.int64)
-        _gather_kernel(m, ring_offsets, colat, lo, ang, cand, False)
+        _gather_kernel(m, ring_offsets, colat, lo, ang, cand, np.bool_(False))
     # local coordinates of the candidates
     idx, pmag, dist, az, xl, yl, hgt = _point_arrays(cnt)
     limit = reach + 2.0 * nominal
@@ -456,4 +457,4 @@ def _stamp_body_kernel(m, ring_offsets, unit, radii, stretch, lat, lon, diam, ta
         _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs, depths,
                    warps, rim_tabs, seeds, xe, slope_erosion, onset_deg, full_deg, rough, gain,
                    out_scale, out_slope, out_centre, out_maxdh, out_nvert, out_spacing,
-                   out_erased, up, naive, stop_after, True, np.inf)
+                   out_erased, up, np.bool_(naive), np.int64(stop_after), np.bool_(True), np.inf)

@@ -70,7 +70,7 @@ def _ply_face_kernel(m, band_lo, band_hi, ring_offsets, band_offsets, out):
         else:
             ra, rb, south = band + 1, band, True
         _band_triangles_kernel(ring_offsets[ra], _ring_size(ra, m), ring_offsets[rb],
-                               _ring_size(rb, m), south, tri, 0)
+                               _ring_size(rb, m), south, tri, np.int64(0))
         p = (t0 - base) * 13
         for t in range(nt):
             out[p] = 3

@@ -57,9 +57,10 @@ def _raycast_kernel(m, ring_offsets, unit, verts, faces, margin, count, tmin, tm
             ang = min(np.pi, ang + margin)
             colat = np.arccos(min(1.0, max(-1.0, sz)))
             lon = np.arctan2(sy, sx)
-        n_cand = _gather_kernel(m, ring_offsets, colat, lon, ang, np.empty(0, np.int64), True)
+        n_cand = _gather_kernel(m, ring_offsets, colat, lon, ang, np.empty(0, np.int64),
+                                np.bool_(True))
         cand = np.empty(n_cand, np.int64)
-        _gather_kernel(m, ring_offsets, colat, lon, ang, cand, False)
+        _gather_kernel(m, ring_offsets, colat, lon, ang, cand, np.bool_(False))
         for q in range(n_cand):
             i = cand[q]
             t = _ray_hit(unit[i, 0], unit[i, 1], unit[i, 2], a, b, c)

@@ -67,7 +67,7 @@ def _band_areas_one(m, band, ring_offsets, radii, stretch, tri, pa, pb, out, t0)
     ob, nb = ring_offsets[rb], _ring_size(rb, m)
     _place_ring(m, ra, oa, na, radii, stretch, pa)
     _place_ring(m, rb, ob, nb, radii, stretch, pb)
-    _band_triangles_kernel(oa, na, ob, nb, south, tri, 0)
+    _band_triangles_kernel(oa, na, ob, nb, south, tri, np.int64(0))
     n_tri = 6 if (na == 1 or nb == 1) else na + nb
     for t in range(n_tri):
         out[t0 + t] = _area_of(tri, t, oa, na, pa, pb, ob)

@@ -120,8 +120,8 @@ def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon
             ok[c] = _stamp_one(c, m, ring_offsets, unit, radii, stretch, lat, lon, diam, tabs,
                                depths, warps, rim_tabs, seeds, xe, slope_erosion, onset_deg,
                                full_deg, rough, gain, out_scale, out_slope, out_centre,
-                               out_maxdh, out_nvert, out_spacing, out_erased, up, False, 0,
-                               True, ang_bound[c])
+                               out_maxdh, out_nvert, out_spacing, out_erased, up, np.bool_(False),
+                               np.int64(0), np.bool_(True), ang_bound[c])
             continue
         for t in prange(nt):
             for k in range(bounds[w, t], bounds[w, t + 1]):
@@ -130,4 +130,5 @@ def _stamp_waves_kernel(order, bounds, m, ring_offsets, radii, stretch, lat, lon
                                    tabs, depths, warps, rim_tabs, seeds, xe, slope_erosion,
                                    onset_deg, full_deg, rough, gain, out_scale, out_slope,
                                    out_centre, out_maxdh, out_nvert, out_spacing, out_erased,
-                                   up, False, 0, False, ang_bound[c])
+                                   up, np.bool_(False), np.int64(0),
+                                   np.bool_(False), ang_bound[c])

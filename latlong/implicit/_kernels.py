@@ -67,13 +67,15 @@ def _voxelize_kernel(verts, faces, origin, h, inside):
     ncol = ny * nz
     counts = np.zeros(ncol, np.int64)
     dummy = np.zeros(1)
-    _column_hits(verts, faces, origin[1], origin[2], h, ny, nz, counts, counts, dummy, False)
+    _column_hits(verts, faces, origin[1], origin[2], h, ny, nz, counts, counts, dummy,
+                 np.bool_(False))
     offsets = np.zeros(ncol + 1, np.int64)
     for c in range(ncol):
         offsets[c + 1] = offsets[c] + counts[c]
     xs = np.empty(offsets[ncol])
     counts[:] = 0
-    _column_hits(verts, faces, origin[1], origin[2], h, ny, nz, counts, offsets, xs, True)
+    _column_hits(verts, faces, origin[1], origin[2], h, ny, nz, counts, offsets, xs,
+                 np.bool_(True))
     odd = 0
     for c in range(ncol):
         n = counts[c]

@@ -180,7 +180,7 @@ def _stamp_mesh_kernel(pos, heights, faces, voff, vnbr, foff, fids, face_of, uv,
         # positions in the crater's frame
         limit = reach + 2.0 * sp
         idx, _, dist, az, xl, yl, hgt = _point_arrays(cnt)
-        keep = 0
+        keep = np.int64(0)  # not a literal 0: one compile of the helpers it reaches
         n_inside = 0
         folded = False
         for q in range(cnt):

@@ -112,13 +112,13 @@ def _cap_blocks_kernel(fc, angles, craters, level, occ, cos_margin):
     none = np.empty(0, dtype=np.int64)
     for t in prange(n_cr):
         counts[t + 1] = _cap_blocks_one(fc, angles, craters[t], level, occ, cos_margin, none,
-                                        none, 0, False)
+                                        none, np.int64(0), np.bool_(False))
     offsets = np.cumsum(counts)
     out_blk = np.empty(offsets[n_cr], dtype=np.int64)
     out_crater = np.empty(offsets[n_cr], dtype=np.int64)
     for t in prange(n_cr):
         _cap_blocks_one(fc, angles, craters[t], level, occ, cos_margin, out_blk, out_crater,
-                        offsets[t], True)
+                        offsets[t], np.bool_(True))
     return out_blk, out_crater
 
 

@@ -189,6 +189,9 @@ def _generations_kernel(todo, dep_start, dep_list, gen):
         gen[k] = g
 
 
+# fc is writable in both kernels that compose craters (the parameters kernel writes it):
+# _tilted_step, which both call, then compiles once, not once per array type
+@read_only_inputs("fc")
 @njit(cache=True, parallel=True)
 def _params_kernel(todo, gen_start, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims,
                    seeds, rough, gain, octaves, xe, xb, age_key, diam, up, onset, full,
@@ -257,7 +260,7 @@ def _crater_params(k, dep_start, dep_list, stencil, st_base, fit, fc, tabs, rims
     fc[k, ACTIVE] = 1.0 if scale > 0.0 else 0.0
 
 
-@read_only_inputs("out")
+@read_only_inputs("out", "fc")
 @njit(cache=True, parallel=True)
 def _points_kernel(points, block_of, blk_start, blk_list, base, fc, tabs, rims, seeds, rough,
                    gain, octaves, xe, xb, age_key, diam, out):
