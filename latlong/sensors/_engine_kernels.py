@@ -1,11 +1,17 @@
-"""Numba kernels of :mod:`latlong.sensors.engine`: Embree's single-ray queries called
+"""Numba kernels of :mod:`latlong.sensors.engine`: Embree's ray-packet queries called
 from parallel numba loops, and the float64 Möller–Trumbore refinement of every hit.
 
 Embree is called through ``ctypes`` function pointers passed in as arguments (numba
 reads their address at run time, so the kernels cache). Each parallel iteration traces a
-fixed block of rays with its own 16-byte-aligned ``RTCRayHit`` buffer (Embree 4
-``rtcore_ray.h`` layout: ray = 12 words, hit = Ng[3], u, v, primID, geomID, instID), so
-every ray's result depends on nothing but that ray: same bytes for any thread count.
+fixed block of rays, W consecutive rays a call, with its own 32-byte-aligned
+``RTCRayHit8`` buffer (Embree 4 ``rtcore_ray.h``'s structure-of-arrays layout: ray = 12
+fields, hit = Ng[3], u, v, primID, geomID, instID; :func:`_packet_buffers`). Each lane of
+a packet is traced on its own (a packet is a batch, not a shared traversal result), so
+every ray's result depends on nothing but that ray: same bytes for any thread count, and
+the same answers as single-ray calls (``rtcIntersect1``, ``rtcOccluded1``) gave on every
+ray of a 1024^2 frame of a 12 M-triangle body, in less time: its primary rays 0.143-0.146 s
+instead of 0.158-0.162 s, its 0.47 M shadow rays 0.127-0.143 s instead of 0.153-0.169 s
+(best of 10, interleaved in one process, 2 threads, two runs, 2026-12-08).
 """
 
 from __future__ import annotations
@@ -19,6 +25,9 @@ from ..geometry._ray_kernels import _moller_trumbore
 
 #: Rays per parallel iteration.
 BLOCK = 256
+#: Rays per Embree call (``rtcIntersect8`` / ``rtcOccluded8``: 8-wide packets, native on
+#: AVX2 and AVX-512).
+W = 8
 _INVALID = np.uint32(0xFFFFFFFF)
 
 
@@ -66,88 +75,124 @@ def _start(origins, directions, i, centre, radius):
 
 
 @njit(cache=True, inline="always")
-def _aligned(raw):
-    """A 32-word view of ``raw`` that starts on a 16-byte boundary, and its address."""
-    p0 = raw.ctypes.data
-    off = ((16 - p0 % 16) % 16) // 4
-    return raw[off:off + 32], p0 + 4 * off
+def _packet_buffers():
+    """Fresh ``RTCRayHit8`` and valid-mask buffers, 32-byte aligned: the packet's float32
+    and uint32 views and address, the int32 mask and its address (the views keep the
+    memory alive). Field f of lane j is word ``f * W + j``: org 0-2, tnear 3, dir 4-6,
+    time 7, tfar 8, mask 9, id 10, flags 11, Ng 12-14, u 15, v 16, primID 17, geomID 18,
+    instID 19 (Embree 4 ``rtcore_ray.h``; 21 fields: room for instPrimID)."""
+    raw = np.empty(21 * W + 8, np.float32)
+    off = ((32 - raw.ctypes.data % 32) % 32) // 4
+    buf = raw[off:off + 21 * W]
+    vraw = np.empty(W + 8, np.int32)
+    voff = ((32 - vraw.ctypes.data % 32) % 32) // 4
+    valid = vraw[voff:voff + W]
+    return buf, buf.view(np.uint32), raw.ctypes.data + 4 * off, valid, \
+        vraw.ctypes.data + 4 * voff
 
 
 @njit(cache=True, inline="always")
-def _ray_buffer():
-    """A fresh ``RTCRayHit`` buffer: its float32 and uint32 views and its address (the
-    views keep the memory alive)."""
-    buf, ptr = _aligned(np.empty(40, np.float32))
-    return buf, buf.view(np.uint32), ptr
-
-
-@njit(cache=True, inline="always")
-def _load_ray(buf, ibuf, origins, directions, i, centre, t0, tnear, tfar):
+def _load_lane(buf, ibuf, j, origins, directions, i, centre, t0, tnear, tfar):
+    """Ray i into lane j of the packet: its float32 origin at ``t0`` along it (relative
+    to the mesh's centre), direction, [tnear, tfar], and no hit yet."""
     r = _row(origins, i)
     for k in range(3):
-        buf[k] = np.float32(origins[r, k] + t0 * directions[i, k] - centre[k])
-        buf[4 + k] = np.float32(directions[i, k])
-    buf[3] = np.float32(tnear)
-    buf[7] = np.float32(0.0)
-    buf[8] = np.float32(tfar)
-    ibuf[9] = _INVALID
-    ibuf[10] = np.uint32(0)
-    ibuf[11] = np.uint32(0)
-    ibuf[17] = _INVALID
-    ibuf[18] = _INVALID
-    ibuf[19] = _INVALID
+        buf[k * W + j] = np.float32(origins[r, k] + t0 * directions[i, k] - centre[k])
+        buf[(4 + k) * W + j] = np.float32(directions[i, k])
+    buf[3 * W + j] = np.float32(tnear)
+    buf[7 * W + j] = np.float32(0.0)
+    buf[8 * W + j] = np.float32(tfar)
+    ibuf[9 * W + j] = _INVALID
+    ibuf[10 * W + j] = np.uint32(0)
+    ibuf[11 * W + j] = np.uint32(0)
+    ibuf[17 * W + j] = _INVALID
+    ibuf[18 * W + j] = _INVALID
+    ibuf[19 * W + j] = _INVALID
+
+
+@njit(cache=True, inline="always")
+def _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radius, t_min,
+                 t_max, shadow):
+    """Rays ``p .. p + W - 1`` (those below n) into the packet's lanes, their start along
+    the ray into ``t0s``; returns how many lanes are live. A closest-hit ray starts just
+    before the bounding sphere; a shadow ray (``shadow``) at ``t_min`` or before."""
+    live = 0
+    for j in range(W):
+        i = p + j
+        valid[j] = 0
+        if i >= n:
+            continue
+        t0 = _start(origins, directions, i, centre, radius)
+        tnear = 0.0
+        if shadow:
+            t0 = min(t0, t_min[i])
+            tnear = t_min[i] - t0
+        span = t_max[i] - t0
+        if not span > tnear:
+            continue
+        _load_lane(buf, ibuf, j, origins, directions, i, centre, t0, tnear, min(span, 3e38))
+        t0s[j] = t0
+        valid[j] = -1
+        live += 1
+    return live
 
 
 @read_only_inputs("t_out", "face_out", "u_out", "v_out")
 @njit(cache=True, parallel=True)
-def _intersect_kernel(intersect1, scene, origins, directions, t_max, centre, radius,
+def _intersect_kernel(intersect8, scene, origins, directions, t_max, centre, radius,
                       vertices, faces, t_out, face_out, u_out, v_out):
-    """Closest hit of every ray (Embree, float32), refined in float64 on its face."""
+    """Closest hit of every ray (Embree, float32, packets of W rays), refined in float64
+    on its face."""
     n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
-        buf, ibuf, ptr = _ray_buffer()
-        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
-            t0 = _start(origins, directions, i, centre, radius)
-            face_out[i] = -1
-            t_out[i] = np.inf
-            u_out[i] = 0.0
-            v_out[i] = 0.0
-            span = t_max[i] - t0
-            if not span > 0.0:
+        buf, ibuf, ptr, valid, vptr = _packet_buffers()
+        t0s = np.empty(W)
+        for p in range(blk * BLOCK, min(n, (blk + 1) * BLOCK), W):
+            for i in range(p, min(n, p + W)):
+                face_out[i] = -1
+                t_out[i] = np.inf
+                u_out[i] = 0.0
+                v_out[i] = 0.0
+            if _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radius,
+                            t_max, t_max, False) == 0:
                 continue
-            _load_ray(buf, ibuf, origins, directions, i, centre, t0, 0.0, min(span, 3e38))
-            intersect1(scene, ptr, 0)
-            if ibuf[18] == _INVALID:
-                continue
-            f = np.int64(ibuf[17])
-            t, u, v, det = _ray_face(origins, directions, vertices, faces, i, f)
-            if det == 0.0:  # a ray in the triangle's plane: keep Embree's answer
-                t, u, v = t0 + np.float64(buf[8]), np.float64(buf[15]), np.float64(buf[16])
-            if t > t_max[i]:
-                continue
-            face_out[i] = f
-            t_out[i] = t
-            u_out[i] = u
-            v_out[i] = v
+            intersect8(vptr, scene, ptr, 0)
+            for j in range(W):
+                i = p + j
+                if valid[j] == 0 or ibuf[18 * W + j] == _INVALID:
+                    continue
+                f = np.int64(ibuf[17 * W + j])
+                t, u, v, det = _ray_face(origins, directions, vertices, faces, i, f)
+                if det == 0.0:  # a ray in the triangle's plane: keep Embree's answer
+                    t = t0s[j] + np.float64(buf[8 * W + j])
+                    u, v = np.float64(buf[15 * W + j]), np.float64(buf[16 * W + j])
+                if t > t_max[i]:
+                    continue
+                face_out[i] = f
+                t_out[i] = t
+                u_out[i] = u
+                v_out[i] = v
 
 
 @njit(cache=True, parallel=True)
-def _occluded_kernel(occluded1, scene, origins, directions, t_min, t_max, centre, radius,
+def _occluded_kernel(occluded8, scene, origins, directions, t_min, t_max, centre, radius,
                      out):
-    """True where something lies on the ray between ``t_min`` and ``t_max``."""
+    """True where something lies on the ray between ``t_min`` and ``t_max`` (packets of
+    W rays)."""
     n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
-        buf, ibuf, ptr = _ray_buffer()
-        for i in range(blk * BLOCK, min(n, (blk + 1) * BLOCK)):
-            t0 = min(_start(origins, directions, i, centre, radius), t_min[i])
-            span = t_max[i] - t0
-            out[i] = False
-            if not span > t_min[i] - t0:
+        buf, ibuf, ptr, valid, vptr = _packet_buffers()
+        t0s = np.empty(W)
+        for p in range(blk * BLOCK, min(n, (blk + 1) * BLOCK), W):
+            for i in range(p, min(n, p + W)):
+                out[i] = False
+            if _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radius,
+                            t_min, t_max, True) == 0:
                 continue
-            _load_ray(buf, ibuf, origins, directions, i, centre, t0, t_min[i] - t0,
-                      min(span, 3e38))
-            occluded1(scene, ptr, 0)
-            out[i] = buf[8] < 0.0  # Embree 4 sets tfar = -inf on occlusion
+            occluded8(vptr, scene, ptr, 0)
+            for j in range(W):
+                if valid[j] != 0:
+                    out[p + j] = buf[8 * W + j] < 0.0  # Embree 4 sets tfar = -inf
 
 
 @njit(cache=True, parallel=True)

@@ -123,8 +123,9 @@ def _embree():
     for name, (res, args) in sigs.items():
         fn = getattr(lib, name)
         fn.restype, fn.argtypes = res, args
-    query = ctypes.CFUNCTYPE(None, vp, vp, vp)
-    return lib, query(("rtcIntersect1", lib)), query(("rtcOccluded1", lib))
+    # rtcIntersect8(valid, scene, rayhit, args), rtcOccluded8(valid, scene, ray, args)
+    query = ctypes.CFUNCTYPE(None, vp, vp, vp, vp)
+    return lib, query(("rtcIntersect8", lib)), query(("rtcOccluded8", lib))
 
 
 def _rays(origins, directions) -> tuple[np.ndarray, np.ndarray]:
@@ -203,7 +204,7 @@ class RayMesh:
         self._centre = centre
         self._face_normals: np.ndarray | None = None
         self._vertex_normals: np.ndarray | None = None
-        lib, self._intersect1, self._occluded1 = _embree()
+        lib, self._intersect8, self._occluded8 = _embree()
         self._lib = lib
         self._device = self._scene = None
         self._device = lib.rtcNewDevice(None)
@@ -305,7 +306,7 @@ class RayMesh:
         face = np.empty(k, dtype=np.int64)
         u = np.empty(k)
         v = np.empty(k)
-        _intersect_kernel(self._intersect1, self._scene, o, d, _limits("t_max", t_max, k),
+        _intersect_kernel(self._intersect8, self._scene, o, d, _limits("t_max", t_max, k),
                           self._centre, self._radius, self._vertices, self._index, t_out,
                           face, u, v)
         return Hits(t_out, face, u, v)
@@ -317,6 +318,6 @@ class RayMesh:
         o, d = _rays(origins, directions)
         k = len(d)
         out = np.empty(k, dtype=np.bool_)
-        _occluded_kernel(self._occluded1, self._scene, o, d, _limits("t_min", t_min, k),
+        _occluded_kernel(self._occluded8, self._scene, o, d, _limits("t_min", t_min, k),
                          _limits("t_max", t_max, k), self._centre, self._radius, out)
         return out
