@@ -137,29 +137,40 @@ def _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radiu
     return live
 
 
-@read_only_inputs("t_out", "face_out", "u_out", "v_out")
+@read_only_inputs("t_out", "face_out", "u_out", "v_out", "blocked")
 @njit(cache=True, parallel=True)
-def _intersect_kernel(intersect8, scene, origins, directions, t_max, centre, radius,
-                      vertices, faces, t_out, face_out, u_out, v_out):
-    """Closest hit of every ray (Embree, float32, packets of W rays), refined in float64
-    on its face."""
+def _trace_kernel(query8, scene, origins, directions, t_min, t_max, centre, radius, vertices,
+                  faces, shadow, t_out, face_out, u_out, v_out, blocked):
+    """Every ray through Embree in packets of W (``query8``: ``rtcIntersect8``, or with
+    ``shadow`` ``rtcOccluded8``). Closest hits: ``t_out``, ``face_out``, ``u_out``,
+    ``v_out``, refined in float64 on the face (``t_min`` unused). Shadow rays:
+    ``blocked`` True where something lies on the ray between ``t_min`` and ``t_max`` (the
+    hit outputs and ``vertices``, ``faces`` unused). One kernel for both: one compile."""
     n = directions.shape[0]
     for blk in prange((n + BLOCK - 1) // BLOCK):
         buf, ibuf, ptr, valid, vptr = _packet_buffers()
         t0s = np.empty(W)
         for p in range(blk * BLOCK, min(n, (blk + 1) * BLOCK), W):
             for i in range(p, min(n, p + W)):
-                face_out[i] = -1
-                t_out[i] = np.inf
-                u_out[i] = 0.0
-                v_out[i] = 0.0
+                if shadow:
+                    blocked[i] = False
+                else:
+                    face_out[i] = -1
+                    t_out[i] = np.inf
+                    u_out[i] = 0.0
+                    v_out[i] = 0.0
             if _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radius,
-                            t_max, t_max, False) == 0:
+                            t_min, t_max, shadow) == 0:
                 continue
-            intersect8(vptr, scene, ptr, 0)
+            query8(vptr, scene, ptr, 0)
             for j in range(W):
                 i = p + j
-                if valid[j] == 0 or ibuf[18 * W + j] == _INVALID:
+                if valid[j] == 0:
+                    continue
+                if shadow:
+                    blocked[i] = buf[8 * W + j] < 0.0  # Embree 4 sets tfar = -inf
+                    continue
+                if ibuf[18 * W + j] == _INVALID:
                     continue
                 f = np.int64(ibuf[17 * W + j])
                 t, u, v, det = _ray_face(origins, directions, vertices, faces, i, f)
@@ -172,27 +183,6 @@ def _intersect_kernel(intersect8, scene, origins, directions, t_max, centre, rad
                 t_out[i] = t
                 u_out[i] = u
                 v_out[i] = v
-
-
-@njit(cache=True, parallel=True)
-def _occluded_kernel(occluded8, scene, origins, directions, t_min, t_max, centre, radius,
-                     out):
-    """True where something lies on the ray between ``t_min`` and ``t_max`` (packets of
-    W rays)."""
-    n = directions.shape[0]
-    for blk in prange((n + BLOCK - 1) // BLOCK):
-        buf, ibuf, ptr, valid, vptr = _packet_buffers()
-        t0s = np.empty(W)
-        for p in range(blk * BLOCK, min(n, (blk + 1) * BLOCK), W):
-            for i in range(p, min(n, p + W)):
-                out[i] = False
-            if _fill_packet(buf, ibuf, valid, t0s, p, n, origins, directions, centre, radius,
-                            t_min, t_max, True) == 0:
-                continue
-            occluded8(vptr, scene, ptr, 0)
-            for j in range(W):
-                if valid[j] != 0:
-                    out[p + j] = buf[8 * W + j] < 0.0  # Embree 4 sets tfar = -inf
 
 
 @njit(cache=True, parallel=True)

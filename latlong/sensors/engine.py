@@ -58,6 +58,8 @@ _SCENE_FLAG_COMPACT = 1 << 1
 _GEOMETRY_TRIANGLE = 0
 _BUFFER_INDEX, _BUFFER_VERTEX = 0, 1
 _FORMAT_UINT3, _FORMAT_FLOAT3 = 0x5003, 0x9003
+# the outputs a query does not write (_trace_kernel: closest hits or shadow rays)
+_NO_FLOAT, _NO_INT, _NO_BOOL = np.empty(0), np.empty(0, dtype=np.int64), np.empty(0, np.bool_)
 
 
 @dataclass(frozen=True, slots=True)
@@ -299,25 +301,28 @@ class RayMesh:
         ``directions`` need not be unit vectors (they are normalised; distances are in
         metres); ``origins`` is (k, 3) or one (3,) origin for all rays.
         """
-        from ._engine_kernels import _intersect_kernel  # numba loads here
+        from ._engine_kernels import _trace_kernel  # numba loads here
         o, d = _rays(origins, directions)
         k = len(d)
         t_out = np.empty(k)
         face = np.empty(k, dtype=np.int64)
         u = np.empty(k)
         v = np.empty(k)
-        _intersect_kernel(self._intersect8, self._scene, o, d, _limits("t_max", t_max, k),
-                          self._centre, self._radius, self._vertices, self._index, t_out,
-                          face, u, v)
+        t_max = _limits("t_max", t_max, k)
+        _trace_kernel(self._intersect8, self._scene, o, d, t_max, t_max, self._centre,
+                      self._radius, self._vertices, self._index, np.bool_(False), t_out, face,
+                      u, v, _NO_BOOL)
         return Hits(t_out, face, u, v)
 
     def occluded(self, origins, directions, t_max, *, t_min=0.0) -> np.ndarray:
         """(k,) bool: something lies on the ray between ``t_min`` and ``t_max`` metres
         (shadow rays; ``t_min`` keeps a ray from hitting the face it starts on)."""
-        from ._engine_kernels import _occluded_kernel  # numba loads here
+        from ._engine_kernels import _trace_kernel  # numba loads here
         o, d = _rays(origins, directions)
         k = len(d)
         out = np.empty(k, dtype=np.bool_)
-        _occluded_kernel(self._occluded8, self._scene, o, d, _limits("t_min", t_min, k),
-                         _limits("t_max", t_max, k), self._centre, self._radius, out)
+        _trace_kernel(self._occluded8, self._scene, o, d, _limits("t_min", t_min, k),
+                      _limits("t_max", t_max, k), self._centre, self._radius, self._vertices,
+                      self._index, np.bool_(True), _NO_FLOAT, _NO_INT, _NO_FLOAT, _NO_FLOAT,
+                      out)
         return out
