@@ -55,7 +55,7 @@ Calling kernels from Python:
 * from numba code, flags and counts go to a compiled (not inlined) kernel as
   ``np.bool_(...)`` and ``np.int64(...)``: a constant ``True`` or ``0`` is a literal type
   of its own, and numba compiles the callee once per literal (``_stamp_one`` ~10 s a
-  time; ``tests/test_kernel_signatures.py`` checks the source)
+  time; ``tests/test_architecture.py`` checks the source)
 
 Cube-sphere cells (:mod:`craters.cells`):
 

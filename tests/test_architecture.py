@@ -18,7 +18,13 @@
   the commands can start without tracebacks (craters.cli.start);
 * callers do not ask which kind of surface they hold (a lat/long body, a mesh surface, an
   implicit surface, a shape model ...): they use the ``Surface`` protocol's members; at
-  most :data:`MAX_KIND_CHECKS` tests of a concrete kind decide what to do.
+  most :data:`MAX_KIND_CHECKS` tests of a concrete kind decide what to do;
+* numba code calls each compiled (not inlined) jitted function with one type per
+  argument: a constant ``True``, ``False`` or ``0`` is a literal type of its own, and a
+  kernel called with ``True`` at one call site and ``False`` at another was compiled twice
+  on first use (``latlong._crater_kernels._stamp_one`` ~10 s a compile; the first README
+  demo build 65.8-69.4 s -> 57.6-65.1 s, 2026-12-08); flags go as ``np.bool_(...)``,
+  counts as ``np.int64(...)``, which numba types as plain ``bool`` and ``int64``.
 """
 
 from __future__ import annotations
@@ -27,6 +33,7 @@ import ast
 import shutil
 import subprocess
 import sys
+from collections import defaultdict
 from pathlib import Path
 
 import pytest
@@ -409,3 +416,81 @@ def _add_argument_calls() -> int:
 def test_options_come_from_declarations():
     # issue 31: one declaration per setting; the kit's own two calls add every option
     assert _add_argument_calls() <= 2
+
+
+# --------------------------------------------------------------- kernel signatures
+def _jit_decorator(node: ast.FunctionDef) -> ast.expr | None:
+    for dec in node.decorator_list:
+        func = dec.func if isinstance(dec, ast.Call) else dec
+        if (func.attr if isinstance(func, ast.Attribute) else getattr(func, "id", "")) \
+                in ("njit", "jit"):
+            return dec
+    return None
+
+
+def _inlined(dec: ast.expr) -> bool:
+    return isinstance(dec, ast.Call) and any(
+        k.arg == "inline" and isinstance(k.value, ast.Constant) and k.value.value == "always"
+        for k in dec.keywords)
+
+
+def _arg_kind(arg: ast.expr) -> str:
+    """How numba types a call's argument: a literal of its value, or by its expression."""
+    if isinstance(arg, ast.Constant) and isinstance(arg.value, bool | int):
+        return f"literal {arg.value!r}"
+    return "expression"
+
+
+def _argument_kinds() -> dict[tuple[str, str, int], dict[str, list[str]]]:
+    """{(module, jitted function, argument position): {kind: [call sites]}} over the calls
+    from numba code to jitted functions compiled on their own (not inlined); a called
+    name is followed through ``from ... import`` (re-exports, aliases)."""
+    inlined: dict[tuple[str, str], bool] = {}
+    bodies, names = [], {}
+    for mod, path in SOURCES.items():
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+        names[mod] = {alias.asname or alias.name: (_resolve(mod, node), alias.name)
+                      for node in tree.body if isinstance(node, ast.ImportFrom)
+                      for alias in node.names}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.FunctionDef) and (dec := _jit_decorator(node)):
+                inlined[(mod, node.name)] = _inlined(dec)
+                bodies.append((mod, node))
+
+    def resolve(mod: str, name: str) -> tuple[str, str] | None:
+        for _ in range(8):
+            if (mod, name) in inlined:
+                return mod, name
+            if name not in names.get(mod, {}):
+                return None
+            mod, name = names[mod][name]
+        return None
+
+    kinds: dict = defaultdict(lambda: defaultdict(list))
+    for mod, fn in bodies:
+        for call in ast.walk(fn):
+            if isinstance(call, ast.Call) and isinstance(call.func, ast.Name):
+                target = resolve(mod, call.func.id)
+                if target is not None and not inlined[target]:
+                    for i, arg in enumerate(call.args):
+                        kinds[(*target, i)][_arg_kind(arg)].append(f"{mod}:{call.lineno}")
+    return kinds
+
+
+def test_compiled_kernels_get_one_type_per_argument_from_numba_code():
+    kinds = _argument_kinds()
+    assert len(kinds) > 50  # the calls were found
+    clashes = [f"{mod}.{name} argument {i}: " + "; ".join(f"{k} at {', '.join(w)}"
+                                                          for k, w in sorted(found.items()))
+               for (mod, name, i), found in sorted(kinds.items())
+               if len(found) > 1 and any(k.startswith("literal") for k in found)]
+    assert not clashes, ("a jitted function compiled once per literal (pass np.bool_(...) "
+                         "/ np.int64(...)):\n" + "\n".join(clashes))
+
+
+def test_the_signature_check_sees_a_literal_clash():
+    code = ast.parse("def f():\n    g(x, True)\n    g(x, False)\n    g(x, y)\n")
+    call_kinds = [[_arg_kind(a) for a in c.args] for c in ast.walk(code)
+                  if isinstance(c, ast.Call)]
+    assert sorted(k[1] for k in call_kinds) == ["expression", "literal False", "literal True"]
+    assert _arg_kind(ast.parse("np.bool_(True)", mode="eval").body) == "expression"
